@@ -1,0 +1,101 @@
+//! The floating-point types haarshift computes in.
+
+use std::fmt::{Debug, Display};
+use std::iter::Sum;
+use std::ops::{AddAssign, DivAssign, MulAssign, SubAssign};
+
+use ndarray::{ArrayBase, Data, Dimension, ScalarOperand};
+
+use crate::{Error, Result};
+
+/// A floating-point sample type: `f32` or `f64`.
+///
+/// Everything numeric in haarshift is generic over `Sample`; f64 is the reference precision
+/// (oracle tests hold to about 1e-12), f32 the fast one.
+///
+/// ```
+/// use haarshift::Sample;
+/// fn mean<T: Sample>(v: &[T]) -> f64 {
+///     v.iter().map(|x| x.as_f64()).sum::<f64>() / v.len() as f64
+/// }
+/// assert_eq!(mean(&[1.0f32, 2.0, 3.0]), 2.0);
+/// ```
+pub trait Sample:
+    num_traits::Float
+    + ScalarOperand
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + DivAssign
+    + Sum
+    + Default
+    + Debug
+    + Display
+    + Send
+    + Sync
+    + 'static
+{
+    /// `"f32"` or `"f64"`.
+    const NAME: &'static str;
+
+    /// Converts from f64, rounding to nearest for f32.
+    fn from_f64(x: f64) -> Self;
+
+    /// Converts to f64 exactly.
+    fn as_f64(self) -> f64;
+}
+
+impl Sample for f32 {
+    const NAME: &'static str = "f32";
+    #[inline(always)]
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    #[inline(always)]
+    fn as_f64(self) -> f64 {
+        self as f64
+    }
+}
+
+impl Sample for f64 {
+    const NAME: &'static str = "f64";
+    #[inline(always)]
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn as_f64(self) -> f64 {
+        self
+    }
+}
+
+/// Returns an error naming the first NaN or infinity in `array`, if any.
+///
+/// ```
+/// use ndarray::array;
+/// assert!(haarshift::ensure_finite(&array![1.0, 2.0]).is_ok());
+/// let err = haarshift::ensure_finite(&array![[1.0, f64::NAN]]).unwrap_err();
+/// assert_eq!(err.to_string(), "non-finite value NaN at index [0, 1]");
+/// ```
+pub fn ensure_finite<T: Sample, S: Data<Elem = T>, D: Dimension>(
+    array: &ArrayBase<S, D>,
+) -> Result<()> {
+    match array.indexed_iter().find(|(_, v)| !v.is_finite()) {
+        None => Ok(()),
+        Some((index, value)) => Err(Error::NonFinite {
+            value: value.as_f64(),
+            index: index.into_pattern_vec(),
+        }),
+    }
+}
+
+/// Turns an ndarray index pattern into a plain vector, for error messages.
+trait IntoPatternVec {
+    fn into_pattern_vec(self) -> Vec<usize>;
+}
+
+impl<P: ndarray::IntoDimension> IntoPatternVec for P {
+    fn into_pattern_vec(self) -> Vec<usize> {
+        self.into_dimension().slice().to_vec()
+    }
+}
