@@ -6,6 +6,8 @@
 //!   the `average` or `orthonormal` normalisation, f32 or f64, any size (padded to powers of two
 //!   with a chosen [`BoundaryMode`] and cropped back on the way out).
 //!
+//! * [`PlanarImage`]: images as planar float channels in their stored units (0..255 for 8-bit).
+//!
 //! Conventions used throughout: arrays are row-major `(row, column)`; row 0 is the top of an
 //! image; a 2x2 block `[[p, q], [r, s]]` has average `A = (p+q+r+s)/4` and details
 //! `a = (p-q+r-s)/4` (horizontal), `b = (p+q-r-s)/4` (vertical), `c = (p-q-r+s)/4` (diagonal)
@@ -15,9 +17,11 @@
 mod boundary;
 mod error;
 mod named;
+mod planar_image;
 mod sample;
 pub mod transform;
 
 pub use boundary::BoundaryMode;
 pub use error::{Error, Result};
+pub use planar_image::{Channels, PlanarImage, SampleDepth};
 pub use sample::{Sample, ensure_finite};

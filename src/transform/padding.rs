@@ -11,7 +11,8 @@ use crate::{BoundaryMode, Error, Result, Sample};
 /// ```
 /// use haarshift::{BoundaryMode, transform::pad_to_power_of_two};
 /// use ndarray::array;
-/// let p = pad_to_power_of_two(array![[1.0, 2.0, 3.0]].view(), BoundaryMode::Reflect).unwrap();
+/// let row = array![[1.0, 2.0, 3.0]];
+/// let p = pad_to_power_of_two(row.view(), BoundaryMode::Reflect).unwrap();
 /// assert_eq!(p, array![[1.0, 2.0, 3.0, 3.0]]);
 /// ```
 pub fn pad_to_power_of_two<T: Sample>(

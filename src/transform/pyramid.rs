@@ -179,13 +179,25 @@ fn analysis_step<T: Sample>(
     }
 }
 
+/// Rows of a 2D block inside a larger row-major buffer.
+#[derive(Clone, Copy)]
+struct Strided<'a, T> {
+    data: &'a [T],
+    stride: usize,
+}
+
+impl<'a, T> Strided<'a, T> {
+    /// `len` values of row `r` from column `col`.
+    fn row(&self, r: usize, col: usize, len: usize) -> &'a [T] {
+        &self.data[r * self.stride + col..][..len]
+    }
+}
+
 /// Synthesis of a `2h x 2w` approximation into `dst` (row stride `dst_stride`) from the
-/// `h x w` approximation `cur` (stride `cur_stride`) and the level's bands in `coeffs`.
+/// `h x w` approximation `cur` and the level's bands in `coeffs`.
 fn synthesis_step<T: Sample>(
-    cur: &[T],
-    cur_stride: usize,
-    coeffs: &[T],
-    coeff_stride: usize,
+    cur: Strided<'_, T>,
+    coeffs: Strided<'_, T>,
     (h, w): (usize, usize),
     dst: &mut [T],
     dst_stride: usize,
@@ -198,11 +210,16 @@ fn synthesis_step<T: Sample>(
         .enumerate()
         .for_each(|(r, rows)| {
             let (r0, r1) = rows.split_at_mut(dst_stride);
-            let approx = &cur[r * cur_stride..][..w];
-            let a = &coeffs[r * coeff_stride + w..][..w];
-            let bc = &coeffs[(h + r) * coeff_stride..][..2 * w];
-            let (b, c) = bc.split_at(w);
-            synthesise_rows(approx, a, b, c, &mut r0[..2 * w], &mut r1[..2 * w], g2);
+            let (b, c) = coeffs.row(h + r, 0, 2 * w).split_at(w);
+            synthesise_rows(
+                cur.row(r, 0, w),
+                coeffs.row(r, w, w),
+                b,
+                c,
+                &mut r0[..2 * w],
+                &mut r1[..2 * w],
+                g2,
+            );
         });
 }
 
@@ -326,18 +343,28 @@ pub fn inverse_into<T: Sample>(
     let (x, y) = ping_pong(work, h, w);
     // Step s (from coarse) produces a (2 h0 << s) x (2 w0 << s) approximation; counted from
     // the last, even distances go to the larger buffer x.
-    let (mut dst, mut spare) = if levels % 2 == 0 { (x, y) } else { (y, x) };
+    let (mut dst, mut spare) = if levels.is_multiple_of(2) {
+        (x, y)
+    } else {
+        (y, x)
+    };
     for step in 0..levels {
         let size = (h0 << step, w0 << step);
-        let (cur, stride): (&[T], usize) = if step == 0 {
-            (coeffs, w)
-        } else {
-            (&*spare, size.1)
+        let bands = Strided {
+            data: coeffs,
+            stride: w,
+        };
+        let cur = match step {
+            0 => bands,
+            _ => Strided {
+                data: &*spare,
+                stride: size.1,
+            },
         };
         if step + 1 == levels {
-            synthesis_step(cur, stride, coeffs, w, size, out, w, g2);
+            synthesis_step(cur, bands, size, out, w, g2);
         } else {
-            synthesis_step(cur, stride, coeffs, w, size, dst, 2 * size.1, g2);
+            synthesis_step(cur, bands, size, dst, 2 * size.1, g2);
         }
         std::mem::swap(&mut dst, &mut spare);
     }

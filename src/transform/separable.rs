@@ -9,7 +9,7 @@ use super::{Normalization, haar1d};
 use crate::{Error, Result, Sample};
 
 /// Checks every axis length and level count.
-fn check<D: Dimension>(shape: &[usize], levels: &[usize]) -> Result<()> {
+fn check(shape: &[usize], levels: &[usize]) -> Result<()> {
     if levels.len() != shape.len() {
         return Err(Error::parameter(
             "levels",
@@ -38,7 +38,7 @@ fn along_each_axis<T: Sample, D: Dimension>(
     norm: Normalization,
     step: fn(&mut [T], usize, Normalization, &mut Vec<T>) -> Result<()>,
 ) -> Result<()> {
-    check::<D>(array.shape(), levels)?;
+    check(array.shape(), levels)?;
     for (axis, &k) in levels.iter().enumerate() {
         if k == 0 {
             continue;

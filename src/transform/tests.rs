@@ -203,7 +203,12 @@ fn f32_transforms_round_trip_to_single_precision() {
             let back = spec.forward(x.view()).unwrap().inverse().unwrap();
             // Relative to the image's peak: f32 carries about 7 digits of the largest value.
             let peak = x.iter().fold(0.0f32, |m, v| m.max(v.abs()));
-            let err = back.iter().zip(x.iter()).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max) / peak;
+            let err = back
+                .iter()
+                .zip(x.iter())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f32, f32::max)
+                / peak;
             assert!(err < 1e-6, "{layout} {normalization}: {err}");
         }
     }
