@@ -16,7 +16,9 @@
 
 mod boundary;
 mod error;
+pub mod metrics;
 mod named;
+pub mod patterns;
 mod planar_image;
 mod sample;
 pub mod transform;

@@ -1,0 +1,160 @@
+//! Error measures between a result and its reference: RMS, PSNR and maximum absolute error,
+//! optionally over a mask (the rotation experiments measure inside a centred disk so that the
+//! corners, which a rotation fills from outside, do not count).
+
+use ndarray::{Array2, ArrayView2, Zip};
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result, Sample};
+
+/// RMS, PSNR and maximum absolute error over the compared samples.
+///
+/// ```
+/// use haarshift::metrics::ErrorStats;
+/// use ndarray::array;
+/// let s = ErrorStats::between(array![[1.0, 2.0]].view(), array![[1.0, 4.0]].view(), None, 255.0).unwrap();
+/// assert_eq!(s.max_error, 2.0);
+/// assert!((s.rms - 2f64.sqrt()).abs() < 1e-15);
+/// assert!((s.psnr - 20.0 * (255.0 / 2f64.sqrt()).log10()).abs() < 1e-12);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ErrorStats {
+    /// Root of the mean squared difference.
+    pub rms: f64,
+    /// `20 log10(peak / rms)` in dB; infinite when the two agree exactly (serialised as null).
+    #[serde(with = "infinite_as_null")]
+    pub psnr: f64,
+    /// Largest absolute difference.
+    pub max_error: f64,
+    /// How many samples were compared.
+    pub count: usize,
+}
+
+impl ErrorStats {
+    /// Compares `result` with `reference` where `mask` is true (everywhere without a mask);
+    /// `peak` is the signal's full scale for PSNR (255 for 8-bit values).
+    pub fn between<T: Sample>(
+        result: ArrayView2<'_, T>,
+        reference: ArrayView2<'_, T>,
+        mask: Option<ArrayView2<'_, bool>>,
+        peak: f64,
+    ) -> Result<Self> {
+        if result.dim() != reference.dim() || mask.is_some_and(|m| m.dim() != result.dim()) {
+            return Err(Error::shape(
+                &[result.nrows(), result.ncols()],
+                "result, reference and mask must have one shape",
+            ));
+        }
+        let (mut sum_sq, mut max_error, mut count) = (0.0f64, 0.0f64, 0usize);
+        let mut add = |a: T, b: T| {
+            let d = (a.as_f64() - b.as_f64()).abs();
+            sum_sq += d * d;
+            max_error = max_error.max(d);
+            count += 1;
+        };
+        match mask {
+            Some(m) => Zip::from(&result)
+                .and(&reference)
+                .and(&m)
+                .for_each(|&a, &b, &inside| {
+                    if inside {
+                        add(a, b)
+                    }
+                }),
+            None => Zip::from(&result)
+                .and(&reference)
+                .for_each(|&a, &b| add(a, b)),
+        }
+        if count == 0 {
+            return Err(Error::parameter("mask", "selects no samples"));
+        }
+        let rms = (sum_sq / count as f64).sqrt();
+        Ok(ErrorStats {
+            rms,
+            psnr: 20.0 * (peak / rms).log10(),
+            max_error,
+            count,
+        })
+    }
+}
+
+/// The pixels whose centres lie within `radius` of the array's centre `((h-1)/2, (w-1)/2)`.
+///
+/// ```
+/// let m = haarshift::metrics::disk_mask(3, 3, 1.0);
+/// assert_eq!(m.iter().filter(|&&v| v).count(), 5); // the centre and its 4 neighbours
+/// ```
+pub fn disk_mask(h: usize, w: usize, radius: f64) -> Array2<bool> {
+    let (ci, cj) = ((h as f64 - 1.0) / 2.0, (w as f64 - 1.0) / 2.0);
+    Array2::from_shape_fn((h, w), |(i, j)| {
+        let (di, dj) = (i as f64 - ci, j as f64 - cj);
+        di * di + dj * dj <= radius * radius
+    })
+}
+
+/// Serialises infinities as JSON `null` (JSON has no infinity) and reads `null` back as +inf.
+mod infinite_as_null {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_finite() {
+            s.serialize_f64(*v)
+        } else {
+            s.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ndarray::array;
+
+    #[test]
+    fn masked_statistics_count_only_the_mask() {
+        let a = array![[0.0, 10.0], [3.0, 0.0]];
+        let b = array![[0.0, 0.0], [0.0, 4.0]];
+        let m = array![[true, false], [true, true]];
+        let s = ErrorStats::between(a.view(), b.view(), Some(m.view()), 255.0).unwrap();
+        assert_eq!(s.count, 3);
+        assert_eq!(s.max_error, 4.0);
+        assert!((s.rms - (25.0f64 / 3.0).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn identical_arrays_have_infinite_psnr_serialised_as_null() {
+        let a = array![[1.0f32, 2.0]];
+        let s = ErrorStats::between(a.view(), a.view(), None, 255.0).unwrap();
+        assert_eq!((s.rms, s.max_error), (0.0, 0.0));
+        assert!(s.psnr.is_infinite());
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(json.contains("\"psnr\":null"));
+        assert_eq!(serde_json::from_str::<ErrorStats>(&json).unwrap(), s);
+    }
+
+    #[test]
+    fn rejects_mismatched_shapes_and_empty_masks() {
+        let a = array![[1.0, 2.0]];
+        assert!(ErrorStats::between(a.view(), array![[1.0]].view(), None, 1.0).is_err());
+        let none = array![[false, false]];
+        assert!(ErrorStats::between(a.view(), a.view(), Some(none.view()), 1.0).is_err());
+    }
+
+    #[test]
+    fn disk_mask_matches_a_direct_count() {
+        // Radius 3 around the centre of a 7x7 grid: lattice points with di^2 + dj^2 <= 9.
+        let m = disk_mask(7, 7, 3.0);
+        let direct = (-3i32..=3)
+            .flat_map(|i| (-3i32..=3).map(move |j| i * i + j * j))
+            .filter(|&r2| r2 <= 9)
+            .count();
+        assert_eq!(m.iter().filter(|&&v| v).count(), direct);
+        // Even sizes: the centre lies between pixels, so the mask is symmetric under flips.
+        let e = disk_mask(8, 6, 2.5);
+        assert_eq!(e, e.slice(ndarray::s![..;-1, ..;-1]));
+    }
+}

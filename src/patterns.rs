@@ -1,0 +1,88 @@
+//! Synthetic test patterns that stress resampling: a zone plate (every frequency up to
+//! Nyquist) and a Siemens star (edges at every orientation, frequency rising toward the
+//! centre). Values are in 0..=255 like an 8-bit image.
+
+use ndarray::Array2;
+
+use crate::{Error, Result};
+
+/// Checks a pattern size.
+fn check(h: usize, w: usize) -> Result<()> {
+    if h == 0 || w == 0 {
+        return Err(Error::shape(&[h, w], "pattern is empty"));
+    }
+    Ok(())
+}
+
+/// A circular zone plate `127.5 (1 + cos(pi r^2 / (2 R)))`, `r` the distance of a pixel centre
+/// from the array centre and `R` half the shorter side: the local frequency `r / (2R)` cycles
+/// per pixel rises linearly from 0 at the centre to Nyquist (0.5) at distance `R`.
+///
+/// ```
+/// let z = haarshift::patterns::zone_plate(64, 64).unwrap();
+/// assert!(z.iter().all(|&v| (0.0..=255.0).contains(&v)));
+/// ```
+pub fn zone_plate(h: usize, w: usize) -> Result<Array2<f64>> {
+    check(h, w)?;
+    let (ci, cj) = ((h as f64 - 1.0) / 2.0, (w as f64 - 1.0) / 2.0);
+    let radius = h.min(w) as f64 / 2.0;
+    Ok(Array2::from_shape_fn((h, w), |(i, j)| {
+        let r2 = (i as f64 - ci).powi(2) + (j as f64 - cj).powi(2);
+        127.5 * (1.0 + (std::f64::consts::PI * r2 / (2.0 * radius)).cos())
+    }))
+}
+
+/// A Siemens star with `spokes` black and `spokes` white sectors (0 and 255), each pixel the
+/// average of 4x4 point samples so that edges are anti-aliased rather than jagged.
+///
+/// ```
+/// let s = haarshift::patterns::siemens_star(65, 65, 16).unwrap();
+/// // Opposite points on the star: with an even spoke count the star is symmetric under a
+/// // half turn about the centre.
+/// assert_eq!(s[[10, 20]], s[[54, 44]]);
+/// ```
+pub fn siemens_star(h: usize, w: usize, spokes: usize) -> Result<Array2<f64>> {
+    check(h, w)?;
+    if spokes == 0 {
+        return Err(Error::parameter("spokes", "must be at least 1"));
+    }
+    const SUB: usize = 4;
+    let (ci, cj) = ((h as f64 - 1.0) / 2.0, (w as f64 - 1.0) / 2.0);
+    Ok(Array2::from_shape_fn((h, w), |(i, j)| {
+        let mut white = 0usize;
+        for si in 0..SUB {
+            for sj in 0..SUB {
+                let y = i as f64 - ci + (si as f64 + 0.5) / SUB as f64 - 0.5;
+                let x = j as f64 - cj + (sj as f64 + 0.5) / SUB as f64 - 0.5;
+                if (spokes as f64 * y.atan2(x)).sin() >= 0.0 {
+                    white += 1;
+                }
+            }
+        }
+        255.0 * white as f64 / (SUB * SUB) as f64
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zone_plate_has_its_documented_values() {
+        let z = zone_plate(33, 33).unwrap();
+        assert_eq!(z[[16, 16]], 255.0); // r = 0
+        // A lattice point at r^2 = 16: value from the formula.
+        let v = 127.5 * (1.0 + (std::f64::consts::PI * 16.0 / 33.0).cos());
+        assert!((z[[16, 20]] - v).abs() < 1e-12);
+    }
+
+    #[test]
+    fn siemens_star_is_half_white_and_binary_away_from_edges() {
+        let s = siemens_star(128, 128, 18).unwrap();
+        let mean = s.mean().unwrap();
+        assert!((mean - 127.5).abs() < 3.0, "mean {mean}");
+        // On the +x axis just above it (small positive angle): white; just below: black.
+        assert_eq!(s[[63, 120]], 0.0); // y = -0.5 < 0: angle slightly negative
+        assert!(siemens_star(0, 4, 3).is_err() && siemens_star(4, 4, 0).is_err());
+    }
+}
