@@ -88,18 +88,17 @@ fn analyse_rows<T: Sample>(
     c: &mut [T],
     f2: T,
 ) {
-    let blocks = r0.chunks_exact(2).zip(r1.chunks_exact(2));
-    let outputs = approx
-        .iter_mut()
-        .zip(a.iter_mut())
-        .zip(b.iter_mut().zip(c.iter_mut()));
-    for ((top, bottom), ((va, vh), (vv, vd))) in blocks.zip(outputs) {
-        let (sum_top, sum_bottom) = (top[0] + top[1], bottom[0] + bottom[1]);
-        let (dif_top, dif_bottom) = (top[0] - top[1], bottom[0] - bottom[1]);
-        *va = f2 * (sum_top + sum_bottom);
-        *vh = f2 * (dif_top + dif_bottom);
-        *vv = f2 * (sum_top - sum_bottom);
-        *vd = f2 * (dif_top - dif_bottom);
+    let n = approx.len();
+    let (top, bottom) = (&r0.as_chunks::<2>().0[..n], &r1.as_chunks::<2>().0[..n]);
+    let (a, b, c) = (&mut a[..n], &mut b[..n], &mut c[..n]);
+    for j in 0..n {
+        let ([p, q], [r, s]) = (top[j], bottom[j]);
+        let (sum_top, sum_bottom) = (p + q, r + s);
+        let (dif_top, dif_bottom) = (p - q, r - s);
+        approx[j] = f2 * (sum_top + sum_bottom);
+        a[j] = f2 * (dif_top + dif_bottom);
+        b[j] = f2 * (sum_top - sum_bottom);
+        c[j] = f2 * (dif_top - dif_bottom);
     }
 }
 
@@ -114,15 +113,17 @@ fn synthesise_rows<T: Sample>(
     r1: &mut [T],
     g2: T,
 ) {
-    let inputs = approx.iter().zip(a).zip(b.iter().zip(c));
-    let blocks = r0.chunks_exact_mut(2).zip(r1.chunks_exact_mut(2));
-    for (((&va, &vh), (&vv, &vd)), (top, bottom)) in inputs.zip(blocks) {
-        let (s_top, s_bottom) = (va + vv, va - vv);
-        let (d_top, d_bottom) = (vh + vd, vh - vd);
-        top[0] = g2 * (s_top + d_top);
-        top[1] = g2 * (s_top - d_top);
-        bottom[0] = g2 * (s_bottom + d_bottom);
-        bottom[1] = g2 * (s_bottom - d_bottom);
+    // Fixed-size pairs (rather than chunks_exact_mut(2)) let the compiler vectorise the
+    // interleaved stores.
+    let (top, _) = r0.as_chunks_mut::<2>();
+    let (bottom, _) = r1.as_chunks_mut::<2>();
+    let n = approx.len();
+    let (top, bottom, a, b, c) = (&mut top[..n], &mut bottom[..n], &a[..n], &b[..n], &c[..n]);
+    for j in 0..n {
+        let (s_top, s_bottom) = (approx[j] + b[j], approx[j] - b[j]);
+        let (d_top, d_bottom) = (a[j] + c[j], a[j] - c[j]);
+        top[j] = [g2 * (s_top + d_top), g2 * (s_top - d_top)];
+        bottom[j] = [g2 * (s_bottom + d_bottom), g2 * (s_bottom - d_bottom)];
     }
 }
 
