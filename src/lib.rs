@@ -16,6 +16,7 @@
 
 mod boundary;
 mod error;
+pub mod experiments;
 pub mod metrics;
 mod named;
 pub mod patterns;

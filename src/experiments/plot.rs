@@ -1,0 +1,270 @@
+//! PNG plots of experiment results, drawn with plotters into memory (the caller writes the
+//! file, atomically, like every other output). Text uses the bundled DejaVu Sans font, so no
+//! system font library is needed.
+
+use std::sync::Once;
+
+use image::RgbImage;
+use plotters::prelude::*;
+use plotters::style::{FontStyle, register_font};
+
+use crate::{Error, Result};
+
+const WIDTH: u32 = 1100;
+const HEIGHT: u32 = 700;
+static FONT: Once = Once::new();
+
+/// Makes the bundled font available under the family name "sans-serif".
+fn register_bundled_font() {
+    FONT.call_once(|| {
+        let bytes = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+        // Registration only fails on a corrupt font, and the bundled one is checked by tests.
+        let _ = register_font("sans-serif", FontStyle::Normal, bytes);
+    });
+}
+
+fn plot_error(e: impl std::fmt::Display) -> Error {
+    Error::parameter("plot", e.to_string())
+}
+
+/// A labelled point of a scatter plot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabeledPoint {
+    /// Shown next to the point.
+    pub label: String,
+    /// Horizontal position (must be > 0 on log axes).
+    pub x: f64,
+    /// Vertical position (must be > 0 on log axes).
+    pub y: f64,
+}
+
+/// A compact tick label: 3 significant digits, no trailing zeros.
+fn short_number(v: f64) -> String {
+    let text = format!("{v:.3e}");
+    let parsed: f64 = text.parse().unwrap_or(v);
+    let plain = format!("{parsed}");
+    if plain.len() <= 8 {
+        plain
+    } else {
+        format!("{parsed:.2e}")
+    }
+}
+
+/// A log axis over `range` with ticks at 1, 2 and 5 times each power of ten, so that a range
+/// within one or two decades still gets readable labels.
+fn log_axis(
+    range: std::ops::Range<f64>,
+) -> impl plotters::coord::ranged1d::Ranged<ValueType = f64>
++ plotters::coord::ranged1d::ValueFormatter<f64> {
+    let (lo, hi) = (range.start, range.end);
+    let ticks: Vec<f64> = (lo.log10().floor() as i32..=hi.log10().ceil() as i32)
+        .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
+        .filter(|v| (lo..=hi).contains(v))
+        .collect();
+    range.log_scale().with_key_points(ticks)
+}
+
+/// The range of `values` widened by a factor on each side, for a log axis.
+fn log_range(values: impl Iterator<Item = f64>) -> Result<std::ops::Range<f64>> {
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    // An empty iterator leaves (inf, 0): refuse it along with zeros and negatives.
+    if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
+        return Err(Error::parameter(
+            "plot",
+            "log-scale plots need positive, finite values",
+        ));
+    }
+    Ok(lo / 1.5..hi * 1.5)
+}
+
+/// A log-log scatter plot of `points` with the points of `frontier` joined by a line (a Pareto
+/// frontier, say), as an RGB image.
+///
+/// ```
+/// use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
+/// let p = |label: &str, x, y| LabeledPoint { label: label.into(), x, y };
+/// let pts = [p("linear", 0.01, 16.0), p("fft", 0.1, 2.4)];
+/// let img = log_log_scatter("RMS against time", "seconds", "RMS", &pts, &pts).unwrap();
+/// assert_eq!(img.dimensions(), (1100, 700));
+/// ```
+pub fn log_log_scatter(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[LabeledPoint],
+    frontier: &[LabeledPoint],
+) -> Result<RgbImage> {
+    register_bundled_font();
+    let x_range = log_range(points.iter().map(|p| p.x))?;
+    let y_range = log_range(points.iter().map(|p| p.y))?;
+    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 26))
+            .margin(20)
+            .margin_right(150)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(log_axis(x_range), log_axis(y_range))
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&|v| short_number(*v))
+            .y_label_formatter(&|v| short_number(*v))
+            .label_style(("sans-serif", 16))
+            .draw()
+            .map_err(plot_error)?;
+        let mut sorted: Vec<(f64, f64)> = frontier.iter().map(|p| (p.x, p.y)).collect();
+        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(sorted, RED.stroke_width(2)))
+            .map_err(plot_error)?;
+        chart
+            .draw_series(points.iter().map(|p| {
+                EmptyElement::at((p.x, p.y))
+                    + Circle::new((0, 0), 5, BLUE.filled())
+                    + Text::new(p.label.clone(), (8, -8), ("sans-serif", 14))
+            }))
+            .map_err(plot_error)?;
+        root.present().map_err(plot_error)?;
+    }
+    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
+        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+}
+
+/// One named series of values, one per category, for [`category_points`]; `None` marks a
+/// missing value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// One value per category.
+    pub values: Vec<Option<f64>>,
+}
+
+/// Values per category (methods, say) on a log vertical axis, one colour of marker per series
+/// (images, say), as an RGB image.
+///
+/// ```
+/// use haarshift::experiments::plot::{Series, category_points};
+/// let s = Series { name: "camera".into(), values: vec![Some(16.0), Some(2.4)] };
+/// let img = category_points("RMS per method", "RMS", &["linear".into(), "fft".into()], &[s]).unwrap();
+/// assert_eq!(img.dimensions(), (1100, 700));
+/// ```
+pub fn category_points(
+    title: &str,
+    y_label: &str,
+    categories: &[String],
+    series: &[Series],
+) -> Result<RgbImage> {
+    register_bundled_font();
+    let y_range = log_range(
+        series
+            .iter()
+            .flat_map(|s| s.values.iter().flatten().copied()),
+    )?;
+    let n = categories.len().max(1);
+    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 26))
+            .margin(20)
+            .x_label_area_size(90)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-0.5f64..n as f64 - 0.5, log_axis(y_range))
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|x| {
+                let i = x.round();
+                if (x - i).abs() < 1e-6 && i >= 0.0 {
+                    categories.get(i as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .y_desc(y_label)
+            .y_label_formatter(&|v| short_number(*v))
+            .label_style(("sans-serif", 15))
+            .draw()
+            .map_err(plot_error)?;
+        // Markers only: the categories are unordered, so lines between them would mislead.
+        // Each series is nudged sideways a little so that equal values stay visible.
+        let spread = 0.3 / series.len().max(1) as f64;
+        for (k, s) in series.iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            let offset = (k as f64 - (series.len() as f64 - 1.0) / 2.0) * spread;
+            let pts = s
+                .values
+                .iter()
+                .enumerate()
+                .filter_map(|(i, v)| v.map(|v| (i as f64 + offset, v)));
+            chart
+                .draw_series(pts.map(|p| Circle::new(p, 5, colour.filled())))
+                .map_err(plot_error)?
+                .label(s.name.clone())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(plot_error)?;
+        root.present().map_err(plot_error)?;
+    }
+    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
+        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plots_draw_points_and_text_in_their_colours() {
+        let p = |label: &str, x, y| LabeledPoint {
+            label: label.into(),
+            x,
+            y,
+        };
+        let pts = [p("a", 1.0, 10.0), p("b", 100.0, 0.1)];
+        let img = log_log_scatter("t", "x", "y", &pts, &pts[..1]).unwrap();
+        let blue = img.pixels().filter(|px| px.0 == [0, 0, 255]).count();
+        assert!(
+            blue > 100,
+            "two filled circles of radius 5: {blue} blue pixels"
+        );
+        // Text was rendered: dark anti-aliased pixels exist beyond the black axes.
+        let grey = img
+            .pixels()
+            .filter(|px| px.0[0] == px.0[1] && px.0[1] == px.0[2] && (30..200).contains(&px.0[0]))
+            .count();
+        assert!(grey > 200, "{grey} grey text pixels");
+    }
+
+    #[test]
+    fn log_plots_refuse_non_positive_values() {
+        let pts = [LabeledPoint {
+            label: "zero".into(),
+            x: 0.0,
+            y: 1.0,
+        }];
+        assert!(log_log_scatter("t", "x", "y", &pts, &[]).is_err());
+        let s = Series {
+            name: "s".into(),
+            values: vec![None],
+        };
+        assert!(category_points("t", "y", &["a".into()], &[s]).is_err());
+    }
+}
