@@ -93,7 +93,7 @@ pub fn disk_mask(h: usize, w: usize, radius: f64) -> Array2<bool> {
 }
 
 /// Serialises infinities as JSON `null` (JSON has no infinity) and reads `null` back as +inf.
-mod infinite_as_null {
+pub(crate) mod infinite_as_null {
     use serde::{Deserialize, Deserializer, Serializer};
 
     pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {

@@ -1,4 +1,10 @@
 //! Experiments that measure what each method costs and how much error it accumulates.
 //!
+//! * [`table`]: Markdown result tables.
+//! * [`pareto`]: the cost/error Pareto frontier.
+//! * [`rotation_cycle`]: the seed's Table 2.2 protocol: rotate back to the start, measure.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
+pub mod pareto;
 pub mod plot;
+pub mod rotation_cycle;
+pub mod table;
