@@ -16,6 +16,7 @@
 
 mod boundary;
 mod error;
+pub mod io;
 mod named;
 mod planar_image;
 mod sample;
