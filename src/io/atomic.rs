@@ -37,7 +37,17 @@ impl PendingFile {
             // The usual mode of a new file (the umask still applies), not tempfile's 0600.
             builder.permissions(std::fs::Permissions::from_mode(0o666));
         }
-        let temp = builder.tempfile_in(dir).map_err(|e| io_error(path, e))?;
+        let temp = builder.tempfile_in(dir).map_err(|e| {
+            // tempfile's message names the temporary file, which the user never asked for.
+            let e = match e.kind() {
+                std::io::ErrorKind::NotFound => std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    "the output directory does not exist",
+                ),
+                kind => std::io::Error::from(kind),
+            };
+            io_error(path, e)
+        })?;
         Ok(PendingFile {
             path: path.to_path_buf(),
             force,

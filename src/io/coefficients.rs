@@ -23,7 +23,7 @@ use ndarray::{Array3, Axis};
 use serde::{Deserialize, Serialize};
 
 use super::atomic::PendingFile;
-use super::{ReadOptions, format_error, format_reason, io_error, npy};
+use super::{ReadOptions, format_reason, io_error, npy};
 use crate::transform::{Coefficients, Layout, Levels, Normalization, TransformInfo, TransformSpec};
 use crate::{BoundaryMode, Channels, Error, PlanarImage, Result, Sample, SampleDepth};
 
@@ -158,8 +158,14 @@ impl<T: Sample> CoefficientFile<T> {
 
     /// Writes the coefficients to `path` (`.npy`, f64, `C x H x W`) and the sidecar beside it.
     /// Both are written atomically; with `options.force` off, neither may exist yet.
-    /// (`options.depth` and `jpeg_quality` do not apply.)
+    /// (`options.depth` and `jpeg_quality` do not apply.) The name must end in `.npy`.
     pub fn write(&self, path: &Path, options: super::WriteOptions) -> Result<()> {
+        if super::FileFormat::from_extension(path) != Some(super::FileFormat::Npy) {
+            return Err(format_reason(
+                path,
+                "coefficients are stored as .npy arrays: give the output a .npy name",
+            ));
+        }
         let sidecar_path = Self::sidecar_path(path);
         let (h, w) = self.planes[0].as_array().dim();
         let shape = [self.planes.len(), h, w];
@@ -329,9 +335,7 @@ impl StoredCoefficients {
             }
             None => {
                 let spec = request.spec();
-                let levels = spec
-                    .resolve_levels(h, w)
-                    .map_err(|e| format_error(&path, e))?;
+                let levels = spec.resolve_levels(h, w).map_err(|e| e.in_file(&path))?;
                 CoefficientMetadata {
                     transform: TransformInfo {
                         layout: spec.layout,
@@ -340,7 +344,7 @@ impl StoredCoefficients {
                         padding: spec.padding,
                         original_shape: [h, w],
                     },
-                    channels: Channels::from_count(c).map_err(|e| format_error(&path, e))?,
+                    channels: Channels::from_count(c).map_err(|e| e.in_file(&path))?,
                     depth: SampleDepth::F64,
                 }
             }
@@ -350,9 +354,9 @@ impl StoredCoefficients {
             .outer_iter()
             .map(|p| Coefficients::from_parts(p.to_owned(), metadata.transform))
             .collect::<Result<Vec<_>>>()
-            .map_err(|e| format_error(&path, e))?;
+            .map_err(|e| e.in_file(&path))?;
         CoefficientFile::from_parts(planes, metadata.channels, metadata.depth)
-            .map_err(|e| format_error(&path, e))
+            .map_err(|e| e.in_file(&path))
     }
 }
 

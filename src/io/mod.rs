@@ -151,6 +151,39 @@ impl FileFormat {
             .map(|&(_, format)| format)
     }
 
+    /// The format of the file at `path`, recognised from its first bytes; an error names the
+    /// file when it cannot be read, is empty or has no known signature.
+    ///
+    /// ```
+    /// use haarshift::io::FileFormat;
+    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/coins.png");
+    /// assert_eq!(FileFormat::of_file(path.as_ref()).unwrap(), FileFormat::Png);
+    /// ```
+    pub fn of_file(path: &Path) -> Result<FileFormat> {
+        let mut head = Vec::with_capacity(16);
+        File::open(path)
+            .and_then(|f| f.take(16).read_to_end(&mut head))
+            .map_err(|e| io_error(path, e))?;
+        if head.is_empty() {
+            return Err(format_reason(path, "file is empty"));
+        }
+        FileFormat::from_signature(&head).ok_or_else(|| {
+            let reason = match FileFormat::from_extension(path) {
+                Some(f) => format!(
+                    "not a valid {} file (its content has no {} signature)",
+                    f.display_name(),
+                    f.display_name()
+                ),
+                None => {
+                    "unsupported file format (expected PNG, JPEG, TIFF, OpenEXR, Radiance HDR or \
+                         .npy content)"
+                        .to_string()
+                }
+            };
+            format_reason(path, reason)
+        })
+    }
+
     /// The format's usual name in messages.
     fn display_name(self) -> &'static str {
         match self {
@@ -224,7 +257,7 @@ pub fn read_image<T: Sample>(path: impl AsRef<Path>) -> Result<PlanarImage<T>> {
 
 /// Reads an image or `.npy` array; the format is recognised from the file's content.
 pub fn read_image_with<T: Sample>(path: &Path, options: &ReadOptions) -> Result<PlanarImage<T>> {
-    let format = sniff_format(path)?;
+    let format = FileFormat::of_file(path)?;
     let image = match format {
         FileFormat::Npy => npy::read(path, options)?,
         FileFormat::Exr => openexr::read(path, options)?,
@@ -233,7 +266,7 @@ pub fn read_image_with<T: Sample>(path: &Path, options: &ReadOptions) -> Result<
             raster::read(path, format, options)?
         }
     };
-    ensure_finite(&image.planes()).map_err(|e| format_error(path, e))?;
+    ensure_finite(&image.planes()).map_err(|e| e.in_file(path))?;
     Ok(image)
 }
 
@@ -250,7 +283,7 @@ pub fn write_image<T: Sample>(
                  or .npy)"
             .into(),
     })?;
-    ensure_finite(&image.planes()).map_err(|e| format_error(path, e))?;
+    ensure_finite(&image.planes()).map_err(|e| e.in_file(path))?;
     let depth =
         stored_depth(format, image.depth(), options.depth).map_err(|reason| Error::Format {
             path: path.to_path_buf(),
@@ -282,20 +315,21 @@ fn stored_depth(
 ) -> std::result::Result<SampleDepth, String> {
     use SampleDepth::*;
     let wanted = requested.unwrap_or(depth);
-    let integer_only = |name: &str| {
+    let integer_only = |stores: &str| {
         format!(
-            "{name} stores 8- or 16-bit integers but the image holds {wanted} samples (choose \
-             an integer depth, or write .exr or .npy to keep float values)"
+            "{} stores {stores} integers but the image holds {wanted} samples (ask for depth \
+             u8 or u16, or write .exr or .npy to keep float values)",
+            format.display_name()
         )
     };
     match format {
         FileFormat::Png | FileFormat::Tiff => match wanted {
             U8 | U16 => Ok(wanted),
-            _ => Err(integer_only(format.display_name())),
+            _ => Err(integer_only("8- or 16-bit")),
         },
         FileFormat::Jpeg => match wanted {
             U8 | U16 => Ok(U8),
-            _ => Err(integer_only("JPEG")),
+            _ => Err(integer_only("8-bit")),
         },
         FileFormat::Exr => Ok(if wanted == F16 { F16 } else { F32 }),
         FileFormat::Npy => Ok(if wanted == F64 { F64 } else { F32 }),
@@ -353,37 +387,6 @@ fn deinterleave<T: Sample, P: Copy>(
     })
 }
 
-/// Identifies the format of `path` from its first bytes.
-fn sniff_format(path: &Path) -> Result<FileFormat> {
-    let mut head = [0u8; 16];
-    let mut file = File::open(path).map_err(|e| io_error(path, e))?;
-    let mut filled = 0;
-    while filled < head.len() {
-        match file.read(&mut head[filled..]) {
-            Ok(0) => break,
-            Ok(n) => filled += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(io_error(path, e)),
-        }
-    }
-    if filled == 0 {
-        return Err(format_reason(path, "file is empty"));
-    }
-    FileFormat::from_signature(&head[..filled]).ok_or_else(|| {
-        let reason = match FileFormat::from_extension(path) {
-            Some(f) => format!(
-                "not a valid {} file (its content has no {} signature)",
-                f.display_name(),
-                f.display_name()
-            ),
-            None => "unsupported file format (expected PNG, JPEG, TIFF, OpenEXR, Radiance HDR or \
-                     .npy content)"
-                .to_string(),
-        };
-        format_reason(path, reason)
-    })
-}
-
 /// Checks that decoding data of `shape` stays within `limit` when the decoder needs
 /// `decoder_bytes_per_sample` per sample and the planar result `size_of::<T>()` more; zero
 /// sizes are refused here too.
@@ -433,19 +436,10 @@ fn format_reason(path: &Path, reason: impl Into<String>) -> Error {
     }
 }
 
-/// Attaches `path` to an error that does not name a file (non-finite values, bad shapes).
-fn format_error(path: &Path, error: Error) -> Error {
-    match error {
-        Error::Io { .. } | Error::Format { .. } | Error::OutputExists { .. } => error,
-        other => format_reason(path, other.to_string()),
-    }
-}
-
 /// A planar image from `(c, h, w)` planes, with `path` attached to any error.
 fn planar<T: Sample>(path: &Path, planes: Array3<T>, depth: SampleDepth) -> Result<PlanarImage<T>> {
-    let channels =
-        crate::Channels::from_count(planes.dim().0).map_err(|e| format_error(path, e))?;
-    PlanarImage::new(planes, channels, depth).map_err(|e| format_error(path, e))
+    let channels = crate::Channels::from_count(planes.dim().0).map_err(|e| e.in_file(path))?;
+    PlanarImage::new(planes, channels, depth).map_err(|e| e.in_file(path))
 }
 
 #[cfg(test)]

@@ -424,7 +424,7 @@ fn unknown_output_extension_and_missing_directory_are_errors() {
     assert_names(&err, &gif, "output format");
     let nowhere = dir.path().join("no/such/dir/a.png");
     let err = write_image(&image, &nowhere, WriteOptions::default()).unwrap_err();
-    assert_names(&err, &nowhere, "No such file");
+    assert_names(&err, &nowhere, "directory does not exist");
 }
 
 #[test]
