@@ -78,6 +78,25 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// This error as one about the file `path`: an error that names no file (a bad shape,
+    /// parameter or value found while processing the file's content) becomes an
+    /// [`Error::Format`] naming it; errors that name a file already are returned unchanged.
+    ///
+    /// ```
+    /// use haarshift::Error;
+    /// let e = Error::InvalidParameter { name: "levels", reason: "too many".into() };
+    /// assert_eq!(e.in_file("a.png".as_ref()).to_string(), "a.png: invalid levels: too many");
+    /// ```
+    pub fn in_file(self, path: &std::path::Path) -> Self {
+        match self {
+            Error::Io { .. } | Error::Format { .. } | Error::OutputExists { .. } => self,
+            other => Error::Format {
+                path: path.to_path_buf(),
+                reason: other.to_string(),
+            },
+        }
+    }
+
     /// Shorthand for [`Error::InvalidParameter`].
     pub(crate) fn parameter(name: &'static str, reason: impl Into<String>) -> Self {
         Error::InvalidParameter {

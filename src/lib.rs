@@ -18,6 +18,7 @@ mod boundary;
 mod error;
 pub mod experiments;
 pub mod metrics;
+pub mod io;
 mod named;
 pub mod patterns;
 mod planar_image;

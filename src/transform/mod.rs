@@ -246,7 +246,7 @@ impl TransformSpec {
     }
 
     /// Steps per axis for a padded `h x w` array.
-    fn resolve_levels(&self, h: usize, w: usize) -> Result<[usize; 2]> {
+    pub(crate) fn resolve_levels(&self, h: usize, w: usize) -> Result<[usize; 2]> {
         let (dh, dw) = (h.trailing_zeros() as usize, w.trailing_zeros() as usize);
         match self.layout {
             Layout::Pyramid => {

@@ -1,0 +1,89 @@
+//! One module per command; flags shared by several commands are defined here.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use haarshift::io::TransformRequest;
+use haarshift::transform::{Layout, Levels, Normalization};
+use haarshift::{BoundaryMode, Error, Result};
+
+pub mod info;
+pub mod inverse;
+pub mod transform;
+
+/// A clap parser accepting exactly `names` and parsing them with the library's `FromStr`, so
+/// that `--help` lists the choices and the library stays the one place that defines them.
+fn choice<T>(names: impl Iterator<Item = &'static str>) -> impl TypedValueParser<Value = T>
+where
+    T: std::str::FromStr<Err = Error> + Clone + Send + Sync + 'static,
+{
+    PossibleValuesParser::new(names.collect::<Vec<_>>()).try_map(|s| s.parse::<T>())
+}
+
+/// The names of a `named_enum!` type, in declaration order.
+macro_rules! names {
+    ($t:ty) => {
+        <$t>::ALL.iter().map(|v| v.name())
+    };
+}
+pub(crate) use names;
+
+/// The transform parameters, shared by `transform` and `inverse`.
+#[derive(clap::Args, Debug)]
+pub struct TransformFlags {
+    /// Transform steps: a whole number K (a partial transform leaving (H >> K) x (W >> K)
+    /// scaling coefficients) or `full` (as many as the padded size allows) [default: full]
+    #[arg(long, value_name = "K|full", value_parser = clap::value_parser!(Levels))]
+    pub levels: Option<Levels>,
+
+    /// `pyramid`: non-separable 2D Haar (each level splits 2x2 blocks into the average A and
+    /// details a, b, c; Mallat layout). `separable`: a full 1D transform along rows, then
+    /// along columns [default: pyramid]
+    #[arg(long, value_parser = choice::<Layout>(names!(Layout)))]
+    pub layout: Option<Layout>,
+
+    /// `average`: parent = mean of children, detail = (first - second) / 2 per axis (the
+    /// seeds' convention). `orthonormal`: 1/sqrt(2) per axis step, energy preserving
+    /// [default: average]
+    #[arg(long, value_parser = choice::<Normalization>(names!(Normalization)))]
+    pub norm: Option<Normalization>,
+
+    /// How an image whose sides are not powers of two is extended (at the bottom and right)
+    /// before the transform; the inverse crops it off again. `zero`: zeros; `edge`: the last
+    /// row/column repeated; `reflect`: mirrored (d c b a | a b c d | d c b a); `wrap`:
+    /// periodic [default: zero]
+    #[arg(long, value_parser = choice::<BoundaryMode>(names!(BoundaryMode)))]
+    pub pad: Option<BoundaryMode>,
+}
+
+impl TransformFlags {
+    /// The parameters as given (unset ones left open).
+    pub fn request(&self) -> TransformRequest {
+        TransformRequest {
+            layout: self.layout,
+            normalization: self.norm,
+            levels: self.levels,
+            padding: self.pad,
+        }
+    }
+}
+
+/// Writes `text` to standard output; a closed pipe (`haarshift info x | head -1`) is not an
+/// error.
+pub fn print(text: &str) -> Result<()> {
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::Io {
+            path: PathBuf::from("<stdout>"),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Refuses `output` (and each of `others`, e.g. a sidecar) when it is the file `input`.
+pub fn refuse_overwriting_input(input: &Path, outputs: &[&Path]) -> Result<()> {
+    outputs
+        .iter()
+        .try_for_each(|out| haarshift::io::ensure_distinct_paths(input, out))
+}

@@ -1,0 +1,47 @@
+//! `haarshift`: Haar-domain signal processing on image files.
+//!
+//! This file parses the command line and reports errors; each command lives in
+//! [`commands`] and does its work through the `haarshift` library.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod commands;
+
+/// Haar wavelet transforms of images, and (soon) shifts and rotations computed directly on the
+/// coefficients.
+#[derive(Parser)]
+#[command(name = "haarshift", version, propagate_version = true)]
+#[command(after_help = "Run `haarshift <COMMAND> --help` for each command's flags and examples.")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    Transform(commands::transform::Args),
+    Inverse(commands::inverse::Args),
+    Info(commands::info::Args),
+}
+
+fn main() -> ExitCode {
+    // A bug must still end in one line, not a backtrace.
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("haarshift: internal error (please report it): {info}");
+    }));
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Transform(args) => commands::transform::run(args),
+        Command::Inverse(args) => commands::inverse::run(args),
+        Command::Info(args) => commands::info::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("haarshift: {error}");
+            ExitCode::FAILURE
+        }
+    }
+}
