@@ -8,6 +8,10 @@
 //!
 //! * [`PlanarImage`]: images as planar float channels in their stored units (0..255 for 8-bit).
 //!
+//! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`],
+//!   written atomically and never over an existing file unless asked; coefficient files (`.npy`
+//!   plus a JSON sidecar) that restore an image exactly.
+//!
 //! Conventions used throughout: arrays are row-major `(row, column)`; row 0 is the top of an
 //! image; a 2x2 block `[[p, q], [r, s]]` has average `A = (p+q+r+s)/4` and details
 //! `a = (p-q+r-s)/4` (horizontal), `b = (p+q-r-s)/4` (vertical), `c = (p-q-r+s)/4` (diagonal)
@@ -29,3 +33,8 @@ pub use boundary::BoundaryMode;
 pub use error::{Error, Result};
 pub use planar_image::{Channels, PlanarImage, SampleDepth};
 pub use sample::{Sample, ensure_finite};
+
+/// The README's Rust examples, compiled and run as doctests so that they stay true.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -653,3 +653,27 @@ fn coefficients_without_a_sidecar_use_the_request_and_do_not_crop() {
     let err = CoefficientFile::read(&path).unwrap_err();
     assert!(message(&err).contains("sidecar is missing"), "{err}");
 }
+
+#[test]
+fn float_tiffs_from_other_writers_read_as_f32() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("float.tif");
+    let values: Vec<f32> = (0..2 * 3 * 3).map(|v| v as f32 * 0.25 - 1.0).collect();
+    let mut file = std::fs::File::create(&path).unwrap();
+    tiff::encoder::TiffEncoder::new(&mut file)
+        .unwrap()
+        .write_image::<tiff::encoder::colortype::RGB32Float>(3, 2, &values)
+        .unwrap();
+    let image = read_image::<f64>(&path).unwrap();
+    assert_eq!(
+        (
+            image.channels(),
+            image.depth(),
+            image.height(),
+            image.width()
+        ),
+        (Channels::Rgb, SampleDepth::F32, 2, 3)
+    );
+    // Pixel (1, 2), channel 1 is interleaved sample (1 * 3 + 2) * 3 + 1.
+    assert_eq!(image.planes()[[1, 1, 2]], f64::from(values[16]));
+}
