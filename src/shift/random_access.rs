@@ -13,6 +13,7 @@
 //! precision on large images.
 
 use ndarray::{Array1, Array2, ArrayView1, ArrayView2, s};
+use rayon::prelude::*;
 
 use super::GridShift;
 use crate::transform::{Band, Band1d, Coefficients, Layout, Normalization, haar1d, pyramid};
@@ -70,7 +71,8 @@ impl Offset {
         let frac = u & ((1 << self.precision) - 1);
         (
             u >> self.precision,
-            frac as f64 / (1u64 << self.precision) as f64,
+            // A multiplication by the exact power of two, not a division: this is the hot path.
+            frac as f64 * f64::powi(0.5, self.precision as i32),
         )
     }
 }
@@ -182,8 +184,9 @@ impl ShiftQuery1d {
 
     /// The prefix sum at any integer position, continued periodically.
     fn extended(&self, k: i64) -> f64 {
-        let n = self.len() as i64;
-        let (wraps, m) = (k.div_euclid(n), k.rem_euclid(n) as usize);
+        // The length is a power of two: floor division and remainder are a shift and a mask.
+        let n = self.len();
+        let (wraps, m) = (k >> n.trailing_zeros(), (k & (n as i64 - 1)) as usize);
         self.prefix[m] + wraps as f64 * self.prefix[self.len()]
     }
 
@@ -314,7 +317,8 @@ impl ShiftQuery1d {
 /// ```
 #[derive(Clone, Debug)]
 pub struct ShiftQuery2d {
-    /// Summed-area table of `x - mean`: `(rows + 1) x (cols + 1)`.
+    /// Inclusive summed-area table of `x - mean`: entry `(i, j)` sums rows `..=i`, columns
+    /// `..=j`.
     table: Array2<f64>,
     mean: f64,
     levels: usize,
@@ -390,16 +394,23 @@ impl ShiftQuery2d {
         let block = coeffs
             .slice(s![..rows >> resolution, ..cols >> resolution])
             .mapv(|v| v.as_f64());
-        let x = pyramid::inverse(block.view(), coarse_levels, norm)?;
-        let (h, w) = x.dim();
-        let mean = x.sum() / (h * w) as f64;
-        let mut table = Array2::zeros((h + 1, w + 1));
-        for i in 0..h {
-            let mut row_sum = 0.0;
-            for j in 0..w {
-                row_sum += x[[i, j]] - mean;
-                table[[i + 1, j + 1]] = table[[i, j + 1]] + row_sum;
+        let mut table = pyramid::inverse(block.view(), coarse_levels, norm)?;
+        drop(block);
+        let (h, w) = table.dim();
+        let mean = table.sum() / (h * w) as f64;
+        // The inclusive summed-area table of `x - mean`, in place: prefix sums along each row
+        // (rows in parallel), then each row accumulates the one above.
+        let data = table.as_slice_mut().expect("owned arrays are contiguous");
+        data.par_chunks_mut(w).for_each(|row| {
+            let mut acc = 0.0;
+            for v in row {
+                acc += *v - mean;
+                *v = acc;
             }
+        });
+        for i in 1..h {
+            let (above, below) = data[(i - 1) * w..(i + 1) * w].split_at_mut(w);
+            below.iter_mut().zip(&*above).for_each(|(v, &up)| *v += up);
         }
         Ok(ShiftQuery2d {
             table,
@@ -412,17 +423,23 @@ impl ShiftQuery2d {
 
     /// Rows and columns of the image the query works on (`>> resolution`).
     pub fn dim(&self) -> (usize, usize) {
-        let (h, w) = self.table.dim();
-        (h - 1, w - 1)
+        self.table.dim()
     }
 
     /// The summed-area table at any integer corner, continued periodically.
     fn extended(&self, k: i64, l: i64) -> f64 {
+        // Sides are powers of two: floor division and remainder are a shift and a mask.
         let (h, w) = self.dim();
-        let (wk, mk) = (k.div_euclid(h as i64), k.rem_euclid(h as i64) as usize);
-        let (wl, ml) = (l.div_euclid(w as i64), l.rem_euclid(w as i64) as usize);
-        let t = &self.table;
-        t[[mk, ml]] + wk as f64 * t[[h, ml]] + wl as f64 * t[[mk, w]] + (wk * wl) as f64 * t[[h, w]]
+        let (bh, bw) = (h.trailing_zeros(), w.trailing_zeros());
+        let (wk, mk) = (k >> bh, (k & (h as i64 - 1)) as usize);
+        let (wl, ml) = (l >> bw, (l & (w as i64 - 1)) as usize);
+        // Exclusive prefix at (k, l) < (h, w) is inclusive entry (k - 1, l - 1); row or column
+        // 0 sums nothing.
+        let p = |k: usize, l: usize| match (k, l) {
+            (0, _) | (_, 0) => 0.0,
+            _ => self.table[[k - 1, l - 1]],
+        };
+        p(mk, ml) + wk as f64 * p(h, ml) + wl as f64 * p(mk, w) + (wk * wl) as f64 * p(h, w)
     }
 
     /// The integral of `D` over `[0, row) x [0, col)` at fine-grid corner positions: the
