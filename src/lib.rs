@@ -6,6 +6,9 @@
 //!   the `average` or `orthonormal` normalisation, f32 or f64, any size (padded to powers of two
 //!   with a chosen [`BoundaryMode`] and cropped back on the way out).
 //!
+//! * [`shift`]: whole and fractional shifts computed directly on the coefficients, 1D, 2D
+//!   non-separable and N-D separable, densely in O(n) or one coefficient at a time in O(1).
+//!
 //! * [`PlanarImage`]: images as planar float channels in their stored units (0..255 for 8-bit).
 //!
 //! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`],
@@ -27,6 +30,7 @@ mod named;
 pub mod patterns;
 mod planar_image;
 mod sample;
+pub mod shift;
 pub mod transform;
 
 pub use boundary::BoundaryMode;

@@ -28,7 +28,7 @@ pub fn max_levels(h: usize, w: usize) -> usize {
 }
 
 /// Validates a power-of-two shape and a level count; returns nothing on success.
-fn check(shape: (usize, usize), levels: usize) -> Result<()> {
+pub(crate) fn check(shape: (usize, usize), levels: usize) -> Result<()> {
     let (h, w) = shape;
     if h == 0 || w == 0 || !h.is_power_of_two() || !w.is_power_of_two() {
         return Err(Error::shape(
@@ -79,7 +79,7 @@ pub(crate) fn band_ranges(
 
 /// One analysis step on a row pair: 2x2 blocks to (A, a, b, c). `f2` is the per-level factor.
 #[inline]
-fn analyse_rows<T: Sample>(
+pub(crate) fn analyse_rows<T: Sample>(
     r0: &[T],
     r1: &[T],
     approx: &mut [T],
@@ -104,7 +104,7 @@ fn analyse_rows<T: Sample>(
 
 /// One synthesis step: (A, a, b, c) rows back to a row pair of 2x2 blocks.
 #[inline]
-fn synthesise_rows<T: Sample>(
+pub(crate) fn synthesise_rows<T: Sample>(
     approx: &[T],
     a: &[T],
     b: &[T],
