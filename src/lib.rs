@@ -6,6 +6,10 @@
 //!   the `average` or `orthonormal` normalisation, f32 or f64, any size (padded to powers of two
 //!   with a chosen [`BoundaryMode`] and cropped back on the way out).
 //!
+//! * [`sphere`]: rotation of lat-long environment maps in pixels and directly in the 2D Haar
+//!   domain (the chain rule on detail coefficients), with a ground-truth reference and
+//!   bilinear/bicubic resampling to compare against.
+//!
 //! * [`PlanarImage`]: images as planar float channels in their stored units (0..255 for 8-bit).
 //!
 //! Conventions used throughout: arrays are row-major `(row, column)`; row 0 is the top of an
@@ -19,6 +23,7 @@ mod error;
 mod named;
 mod planar_image;
 mod sample;
+pub mod sphere;
 pub mod transform;
 
 pub use boundary::BoundaryMode;
