@@ -227,13 +227,27 @@ enum Along {
 struct ChainRule<'a, T> {
     grad: &'a SourceGradient<T>,
     rotation: &'a SphereRotation,
+    /// `(sin, cos)` of `k delta / 2`: every angle the grids use.
+    trig: Vec<(f64, f64)>,
 }
 
-impl<T: Sample> ChainRule<'_, T> {
-    /// `scale * dg/d(along)` at `(theta, phi)` into `out`.
-    fn derivative(&self, theta: f64, phi: f64, along: Along, scale: f64, out: &mut [T]) {
-        let (st, ct) = theta.sin_cos();
-        let (sp, cp) = phi.sin_cos();
+impl<'a, T: Sample> ChainRule<'a, T> {
+    fn new(grad: &'a SourceGradient<T>, rotation: &'a SphereRotation) -> Self {
+        let half = 0.5 * grad.step;
+        let trig = (0..=2 * grad.n + 2)
+            .map(|k| (k as f64 * half).sin_cos())
+            .collect();
+        ChainRule {
+            grad,
+            rotation,
+            trig,
+        }
+    }
+
+    /// `scale * dg/d(along)` at the angles `(theta, phi) = (kt, kp) * delta / 2` into `out`.
+    fn derivative(&self, kt: usize, kp: usize, along: Along, scale: f64, out: &mut [T]) {
+        let (st, ct) = self.trig[kt];
+        let (sp, cp) = self.trig[kp];
         let p = [st * sp, ct, st * cp];
         let tangent = match along {
             Along::Theta => [ct * sp, -st, ct * cp],
@@ -242,8 +256,14 @@ impl<T: Sample> ChainRule<'_, T> {
         let q = self.rotation.apply(p);
         let tq = self.rotation.apply(tangent);
         let (big_t, big_p) = angles(q);
-        let (s_t, c_t) = big_t.sin_cos();
-        let (s_p, c_p) = big_p.sin_cos();
+        // The frame at q straight from q (atan2's convention at the poles: Phi = 0).
+        let rho = q[0].hypot(q[2]);
+        let (s_p, c_p) = if rho > 0.0 {
+            (q[0] / rho, q[2] / rho)
+        } else {
+            (0.0, 1.0)
+        };
+        let (s_t, c_t) = (rho, q[1].clamp(-1.0, 1.0));
         let alpha = T::from_f64(scale * dot([c_t * s_p, -s_t, c_t * c_p], tq));
         let beta = T::from_f64(scale * dot([c_p, 0.0, -s_p], tq));
         let mut ft = [T::zero(); 64];
@@ -257,16 +277,12 @@ impl<T: Sample> ChainRule<'_, T> {
 
     /// `V[i][j] = -delta g_theta((i + 1) delta, (j + 1/2) delta)`.
     fn vertical(&self, i: usize, j: usize, out: &mut [T]) {
-        let d = self.grad.step;
-        let (t, p) = ((i + 1) as f64 * d, (j as f64 + 0.5) * d);
-        self.derivative(t, p, Along::Theta, -d, out);
+        self.derivative(2 * i + 2, 2 * j + 1, Along::Theta, -self.grad.step, out);
     }
 
     /// `U[i][j] = -delta g_phi((i + 1/2) delta, (j + 1) delta)`.
     fn horizontal(&self, i: usize, j: usize, out: &mut [T]) {
-        let d = self.grad.step;
-        let (t, p) = ((i as f64 + 0.5) * d, (j + 1) as f64 * d);
-        self.derivative(t, p, Along::Phi, -d, out);
+        self.derivative(2 * i + 1, 2 * j + 2, Along::Phi, -self.grad.step, out);
     }
 }
 
@@ -293,10 +309,7 @@ impl<T: Sample> DifferenceFields<T> {
     pub fn rotated(approx: &LatLongMap<T>, rotation: &SphereRotation) -> Self {
         let (m, n, ch) = approx.as_array().dim();
         let grad = SourceGradient::new(approx);
-        let rule = ChainRule {
-            grad: &grad,
-            rotation,
-        };
+        let rule = ChainRule::new(&grad, rotation);
         let v = fill_grid((m - 1, n, ch), |i, j, out| rule.vertical(i, j, out));
         let u = fill_grid((m, n, ch), |i, j, out| rule.horizontal(i, j, out));
         let c = mixed_from(v.view(), u.view());
@@ -316,8 +329,8 @@ impl<T: Sample> DifferenceFields<T> {
     pub fn of_map(x: &LatLongMap<T>) -> Self {
         let a = x.as_array();
         let (m, n, ch) = a.dim();
-        let v = Array3::from_shape_fn((m - 1, n, ch), |(i, j, k)| a[[i, j, k]] - a[[i + 1, j, k]]);
-        let u = Array3::from_shape_fn((m, n, ch), |(i, j, k)| {
+        let v = grid_from_fn((m - 1, n, ch), |(i, j, k)| a[[i, j, k]] - a[[i + 1, j, k]]);
+        let u = grid_from_fn((m, n, ch), |(i, j, k)| {
             a[[i, j, k]] - a[[i, (j + 1) % n, k]]
         });
         let c = mixed_from(v.view(), u.view());
@@ -378,13 +391,13 @@ impl<T: Sample> DifferenceFields<T> {
         let (mh, nh) = (m / 2, n / 2);
         let q = T::from_f64(0.25);
         let two = T::from_f64(2.0);
-        let v = Array3::from_shape_fn((mh.saturating_sub(1), nh, ch), |(i, j, k)| {
+        let v = grid_from_fn((mh.saturating_sub(1), nh, ch), |(i, j, k)| {
             let col = |c: usize| {
                 self.v[[2 * i, c, k]] + two * self.v[[2 * i + 1, c, k]] + self.v[[2 * i + 2, c, k]]
             };
             q * (col(2 * j) + col(2 * j + 1))
         });
-        let u = Array3::from_shape_fn((mh, nh, ch), |(i, j, k)| {
+        let u = grid_from_fn((mh, nh, ch), |(i, j, k)| {
             let row = |r: usize| {
                 self.u[[r, 2 * j, k]]
                     + two * self.u[[r, 2 * j + 1, k]]
@@ -392,7 +405,7 @@ impl<T: Sample> DifferenceFields<T> {
             };
             q * (row(2 * i) + row(2 * i + 1))
         });
-        let c = Array3::from_shape_fn((mh.saturating_sub(1), nh, ch), |(i, j, k)| {
+        let c = grid_from_fn((mh.saturating_sub(1), nh, ch), |(i, j, k)| {
             let row = |r: usize| {
                 self.c[[r, 2 * j, k]]
                     + two * self.c[[r, 2 * j + 1, k]]
@@ -432,12 +445,24 @@ impl<T: Sample> DifferenceFields<T> {
     }
 }
 
+/// `Array3::from_shape_fn` with the rows computed in parallel.
+fn grid_from_fn<T: Sample>(
+    shape: (usize, usize, usize),
+    f: impl Fn((usize, usize, usize)) -> T + Sync,
+) -> Array3<T> {
+    fill_grid(shape, |i, j, out| {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = f((i, j, k));
+        }
+    })
+}
+
 /// `C = (V[i][j] - V[i][j+1] + U[i][j] - U[i+1][j]) / 2`, the mixed difference from both
 /// first-difference fields (step 4).
 fn mixed_from<T: Sample>(v: ArrayView3<'_, T>, u: ArrayView3<'_, T>) -> Array3<T> {
     let (rows, n, ch) = v.dim();
     let half = T::from_f64(0.5);
-    Array3::from_shape_fn((rows, n, ch), |(i, j, k)| {
+    grid_from_fn((rows, n, ch), |(i, j, k)| {
         half * (v[[i, j, k]] - v[[i, (j + 1) % n, k]] + u[[i, j, k]] - u[[i + 1, j, k]])
     })
 }
@@ -575,10 +600,7 @@ pub fn rotate_selected<T: Sample>(
         }
     }
     let grad = SourceGradient::new(approx);
-    let rule = ChainRule {
-        grad: &grad,
-        rotation,
-    };
+    let rule = ChainRule::new(&grad, rotation);
     requests
         .par_iter()
         .map(|r| Ok(footprint_coefficient(&rule, r, m, ch)))

@@ -8,11 +8,16 @@
 //! * [`relative_energy_error`]: `(E(a) - E(b)) / E(b)` for the solid-angle integral `E`
 //!   summed over channels; rotation preserves `E` exactly.
 //! * [`Comparison`]: all of them at once, plus the RMS at the computed level's resolution.
+//! * [`run`]: a table of [`Record`]s (map, method, rotation, level, errors, seconds).
+
+use std::time::Instant;
 
 use ndarray::Axis;
 
 use super::latlong::pixel_solid_angle;
-use super::{LatLongMap, Rotated, SphereCoefficients};
+use super::{
+    LatLongMap, Method, Rotated, SphereCoefficients, SphereOptions, SphereRotation, rotate_map,
+};
 use crate::{Error, Result, Sample};
 
 /// The solid-angle weighted RMS difference of two maps of the same shape.
@@ -140,4 +145,83 @@ impl Comparison {
             energy_error: relative_energy_error(&result.map, original),
         })
     }
+}
+
+/// One row of a method comparison: a map, a rotation, a method at a level, its errors
+/// against the reference and its time.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Record {
+    /// Name of the map.
+    pub map: String,
+    /// The method.
+    pub method: Method,
+    /// Yaw, degrees.
+    pub yaw: f64,
+    /// Pitch, degrees.
+    pub pitch: f64,
+    /// Roll, degrees.
+    pub roll: f64,
+    /// The finest detail level computed.
+    pub level: usize,
+    /// The errors (see [`Comparison`]).
+    #[serde(flatten)]
+    pub comparison: Comparison,
+    /// Wall-clock seconds of the [`rotate_map`] call.
+    pub seconds: f64,
+}
+
+/// Rotates `map` by each `(yaw, pitch, roll)` with each `(method, level)` and compares with
+/// the full-resolution [`Method::Reference`] (`reference_samples` per axis), which is also
+/// reported (its own errors are zero, its energy error is its quadrature's).
+///
+/// ```
+/// use haarshift::sphere::{LatLongMap, Method, experiment::run};
+/// let f = LatLongMap::<f64>::from_fn(16, 1, |d, o| o[0] = 1.0 + d[0]).unwrap();
+/// let rows = run("smooth", &f, &[(0.0, 30.0, 0.0)], &[(Method::Haar, None), (Method::Bilinear, Some(2))], 4).unwrap();
+/// assert_eq!(rows.len(), 3);
+/// assert_eq!((rows[2].method, rows[2].level), (Method::Bilinear, 2));
+/// assert!(rows[1].comparison.rms < 0.05);
+/// ```
+pub fn run<T: Sample>(
+    name: &str,
+    map: &LatLongMap<T>,
+    rotations: &[(f64, f64, f64)],
+    methods: &[(Method, Option<usize>)],
+    reference_samples: usize,
+) -> Result<Vec<Record>> {
+    let finest = map.height().trailing_zeros().saturating_sub(1) as usize;
+    let mut records = Vec::new();
+    for &(yaw, pitch, roll) in rotations {
+        let rotation = SphereRotation::from_degrees(yaw, pitch, roll)?;
+        let timed = |method: Method, level: Option<usize>| {
+            let options = SphereOptions {
+                method,
+                level,
+                reference_samples,
+            };
+            let start = Instant::now();
+            let rotated = rotate_map(map, &rotation, &options)?;
+            Ok::<_, Error>((rotated, start.elapsed().as_secs_f64()))
+        };
+        let (truth, seconds) = timed(Method::Reference, None)?;
+        let record = |method, level, comparison, seconds| Record {
+            map: name.to_string(),
+            method,
+            yaw,
+            pitch,
+            roll,
+            level,
+            comparison,
+            seconds,
+        };
+        let own = Comparison::new(&truth, &truth, finest, map)?;
+        records.push(record(Method::Reference, finest, own, seconds));
+        for &(method, level) in methods {
+            let (rotated, seconds) = timed(method, level)?;
+            let level = level.unwrap_or(finest);
+            let comparison = Comparison::new(&rotated, &truth, level, map)?;
+            records.push(record(method, level, comparison, seconds));
+        }
+    }
+    Ok(records)
 }

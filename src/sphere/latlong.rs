@@ -287,16 +287,23 @@ impl<T: Sample> LatLongMap<T> {
         }
         let (sh, sw) = (h / factor, w / factor);
         let scale = T::from_f64(1.0 / (factor * factor) as f64);
+        let src = self.data.as_slice().expect("standard layout");
         let mut out = Array3::zeros((sh, sw, ch));
         out.axis_iter_mut(Axis(0))
             .into_par_iter()
             .enumerate()
             .for_each(|(i, mut row)| {
-                let block = self.data.slice(s![i * factor..(i + 1) * factor, .., ..]);
-                for ((j, c), v) in row.indexed_iter_mut() {
-                    let cols = block.slice(s![.., j * factor..(j + 1) * factor, c]);
-                    *v = cols.sum() * scale;
+                let row = row.as_slice_mut().expect("standard layout");
+                for r in i * factor..(i + 1) * factor {
+                    let line = &src[r * w * ch..][..w * ch];
+                    for (jj, px) in line.chunks_exact(ch).enumerate() {
+                        let acc = &mut row[(jj / factor) * ch..][..ch];
+                        for (a, &v) in acc.iter_mut().zip(px) {
+                            *a += v;
+                        }
+                    }
                 }
+                row.iter_mut().for_each(|v| *v *= scale);
             });
         Ok(LatLongMap { data: out })
     }
