@@ -6,7 +6,7 @@
 //!
 //! | method | what it does | cost |
 //! |---|---|---|
-//! | [`Method::Reference`] | ground truth: each target pixel is the solid-angle mean of `f(R p)` over the pixel, `n x n` stratified samples of the bilinear `f` ([`reference`]) | `n^2` lookups per pixel |
+//! | [`Method::Reference`] | ground truth: each target pixel is the solid-angle mean of `f(R p)` over the pixel, `n x n` stratified samples of the bilinear `f` ([`reference`](mod@reference)) | `n^2` lookups per pixel |
 //! | [`Method::Bilinear`], [`Method::Bicubic`] | one lookup per target pixel at `R p` ([`resample`]) | 4 or 16 taps per pixel |
 //! | [`Method::Haar`] | the chain rule on the detail coefficients at one level, exact recursive filters for the coarser ones ([`chain_rule`]) | two chain-rule evaluations per pixel of the working level |
 //!
@@ -54,7 +54,7 @@ named_enum! {
     /// How [`rotate_map`] computes the rotated map.
     #[derive(Default)]
     pub enum Method ("method") {
-        /// Ground truth: per-pixel solid-angle integration ([`reference`]).
+        /// Ground truth: per-pixel solid-angle integration ([`reference`](mod@reference)).
         Reference = "reference",
         /// One bilinear lookup per pixel ([`resample`]).
         Bilinear = "bilinear",
