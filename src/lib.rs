@@ -5,15 +5,17 @@
 //! * [`transform`]: 1D, 2D non-separable ("standard pyramid") and separable Haar transforms, in
 //!   the `average` or `orthonormal` normalisation, f32 or f64, any size (padded to powers of two
 //!   with a chosen [`BoundaryMode`] and cropped back on the way out).
-//!
 //! * [`shift`]: whole and fractional shifts computed directly on the coefficients, 1D, 2D
 //!   non-separable and N-D separable, densely in O(n) or one coefficient at a time in O(1).
-//!
-//! * [`PlanarImage`]: images as planar float channels in their stored units (0..255 for 8-bit).
-//!
-//! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`],
-//!   written atomically and never over an existing file unless asked; coefficient files (`.npy`
-//!   plus a JSON sidecar) that restore an image exactly.
+//! * [`sphere`]: rotation of lat-long environment maps in pixels and directly in the 2D Haar
+//!   domain (the chain rule on detail coefficients), with a ground-truth reference and
+//!   bilinear/bicubic resampling to compare against.
+//! * [`experiments`], [`metrics`], [`patterns`]: error-accumulation experiments, the error
+//!   measures they report, and the synthetic test patterns they use.
+//! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`]
+//!   (planar float channels in their stored units, 0..255 for 8-bit), written atomically and
+//!   never over an existing file unless asked; coefficient files (`.npy` plus a JSON sidecar)
+//!   that restore an image exactly.
 //!
 //! Conventions used throughout: arrays are row-major `(row, column)`; row 0 is the top of an
 //! image; a 2x2 block `[[p, q], [r, s]]` has average `A = (p+q+r+s)/4` and details
@@ -24,13 +26,14 @@
 mod boundary;
 mod error;
 pub mod experiments;
-pub mod metrics;
 pub mod io;
+pub mod metrics;
 mod named;
 pub mod patterns;
 mod planar_image;
 mod sample;
 pub mod shift;
+pub mod sphere;
 pub mod transform;
 
 pub use boundary::BoundaryMode;

@@ -1,0 +1,423 @@
+//! [`LatLongMap`]: a spherical function stored as a latitude-longitude (equirectangular) map,
+//! with the geometry of its pixels and continuous lookups across the seam and the poles.
+//!
+//! # Conventions (the seed's section 4.5.1)
+//!
+//! Row `i` is the elevation `theta` measured from +Y (up), column `j` the azimuth `phi`;
+//! pixel `(i, j)` of an `H x W` map has its centre at
+//! `theta = (i + 0.5) pi / H`, `phi = (j + 0.5) 2 pi / W`, and the direction of `(theta, phi)`
+//! is `(sin theta sin phi, cos theta, sin theta cos phi)` (right-handed, Y up, Z the depth).
+//! Maps are 2:1 (`W = 2 H`), so a pixel spans the same angle `pi / H` along both axes.
+//!
+//! # Continuing the map past its edges
+//!
+//! * The seam: `phi` is periodic, column `-1` is column `W - 1`.
+//! * The poles: the point `(-theta, phi)` is the point `(theta, phi + pi)`, so row `-1 - r`
+//!   is row `r` half a turn away (column `j + W / 2`), and likewise past the south pole. A
+//!   lookup near a pole therefore interpolates between pixels on both sides of the pole, which
+//!   is what they are on the sphere. (Tangent-vector components flip sign there; see
+//!   [`chain_rule`](super::chain_rule).)
+
+use ndarray::{Array3, ArrayView3, Axis, s};
+use rayon::prelude::*;
+
+use crate::{Error, Result, Sample, ensure_finite};
+
+/// The unit direction of elevation `theta` (from +Y) and azimuth `phi`.
+///
+/// ```
+/// use haarshift::sphere::latlong::direction;
+/// let d = direction(std::f64::consts::FRAC_PI_2, 0.0);
+/// assert!((d[2] - 1.0).abs() < 1e-15 && d[0].abs() < 1e-15); // the horizon at phi = 0 is +Z
+/// ```
+#[inline]
+pub fn direction(theta: f64, phi: f64) -> [f64; 3] {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    [st * sp, ct, st * cp]
+}
+
+/// The angles `(theta, phi)` of a unit direction, `theta` in `[0, pi]`, `phi` in `[0, 2 pi)`.
+///
+/// The azimuth is `atan2(x, z)`: the seed's (4.13) prints `tan^-1(x / z)`, which loses the
+/// quadrant.
+///
+/// ```
+/// use haarshift::sphere::latlong::{angles, direction};
+/// let (t, p) = angles(direction(1.0, 5.0));
+/// assert!((t - 1.0).abs() < 1e-12 && (p - 5.0).abs() < 1e-12);
+/// ```
+#[inline]
+pub fn angles(d: [f64; 3]) -> (f64, f64) {
+    let theta = d[1].clamp(-1.0, 1.0).acos();
+    let phi = d[0].atan2(d[2]);
+    let phi = if phi < 0.0 {
+        phi + std::f64::consts::TAU
+    } else {
+        phi
+    };
+    // atan2 of a tiny negative x can round to exactly TAU.
+    (
+        theta,
+        if phi >= std::f64::consts::TAU {
+            0.0
+        } else {
+            phi
+        },
+    )
+}
+
+/// Catmull-Rom weights (Keys' cubic with `a = -1/2`) of the four samples around `t` in `[0, 1)`.
+#[inline]
+fn catmull_rom(t: f64) -> [f64; 4] {
+    let (t2, t3) = (t * t, t * t * t);
+    [
+        0.5 * (-t3 + 2.0 * t2 - t),
+        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+        0.5 * (t3 - t2),
+    ]
+}
+
+/// Where sample `(r, c)` of an `h x w` lat-long grid lives when `r` or `c` is out of range:
+/// the index inside the grid and whether the pole was crossed (tangent components flip).
+#[inline]
+pub(crate) fn continue_index(r: isize, c: isize, h: usize, w: usize) -> (usize, usize, bool) {
+    let (hi, wi) = (h as isize, w as isize);
+    let (r, c, crossed) = if r < 0 {
+        (-1 - r, c + wi / 2, true)
+    } else if r >= hi {
+        (2 * hi - 1 - r, c + wi / 2, true)
+    } else {
+        (r, c, false)
+    };
+    (
+        r.clamp(0, hi - 1) as usize,
+        c.rem_euclid(wi) as usize,
+        crossed,
+    )
+}
+
+/// A lat-long map: `H` rows of elevation by `W = 2 H` columns of azimuth by `C` channels.
+///
+/// ```
+/// use haarshift::sphere::LatLongMap;
+/// let map = LatLongMap::<f64>::from_fn(4, 1, |d, out| out[0] = d[1]).unwrap(); // f = y
+/// assert_eq!((map.height(), map.width(), map.channels()), (4, 8, 1));
+/// let mut v = [0.0];
+/// map.bilinear(0.5 * std::f64::consts::PI, 1.0, &mut v); // on the horizon
+/// assert!(v[0].abs() < 1e-12);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct LatLongMap<T> {
+    data: Array3<T>,
+}
+
+impl<T: Sample> LatLongMap<T> {
+    /// Wraps an `(H, W, C)` array: `W = 2 H`, `H >= 1`, `C >= 1`, finite values.
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// use ndarray::Array3;
+    /// assert!(LatLongMap::new(Array3::<f32>::zeros((4, 8, 3))).is_ok());
+    /// assert!(LatLongMap::new(Array3::<f32>::zeros((4, 4, 3))).is_err());
+    /// ```
+    pub fn new(data: Array3<T>) -> Result<Self> {
+        let (h, w, c) = data.dim();
+        if h == 0 || c == 0 || w != 2 * h {
+            return Err(Error::shape(
+                &[h, w, c],
+                "a lat-long map is (H, W = 2 H, channels) with H and channels at least 1",
+            ));
+        }
+        ensure_finite(&data)?;
+        let data = if data.is_standard_layout() {
+            data
+        } else {
+            data.as_standard_layout().into_owned()
+        };
+        Ok(LatLongMap { data })
+    }
+
+    /// Samples `f(direction, channels_out)` at every pixel centre of an `h x 2h` map.
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// let m = LatLongMap::<f64>::from_fn(2, 2, |d, out| { out[0] = d[0]; out[1] = 1.0 }).unwrap();
+    /// assert_eq!(m.as_array()[[0, 0, 1]], 1.0);
+    /// ```
+    pub fn from_fn(
+        h: usize,
+        channels: usize,
+        f: impl Fn([f64; 3], &mut [T]) + Sync,
+    ) -> Result<Self> {
+        let data = fill_pixels(h, channels, |i, j, px| {
+            let (t, p) = pixel_centre(h, i, j);
+            f(direction(t, p), px)
+        })?;
+        LatLongMap::new(data)
+    }
+
+    /// Rows (`H`).
+    pub fn height(&self) -> usize {
+        self.data.dim().0
+    }
+
+    /// Columns (`W = 2 H`).
+    pub fn width(&self) -> usize {
+        self.data.dim().1
+    }
+
+    /// Channels per pixel.
+    pub fn channels(&self) -> usize {
+        self.data.dim().2
+    }
+
+    /// The `(H, W, C)` array.
+    pub fn as_array(&self) -> ArrayView3<'_, T> {
+        self.data.view()
+    }
+
+    /// The `(H, W, C)` array, owned.
+    pub fn into_array(self) -> Array3<T> {
+        self.data
+    }
+
+    /// The channels of pixel `(r, c)` after continuing `r` over the poles and `c` around the
+    /// seam (see the [module docs](self)).
+    #[inline]
+    fn pixel(&self, r: isize, c: isize) -> &[T] {
+        let (h, w, ch) = self.data.dim();
+        let (r, c, _) = continue_index(r, c, h, w);
+        let flat = self.data.as_slice().expect("standard layout");
+        &flat[(r * w + c) * ch..][..ch]
+    }
+
+    /// Bilinear lookup at `(theta, phi)` into `out` (one value per channel), between the four
+    /// nearest pixel centres, continued over the seam and the poles.
+    pub fn bilinear(&self, theta: f64, phi: f64, out: &mut [T]) {
+        let (y, x) = self.grid_position(theta, phi);
+        let (r0, c0) = (y.floor(), x.floor());
+        let (fy, fx) = (y - r0, x - c0);
+        let (r0, c0) = (r0 as isize, c0 as isize);
+        out.fill(T::zero());
+        for (dr, wy) in [(0, 1.0 - fy), (1, fy)] {
+            for (dc, wx) in [(0, 1.0 - fx), (1, fx)] {
+                let weight = T::from_f64(wy * wx);
+                for (o, &v) in out.iter_mut().zip(self.pixel(r0 + dr, c0 + dc)) {
+                    *o += weight * v;
+                }
+            }
+        }
+    }
+
+    /// Bicubic (Catmull-Rom) lookup at `(theta, phi)` over the 4 x 4 nearest pixel centres,
+    /// continued over the seam and the poles. Like every interpolating cubic it can overshoot
+    /// next to a sharp peak (and go negative).
+    pub fn bicubic(&self, theta: f64, phi: f64, out: &mut [T]) {
+        let (y, x) = self.grid_position(theta, phi);
+        let (r0, c0) = (y.floor(), x.floor());
+        let (wy, wx) = (catmull_rom(y - r0), catmull_rom(x - c0));
+        let (r0, c0) = (r0 as isize - 1, c0 as isize - 1);
+        out.fill(T::zero());
+        for (dr, &wr) in wy.iter().enumerate() {
+            for (dc, &wc) in wx.iter().enumerate() {
+                let weight = T::from_f64(wr * wc);
+                let px = self.pixel(r0 + dr as isize, c0 + dc as isize);
+                for (o, &v) in out.iter_mut().zip(px) {
+                    *o += weight * v;
+                }
+            }
+        }
+    }
+
+    /// Continuous pixel coordinates `(row, column)` of `(theta, phi)`: pixel centres sit at
+    /// whole numbers.
+    #[inline]
+    fn grid_position(&self, theta: f64, phi: f64) -> (f64, f64) {
+        let h = self.height() as f64;
+        let step = std::f64::consts::PI / h;
+        (theta / step - 0.5, phi / step - 0.5)
+    }
+
+    /// The solid-angle integral of each channel, `sum_ij f_ij * solid_angle(i)`: the energy a
+    /// rotation preserves.
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// let one = LatLongMap::<f64>::from_fn(8, 1, |_, out| out[0] = 1.0).unwrap();
+    /// assert!((one.energy()[0] - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+    /// ```
+    pub fn energy(&self) -> Vec<f64> {
+        let (h, _, ch) = self.data.dim();
+        let mut total = vec![0.0; ch];
+        for (i, row) in self.data.axis_iter(Axis(0)).enumerate() {
+            let weight = pixel_solid_angle(h, i);
+            for px in row.as_slice().expect("standard layout").chunks_exact(ch) {
+                for (t, &v) in total.iter_mut().zip(px) {
+                    *t += weight * v.as_f64();
+                }
+            }
+        }
+        total
+    }
+
+    /// The map box-filtered by `factor x factor` (a power of two dividing `H`): each output
+    /// pixel is the mean of its block, which is exactly the approximation a Haar pyramid
+    /// holds at that resolution.
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// let m = LatLongMap::<f64>::from_fn(4, 1, |d, out| out[0] = d[0]).unwrap();
+    /// let small = m.downsample(2).unwrap();
+    /// assert_eq!((small.height(), small.width()), (2, 4));
+    /// let block: f64 = m.as_array().slice(ndarray::s![0..2, 0..2, 0]).sum() / 4.0;
+    /// assert!((small.as_array()[[0, 0, 0]] - block).abs() < 1e-15);
+    /// ```
+    pub fn downsample(&self, factor: usize) -> Result<Self> {
+        let (h, w, ch) = self.data.dim();
+        if factor == 0 || !factor.is_power_of_two() || !h.is_multiple_of(factor) {
+            return Err(Error::parameter(
+                "factor",
+                format!("{factor} is not a power of two dividing the height {h}"),
+            ));
+        }
+        if factor == 1 {
+            return Ok(self.clone());
+        }
+        let (sh, sw) = (h / factor, w / factor);
+        let scale = T::from_f64(1.0 / (factor * factor) as f64);
+        let src = self.data.as_slice().expect("standard layout");
+        let mut out = Array3::zeros((sh, sw, ch));
+        out.axis_iter_mut(Axis(0))
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(i, mut row)| {
+                let row = row.as_slice_mut().expect("standard layout");
+                for r in i * factor..(i + 1) * factor {
+                    let line = &src[r * w * ch..][..w * ch];
+                    for (jj, px) in line.chunks_exact(ch).enumerate() {
+                        let acc = &mut row[(jj / factor) * ch..][..ch];
+                        for (a, &v) in acc.iter_mut().zip(px) {
+                            *a += v;
+                        }
+                    }
+                }
+                row.iter_mut().for_each(|v| *v *= scale);
+            });
+        Ok(LatLongMap { data: out })
+    }
+
+    /// The map turned about +Y by `k` whole columns (`k * 360 / W` degrees of yaw): pixel
+    /// `(i, j)` of the result is pixel `(i, j + k)` of `self`, an exact permutation.
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// let m = LatLongMap::<f64>::from_fn(2, 1, |d, out| out[0] = d[0] + 2.0 * d[2]).unwrap();
+    /// let r = m.roll_columns(3);
+    /// assert_eq!(r.as_array()[[1, 0, 0]], m.as_array()[[1, 3, 0]]);
+    /// ```
+    pub fn roll_columns(&self, k: usize) -> Self {
+        let w = self.width();
+        let k = k % w;
+        let mut data = Array3::zeros(self.data.dim());
+        data.slice_mut(s![.., ..w - k, ..])
+            .assign(&self.data.slice(s![.., k.., ..]));
+        data.slice_mut(s![.., w - k.., ..])
+            .assign(&self.data.slice(s![.., ..k, ..]));
+        LatLongMap { data }
+    }
+
+    /// The pixel with the largest channel sum and its `(row, column)`.
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// let m = LatLongMap::<f64>::from_fn(4, 1, |d, out| out[0] = d[1]).unwrap();
+    /// assert_eq!(m.brightest().0, 0); // the top row is nearest +Y
+    /// ```
+    pub fn brightest(&self) -> (usize, usize) {
+        let ch = self.channels();
+        let w = self.width();
+        let flat = self.data.as_slice().expect("standard layout");
+        let (best, _) = flat
+            .chunks_exact(ch)
+            .map(|px| px.iter().map(|v| v.as_f64()).sum::<f64>())
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |acc, (k, v)| {
+                    if v > acc.1 { (k, v) } else { acc }
+                },
+            );
+        (best / w, best % w)
+    }
+}
+
+/// An `(h, 2h, channels)` array whose pixel `(i, j)` is written by `f(i, j, channels_out)`,
+/// rows in parallel.
+pub(crate) fn fill_pixels<T: Sample>(
+    h: usize,
+    channels: usize,
+    f: impl Fn(usize, usize, &mut [T]) + Sync,
+) -> Result<Array3<T>> {
+    check_size(h, channels)?;
+    Ok(fill_grid((h, 2 * h, channels), f))
+}
+
+/// A `(rows, cols, channels)` array whose entry `(i, j, ..)` is written by
+/// `f(i, j, channels_out)`, rows in parallel.
+pub(crate) fn fill_grid<T: Sample>(
+    shape: (usize, usize, usize),
+    f: impl Fn(usize, usize, &mut [T]) + Sync,
+) -> Array3<T> {
+    let channels = shape.2;
+    let mut data = Array3::zeros(shape);
+    data.axis_iter_mut(Axis(0))
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(i, mut row)| {
+            let row = row.as_slice_mut().expect("standard layout");
+            for (j, px) in row.chunks_exact_mut(channels).enumerate() {
+                f(i, j, px);
+            }
+        });
+    data
+}
+
+/// Checks the height and channel count of a map to be made.
+pub(crate) fn check_size(h: usize, channels: usize) -> Result<()> {
+    if h == 0 || channels == 0 || h > 1 << 20 || channels > 64 {
+        return Err(Error::shape(
+            &[h, 2 * h, channels],
+            "lat-long maps need 1 to 2^20 rows and 1 to 64 channels",
+        ));
+    }
+    Ok(())
+}
+
+/// The centre `(theta, phi)` of pixel `(i, j)` of an `h x 2h` map.
+///
+/// ```
+/// use haarshift::sphere::latlong::pixel_centre;
+/// let (t, p) = pixel_centre(4, 0, 0);
+/// assert!((t - std::f64::consts::PI / 8.0).abs() < 1e-15 && (p - t).abs() < 1e-15);
+/// ```
+#[inline]
+pub fn pixel_centre(h: usize, i: usize, j: usize) -> (f64, f64) {
+    let step = std::f64::consts::PI / h as f64;
+    ((i as f64 + 0.5) * step, (j as f64 + 0.5) * step)
+}
+
+/// The solid angle of one pixel of row `i` of an `h x 2h` map:
+/// `(cos theta_top - cos theta_bottom) * 2 pi / W`. The rows' pixels sum to `4 pi`.
+///
+/// ```
+/// use haarshift::sphere::latlong::pixel_solid_angle;
+/// let total: f64 = (0..16).map(|i| 32.0 * pixel_solid_angle(16, i)).sum();
+/// assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+/// ```
+#[inline]
+pub fn pixel_solid_angle(h: usize, i: usize) -> f64 {
+    let step = std::f64::consts::PI / h as f64;
+    ((i as f64 * step).cos() - ((i + 1) as f64 * step).cos()) * step
+}
