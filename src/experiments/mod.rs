@@ -3,7 +3,9 @@
 //! * [`table`]: Markdown result tables.
 //! * [`pareto`]: the cost/error Pareto frontier.
 //! * [`rotation_cycle`]: the seed's Table 2.2 protocol: rotate back to the start, measure.
+//! * [`output`]: CSV, JSON and PNG files side by side, written atomically.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
+pub mod output;
 pub mod pareto;
 pub mod plot;
 pub mod rotation_cycle;

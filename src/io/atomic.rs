@@ -124,3 +124,25 @@ fn is_same_file(a: &Path, b: &Path) -> bool {
         matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
     }
 }
+
+/// Writes a file atomically: `write` fills a temporary file in the destination's directory,
+/// which is then synced and renamed over `path`. An existing `path` is replaced only when
+/// `force` is set; on any error nothing is left behind.
+///
+/// ```
+/// use std::io::Write;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("notes.txt");
+/// haarshift::io::write_file_atomically(&path, false, |w| w.write_all(b"hello")).unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), b"hello");
+/// assert!(haarshift::io::write_file_atomically(&path, false, |w| w.write_all(b"again")).is_err());
+/// ```
+pub fn write_file_atomically(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<()> {
+    let mut file = PendingFile::create(path, force)?;
+    write(file.writer()).map_err(|e| io_error(path, e))?;
+    file.commit()
+}

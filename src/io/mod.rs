@@ -78,7 +78,7 @@ mod openexr;
 mod raster;
 mod tiff_codec;
 
-pub use atomic::ensure_distinct_paths;
+pub use atomic::{ensure_distinct_paths, write_file_atomically};
 pub use coefficients::{
     CoefficientFile, CoefficientMetadata, StoredCoefficients, TransformRequest,
 };
