@@ -16,8 +16,10 @@
 
 mod boundary;
 mod error;
+pub mod kernels;
 mod named;
 mod planar_image;
+pub mod rotate;
 mod sample;
 pub mod transform;
 
