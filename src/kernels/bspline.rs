@@ -1,0 +1,212 @@
+//! Interpolating B-splines of degree 3 and 5 with the exact recursive prefilter (M. Unser,
+//! "Splines: a perfect fit for signal and image processing", 1999; the boundary handling of
+//! P. Thevenaz, T. Blu, M. Unser, "Interpolation revisited", 2000).
+
+use super::taps::{fir, split_shift, weights_into};
+use super::{Outside, RowGeometry, RowShifter, ShearKernel};
+use crate::{Error, Result, Sample};
+
+/// Interpolating B-spline of degree 3 or 5: the row is first turned into spline coefficients
+/// `c` with `sum_k c_k beta(i - k) = row(i)` for every integer `i` (the row continued by the
+/// [`Outside`] rule), by the causal/anticausal IIR filters of the poles of the sampled
+/// B-spline (`sqrt(3) - 2` for the cubic, two poles for the quintic); then
+/// `row(x) = sum_k c_k beta(x - k)` is evaluated with `degree + 1` taps.
+///
+/// Boundaries: the filters run over the row continued by the rule for `horizon` extra samples
+/// on each side, where `|z|^horizon` is below a tenth of the sample type's epsilon, so the
+/// initial values' truncation error is below rounding: the coefficients are those of the
+/// infinite continued signal.
+///
+/// ```
+/// use haarshift::kernels::{BSpline, Outside, shear_rows};
+/// use ndarray::array;
+/// let cubic = BSpline::cubic();
+/// assert_eq!(cubic.value(0.0), 2.0 / 3.0);
+/// // The cubic spline interpolant reproduces polynomials up to degree 3 (here far from the
+/// // edges, where the zero outside no longer matters).
+/// let row = ndarray::Array2::from_shape_fn((1, 80), |(_, i)| (i as f64 - 40.0).powi(2));
+/// let out = shear_rows(row.view(), 80, &[0.25], &cubic, Outside::Fill(0.0)).unwrap();
+/// assert!((out[[0, 40]] - 0.0625).abs() < 1e-9);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct BSpline {
+    degree: usize,
+    poles: &'static [f64],
+}
+
+/// The pole of the cubic: root of `z + 4 + 1/z` inside the unit circle.
+const CUBIC_POLES: [f64; 1] = [-0.267_949_192_431_122_7];
+/// The poles of the quintic: roots of `z^2 + 26z + 66 + 26/z + 1/z^2` inside the unit circle.
+const QUINTIC_POLES: [f64; 2] = [-0.430_575_347_099_973_8, -0.043_096_288_203_264_65];
+
+impl BSpline {
+    /// The cubic B-spline (4 taps, one pole).
+    pub fn cubic() -> Self {
+        BSpline {
+            degree: 3,
+            poles: &CUBIC_POLES,
+        }
+    }
+
+    /// The quintic B-spline (6 taps, two poles).
+    pub fn quintic() -> Self {
+        BSpline {
+            degree: 5,
+            poles: &QUINTIC_POLES,
+        }
+    }
+
+    /// The B-spline of `degree` 3 or 5.
+    ///
+    /// ```
+    /// use haarshift::kernels::BSpline;
+    /// assert_eq!(BSpline::new(5).unwrap(), BSpline::quintic());
+    /// assert!(BSpline::new(4).is_err());
+    /// ```
+    pub fn new(degree: usize) -> Result<Self> {
+        match degree {
+            3 => Ok(Self::cubic()),
+            5 => Ok(Self::quintic()),
+            d => Err(Error::parameter(
+                "spline degree",
+                format!("{d} (supported: 3, 5)"),
+            )),
+        }
+    }
+
+    /// The degree, 3 or 5.
+    ///
+    /// ```
+    /// assert_eq!(haarshift::kernels::BSpline::cubic().degree(), 3);
+    /// ```
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// The poles of the prefilter, `|z| < 1`.
+    ///
+    /// ```
+    /// let z = haarshift::kernels::BSpline::cubic().poles()[0];
+    /// assert!((z - (3f64.sqrt() - 2.0)).abs() < 1e-15);
+    /// ```
+    pub fn poles(&self) -> &'static [f64] {
+        self.poles
+    }
+
+    /// The centred B-spline `beta^n(x)` of this degree.
+    ///
+    /// ```
+    /// use haarshift::kernels::BSpline;
+    /// let q = BSpline::quintic();
+    /// assert!((q.value(1.0) - 26.0 / 120.0).abs() < 1e-16);
+    /// assert_eq!(q.value(3.0), 0.0);
+    /// ```
+    pub fn value(&self, x: f64) -> f64 {
+        bspline_value(self.degree, x)
+    }
+
+    /// Filter run-in, in samples, for sample type `T` (see the type docs).
+    fn horizon<T: Sample>(&self) -> usize {
+        let tolerance = T::epsilon().as_f64() * 0.1;
+        let slowest = self.poles[0].abs();
+        (tolerance.ln() / slowest.ln()).ceil() as usize
+    }
+}
+
+/// The centred B-spline of degree 3 or 5 at `x` (zero for other degrees).
+///
+/// ```
+/// use haarshift::kernels::bspline_value;
+/// assert_eq!(bspline_value(3, 1.0), 1.0 / 6.0);
+/// assert_eq!(bspline_value(5, 0.0), 0.55);
+/// ```
+pub fn bspline_value(degree: usize, x: f64) -> f64 {
+    let x = x.abs();
+    match degree {
+        3 if x < 1.0 => 2.0 / 3.0 - x * x * (1.0 - 0.5 * x),
+        3 if x < 2.0 => (2.0 - x).powi(3) / 6.0,
+        5 if x < 1.0 => {
+            let x2 = x * x;
+            0.55 - x2 * (0.5 - x2 * (0.25 - x / 12.0))
+        }
+        5 if x < 2.0 => {
+            17.0 / 40.0
+                + x * (5.0 / 8.0 + x * (-7.0 / 4.0 + x * (5.0 / 4.0 + x * (-3.0 / 8.0 + x / 24.0))))
+        }
+        5 if x < 3.0 => (3.0 - x).powi(5) / 120.0,
+        _ => 0.0,
+    }
+}
+
+/// Turns samples into B-spline coefficients in place, treating the samples beyond the buffer
+/// as zero (callers extend the buffer by the horizon so that this truncation is invisible).
+fn prefilter<T: Sample>(c: &mut [T], poles: &[f64]) {
+    let n = c.len();
+    if n < 2 {
+        return;
+    }
+    // Gain: the product of (1 - z)(1 - 1/z) over the poles makes the filter's DC gain one.
+    let gain: f64 = poles.iter().map(|z| (1.0 - z) * (1.0 - 1.0 / z)).product();
+    let gain = T::from_f64(gain);
+    for v in c.iter_mut() {
+        *v *= gain;
+    }
+    for &z in poles {
+        let zt = T::from_f64(z);
+        for i in 1..n {
+            let prev = c[i - 1];
+            c[i] += zt * prev;
+        }
+        // Anticausal start for a signal that is zero beyond the end: c-[n-1] = z/(z^2-1) c+[n-1].
+        c[n - 1] *= T::from_f64(z / (z * z - 1.0));
+        for i in (0..n - 1).rev() {
+            c[i] = zt * (c[i + 1] - c[i]);
+        }
+    }
+}
+
+struct BSplineShifter<'k, T> {
+    spline: &'k BSpline,
+    horizon: usize,
+    outside: Outside,
+    weights: Vec<T>,
+    coefficients: Vec<T>,
+}
+
+impl<T: Sample> RowShifter<T> for BSplineShifter<'_, T> {
+    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
+        let (k, f) = split_shift(shift);
+        let taps = self.weights.len();
+        let degree = self.spline.degree;
+        weights_into(|x| bspline_value(degree, x), f, false, &mut self.weights);
+        // Coefficients needed: positions -k - taps/2 .. + out.len() + taps - 1, plus the horizon
+        // on each side for the filters to settle.
+        let h = self.horizon;
+        let lo = -k - (taps / 2) as isize - h as isize;
+        self.coefficients
+            .resize(out.len() + taps - 1 + 2 * h, T::zero());
+        self.outside.extend_into(row, lo, &mut self.coefficients);
+        prefilter(&mut self.coefficients, self.spline.poles);
+        fir(&self.coefficients[h..], &self.weights, out);
+    }
+}
+
+impl<T: Sample> ShearKernel<T> for BSpline {
+    fn name(&self) -> String {
+        format!("bspline{}", self.degree)
+    }
+
+    fn support_radius(&self) -> usize {
+        self.degree.div_ceil(2) + self.horizon::<T>()
+    }
+
+    fn row_shifter(&self, _: RowGeometry, outside: Outside) -> Box<dyn RowShifter<T> + '_> {
+        Box::new(BSplineShifter {
+            spline: self,
+            horizon: self.horizon::<T>(),
+            outside,
+            weights: vec![T::zero(); self.degree + 1],
+            coefficients: Vec::new(),
+        })
+    }
+}

@@ -1,0 +1,222 @@
+//! The drivers: shift every row of an array by its own amount, in parallel, optionally writing
+//! the result transposed (so a column shear is a row shear between two fused transposes).
+
+use ndarray::{Array2, ArrayView2, Axis};
+use rayon::prelude::*;
+
+use super::grid::{box_average, upsample_nearest};
+use super::{Outside, RowGeometry, RowShifter, ShearKernel};
+use crate::{Error, Result, Sample, ensure_finite};
+
+/// Rows per parallel task when writing transposed: 32 output values per row segment (128 bytes
+/// of f32) keep the transposed writes in whole cache lines while the tile stays in L2.
+const TILE: usize = 32;
+
+/// Shifts beyond this are rejected: far past any image, and safe to convert to `isize`.
+const MAX_SHIFT: f64 = 1e15;
+
+/// Checks `shifts` (one per row, finite, not absurd) and the sizes.
+fn validate(rows: usize, len_in: usize, len_out: usize, shifts: &[f64]) -> Result<()> {
+    if rows == 0 || len_in == 0 || len_out == 0 {
+        return Err(Error::shape(
+            &[rows, len_in, len_out],
+            "rows must not be empty",
+        ));
+    }
+    if shifts.len() != rows {
+        return Err(Error::shape(
+            &[shifts.len()],
+            format!("{} shifts for {rows} rows", shifts.len()),
+        ));
+    }
+    if let Some(s) = shifts.iter().find(|s| s.is_nan() || s.abs() > MAX_SHIFT) {
+        return Err(Error::parameter(
+            "shift",
+            format!("{s} is not a finite shift of at most {MAX_SHIFT:e}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Shifts row `r` of `input` by `shifts[r]` into a row of `len_out` samples:
+/// `out[r][n] = input_r(n - shifts[r])`, samples outside the row from `outside`.
+///
+/// Integer shifts are exact copies; the others go to the kernel. Rows run in parallel, each
+/// worker thread reusing one [`RowShifter`].
+///
+/// ```
+/// use haarshift::kernels::{Outside, ShiftMethod, shear_rows};
+/// use ndarray::array;
+/// let k = ShiftMethod::Nearest.kernel::<f32>();
+/// let out = shear_rows(array![[1.0f32, 2.0], [3.0, 4.0]].view(), 3, &[1.0, -1.0], k.as_ref(),
+///                      Outside::Fill(9.0)).unwrap();
+/// assert_eq!(out, array![[9.0, 1.0, 2.0], [4.0, 9.0, 9.0]]);
+/// ```
+pub fn shear_rows<T: Sample>(
+    input: ArrayView2<'_, T>,
+    len_out: usize,
+    shifts: &[f64],
+    kernel: &dyn ShearKernel<T>,
+    outside: Outside,
+) -> Result<Array2<T>> {
+    let (rows, len_in) = input.dim();
+    validate(rows, len_in, len_out, shifts)?;
+    ensure_finite(&input)?;
+    Ok(shear_pass(
+        input,
+        len_out,
+        shifts,
+        kernel,
+        outside.validate()?,
+        false,
+    ))
+}
+
+/// Shifts a whole plane by `(dx, dy)` pixels: `out[r][c] = plane(r - dy, c - dx)`, separably
+/// (rows, then columns), samples outside from `outside`. A kernel with a
+/// [`grid_exponent`](ShearKernel::grid_exponent) `h` works on the `2^h`-finer grid.
+///
+/// ```
+/// use haarshift::kernels::{Outside, ShiftMethod, shift_plane};
+/// use ndarray::array;
+/// let k = ShiftMethod::Linear.kernel::<f64>();
+/// let p = array![[0.0, 0.0], [0.0, 4.0]];
+/// let out = shift_plane(p.view(), -0.5, -0.5, k.as_ref(), Outside::Fill(0.0)).unwrap();
+/// assert_eq!(out[[0, 0]], 1.0);
+/// ```
+pub fn shift_plane<T: Sample>(
+    plane: ArrayView2<'_, T>,
+    dx: f64,
+    dy: f64,
+    kernel: &dyn ShearKernel<T>,
+    outside: Outside,
+) -> Result<Array2<T>> {
+    let (h, w) = plane.dim();
+    let e = kernel.grid_exponent();
+    let scale = f64::from(1u32 << e.min(31));
+    let fine = upsample_nearest(plane, e)?;
+    let (fh, fw) = fine.dim();
+    validate(fh, fw, fw, &vec![dx * scale; fh])?;
+    validate(fw, fh, fh, &vec![dy * scale; fw])?;
+    ensure_finite(&plane)?;
+    let outside = outside.validate()?;
+    let columns = shear_pass(
+        fine.view(),
+        fw,
+        &vec![dx * scale; fh],
+        kernel,
+        outside,
+        true,
+    );
+    let fine = shear_pass(
+        columns.view(),
+        fh,
+        &vec![dy * scale; fw],
+        kernel,
+        outside,
+        true,
+    );
+    let out = box_average(fine.view(), e);
+    debug_assert_eq!(out.dim(), (h, w));
+    Ok(out)
+}
+
+/// [`shear_rows`] without validation; with `transposed`, the result is stored transposed
+/// (`len_out x rows`) through a tile per task, which is the blocked transpose fused in.
+pub(crate) fn shear_pass<T: Sample>(
+    input: ArrayView2<'_, T>,
+    len_out: usize,
+    shifts: &[f64],
+    kernel: &dyn ShearKernel<T>,
+    outside: Outside,
+    transposed: bool,
+) -> Array2<T> {
+    let input = input.as_standard_layout();
+    let (rows, len_in) = input.dim();
+    let src = input.as_slice().expect("standard layout");
+    let geometry = RowGeometry {
+        len_in,
+        len_out,
+        min_shift: shifts.iter().copied().fold(f64::INFINITY, f64::min),
+        max_shift: shifts.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    };
+    let shift_one = |shifter: &mut Box<dyn RowShifter<T> + '_>, r: usize, out: &mut [T]| {
+        let row = &src[r * len_in..(r + 1) * len_in];
+        let s = shifts[r];
+        if s.fract() == 0.0 {
+            outside.extend_into(row, -(s as isize), out);
+        } else {
+            shifter.shift_row(row, s, out);
+        }
+    };
+    if !transposed {
+        let mut out = Array2::zeros((rows, len_out));
+        out.as_slice_mut()
+            .expect("new array")
+            .par_chunks_mut(len_out)
+            .enumerate()
+            .for_each_init(
+                || kernel.row_shifter(geometry, outside),
+                |shifter, (r, o)| shift_one(shifter, r, o),
+            );
+        return out;
+    }
+    let mut out = Array2::zeros((len_out, rows));
+    out.axis_chunks_iter_mut(Axis(1), TILE)
+        .into_par_iter()
+        .enumerate()
+        .for_each_init(
+            || {
+                let tile = vec![T::zero(); TILE * len_out];
+                (kernel.row_shifter(geometry, outside), tile)
+            },
+            |(shifter, tile), (chunk, mut block)| {
+                let r0 = chunk * TILE;
+                let t = block.ncols();
+                for (i, o) in tile.chunks_exact_mut(len_out).take(t).enumerate() {
+                    shift_one(shifter, r0 + i, o);
+                }
+                for (j, mut orow) in block.rows_mut().into_iter().enumerate() {
+                    let orow = orow.as_slice_mut().expect("rows of a standard array");
+                    for (i, v) in orow.iter_mut().enumerate() {
+                        *v = tile[i * len_out + j];
+                    }
+                }
+            },
+        );
+    out
+}
+
+/// The transpose of `a` as a new standard-layout array, copied in cache-sized blocks in
+/// parallel.
+///
+/// ```
+/// use ndarray::array;
+/// let t = haarshift::kernels::transpose(array![[1, 2, 3], [4, 5, 6]].view());
+/// assert_eq!(t, array![[1, 4], [2, 5], [3, 6]]);
+/// ```
+pub fn transpose<A: Copy + Default + Send + Sync>(a: ArrayView2<'_, A>) -> Array2<A> {
+    let a = a.as_standard_layout();
+    let (h, w) = a.dim();
+    let src = a.as_slice().expect("standard layout");
+    let mut out = Array2::from_elem((w, h), A::default());
+    if h == 0 || w == 0 {
+        return out;
+    }
+    out.as_slice_mut()
+        .expect("new array")
+        .par_chunks_mut(TILE * h)
+        .enumerate()
+        .for_each(|(chunk, block)| {
+            let j0 = chunk * TILE;
+            for i0 in (0..h).step_by(TILE) {
+                let i1 = (i0 + TILE).min(h);
+                for (dj, orow) in block.chunks_exact_mut(h).enumerate() {
+                    for (i, v) in orow[i0..i1].iter_mut().enumerate() {
+                        *v = src[(i0 + i) * w + j0 + dj];
+                    }
+                }
+            }
+        });
+    out
+}

@@ -1,0 +1,537 @@
+//! Image rotation by three 1D shears (the seed's equation 2.26; Unser, Thevenaz and
+//! Yaroslavsky 1995):
+//!
+//! `R(theta) = [[1, -tan(theta/2)], [0, 1]] x [[1, 0], [sin(theta), 1]] x [[1, -tan(theta/2)], [0, 1]]`
+//!
+//! Each shear shifts every row (or column) by its own fractional amount with a
+//! [`ShearKernel`]; the column shear is a row shear between two transposes that are fused into
+//! the shear passes.
+//!
+//! # Geometry
+//!
+//! * A positive angle turns the image counter-clockwise as displayed (row 0 at the top), like
+//!   `scipy.ndimage.rotate`, about the centre `((w-1)/2, (h-1)/2)`.
+//! * Any angle is reduced to an exact multiple of 90 degrees, done by transposes and flips
+//!   (bit-exact), plus a residual in `[-45, 45]` degrees done by the shears, so that
+//!   `tan(theta/2)` stays at most `tan(22.5)`. See [`reduce_angle`].
+//! * [`Canvas::Same`] keeps the input size; [`Canvas::Expand`] grows to
+//!   `round(w|cos| + h|sin|) x round(w|sin| + h|cos|)` (scipy's `reshape=True`), which holds
+//!   the whole rotated image. Turning a non-square image by a quarter turn into the same
+//!   canvas with `w - h` odd moves the centre by half a pixel: the shears then interpolate
+//!   that half pixel, so only this case of a multiple of 90 degrees is not a pure copy.
+//! * Samples from outside the image come from [`RotateOptions::outside`]: a fill value
+//!   (default 0) or a boundary mode, which continues the input in 2D before rotating.
+//! * Intermediate images are sized to hold everything the output needs plus the kernel's
+//!   [`support_radius`](ShearKernel::support_radius); all work is in `T`, with no rounding
+//!   between the shears.
+//!
+//! # Supersampling and finer-grid kernels
+//!
+//! With `supersample = S` (and a kernel whose [`grid_exponent`](ShearKernel::grid_exponent)
+//! is `h`), the image is replicated onto a grid `2^(S+h)` times finer per axis (each pixel
+//! becomes a block of equal samples), rotated there about the same continuous centre, and
+//! box-averaged back. [`RotationChain`] keeps that fine grid across successive rotations and
+//! projects only at the end, for error-accumulation experiments.
+//!
+//! ```
+//! use haarshift::kernels::ShiftMethod;
+//! use haarshift::rotate::{RotateOptions, rotate_plane};
+//! use ndarray::array;
+//! let p = array![[1.0, 2.0], [3.0, 4.0]];
+//! let k = ShiftMethod::BSpline3.kernel::<f64>();
+//! // A quarter turn counter-clockwise: the right column becomes the top row.
+//! let r = rotate_plane(p.view(), 90.0, k.as_ref(), &RotateOptions::default()).unwrap();
+//! assert_eq!(r, array![[2.0, 4.0], [1.0, 3.0]]);
+//! ```
+
+use ndarray::{Array2, ArrayView2, Axis, CowArray, s};
+
+use crate::kernels::shear::shear_pass;
+use crate::kernels::{Outside, ShearKernel, grid, transpose};
+use crate::named::named_enum;
+use crate::{BoundaryMode, Error, PlanarImage, Result, Sample, ensure_finite};
+
+named_enum! {
+    /// The size of the rotated image.
+    #[derive(Default)]
+    pub enum Canvas ("canvas") {
+        /// The input's size (corners are cut off, the outside fills in).
+        #[default]
+        Same = "same",
+        /// Large enough for the whole rotated image.
+        Expand = "expand",
+    }
+}
+
+/// The largest `supersample` exponent accepted (a 256-times finer grid per axis).
+pub const MAX_SUPERSAMPLE: u32 = 8;
+
+/// Default [`RotateOptions::memory_budget`]: 4 GiB.
+pub const DEFAULT_MEMORY_BUDGET: u64 = 4 << 30;
+
+/// How to rotate, apart from the angle and the kernel.
+///
+/// ```
+/// use haarshift::rotate::{Canvas, RotateOptions};
+/// let o = RotateOptions { canvas: Canvas::Expand, supersample: 1, ..Default::default() };
+/// assert_eq!(o.outside, haarshift::kernels::Outside::Fill(0.0));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RotateOptions {
+    /// Output size.
+    pub canvas: Canvas,
+    /// Where samples from outside the image come from. For images with alpha, a fill value
+    /// is the colour of the (fully transparent) outside; see [`rotate_image`].
+    pub outside: Outside,
+    /// Rotate on a `2^supersample`-finer grid (at most [`MAX_SUPERSAMPLE`]).
+    pub supersample: u32,
+    /// Largest number of bytes the working arrays may take together.
+    pub memory_budget: u64,
+}
+
+impl Default for RotateOptions {
+    fn default() -> Self {
+        RotateOptions {
+            canvas: Canvas::Same,
+            outside: Outside::Fill(0.0),
+            supersample: 0,
+            memory_budget: DEFAULT_MEMORY_BUDGET,
+        }
+    }
+}
+
+/// An angle split into exact quarter turns and a residual.
+///
+/// ```
+/// let r = haarshift::rotate::reduce_angle(1e6).unwrap();
+/// assert_eq!((r.quarter_turns, r.residual_deg), (3, 10.0));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReducedAngle {
+    /// Counter-clockwise quarter turns, `0..4`.
+    pub quarter_turns: u8,
+    /// The rest, in `[-45, 45]` degrees.
+    pub residual_deg: f64,
+}
+
+/// Splits `deg` into `quarter_turns * 90 + residual_deg` modulo 360, exactly: `deg % 360` is
+/// exact in floating point, and so is subtracting the nearest multiple of 90 (the two are
+/// within a factor of two). Halfway cases (45, 135, ...) go to an even number of quarter turns.
+///
+/// ```
+/// use haarshift::rotate::reduce_angle;
+/// let r = reduce_angle(-180.0).unwrap();
+/// assert_eq!((r.quarter_turns, r.residual_deg), (2, 0.0));
+/// assert!(reduce_angle(f64::NAN).is_err());
+/// ```
+pub fn reduce_angle(deg: f64) -> Result<ReducedAngle> {
+    if !deg.is_finite() {
+        return Err(Error::parameter(
+            "angle",
+            format!("{deg} is not a finite number of degrees"),
+        ));
+    }
+    let r = deg % 360.0;
+    let q = (r / 90.0).round_ties_even();
+    let residual = r - 90.0 * q;
+    Ok(ReducedAngle {
+        quarter_turns: (q as i64).rem_euclid(4) as u8,
+        // -0.0 and 0.0 are the same rotation; report the plain zero.
+        residual_deg: residual + 0.0,
+    })
+}
+
+/// `plane` turned counter-clockwise (as displayed) by `turns` quarter turns: a copy, no
+/// arithmetic (`np.rot90`).
+///
+/// ```
+/// use ndarray::array;
+/// let t = haarshift::rotate::quarter_turn(array![[1, 2, 3], [4, 5, 6]].view(), 1);
+/// assert_eq!(t, array![[3, 6], [2, 5], [1, 4]]);
+/// ```
+pub fn quarter_turn<A: Copy + Default + Send + Sync>(
+    plane: ArrayView2<'_, A>,
+    turns: u8,
+) -> Array2<A> {
+    match turns % 4 {
+        0 => plane.to_owned(),
+        1 => transpose(plane).slice(s![..;-1, ..]).to_owned(),
+        2 => plane.slice(s![..;-1, ..;-1]).to_owned(),
+        _ => transpose(plane.slice(s![..;-1, ..])),
+    }
+}
+
+/// The [`Canvas::Expand`] size `(rows, cols)` of an `h x w` image turned by `deg`:
+/// `round(w|cos| + h|sin|)` columns and `round(w|sin| + h|cos|)` rows, with the quarter turns
+/// exact.
+///
+/// ```
+/// use haarshift::rotate::expanded_size;
+/// assert_eq!(expanded_size(100, 100, 45.0).unwrap(), (141, 141));
+/// assert_eq!(expanded_size(30, 50, 90.0).unwrap(), (50, 30));
+/// ```
+pub fn expanded_size(h: usize, w: usize, deg: f64) -> Result<(usize, usize)> {
+    let r = reduce_angle(deg)?;
+    let (h1, w1) = if r.quarter_turns % 2 == 1 {
+        (w, h)
+    } else {
+        (h, w)
+    };
+    let t = r.residual_deg.to_radians();
+    let (sin, cos) = (t.sin().abs(), t.cos().abs());
+    let (h1, w1) = (h1 as f64, w1 as f64);
+    let rows = (w1 * sin + h1 * cos + 0.5).floor();
+    let cols = (w1 * cos + h1 * sin + 0.5).floor();
+    Ok((rows.max(1.0) as usize, cols.max(1.0) as usize))
+}
+
+/// Whether rotating an `h x w` image by `deg` onto `canvas` only moves pixels: a multiple of 90
+/// degrees whose centre stays on the pixel grid.
+fn is_pure_copy(h: usize, w: usize, deg: f64, canvas: Canvas) -> Result<bool> {
+    let r = reduce_angle(deg)?;
+    Ok(r.residual_deg == 0.0
+        && (canvas == Canvas::Expand
+            || r.quarter_turns.is_multiple_of(2)
+            || h.abs_diff(w).is_multiple_of(2)))
+}
+
+/// Returns an error when `elements` samples of `T` exceed `budget` bytes.
+fn check_budget<T>(what: &str, elements: u128, budget: u64) -> Result<()> {
+    let needed = elements.saturating_mul(std::mem::size_of::<T>() as u128);
+    if needed > u128::from(budget) {
+        return Err(Error::MemoryBudget {
+            what: what.to_string(),
+            needed,
+            budget: u128::from(budget),
+        });
+    }
+    Ok(())
+}
+
+/// `a` continued by `mode` by `py` rows and `px` columns on each side.
+fn pad_with_mode<T: Sample>(
+    a: ArrayView2<'_, T>,
+    py: usize,
+    px: usize,
+    mode: BoundaryMode,
+) -> Array2<T> {
+    let (h, w) = a.dim();
+    let rows: Vec<usize> = (0..h + 2 * py)
+        .map(|r| mode.source_index(r as isize - py as isize, h).unwrap_or(0))
+        .collect();
+    let cols: Vec<usize> = (0..w + 2 * px)
+        .map(|c| mode.source_index(c as isize - px as isize, w).unwrap_or(0))
+        .collect();
+    Array2::from_shape_fn((rows.len(), cols.len()), |(r, c)| a[[rows[r], cols[c]]])
+}
+
+/// Rotates the working-grid array `a` by `deg`; `granule` is the number of working samples
+/// per pixel along each axis (the expanded canvas is rounded in whole pixels).
+fn rotate_grid<T: Sample>(
+    a: ArrayView2<'_, T>,
+    deg: f64,
+    granule: usize,
+    kernel: &dyn ShearKernel<T>,
+    options: &RotateOptions,
+) -> Result<Array2<T>> {
+    let reduced = reduce_angle(deg)?;
+    let a1 = match reduced.quarter_turns {
+        0 => CowArray::from(a),
+        q => CowArray::from(quarter_turn(a, q)),
+    };
+    let (h1, w1) = a1.dim();
+    let (out_h, out_w) = match options.canvas {
+        Canvas::Same => a.dim(),
+        Canvas::Expand => {
+            let (h, w) = expanded_size(h1 / granule, w1 / granule, reduced.residual_deg)?;
+            let too_large = || Error::shape(&[h, w], "expanded canvas too large");
+            (
+                h.checked_mul(granule).ok_or_else(too_large)?,
+                w.checked_mul(granule).ok_or_else(too_large)?,
+            )
+        }
+    };
+    if reduced.residual_deg == 0.0 && (out_h, out_w) == (h1, w1) {
+        return Ok(a1.into_owned());
+    }
+    let theta = reduced.residual_deg.to_radians();
+    let (a_x, s_y) = (-(theta / 2.0).tan(), theta.sin());
+    let (cx_out, cy_out) = ((out_w as f64 - 1.0) / 2.0, (out_h as f64 - 1.0) / 2.0);
+    let reach = kernel.support_radius().min(h1.max(w1)) as f64;
+
+    // With a boundary mode, continue the input in 2D far enough that every position the output
+    // needs (its preimage plus the kernel's reach through three shears) lies inside.
+    let (a2, outside) = match options.outside {
+        Outside::Boundary(mode) if mode != BoundaryMode::Zero => {
+            let (sin, cos) = (theta.sin().abs(), theta.cos().abs());
+            let pad = |half_extent: f64, centre: f64| {
+                ((half_extent - centre).max(0.0) + 3.0 * reach + 2.0).ceil() as usize
+            };
+            let px = pad(cos * cx_out + sin * cy_out, (w1 as f64 - 1.0) / 2.0);
+            let py = pad(sin * cx_out + cos * cy_out, (h1 as f64 - 1.0) / 2.0);
+            check_budget::<T>(
+                "padding for the boundary mode",
+                ((h1 + 2 * py) * (w1 + 2 * px)) as u128,
+                options.memory_budget,
+            )?;
+            (
+                CowArray::from(pad_with_mode(a1.view(), py, px, mode)),
+                Outside::Boundary(mode),
+            )
+        }
+        Outside::Boundary(_) => (a1, Outside::Fill(0.0)),
+        fill => (a1, fill),
+    };
+    let (h_a, w_a) = a2.dim();
+    let (cx_a, cy_a) = ((w_a as f64 - 1.0) / 2.0, (h_a as f64 - 1.0) / 2.0);
+
+    // Columns of the two intermediate images (x in centred coordinates): what the last shear
+    // reads (x = X - a_x Y over the output) that the first shear can produce (x + a_x y over
+    // the input), plus the kernel's reach. Both ranges are symmetric about 0.
+    let need = cx_out + a_x.abs() * cy_out;
+    let content = cx_a + a_x.abs() * cy_a;
+    let half = need.min(content) + reach;
+    let margin = (half - cx_a).ceil(); // integer: keeps the first shift an exact integer at 0
+    let ox = cx_a + margin;
+    let w_b = (half + ox).floor() as usize + 1;
+    check_budget::<T>(
+        "the intermediate images of the rotation",
+        (h_a * w_a + w_b * h_a + out_h * w_b + out_h * out_w) as u128,
+        options.memory_budget,
+    )?;
+
+    // x-shear: row r (y = cy_a - r) of A moves by a_x y; stored transposed (w_b x h_a).
+    let shifts: Vec<f64> = (0..h_a).map(|r| margin + a_x * (cy_a - r as f64)).collect();
+    let b1t = shear_pass(a2.view(), w_b, &shifts, kernel, outside, true);
+    // y-shear: column c (x = c - ox) moves up by s_y x, i.e. by -s_y x in row index, onto the
+    // output's rows; stored transposed back (out_h x w_b).
+    let shifts: Vec<f64> = (0..w_b)
+        .map(|c| (cy_out - cy_a) - s_y * (c as f64 - ox))
+        .collect();
+    let b2 = shear_pass(b1t.view(), out_h, &shifts, kernel, outside, true);
+    drop(b1t);
+    // x-shear again: row r (y = cy_out - r) onto the output's columns.
+    let shifts: Vec<f64> = (0..out_h)
+        .map(|r| (cx_out - ox) + a_x * (cy_out - r as f64))
+        .collect();
+    Ok(shear_pass(
+        b2.view(),
+        out_w,
+        &shifts,
+        kernel,
+        outside,
+        false,
+    ))
+}
+
+/// Successive rotations of one plane on a persistent working grid, projected to pixels only
+/// by [`finish`](Self::finish): the setting of error-accumulation experiments (rotate by
+/// 22.5 degrees sixteen times and compare with the original).
+///
+/// ```
+/// use haarshift::kernels::ShiftMethod;
+/// use haarshift::rotate::{RotateOptions, RotationChain};
+/// use ndarray::Array2;
+/// let p = Array2::from_shape_fn((8, 8), |(r, c)| (r * 8 + c) as f64);
+/// let k = ShiftMethod::Nearest.kernel::<f64>();
+/// let opts = RotateOptions { supersample: 1, ..Default::default() };
+/// let mut chain = RotationChain::new(p.view(), k.as_ref(), opts).unwrap();
+/// assert_eq!(chain.working().dim(), (16, 16));
+/// for _ in 0..4 {
+///     chain.rotate(90.0).unwrap();
+/// }
+/// assert_eq!(chain.finish(), p);
+/// ```
+pub struct RotationChain<'k, T: Sample> {
+    work: Array2<T>,
+    exponent: u32,
+    kernel: &'k dyn ShearKernel<T>,
+    options: RotateOptions,
+}
+
+impl<'k, T: Sample> RotationChain<'k, T> {
+    /// Puts `plane` on the working grid (`2^(supersample + kernel.grid_exponent())` samples per
+    /// pixel per axis, nearest replication).
+    pub fn new(
+        plane: ArrayView2<'_, T>,
+        kernel: &'k dyn ShearKernel<T>,
+        options: RotateOptions,
+    ) -> Result<Self> {
+        let (h, w) = plane.dim();
+        if h == 0 || w == 0 {
+            return Err(Error::shape(&[h, w], "image is empty"));
+        }
+        if options.supersample > MAX_SUPERSAMPLE {
+            return Err(Error::parameter(
+                "supersample",
+                format!("{} (at most {MAX_SUPERSAMPLE})", options.supersample),
+            ));
+        }
+        options.outside.validate()?;
+        ensure_finite(&plane)?;
+        let exponent = options.supersample + kernel.grid_exponent();
+        if exponent > 30 {
+            return Err(Error::parameter(
+                "grid exponent",
+                format!("2^{exponent} samples per pixel is too fine"),
+            ));
+        }
+        let fine = ((h as u128) << exponent) * ((w as u128) << exponent);
+        check_budget::<T>("the working grid", fine, options.memory_budget)?;
+        Ok(RotationChain {
+            work: grid::upsample_nearest(plane, exponent)?,
+            exponent,
+            kernel,
+            options,
+        })
+    }
+
+    /// Rotates the working grid by `deg` (counter-clockwise as displayed).
+    pub fn rotate(&mut self, deg: f64) -> Result<&mut Self> {
+        let granule = 1usize << self.exponent;
+        self.work = rotate_grid(self.work.view(), deg, granule, self.kernel, &self.options)?;
+        Ok(self)
+    }
+
+    /// The working grid as it stands.
+    pub fn working(&self) -> ArrayView2<'_, T> {
+        self.work.view()
+    }
+
+    /// Box-averages the working grid back to pixels.
+    pub fn finish(self) -> Array2<T> {
+        grid::box_average(self.work.view(), self.exponent)
+    }
+}
+
+/// Rotates one plane by `deg` degrees (counter-clockwise as displayed) with `kernel`.
+///
+/// ```
+/// use haarshift::kernels::ShiftMethod;
+/// use haarshift::rotate::{Canvas, RotateOptions, rotate_plane};
+/// use ndarray::Array2;
+/// let p = Array2::<f32>::ones((20, 30));
+/// let k = ShiftMethod::Keys.kernel::<f32>();
+/// let opts = RotateOptions { canvas: Canvas::Expand, ..Default::default() };
+/// let r = rotate_plane(p.view(), 30.0, k.as_ref(), &opts).unwrap();
+/// assert_eq!(r.dim(), (32, 36));
+/// assert!((r[[16, 18]] - 1.0).abs() < 1e-6);
+/// ```
+pub fn rotate_plane<T: Sample>(
+    plane: ArrayView2<'_, T>,
+    deg: f64,
+    kernel: &dyn ShearKernel<T>,
+    options: &RotateOptions,
+) -> Result<Array2<T>> {
+    let mut chain = RotationChain::new(plane, kernel, *options)?;
+    chain.rotate(deg)?;
+    Ok(chain.finish())
+}
+
+/// Below this alpha (as a fraction of opaque) a rotated pixel counts as fully transparent and
+/// takes the fill colour instead of an unstable `colour / alpha`.
+const TRANSPARENT: f64 = 1e-6;
+
+/// Rotates every plane of `image`.
+///
+/// With alpha, colour is premultiplied by alpha before rotating and divided by the rotated
+/// alpha after, so colour from transparent pixels does not bleed into opaque ones; outside the
+/// image alpha is 0 (with a fill value) and pixels whose rotated alpha is below `1e-6` of
+/// opaque get the fill value as colour (0 with a boundary mode). Integer depths (8, 16 bit)
+/// are rounded to the nearest code value and clamped to their range; float depths are
+/// returned as computed.
+///
+/// ```
+/// use haarshift::{PlanarImage, SampleDepth};
+/// use haarshift::kernels::ShiftMethod;
+/// use haarshift::rotate::{Canvas, RotateOptions, rotate_image};
+/// use ndarray::Array2;
+/// let img = PlanarImage::from_gray(Array2::from_elem((9, 9), 200.0f32), SampleDepth::U8).unwrap();
+/// let k = ShiftMethod::Lanczos3.kernel::<f32>();
+/// let opts = RotateOptions { canvas: Canvas::Expand, ..Default::default() };
+/// let r = rotate_image(&img, 30.0, k.as_ref(), &opts).unwrap();
+/// assert_eq!(r.plane(0)[[6, 6]], 200.0);
+/// assert_eq!(r.plane(0)[[0, 0]], 0.0);
+/// ```
+pub fn rotate_image<T: Sample>(
+    image: &PlanarImage<T>,
+    deg: f64,
+    kernel: &dyn ShearKernel<T>,
+    options: &RotateOptions,
+) -> Result<PlanarImage<T>> {
+    let depth = image.depth();
+    let opaque = depth.integer_max().unwrap_or(1.0);
+    let alpha_plane = image.channels().count() - 1;
+    let rotated = match image.alpha() {
+        None => image.map_planes(|p| rotate_plane(p, deg, kernel, options))?,
+        Some(_) if is_pure_copy(image.height(), image.width(), deg, options.canvas)? => {
+            // Nothing is interpolated: copy colour as it is (even under alpha 0), with a
+            // transparent outside.
+            let mut c = 0;
+            image.map_planes(|p| {
+                let transparent = RotateOptions {
+                    outside: Outside::Fill(0.0),
+                    ..*options
+                };
+                let opts = if c == alpha_plane {
+                    &transparent
+                } else {
+                    options
+                };
+                c += 1;
+                rotate_plane(p, deg, kernel, opts)
+            })?
+        }
+        Some(alpha) => {
+            let fill = match options.outside.validate()? {
+                Outside::Fill(v) => v,
+                Outside::Boundary(_) => 0.0,
+            };
+            let premultiplied_outside = match options.outside {
+                Outside::Fill(_) => Outside::Fill(0.0),
+                mode => mode,
+            };
+            let scale = T::from_f64(1.0 / opaque);
+            let opts = RotateOptions {
+                outside: premultiplied_outside,
+                ..*options
+            };
+            let mut planes: Vec<Array2<T>> = Vec::with_capacity(alpha_plane + 1);
+            for (c, p) in image.planes().outer_iter().enumerate() {
+                let p = if c == alpha_plane {
+                    p.to_owned()
+                } else {
+                    &p * &alpha * scale
+                };
+                planes.push(rotate_plane(p.view(), deg, kernel, &opts)?);
+            }
+            let new_alpha = planes.pop().expect("alpha plane");
+            let threshold = T::from_f64(TRANSPARENT * opaque);
+            let (fill, opaque_t) = (T::from_f64(fill), T::from_f64(opaque));
+            for p in planes.iter_mut() {
+                ndarray::Zip::from(p).and(&new_alpha).par_for_each(|v, &a| {
+                    *v = if a > threshold {
+                        *v * opaque_t / a
+                    } else {
+                        fill
+                    };
+                });
+            }
+            planes.push(new_alpha);
+            let views: Vec<ArrayView2<'_, T>> = planes.iter().map(|p| p.view()).collect();
+            let stacked = ndarray::stack(Axis(0), &views)
+                .map_err(|e| Error::shape(&[planes.len()], e.to_string()))?;
+            PlanarImage::new(stacked, image.channels(), depth)?
+        }
+    };
+    Ok(match depth.integer_max() {
+        None => rotated,
+        Some(max) => {
+            let max = T::from_f64(max);
+            rotated.map_planes(|p| Ok(p.mapv(|v| v.round().max(T::zero()).min(max))))?
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests;
