@@ -36,6 +36,7 @@
 mod bspline;
 mod fft;
 pub(crate) mod grid;
+mod haar;
 mod keys;
 mod lanczos;
 mod linear;
@@ -45,6 +46,7 @@ mod taps;
 
 pub use bspline::{BSpline, bspline_value};
 pub use fft::FftShift;
+pub use haar::HaarShift;
 pub use keys::{Keys, keys_value};
 pub use lanczos::{Lanczos, lanczos_value};
 pub use linear::Linear;
@@ -255,6 +257,37 @@ named_enum! {
         Lanczos4 = "lanczos4",
         /// Band-limited FFT phase shift.
         Fft = "fft",
+        /// Shift in the Haar domain with precision `1/2^h` ([`HaarShift`]).
+        Haar = "haar",
+    }
+}
+
+/// The parameters a [`ShiftMethod`] may take; each method reads the ones it has.
+///
+/// ```
+/// use haarshift::kernels::{KernelOptions, ShiftMethod};
+/// let opts = KernelOptions { precision: 4, retain: true, ..Default::default() };
+/// let k = ShiftMethod::Haar.kernel_with::<f32>(&opts).unwrap();
+/// assert_eq!(k.name(), "haar(h=4, retained)");
+/// assert_eq!(k.grid_exponent(), 4);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct KernelOptions {
+    /// Haar precision `h`: shifts are rounded to `1/2^h` (default 3).
+    pub precision: u32,
+    /// Haar: keep the `N + h` levels across shears and rotations (default false: compact).
+    pub retain: bool,
+    /// Keys' parameter `a` (default -0.5).
+    pub keys_a: f64,
+}
+
+impl Default for KernelOptions {
+    fn default() -> Self {
+        KernelOptions {
+            precision: 3,
+            retain: false,
+            keys_a: -0.5,
+        }
     }
 }
 
@@ -268,16 +301,26 @@ impl ShiftMethod {
     /// }
     /// ```
     pub fn kernel<T: Sample>(self) -> Box<dyn ShearKernel<T>> {
-        match self {
+        self.kernel_with(&KernelOptions::default())
+            .expect("the default options are valid")
+    }
+
+    /// The kernel with the parameters of `options` that apply to it.
+    pub fn kernel_with<T: Sample>(
+        self,
+        options: &KernelOptions,
+    ) -> Result<Box<dyn ShearKernel<T>>> {
+        Ok(match self {
             ShiftMethod::Nearest => Box::new(Nearest),
             ShiftMethod::Linear => Box::new(Linear),
-            ShiftMethod::Keys => Box::new(Keys::default()),
+            ShiftMethod::Keys => Box::new(Keys::new(options.keys_a)?),
+            ShiftMethod::Haar => Box::new(HaarShift::new(options.precision, options.retain)?),
             ShiftMethod::BSpline3 => Box::new(BSpline::cubic()),
             ShiftMethod::BSpline5 => Box::new(BSpline::quintic()),
             ShiftMethod::Lanczos3 => Box::new(Lanczos::new(3)),
             ShiftMethod::Lanczos4 => Box::new(Lanczos::new(4)),
             ShiftMethod::Fft => fft::boxed(),
-        }
+        })
     }
 }
 
