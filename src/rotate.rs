@@ -46,10 +46,10 @@
 
 use ndarray::{Array2, ArrayView2, Axis, CowArray, s};
 
-use crate::kernels::shear::shear_pass;
+use crate::kernels::shear::{check_finite, shear_pass};
 use crate::kernels::{Outside, ShearKernel, grid, transpose};
 use crate::named::named_enum;
-use crate::{BoundaryMode, Error, PlanarImage, Result, Sample, ensure_finite};
+use crate::{BoundaryMode, Error, PlanarImage, Result, Sample};
 
 named_enum! {
     /// The size of the rotated image.
@@ -193,6 +193,22 @@ fn is_pure_copy(h: usize, w: usize, deg: f64, canvas: Canvas) -> Result<bool> {
         && (canvas == Canvas::Expand
             || r.quarter_turns.is_multiple_of(2)
             || h.abs_diff(w).is_multiple_of(2)))
+}
+
+/// Checks the plane (non-empty, finite) and the options that do not depend on the kernel.
+fn validate_plane<T: Sample>(plane: ArrayView2<'_, T>, options: &RotateOptions) -> Result<()> {
+    let (h, w) = plane.dim();
+    if h == 0 || w == 0 {
+        return Err(Error::shape(&[h, w], "image is empty"));
+    }
+    if options.supersample > MAX_SUPERSAMPLE {
+        return Err(Error::parameter(
+            "supersample",
+            format!("{} (at most {MAX_SUPERSAMPLE})", options.supersample),
+        ));
+    }
+    options.outside.validate()?;
+    check_finite(plane)
 }
 
 /// Returns an error when `elements` samples of `T` exceed `budget` bytes.
@@ -357,18 +373,8 @@ impl<'k, T: Sample> RotationChain<'k, T> {
         kernel: &'k dyn ShearKernel<T>,
         options: RotateOptions,
     ) -> Result<Self> {
+        validate_plane(plane, &options)?;
         let (h, w) = plane.dim();
-        if h == 0 || w == 0 {
-            return Err(Error::shape(&[h, w], "image is empty"));
-        }
-        if options.supersample > MAX_SUPERSAMPLE {
-            return Err(Error::parameter(
-                "supersample",
-                format!("{} (at most {MAX_SUPERSAMPLE})", options.supersample),
-            ));
-        }
-        options.outside.validate()?;
-        ensure_finite(&plane)?;
         let exponent = options.supersample + kernel.grid_exponent();
         if exponent > 30 {
             return Err(Error::parameter(
@@ -400,6 +406,9 @@ impl<'k, T: Sample> RotationChain<'k, T> {
 
     /// Box-averages the working grid back to pixels.
     pub fn finish(self) -> Array2<T> {
+        if self.exponent == 0 {
+            return self.work;
+        }
         grid::box_average(self.work.view(), self.exponent)
     }
 }
@@ -423,6 +432,11 @@ pub fn rotate_plane<T: Sample>(
     kernel: &dyn ShearKernel<T>,
     options: &RotateOptions,
 ) -> Result<Array2<T>> {
+    if options.supersample == 0 && kernel.grid_exponent() == 0 {
+        // The chain would copy the plane onto its (here identical) working grid first.
+        validate_plane(plane, options)?;
+        return rotate_grid(plane, deg, 1, kernel, options);
+    }
     let mut chain = RotationChain::new(plane, kernel, *options)?;
     chain.rotate(deg)?;
     Ok(chain.finish())

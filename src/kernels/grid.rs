@@ -25,11 +25,8 @@ pub(crate) fn upsample_nearest<T: Sample>(plane: ArrayView2<'_, T>, e: u32) -> R
     }))
 }
 
-/// The mean of each `2^e x 2^e` block; the sides must be multiples of `2^e`.
+/// The mean of each `2^e x 2^e` block (`e > 0`); the sides must be multiples of `2^e`.
 pub(crate) fn box_average<T: Sample>(fine: ArrayView2<'_, T>, e: u32) -> Array2<T> {
-    if e == 0 {
-        return fine.to_owned();
-    }
     let (fh, fw) = fine.dim();
     let f = 1usize << e;
     let mut out = Array2::zeros((fh >> e, fw >> e));

@@ -1,7 +1,7 @@
 //! The drivers: shift every row of an array by its own amount, in parallel, optionally writing
 //! the result transposed (so a column shear is a row shear between two fused transposes).
 
-use ndarray::{Array2, ArrayView2, Axis};
+use ndarray::{Array2, ArrayView2, Axis, CowArray};
 use rayon::prelude::*;
 
 use super::grid::{box_average, upsample_nearest};
@@ -61,7 +61,7 @@ pub fn shear_rows<T: Sample>(
 ) -> Result<Array2<T>> {
     let (rows, len_in) = input.dim();
     validate(rows, len_in, len_out, shifts)?;
-    ensure_finite(&input)?;
+    check_finite(input)?;
     Ok(shear_pass(
         input,
         len_out,
@@ -94,11 +94,14 @@ pub fn shift_plane<T: Sample>(
     let (h, w) = plane.dim();
     let e = kernel.grid_exponent();
     let scale = f64::from(1u32 << e.min(31));
-    let fine = upsample_nearest(plane, e)?;
+    let fine = match e {
+        0 => CowArray::from(plane),
+        _ => CowArray::from(upsample_nearest(plane, e)?),
+    };
     let (fh, fw) = fine.dim();
     validate(fh, fw, fw, &vec![dx * scale; fh])?;
     validate(fw, fh, fh, &vec![dy * scale; fw])?;
-    ensure_finite(&plane)?;
+    check_finite(plane)?;
     let outside = outside.validate()?;
     let columns = shear_pass(
         fine.view(),
@@ -116,9 +119,23 @@ pub fn shift_plane<T: Sample>(
         outside,
         true,
     );
-    let out = box_average(fine.view(), e);
+    let out = if e == 0 {
+        fine
+    } else {
+        box_average(fine.view(), e)
+    };
     debug_assert_eq!(out.dim(), (h, w));
     Ok(out)
+}
+
+/// [`ensure_finite`] in one vectorised pass (`v * 0` is NaN exactly for NaN and infinities);
+/// the slower indexed search runs only to name the culprit.
+pub(crate) fn check_finite<T: Sample>(plane: ArrayView2<'_, T>) -> Result<()> {
+    let probe = plane.fold(T::zero(), |acc, v| acc + *v * T::zero());
+    if probe.is_nan() {
+        ensure_finite(&plane)?;
+    }
+    Ok(())
 }
 
 /// [`shear_rows`] without validation; with `transposed`, the result is stored transposed
@@ -176,15 +193,31 @@ pub(crate) fn shear_pass<T: Sample>(
                 for (i, o) in tile.chunks_exact_mut(len_out).take(t).enumerate() {
                     shift_one(shifter, r0 + i, o);
                 }
-                for (j, mut orow) in block.rows_mut().into_iter().enumerate() {
-                    let orow = orow.as_slice_mut().expect("rows of a standard array");
-                    for (i, v) in orow.iter_mut().enumerate() {
-                        *v = tile[i * len_out + j];
-                    }
-                }
+                write_transposed(&tile[..t * len_out], len_out, &mut block);
             },
         );
     out
+}
+
+/// Writes the `t x len` rows of `tile` into the `len x t` block, through a small square that
+/// stays in L1: whole cache lines are read from the tile and written to the block.
+fn write_transposed<T: Sample>(tile: &[T], len: usize, block: &mut ndarray::ArrayViewMut2<'_, T>) {
+    const SQUARE: usize = 16;
+    let t = block.ncols();
+    let mut square = [[T::zero(); TILE]; SQUARE];
+    for j0 in (0..len).step_by(SQUARE) {
+        let width = SQUARE.min(len - j0);
+        for (i, row) in tile.chunks_exact(len).enumerate() {
+            for (dj, v) in row[j0..j0 + width].iter().enumerate() {
+                square[dj][i] = *v;
+            }
+        }
+        for (dj, values) in square.iter().enumerate().take(width) {
+            let mut out = block.row_mut(j0 + dj);
+            let out = out.as_slice_mut().expect("rows of a standard array");
+            out.copy_from_slice(&values[..t]);
+        }
+    }
 }
 
 /// The transpose of `a` as a new standard-layout array, copied in cache-sized blocks in
