@@ -21,7 +21,14 @@ use crate::shift::{GridShift, MAX_PRECISION, ShiftWorkspace, dense::shift_slice_
 use crate::transform::{Normalization, haar1d};
 use crate::{Error, Result, Sample};
 
-/// Shifts rows in the Haar domain with precision `1/2^h`; see the [module docs](self).
+/// Shifts rows in the Haar domain with precision `1/2^h`.
+///
+/// Compact (`retain = false`): each shift is made on the row's coefficients upsampled by `h`
+/// zero-detail levels and read back at the original levels, which in the pixel domain is
+/// linear interpolation with the shift rounded to `1/2^h` (ties toward +infinity). Retained
+/// (`retain = true`): the kernel works on a `2^h`-finer grid that the rotation drivers keep
+/// across shears and rotations, shifting by whole fine samples in the Haar domain, which is
+/// nearest neighbour on that grid, box-averaged at the end.
 ///
 /// ```
 /// use haarshift::kernels::{HaarShift, Outside, RowGeometry, ShearKernel};
