@@ -24,6 +24,16 @@ enum Command {
     Transform(commands::transform::Args),
     Inverse(commands::inverse::Args),
     Info(commands::info::Args),
+    /// Spherical environment maps: rotate a lat-long map
+    Sphere {
+        #[command(subcommand)]
+        command: commands::sphere::SphereCommand,
+    },
+    /// Measure methods against ground truth: table, CSV, JSON and plot
+    Experiment {
+        #[command(subcommand)]
+        command: commands::experiment::ExperimentCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -36,6 +46,8 @@ fn main() -> ExitCode {
         Command::Transform(args) => commands::transform::run(args),
         Command::Inverse(args) => commands::inverse::run(args),
         Command::Info(args) => commands::info::run(args),
+        Command::Sphere { command } => commands::sphere::run(command),
+        Command::Experiment { command } => commands::experiment::run(command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -20,8 +20,9 @@ use ndarray::{Array2, Array3, ArrayView2, ArrayView3, Axis, s};
 use rayon::prelude::*;
 
 use super::LatLongMap;
-use crate::transform::{Band, Normalization, pyramid};
-use crate::{Error, Result, Sample, ensure_finite};
+use crate::io::CoefficientFile;
+use crate::transform::{Band, Coefficients, Layout, Normalization, TransformInfo, pyramid};
+use crate::{BoundaryMode, Channels, Error, Result, Sample, SampleDepth, ensure_finite};
 
 /// Full-depth, average-normalised Haar pyramids of a lat-long map: shape `(C, H, 2H)`.
 ///
@@ -193,6 +194,41 @@ impl<T: Sample> SphereCoefficients<T> {
         let mut out = Array3::zeros((c, height, 2 * height));
         out.slice_mut(s![.., ..h, ..w]).assign(&self.data);
         Ok(SphereCoefficients { data: out })
+    }
+
+    /// The pyramids as a [`CoefficientFile`] (one plane per channel, `depth` recorded as the
+    /// map's sample depth), so that they can be written as `.npy` plus sidecar and read back
+    /// or inverted like any coefficient file: each plane is exactly what
+    /// [`TransformSpec::default()`](crate::transform::TransformSpec) (pyramid layout, average
+    /// normalisation, full depth) makes of the `H x 2H` channel, so the file's inverse is
+    /// [`to_map`](Self::to_map) as an image.
+    ///
+    /// ```
+    /// use haarshift::sphere::{LatLongMap, SphereCoefficients};
+    /// use haarshift::SampleDepth;
+    /// let map = LatLongMap::<f64>::from_fn(4, 3, |d, out| out.copy_from_slice(&d)).unwrap();
+    /// let c = SphereCoefficients::from_map(&map).unwrap();
+    /// let file = c.to_coefficient_file(SampleDepth::F32).unwrap();
+    /// assert_eq!(file.metadata().transform.levels, [2, 2]);
+    /// let back = file.inverse().unwrap();
+    /// let want = map.to_image(SampleDepth::F32).unwrap();
+    /// assert!((&back.planes() - &want.planes()).iter().all(|v| v.abs() < 1e-15));
+    /// ```
+    pub fn to_coefficient_file(&self, depth: SampleDepth) -> Result<CoefficientFile<T>> {
+        let (_, h, w) = self.data.dim();
+        let info = TransformInfo {
+            layout: Layout::Pyramid,
+            normalization: Normalization::Average,
+            levels: [self.levels(); 2],
+            padding: BoundaryMode::Zero,
+            original_shape: [h, w],
+        };
+        let planes = self
+            .data
+            .outer_iter()
+            .map(|plane| Coefficients::from_parts(plane.to_owned(), info))
+            .collect::<Result<Vec<_>>>()?;
+        CoefficientFile::from_parts(planes, Channels::from_count(self.channels())?, depth)
     }
 
     /// Rows of the approximation at resolution `level + 1`, after checking the level exists.

@@ -20,6 +20,26 @@ use super::{
 };
 use crate::{Error, Result, Sample};
 
+/// The rotations `haarshift experiment sphere` measures, as `(yaw, pitch, roll)` in degrees:
+/// pitches of 5, 30, 60 and 90 degrees (small to large tilts of the pole, where the map's
+/// distortion changes fastest), a yaw of 10 degrees (`W / 36` columns, never a whole number for a
+/// power-of-two width `W`, so a genuinely fractional azimuth shift) and a compound
+/// rotation.
+///
+/// ```
+/// use haarshift::sphere::experiment::STANDARD_ROTATIONS;
+/// assert_eq!(STANDARD_ROTATIONS[1], (0.0, 30.0, 0.0));
+/// assert_eq!(STANDARD_ROTATIONS.len(), 6);
+/// ```
+pub const STANDARD_ROTATIONS: [(f64, f64, f64); 6] = [
+    (0.0, 5.0, 0.0),
+    (0.0, 30.0, 0.0),
+    (0.0, 60.0, 0.0),
+    (0.0, 90.0, 0.0),
+    (10.0, 0.0, 0.0),
+    (40.0, -25.0, 60.0),
+];
+
 /// The solid-angle weighted RMS difference of two maps of the same shape.
 ///
 /// ```

@@ -21,7 +21,7 @@
 use ndarray::{Array3, ArrayView3, Axis, s};
 use rayon::prelude::*;
 
-use crate::{Error, Result, Sample, ensure_finite};
+use crate::{Channels, Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
 /// The unit direction of elevation `theta` (from +Y) and azimuth `phi`.
 ///
@@ -181,6 +181,42 @@ impl<T: Sample> LatLongMap<T> {
     /// The `(H, W, C)` array, owned.
     pub fn into_array(self) -> Array3<T> {
         self.data
+    }
+
+    /// The map held by an image read from a file (channels become the map's channels, in
+    /// order); the image must be 2:1 (width twice the height).
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// use haarshift::{Channels, PlanarImage, SampleDepth};
+    /// use ndarray::Array3;
+    /// let planes = Array3::from_shape_fn((3, 2, 4), |(c, i, j)| (100 * c + 10 * i + j) as f32);
+    /// let image = PlanarImage::new(planes, Channels::Rgb, SampleDepth::F32).unwrap();
+    /// let map = LatLongMap::from_image(&image).unwrap();
+    /// assert_eq!(map.as_array()[[1, 3, 2]], 213.0);
+    /// assert_eq!(map.to_image(SampleDepth::F32).unwrap(), image);
+    /// ```
+    pub fn from_image(image: &PlanarImage<T>) -> Result<Self> {
+        let (h, w) = (image.height(), image.width());
+        if w != 2 * h {
+            return Err(Error::shape(
+                &[h, w],
+                format!(
+                    "a lat-long map must be twice as wide as it is high, but this image is \
+                     {w} x {h} (width x height)"
+                ),
+            ));
+        }
+        let hwc = image.planes().permuted_axes([1, 2, 0]);
+        LatLongMap::new(hwc.as_standard_layout().into_owned())
+    }
+
+    /// The map as an image with samples of `depth` (the depth to report and store; values
+    /// are not rescaled): 1 to 4 channels become gray, gray + alpha, RGB or RGBA.
+    pub fn to_image(&self, depth: SampleDepth) -> Result<PlanarImage<T>> {
+        let channels = Channels::from_count(self.channels())?;
+        let planes = self.data.view().permuted_axes([2, 0, 1]);
+        PlanarImage::new(planes.as_standard_layout().into_owned(), channels, depth)
     }
 
     /// The channels of pixel `(r, c)` after continuing `r` over the poles and `c` around the

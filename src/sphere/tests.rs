@@ -320,6 +320,40 @@ fn coefficients_in_equal_pixels_in() {
 }
 
 #[test]
+fn coefficient_files_hold_the_generic_pyramid_of_each_channel() {
+    let f = harmonic_map(16, 3);
+    let rotated = rotate_map(&f, &compound(), &options(Method::Haar)).unwrap();
+    let file = rotated
+        .coefficients
+        .to_coefficient_file(crate::SampleDepth::F64)
+        .unwrap();
+    let image = rotated.map.to_image(crate::SampleDepth::F64).unwrap();
+    assert_eq!(LatLongMap::from_image(&image).unwrap(), rotated.map);
+    assert_eq!(file.metadata().channels, crate::Channels::Rgb);
+    for (k, plane) in file.planes().iter().enumerate() {
+        // The oracle: the generic transform of the channel, with the default spec.
+        let generic = crate::transform::TransformSpec::default()
+            .forward(image.plane(k))
+            .unwrap();
+        assert_eq!(plane.info(), generic.info());
+        let err = (&plane.as_array() - &generic.as_array())
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(err < 1e-12, "channel {k}: {err}");
+    }
+    let back = file.inverse().unwrap();
+    let err = (&back.planes() - &image.planes())
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(err < 1e-12, "{err}");
+    // Five channels have no image layout.
+    let five = LatLongMap::<f64>::from_fn(2, 5, |_, o| o.fill(1.0)).unwrap();
+    assert!(five.to_image(crate::SampleDepth::F64).is_err());
+    let square = image.map_planes(|p| Ok(p.slice(ndarray::s![.., ..16]).to_owned()));
+    assert!(LatLongMap::from_image(&square.unwrap()).is_err());
+}
+
+#[test]
 fn lookups_are_exact_at_centres_and_continue_over_seam_and_poles() {
     let f = harmonic_map(64, 1);
     let mut v = [0.0];

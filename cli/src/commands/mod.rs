@@ -8,8 +8,10 @@ use haarshift::io::TransformRequest;
 use haarshift::transform::{Layout, Levels, Normalization};
 use haarshift::{BoundaryMode, Error, Result};
 
+pub mod experiment;
 pub mod info;
 pub mod inverse;
+pub mod sphere;
 pub mod transform;
 
 /// A clap parser accepting exactly `names` and parsing them with the library's `FromStr`, so

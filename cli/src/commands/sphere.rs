@@ -1,0 +1,175 @@
+//! `haarshift sphere ...`: spherical environment maps (lat-long, 2:1).
+
+use std::path::{Path, PathBuf};
+
+use clap::Subcommand;
+use haarshift::io::{CoefficientFile, WriteOptions, read_image};
+use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
+use haarshift::{PlanarImage, Result, Sample, SampleDepth};
+
+use super::{choice, names, print, refuse_overwriting_input};
+
+/// Operations on lat-long environment maps.
+#[derive(Subcommand, Debug)]
+pub enum SphereCommand {
+    Rotate(RotateArgs),
+}
+
+pub fn run(command: SphereCommand) -> Result<()> {
+    match command {
+        SphereCommand::Rotate(args) => rotate(args),
+    }
+}
+
+const ROTATE_HELP: &str = "\
+Conventions:
+  The map is a lat-long (equirectangular) map, W = 2 H, H a power of two. Row i is the
+  elevation theta from +Y (up), column j the azimuth phi; pixel centres are at
+  theta = (i + 0.5) pi / H, phi = (j + 0.5) 2 pi / W, and (theta, phi) is the direction
+  (sin theta sin phi, cos theta, sin theta cos phi): right-handed, Y up.
+  Angles are in degrees: yaw about +Y, pitch about +X, roll about +Z, combined as
+  R = Rz(roll) Ry(yaw) Rx(pitch), and the rotated map is g(p) = f(R p): the output pixel
+  looking along p shows what the input saw along R p. A yaw by a whole number of columns
+  (a multiple of 360 / W degrees) is an exact shift for every method.
+
+Examples:
+  haarshift sphere rotate park.hdr -o park-tilted.exr --pitch 30
+  haarshift sphere rotate park.exr -o park.npy --yaw 40 --pitch -25 --roll 60 --method bicubic
+  haarshift sphere rotate park.npy -o coarse.exr --pitch 90 --method haar --level 5
+  haarshift sphere rotate park.hdr -o truth.exr --pitch 30 --method reference --samples 16
+  haarshift sphere rotate park.hdr -o park-coeffs.npy --yaw 10 --coefficients
+
+Input and output are HDR, OpenEXR or .npy (H x W x C float); the output keeps the input's
+sample precision (f32, or f64 for an f64 .npy). With --coefficients the output is the
+rotated map's Haar pyramid (C x H x W float64 .npy, the 2:1 map as two square pyramids side
+by side, average normalisation) with a sidecar OUT.npy.json, as `haarshift transform` writes
+it: `haarshift inverse OUT.npy -o map.exr` turns it back into pixels.";
+
+/// Rotate a lat-long environment map (g(p) = f(R p)), in pixels or in the Haar domain.
+#[derive(clap::Args, Debug)]
+#[command(after_help = ROTATE_HELP)]
+pub struct RotateArgs {
+    /// Lat-long map to rotate: Radiance .hdr, OpenEXR or .npy, twice as wide as high, the
+    /// height a power of two
+    pub input: PathBuf,
+
+    /// Where to write the rotated map (.exr, .npy or .hdr), or with --coefficients its
+    /// coefficients (.npy, plus the sidecar OUT.npy.json)
+    #[arg(short, long, value_name = "OUTPUT")]
+    pub output: PathBuf,
+
+    /// Rotation about +Y (the vertical axis), degrees; yaw 90: the output's +Z (phi = 0)
+    /// shows the input's +X (phi = 90 degrees)
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub yaw: f64,
+
+    /// Rotation about +X, degrees; pitch 90: the output's top (+Y) shows the input's +Z
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub pitch: f64,
+
+    /// Rotation about +Z, degrees; roll 90: the output's top (+Y) shows the input's -X
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub roll: f64,
+
+    /// `haar`: the chain rule on the Haar detail coefficients, coarser levels by recursive
+    /// filters (no pixel lookups). `bilinear`, `bicubic`: one lookup per output pixel.
+    /// `reference`: ground truth, the solid-angle mean of SAMPLES x SAMPLES bilinear lookups
+    /// per output pixel (slow)
+    #[arg(long, default_value = "haar", value_parser = choice::<Method>(names!(Method)))]
+    pub method: Method,
+
+    /// Compute only detail levels 0..=L (0 the coarsest; a map of H rows has levels
+    /// 0..=log2(H)-1): the work is on the 2^(L+1) x 2^(L+2) approximation, 4x less per level
+    /// dropped, and the output has blocks of equal pixels [default: the finest level]
+    #[arg(long, value_name = "L")]
+    pub level: Option<usize>,
+
+    /// Samples per axis and pixel for --method reference (1 to 64)
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub samples: usize,
+
+    /// Write the rotated Haar coefficients (.npy + .npy.json sidecar) instead of pixels
+    #[arg(long)]
+    pub coefficients: bool,
+
+    /// Replace the output (and its sidecar) if it exists
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn rotate(args: RotateArgs) -> Result<()> {
+    let sidecar = CoefficientFile::<f64>::sidecar_path(&args.output);
+    let outputs: &[&Path] = if args.coefficients {
+        &[&args.output, &sidecar]
+    } else {
+        &[&args.output]
+    };
+    refuse_overwriting_input(&args.input, outputs)?;
+    let rotation = SphereRotation::from_degrees(args.yaw, args.pitch, args.roll)?;
+    let options = SphereOptions {
+        method: args.method,
+        level: args.level,
+        reference_samples: args.samples,
+    };
+    // Work in the input's own precision: f64 only for f64 data.
+    let image = read_image::<f64>(&args.input)?;
+    let (h, w) = (image.height(), image.width());
+    if image.depth() == SampleDepth::F64 {
+        rotate_image(&args, image, &rotation, &options)?;
+    } else {
+        let (planes, channels, depth) = image.into_parts();
+        let single = PlanarImage::new(planes.mapv(|v| v as f32), channels, depth)?;
+        rotate_image(&args, single, &rotation, &options)?;
+    }
+    let what = if args.coefficients {
+        format!("coefficients, sidecar {}", sidecar.display())
+    } else {
+        "pixels".into()
+    };
+    print(&format!(
+        "{}: {w} x {h} map rotated by yaw {} pitch {} roll {} ({} method, {what})\n",
+        args.output.display(),
+        args.yaw,
+        args.pitch,
+        args.roll,
+        args.method,
+    ))
+}
+
+/// Rotates `image` and writes the pixels or coefficients `args` ask for.
+fn rotate_image<T: Sample>(
+    args: &RotateArgs,
+    image: PlanarImage<T>,
+    rotation: &SphereRotation,
+    options: &SphereOptions,
+) -> Result<()> {
+    let in_input = |e: haarshift::Error| e.in_file(&args.input);
+    let map = LatLongMap::from_image(&image).map_err(in_input)?;
+    let rotated = rotate_map(&map, rotation, options).map_err(in_input)?;
+    let write = WriteOptions {
+        force: args.force,
+        ..Default::default()
+    };
+    if args.coefficients {
+        let file = rotated.coefficients.to_coefficient_file(image.depth())?;
+        file.write(&args.output, write)
+    } else {
+        let out = rotated.map.to_image(image.depth())?;
+        haarshift::io::write_image(&out, &args.output, write)
+    }
+}
