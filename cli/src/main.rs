@@ -24,6 +24,8 @@ enum Command {
     Transform(commands::transform::Args),
     Inverse(commands::inverse::Args),
     Info(commands::info::Args),
+    Rotate(commands::rotate::Args),
+    Shift(commands::shift::Args),
 }
 
 fn main() -> ExitCode {
@@ -36,6 +38,8 @@ fn main() -> ExitCode {
         Command::Transform(args) => commands::transform::run(args),
         Command::Inverse(args) => commands::inverse::run(args),
         Command::Info(args) => commands::info::run(args),
+        Command::Rotate(args) => commands::rotate::run(args),
+        Command::Shift(args) => commands::shift::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

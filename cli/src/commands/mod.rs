@@ -10,6 +10,9 @@ use haarshift::{BoundaryMode, Error, Result};
 
 pub mod info;
 pub mod inverse;
+mod method;
+pub mod rotate;
+pub mod shift;
 pub mod transform;
 
 /// A clap parser accepting exactly `names` and parsing them with the library's `FromStr`, so
