@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand};
 
 mod commands;
 
-/// Haar wavelet transforms of images, and (soon) shifts and rotations computed directly on the
+/// Haar wavelet transforms of images, shifts and rotations computed directly on the
 /// coefficients.
 #[derive(Parser)]
 #[command(name = "haarshift", version, propagate_version = true)]
@@ -24,6 +24,8 @@ enum Command {
     Transform(commands::transform::Args),
     Inverse(commands::inverse::Args),
     Info(commands::info::Args),
+    Rotate(commands::rotate::Args),
+    Shift(commands::shift::Args),
     /// Spherical environment maps: rotate a lat-long map
     Sphere {
         #[command(subcommand)]
@@ -46,6 +48,8 @@ fn main() -> ExitCode {
         Command::Transform(args) => commands::transform::run(args),
         Command::Inverse(args) => commands::inverse::run(args),
         Command::Info(args) => commands::info::run(args),
+        Command::Rotate(args) => commands::rotate::run(args),
+        Command::Shift(args) => commands::shift::run(args),
         Command::Sphere { command } => commands::sphere::run(command),
         Command::Experiment { command } => commands::experiment::run(command),
     };

@@ -11,6 +11,9 @@ use haarshift::{BoundaryMode, Error, Result};
 pub mod experiment;
 pub mod info;
 pub mod inverse;
+mod method;
+pub mod rotate;
+pub mod shift;
 pub mod sphere;
 pub mod transform;
 
