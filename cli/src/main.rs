@@ -9,6 +9,10 @@ use clap::{Parser, Subcommand};
 
 mod commands;
 
+/// Counts heap use, so that the experiments can report peak memory per run.
+#[global_allocator]
+static PEAK: peak_alloc::PeakAlloc = peak_alloc::PeakAlloc;
+
 /// Haar wavelet transforms of images, and (soon) shifts and rotations computed directly on the
 /// coefficients.
 #[derive(Parser)]
@@ -24,6 +28,11 @@ enum Command {
     Transform(commands::transform::Args),
     Inverse(commands::inverse::Args),
     Info(commands::info::Args),
+    /// Error-accumulation experiments: rotation cycle, shift chain
+    Experiment {
+        #[command(subcommand)]
+        command: commands::experiment::ExperimentCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -36,6 +45,7 @@ fn main() -> ExitCode {
         Command::Transform(args) => commands::transform::run(args),
         Command::Inverse(args) => commands::inverse::run(args),
         Command::Info(args) => commands::info::run(args),
+        Command::Experiment { command } => commands::experiment::run(command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -264,15 +264,23 @@ mod rotation_tests {
         let plane = Array2::from_shape_fn((21, 26), |(i, j)| ((i * 37 + j * 101) % 23) as f64);
         for h in 1..=3u32 {
             let haar = HaarShift::new(h, true).unwrap();
-            let mut chain = RotationChain::new(plane.view(), &haar, RotateOptions::default()).unwrap();
-            let nn_options = RotateOptions { supersample: h, ..Default::default() };
+            let mut chain =
+                RotationChain::new(plane.view(), &haar, RotateOptions::default()).unwrap();
+            let nn_options = RotateOptions {
+                supersample: h,
+                ..Default::default()
+            };
             let mut reference = RotationChain::new(plane.view(), &Nearest, nn_options).unwrap();
             for deg in [17.3, -31.1, 8.9] {
                 chain.rotate(deg).unwrap();
                 reference.rotate(deg).unwrap();
             }
             let (a, b) = (chain.finish(), reference.finish());
-            let err = a.iter().zip(b.iter()).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            let err = a
+                .iter()
+                .zip(b.iter())
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
             assert!(err < 1e-9, "h={h}: {err}");
         }
     }

@@ -8,6 +8,7 @@ use haarshift::io::TransformRequest;
 use haarshift::transform::{Layout, Levels, Normalization};
 use haarshift::{BoundaryMode, Error, Result};
 
+pub mod experiment;
 pub mod info;
 pub mod inverse;
 pub mod transform;
