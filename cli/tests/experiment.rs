@@ -1,0 +1,166 @@
+//! `haarshift experiment`: the command's figures against a computation made directly here.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use haarshift::io::{WriteOptions, write_image};
+use haarshift::kernels::ShiftMethod;
+use haarshift::metrics::{ErrorStats, disk_mask};
+use haarshift::rotate::{RotateOptions, RotationChain};
+use haarshift::{PlanarImage, SampleDepth};
+use ndarray::{Array2, s};
+use serde_json::Value;
+
+fn haarshift(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_haarshift"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// A 40x24 gray test image with integer values (exactly representable in 8 bits).
+fn small_image() -> Array2<f64> {
+    Array2::from_shape_fn((24, 40), |(i, j)| ((i * 7 + j * 13) % 256) as f64)
+}
+
+fn write_small_image(path: &Path) {
+    let img = PlanarImage::from_gray(small_image().mapv(|v| v as f32), SampleDepth::U8).unwrap();
+    write_image(&img, path, WriteOptions::default()).unwrap();
+}
+
+fn run_json(dir: &Path, extra: &[&str]) -> Vec<Value> {
+    let image = dir.join("small.png");
+    if !image.exists() {
+        write_small_image(&image);
+    }
+    let json = dir.join("out.json");
+    let out_dir = dir.join("results");
+    let mut args = vec![
+        "experiment",
+        "rotation-cycle",
+        image.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+        "--out-dir",
+        out_dir.to_str().unwrap(),
+        "--force",
+    ];
+    args.extend_from_slice(extra);
+    let out = haarshift(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("protocol: luma"), "{stdout}");
+    assert!(out_dir.join("rotation-cycle.csv").exists());
+    serde_json::from_str::<Value>(&std::fs::read_to_string(json).unwrap())
+        .unwrap()
+        .as_array()
+        .unwrap()
+        .clone()
+}
+
+#[test]
+fn rotation_cycle_figure_matches_an_independent_computation() {
+    let dir = tempfile::tempdir().unwrap();
+    let records = run_json(dir.path(), &["--methods", "keys", "--steps", "6"]);
+    assert_eq!(records.len(), 1);
+    let r = &records[0];
+    assert_eq!(r["image"], "small.png");
+    assert_eq!(r["method"], "keys");
+    for field in [
+        "precision",
+        "retain",
+        "supersample",
+        "psnr",
+        "seconds",
+        "peak_bytes",
+    ] {
+        assert!(r.get(field).is_some(), "missing {field}");
+    }
+    // The protocol by hand: gray is its own luma; crop 24x24 from column 8; pad by 12.
+    let plane = small_image();
+    let mut canvas = Array2::zeros((48, 48));
+    canvas
+        .slice_mut(s![12..36, 12..36])
+        .assign(&plane.slice(s![.., 8..32]));
+    let kernel = ShiftMethod::Keys.kernel::<f64>();
+    let mut chain =
+        RotationChain::new(canvas.view(), kernel.as_ref(), RotateOptions::default()).unwrap();
+    for _ in 0..6 {
+        chain.rotate(60.0).unwrap();
+    }
+    let result = chain.finish();
+    let mask = disk_mask(48, 48, 12.0 - 2.0);
+    let want = ErrorStats::between(result.view(), canvas.view(), Some(mask.view()), 255.0).unwrap();
+    assert!(want.rms > 1.0);
+    assert!((r["rms"].as_f64().unwrap() - want.rms).abs() < 1e-9 * want.rms);
+    assert!((r["max_error"].as_f64().unwrap() - want.max_error).abs() < 1e-9 * want.max_error);
+    assert!(r["peak_bytes"].as_u64().unwrap() > 0);
+}
+
+#[test]
+fn nearest_quarter_turns_are_exact_and_haar_runs_in_both_modes() {
+    let dir = tempfile::tempdir().unwrap();
+    let records = run_json(dir.path(), &["--methods", "nearest,haar", "--steps", "4"]);
+    let labels: Vec<_> = records
+        .iter()
+        .map(|r| {
+            (
+                r["method"].as_str().unwrap().to_owned(),
+                r["retain"].clone(),
+            )
+        })
+        .collect();
+    assert_eq!(labels[0], ("nearest".into(), Value::Null));
+    assert_eq!(labels[1], ("haar".into(), Value::Bool(false)));
+    assert_eq!(labels[2], ("haar".into(), Value::Bool(true)));
+    assert_eq!(records[2]["precision"], 1);
+    // Multiples of 90 degrees are exact for every method.
+    for r in &records {
+        assert_eq!(r["rms"], 0.0, "{r}");
+        assert_eq!(r["psnr"], Value::Null);
+    }
+}
+
+#[test]
+fn shift_chain_with_integer_steps_is_exact_for_haar() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("small.png");
+    write_small_image(&image);
+    let json = dir.path().join("chain.json");
+    let out = haarshift(&[
+        "experiment",
+        "shift-chain",
+        image.to_str().unwrap(),
+        "--methods",
+        "haar",
+        "--dx",
+        "8",
+        "--dy",
+        "-4",
+        "--steps",
+        "4",
+        "--json",
+        json.to_str().unwrap(),
+        "--out-dir",
+        dir.path().join("r").to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let records: Vec<Value> =
+        serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    assert_eq!(records.len(), 2);
+    for r in &records {
+        assert_eq!(
+            (r["rms"].as_f64(), r["size"].as_u64()),
+            (Some(0.0), Some(16)),
+            "{r}"
+        );
+    }
+}

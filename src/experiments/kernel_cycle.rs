@@ -1,0 +1,189 @@
+//! The rotation-cycle experiment run with the library's kernels: [`KernelCycle`] adapts any
+//! [`ShiftMethod`] to [`CycleMethod`], [`default_images`] is the fixed image set and
+//! [`run_rotation_cycle`] runs every method on every image.
+
+use std::path::Path;
+
+use ndarray::{Array2, ArrayView2};
+
+use super::rotation_cycle::{CycleMethod, CycleRecord, MemoryMeter, MethodSpec, luma, run_cycle};
+use crate::kernels::{KernelOptions, ShiftMethod};
+use crate::rotate::{RotateOptions, RotationChain};
+use crate::{Error, Result, patterns};
+
+/// A kernel rotating in f64 through a [`RotationChain`], which keeps its working grid (the
+/// retained Haar mode's `2^h`-finer grid, or the `2^supersample`-finer one) across the whole
+/// cycle and box-averages back to pixels only at the end.
+///
+/// ```
+/// use haarshift::experiments::kernel_cycle::KernelCycle;
+/// use haarshift::experiments::rotation_cycle::{CycleMethod, NoMeter, run_cycle};
+/// use haarshift::kernels::{KernelOptions, ShiftMethod};
+/// let nearest = KernelCycle::new(ShiftMethod::Nearest, KernelOptions::default(), 0);
+/// let plane = haarshift::patterns::zone_plate(16, 16).unwrap();
+/// let r = run_cycle("zone", plane.view(), &nearest, 4, &NoMeter).unwrap();
+/// assert_eq!(r.rms, 0.0); // quarter turns are exact
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KernelCycle {
+    /// The kernel.
+    pub method: ShiftMethod,
+    /// Its parameters (Haar precision and mode, Keys' `a`).
+    pub options: KernelOptions,
+    /// Rotate on a `2^supersample`-finer grid.
+    pub supersample: u32,
+}
+
+impl KernelCycle {
+    /// A kernel with its options and supersampling exponent.
+    pub fn new(method: ShiftMethod, options: KernelOptions, supersample: u32) -> Self {
+        KernelCycle {
+            method,
+            options,
+            supersample,
+        }
+    }
+
+    /// Every built-in kernel with `options`, the Haar method twice (compact and retained).
+    ///
+    /// ```
+    /// use haarshift::experiments::kernel_cycle::KernelCycle;
+    /// use haarshift::kernels::KernelOptions;
+    /// let all = KernelCycle::every_kernel(KernelOptions::default(), 0);
+    /// assert_eq!(all.len(), 10);
+    /// ```
+    pub fn every_kernel(options: KernelOptions, supersample: u32) -> Vec<KernelCycle> {
+        ShiftMethod::ALL
+            .iter()
+            .flat_map(|&method| {
+                let retains: &[bool] = match method {
+                    ShiftMethod::Haar => &[false, true],
+                    _ => &[false],
+                };
+                retains.iter().map(move |&retain| {
+                    KernelCycle::new(method, KernelOptions { retain, ..options }, supersample)
+                })
+            })
+            .collect()
+    }
+}
+
+impl CycleMethod for KernelCycle {
+    fn spec(&self) -> MethodSpec {
+        let haar = self.method == ShiftMethod::Haar;
+        MethodSpec {
+            method: self.method.name().to_owned(),
+            precision: haar.then_some(self.options.precision),
+            retain: haar.then_some(self.options.retain),
+            supersample: self.supersample,
+        }
+    }
+
+    fn rotate_repeatedly(
+        &self,
+        plane: ArrayView2<'_, f64>,
+        angle_deg: f64,
+        steps: usize,
+    ) -> Result<Array2<f64>> {
+        let kernel = self.method.kernel_with::<f64>(&self.options)?;
+        let options = RotateOptions {
+            supersample: self.supersample,
+            ..Default::default()
+        };
+        let mut chain = RotationChain::new(plane, kernel.as_ref(), options)?;
+        for _ in 0..steps {
+            chain.rotate(angle_deg)?;
+        }
+        Ok(chain.finish())
+    }
+}
+
+/// One input of an experiment: a name (file name or pattern) and its luma plane.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedPlane {
+    /// File name, or pattern name with its size.
+    pub name: String,
+    /// The luma plane in 0..255 units.
+    pub plane: Array2<f64>,
+}
+
+impl NamedPlane {
+    /// Reads an image file and converts it to luma by the protocol's weights.
+    pub fn read(path: &Path) -> Result<NamedPlane> {
+        let image = crate::io::read_image::<f64>(path)?;
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
+        Ok(NamedPlane {
+            name,
+            plane: luma(&image),
+        })
+    }
+}
+
+/// The synthetic images of the default set: a 300x200 zone plate (non-square, rising to
+/// Nyquist at the crop's edge) and a 256x256 Siemens star with 32 spokes.
+///
+/// ```
+/// let p = haarshift::experiments::kernel_cycle::synthetic_images().unwrap();
+/// assert_eq!(p[0].plane.dim(), (200, 300));
+/// ```
+pub fn synthetic_images() -> Result<Vec<NamedPlane>> {
+    Ok(vec![
+        NamedPlane {
+            name: "zone-plate-300x200".into(),
+            plane: patterns::zone_plate(200, 300)?,
+        },
+        NamedPlane {
+            name: "siemens-star-256x256".into(),
+            plane: patterns::siemens_star(256, 256, 32)?,
+        },
+    ])
+}
+
+/// The default image set: every `.png` in `dir` (sorted by name) followed by
+/// [`synthetic_images`]. Errors when `dir` holds no PNG.
+pub fn default_images(dir: &Path) -> Result<Vec<NamedPlane>> {
+    let listing = std::fs::read_dir(dir).map_err(|source| Error::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut paths: Vec<_> = listing
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
+        .collect();
+    if paths.is_empty() {
+        return Err(Error::parameter(
+            "images",
+            format!("{} holds no PNG image", dir.display()),
+        ));
+    }
+    paths.sort();
+    let mut images = paths
+        .iter()
+        .map(|p| NamedPlane::read(p))
+        .collect::<Result<Vec<_>>>()?;
+    images.extend(synthetic_images()?);
+    Ok(images)
+}
+
+/// Runs the protocol for every image and method, images outermost; `progress` is called after
+/// each run. Runs one at a time so that the wall time and peak memory of each are its own.
+pub fn run_rotation_cycle(
+    images: &[NamedPlane],
+    methods: &[KernelCycle],
+    steps: usize,
+    meter: &dyn MemoryMeter,
+    mut progress: impl FnMut(&CycleRecord),
+) -> Result<Vec<CycleRecord>> {
+    let mut records = Vec::with_capacity(images.len() * methods.len());
+    for image in images {
+        for method in methods {
+            let record = run_cycle(&image.name, image.plane.view(), method, steps, meter)?;
+            progress(&record);
+            records.push(record);
+        }
+    }
+    Ok(records)
+}
