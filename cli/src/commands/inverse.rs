@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use haarshift::io::{CoefficientFile, ReadOptions, StoredCoefficients, WriteOptions, write_image};
+use haarshift::io::{CoefficientFile, ReadOptions, StoredCoefficients};
 use haarshift::{Result, SampleDepth};
 
-use super::{TransformFlags, choice, names, print, refuse_overwriting_input};
+use super::{TransformFlags, choice, names, refuse_overwriting_input, write_and_report};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -62,17 +62,5 @@ pub fn run(args: Args) -> Result<()> {
     }
     let coefficients = stored.resolve(&args.transform.request())?;
     let image = coefficients.inverse().map_err(|e| e.in_file(&args.input))?;
-    let options = WriteOptions {
-        force: args.force,
-        depth: args.depth,
-        ..Default::default()
-    };
-    write_image(&image, &args.output, options)?;
-    print(&format!(
-        "{}: {} x {} {} image\n",
-        args.output.display(),
-        image.width(),
-        image.height(),
-        image.channels()
-    ))
+    write_and_report(&image, &args.output, args.force, args.depth, "")
 }

@@ -74,6 +74,30 @@ impl TransformFlags {
     }
 }
 
+/// Writes `image` to `output` (atomically; replaced only with `force`; stored at `depth` when
+/// given) and prints `OUTPUT: W x H CHANNELS image` followed by `what` (", rotated by ...").
+pub fn write_and_report<T: haarshift::Sample>(
+    image: &haarshift::PlanarImage<T>,
+    output: &Path,
+    force: bool,
+    depth: Option<haarshift::SampleDepth>,
+    what: &str,
+) -> Result<()> {
+    let options = haarshift::io::WriteOptions {
+        force,
+        depth,
+        ..Default::default()
+    };
+    haarshift::io::write_image(image, output, options)?;
+    print(&format!(
+        "{}: {} x {} {} image{what}\n",
+        output.display(),
+        image.width(),
+        image.height(),
+        image.channels()
+    ))
+}
+
 /// Writes `text` to standard output; a closed pipe (`haarshift info x | head -1`) is not an
 /// error.
 pub fn print(text: &str) -> Result<()> {

@@ -2,13 +2,13 @@
 
 use std::path::PathBuf;
 
-use haarshift::io::{WriteOptions, read_image, write_image};
+use haarshift::io::read_image;
 use haarshift::kernels::{Outside, ShiftMethod};
 use haarshift::rotate::{Canvas, RotateOptions, rotate_image};
 use haarshift::{BoundaryMode, Result, SampleDepth};
 
 use super::method::MethodFlags;
-use super::{choice, names, print, refuse_overwriting_input};
+use super::{choice, names, refuse_overwriting_input, write_and_report};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -106,19 +106,6 @@ pub fn run(args: Args) -> Result<()> {
     };
     let image = read_image::<f64>(&args.input)?;
     let rotated = rotate_image(&image, args.angle, kernel.as_ref(), &options)?;
-    let write = WriteOptions {
-        force: args.force,
-        depth: args.depth,
-        ..Default::default()
-    };
-    write_image(&rotated, &args.output, write)?;
-    print(&format!(
-        "{}: {} x {} {} image, rotated by {} degrees with {}\n",
-        args.output.display(),
-        rotated.width(),
-        rotated.height(),
-        rotated.channels(),
-        args.angle,
-        kernel.name()
-    ))
+    let what = format!(", rotated by {} degrees with {}", args.angle, kernel.name());
+    write_and_report(&rotated, &args.output, args.force, args.depth, &what)
 }

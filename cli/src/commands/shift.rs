@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use haarshift::io::{WriteOptions, read_image, write_image};
+use haarshift::io::read_image;
 use haarshift::kernels::{KernelOptions, Outside, ShiftMethod, shift_plane};
 use haarshift::shift::{RetainedImage, shift_image};
 use haarshift::transform::{TransformSpec, pyramid};
@@ -11,7 +11,7 @@ use haarshift::{BoundaryMode, Error, Result};
 use ndarray::{Array2, ArrayView2, s};
 
 use super::method::MethodFlags;
-use super::{choice, names, print, refuse_overwriting_input};
+use super::{choice, names, refuse_overwriting_input, write_and_report};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -97,19 +97,8 @@ pub fn run(args: Args) -> Result<()> {
         let outside = Outside::Boundary(boundary);
         image.map_planes(|p| shift_plane(p, dx, dy, kernel.as_ref(), outside))?
     };
-    let write = WriteOptions {
-        force: args.force,
-        ..Default::default()
-    };
-    write_image(&shifted, &args.output, write)?;
-    print(&format!(
-        "{}: {} x {} {} image, shifted by ({dx}, {dy}) with {}\n",
-        args.output.display(),
-        shifted.width(),
-        shifted.height(),
-        shifted.channels(),
-        method
-    ))
+    let what = format!(", shifted by ({dx}, {dy}) with {method}");
+    write_and_report(&shifted, &args.output, args.force, None, &what)
 }
 
 /// One plane shifted in the Haar domain: compact (same size), or the retained `2^h`-finer
