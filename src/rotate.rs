@@ -46,7 +46,7 @@
 
 use ndarray::{Array2, ArrayView2, Axis, CowArray, s};
 
-use crate::kernels::shear::{check_finite, shear_pass};
+use crate::kernels::shear::{check_finite, shear_pass_into};
 use crate::kernels::{Outside, ShearKernel, grid, transpose};
 use crate::named::named_enum;
 use crate::{BoundaryMode, Error, PlanarImage, Result, Sample};
@@ -241,103 +241,257 @@ fn pad_with_mode<T: Sample>(
     Array2::from_shape_fn((rows.len(), cols.len()), |(r, c)| a[[rows[r], cols[c]]])
 }
 
-/// Rotates the working-grid array `a` by `deg`; `granule` is the number of working samples
-/// per pixel along each axis (the expanded canvas is rounded in whole pixels).
-fn rotate_grid<T: Sample>(
-    a: ArrayView2<'_, T>,
-    deg: f64,
-    granule: usize,
-    kernel: &dyn ShearKernel<T>,
-    options: &RotateOptions,
-) -> Result<Array2<T>> {
-    let reduced = reduce_angle(deg)?;
-    let a1 = match reduced.quarter_turns {
-        0 => CowArray::from(a),
-        q => CowArray::from(quarter_turn(a, q)),
-    };
-    let (h1, w1) = a1.dim();
-    let (out_h, out_w) = match options.canvas {
-        Canvas::Same => a.dim(),
-        Canvas::Expand => {
-            let (h, w) = expanded_size(h1 / granule, w1 / granule, reduced.residual_deg)?;
-            let too_large = || Error::shape(&[h, w], "expanded canvas too large");
-            (
-                h.checked_mul(granule).ok_or_else(too_large)?,
-                w.checked_mul(granule).ok_or_else(too_large)?,
-            )
-        }
-    };
-    if reduced.residual_deg == 0.0 && (out_h, out_w) == (h1, w1) {
-        return Ok(a1.into_owned());
+/// The quarter turns, the output size and whether shears are needed for `deg` on an `h x w`
+/// working grid with `granule` samples per pixel per axis (the expanded canvas is rounded in
+/// whole pixels).
+struct GridRotation {
+    reduced: ReducedAngle,
+    out: (usize, usize),
+    sheared: bool,
+}
+
+impl GridRotation {
+    fn new(dim: (usize, usize), deg: f64, granule: usize, options: &RotateOptions) -> Result<Self> {
+        let reduced = reduce_angle(deg)?;
+        let (h1, w1) = if reduced.quarter_turns % 2 == 1 {
+            (dim.1, dim.0)
+        } else {
+            dim
+        };
+        let out = match options.canvas {
+            Canvas::Same => dim,
+            Canvas::Expand => {
+                let (h, w) = expanded_size(h1 / granule, w1 / granule, reduced.residual_deg)?;
+                let too_large = || Error::shape(&[h, w], "expanded canvas too large");
+                (
+                    h.checked_mul(granule).ok_or_else(too_large)?,
+                    w.checked_mul(granule).ok_or_else(too_large)?,
+                )
+            }
+        };
+        Ok(GridRotation {
+            reduced,
+            out,
+            sheared: reduced.residual_deg != 0.0 || out != (h1, w1),
+        })
     }
-    let theta = reduced.residual_deg.to_radians();
-    let (a_x, s_y) = (-(theta / 2.0).tan(), theta.sin());
-    let (cx_out, cy_out) = ((out_w as f64 - 1.0) / 2.0, (out_h as f64 - 1.0) / 2.0);
-    let reach = kernel.support_radius().min(h1.max(w1)) as f64;
+}
 
-    // With a boundary mode, continue the input in 2D far enough that every position the output
-    // needs (its preimage plus the kernel's reach through three shears) lies inside.
-    let (a2, outside) = match options.outside {
-        Outside::Boundary(mode) if mode != BoundaryMode::Zero => {
-            let (sin, cos) = (theta.sin().abs(), theta.cos().abs());
-            let pad = |half_extent: f64, centre: f64| {
-                ((half_extent - centre).max(0.0) + 3.0 * reach + 2.0).ceil() as usize
-            };
-            let px = pad(cos * cx_out + sin * cy_out, (w1 as f64 - 1.0) / 2.0);
-            let py = pad(sin * cx_out + cos * cy_out, (h1 as f64 - 1.0) / 2.0);
-            check_budget::<T>(
-                "padding for the boundary mode",
-                ((h1 + 2 * py) * (w1 + 2 * px)) as u128,
-                options.memory_budget,
-            )?;
-            (
-                CowArray::from(pad_with_mode(a1.view(), py, px, mode)),
-                Outside::Boundary(mode),
-            )
+/// Working memory of the three shears: the two intermediate images, kept between rotations.
+///
+/// Rotating many images (or one image many times) through one workspace allocates the
+/// intermediates once: fresh memory costs a page fault per 4 KiB, which at 2048^2 is about a
+/// third of a rotation's time. [`rotate_plane`] is the one-shot form.
+///
+/// ```
+/// use haarshift::kernels::ShiftMethod;
+/// use haarshift::rotate::{RotateOptions, RotationWorkspace, rotate_plane, rotated_size};
+/// use ndarray::Array2;
+/// let k = ShiftMethod::Keys.kernel::<f32>();
+/// let opts = RotateOptions::default();
+/// let mut workspace = RotationWorkspace::new();
+/// let p = Array2::from_shape_fn((32, 48), |(r, c)| (r * c) as f32);
+/// let mut out = Array2::zeros(rotated_size(32, 48, 30.0, &opts).unwrap());
+/// for _ in 0..3 {
+///     workspace.rotate_plane_into(p.view(), 30.0, k.as_ref(), &opts, out.view_mut()).unwrap();
+/// }
+/// assert_eq!(out, rotate_plane(p.view(), 30.0, k.as_ref(), &opts).unwrap());
+/// ```
+#[derive(Debug, Default)]
+pub struct RotationWorkspace<T> {
+    first: Vec<T>,
+    second: Vec<T>,
+}
+
+/// The first `len` samples of `buffer`, grown (never shrunk) to hold them.
+fn buffer<T: Sample>(buffer: &mut Vec<T>, len: usize) -> &mut [T] {
+    if buffer.len() < len {
+        buffer.resize(len, T::zero());
+    }
+    &mut buffer[..len]
+}
+
+impl<T: Sample> RotationWorkspace<T> {
+    /// An empty workspace; it grows to the largest rotation it serves.
+    pub fn new() -> Self {
+        RotationWorkspace {
+            first: Vec::new(),
+            second: Vec::new(),
         }
-        Outside::Boundary(_) => (a1, Outside::Fill(0.0)),
-        fill => (a1, fill),
-    };
-    let (h_a, w_a) = a2.dim();
-    let (cx_a, cy_a) = ((w_a as f64 - 1.0) / 2.0, (h_a as f64 - 1.0) / 2.0);
+    }
 
-    // Columns of the two intermediate images (x in centred coordinates): what the last shear
-    // reads (x = X - a_x Y over the output) that the first shear can produce (x + a_x y over
-    // the input), plus the kernel's reach. Both ranges are symmetric about 0.
-    let need = cx_out + a_x.abs() * cy_out;
-    let content = cx_a + a_x.abs() * cy_a;
-    let half = need.min(content) + reach;
-    let margin = (half - cx_a).ceil(); // integer: keeps the first shift an exact integer at 0
-    let ox = cx_a + margin;
-    let w_b = (half + ox).floor() as usize + 1;
-    check_budget::<T>(
-        "the intermediate images of the rotation",
-        (h_a * w_a + w_b * h_a + out_h * w_b + out_h * out_w) as u128,
-        options.memory_budget,
-    )?;
+    /// [`rotate_plane`] through this workspace.
+    ///
+    /// ```
+    /// use haarshift::kernels::ShiftMethod;
+    /// use haarshift::rotate::{RotateOptions, RotationWorkspace};
+    /// let k = ShiftMethod::Linear.kernel::<f64>();
+    /// let p = ndarray::array![[1.0, 2.0], [3.0, 4.0]];
+    /// let r = RotationWorkspace::new()
+    ///     .rotate_plane(p.view(), -90.0, k.as_ref(), &RotateOptions::default())
+    ///     .unwrap();
+    /// assert_eq!(r, ndarray::array![[3.0, 1.0], [4.0, 2.0]]);
+    /// ```
+    pub fn rotate_plane(
+        &mut self,
+        plane: ArrayView2<'_, T>,
+        deg: f64,
+        kernel: &dyn ShearKernel<T>,
+        options: &RotateOptions,
+    ) -> Result<Array2<T>> {
+        let mut out = Array2::zeros(rotated_size(plane.nrows(), plane.ncols(), deg, options)?);
+        self.rotate_plane_into(plane, deg, kernel, options, out.view_mut())?;
+        Ok(out)
+    }
 
-    // x-shear: row r (y = cy_a - r) of A moves by a_x y; stored transposed (w_b x h_a).
-    let shifts: Vec<f64> = (0..h_a).map(|r| margin + a_x * (cy_a - r as f64)).collect();
-    let b1t = shear_pass(a2.view(), w_b, &shifts, kernel, outside, true);
-    // y-shear: column c (x = c - ox) moves up by s_y x, i.e. by -s_y x in row index, onto the
-    // output's rows; stored transposed back (out_h x w_b).
-    let shifts: Vec<f64> = (0..w_b)
-        .map(|c| (cy_out - cy_a) - s_y * (c as f64 - ox))
-        .collect();
-    let b2 = shear_pass(b1t.view(), out_h, &shifts, kernel, outside, true);
-    drop(b1t);
-    // x-shear again: row r (y = cy_out - r) onto the output's columns.
-    let shifts: Vec<f64> = (0..out_h)
-        .map(|r| (cx_out - ox) + a_x * (cy_out - r as f64))
-        .collect();
-    Ok(shear_pass(
-        b2.view(),
-        out_w,
-        &shifts,
-        kernel,
-        outside,
-        false,
-    ))
+    /// [`rotate_plane`] into `out`, which must have the size [`rotated_size`] gives.
+    pub fn rotate_plane_into(
+        &mut self,
+        plane: ArrayView2<'_, T>,
+        deg: f64,
+        kernel: &dyn ShearKernel<T>,
+        options: &RotateOptions,
+        mut out: ndarray::ArrayViewMut2<'_, T>,
+    ) -> Result<()> {
+        let expected = rotated_size(plane.nrows(), plane.ncols(), deg, options)?;
+        if out.dim() != expected {
+            return Err(Error::shape(
+                &[out.nrows(), out.ncols()],
+                format!("the rotated image is {}x{}", expected.0, expected.1),
+            ));
+        }
+        if options.supersample > 0 || kernel.grid_exponent() > 0 {
+            let mut chain = RotationChain::new(plane, kernel, *options)?;
+            chain.rotate(deg)?;
+            out.assign(&chain.finish());
+            return Ok(());
+        }
+        validate_plane(plane, options)?;
+        let rotation = GridRotation::new(plane.dim(), deg, 1, options)?;
+        match out.as_slice_mut() {
+            Some(slice) => self.rotate_grid(plane, &rotation, kernel, options, slice),
+            None => {
+                let mut owned = Array2::zeros(expected);
+                let slice = owned.as_slice_mut().expect("new array");
+                self.rotate_grid(plane, &rotation, kernel, options, slice)?;
+                out.assign(&owned);
+                Ok(())
+            }
+        }
+    }
+
+    /// Rotates the working-grid array `a` as `rotation` says into `out` (row-major, of the
+    /// rotation's output size).
+    fn rotate_grid(
+        &mut self,
+        a: ArrayView2<'_, T>,
+        rotation: &GridRotation,
+        kernel: &dyn ShearKernel<T>,
+        options: &RotateOptions,
+        out: &mut [T],
+    ) -> Result<()> {
+        let reduced = rotation.reduced;
+        let a1 = match reduced.quarter_turns {
+            0 => CowArray::from(a),
+            q => CowArray::from(quarter_turn(a, q)),
+        };
+        let (h1, w1) = a1.dim();
+        let (out_h, out_w) = rotation.out;
+        if !rotation.sheared {
+            out.copy_from_slice(a1.as_standard_layout().as_slice().expect("standard layout"));
+            return Ok(());
+        }
+        let theta = reduced.residual_deg.to_radians();
+        let (a_x, s_y) = (-(theta / 2.0).tan(), theta.sin());
+        let (cx_out, cy_out) = ((out_w as f64 - 1.0) / 2.0, (out_h as f64 - 1.0) / 2.0);
+        let reach = kernel.support_radius().min(h1.max(w1)) as f64;
+
+        // With a boundary mode, continue the input in 2D far enough that every position the
+        // output needs (its preimage plus the kernel's reach through three shears) lies inside.
+        let (a2, outside) = match options.outside {
+            Outside::Boundary(mode) if mode != BoundaryMode::Zero => {
+                let (sin, cos) = (theta.sin().abs(), theta.cos().abs());
+                let pad = |half_extent: f64, centre: f64| {
+                    ((half_extent - centre).max(0.0) + 3.0 * reach + 2.0).ceil() as usize
+                };
+                let px = pad(cos * cx_out + sin * cy_out, (w1 as f64 - 1.0) / 2.0);
+                let py = pad(sin * cx_out + cos * cy_out, (h1 as f64 - 1.0) / 2.0);
+                check_budget::<T>(
+                    "padding for the boundary mode",
+                    ((h1 + 2 * py) * (w1 + 2 * px)) as u128,
+                    options.memory_budget,
+                )?;
+                (
+                    CowArray::from(pad_with_mode(a1.view(), py, px, mode)),
+                    Outside::Boundary(mode),
+                )
+            }
+            Outside::Boundary(_) => (a1, Outside::Fill(0.0)),
+            fill => (a1, fill),
+        };
+        let (h_a, w_a) = a2.dim();
+        let (cx_a, cy_a) = ((w_a as f64 - 1.0) / 2.0, (h_a as f64 - 1.0) / 2.0);
+
+        // Columns of the two intermediate images (x in centred coordinates): what the last
+        // shear reads (x = X - a_x Y over the output) that the first shear can produce
+        // (x + a_x y over the input), plus the kernel's reach. Both ranges are symmetric
+        // about 0.
+        let need = cx_out + a_x.abs() * cy_out;
+        let content = cx_a + a_x.abs() * cy_a;
+        let half = need.min(content) + reach;
+        let margin = (half - cx_a).ceil(); // integer: keeps the first shift an exact integer at 0
+        let ox = cx_a + margin;
+        let w_b = (half + ox).floor() as usize + 1;
+        check_budget::<T>(
+            "the intermediate images of the rotation",
+            (h_a * w_a + w_b * h_a + out_h * w_b + out_h * out_w) as u128,
+            options.memory_budget,
+        )?;
+
+        // x-shear: row r (y = cy_a - r) of A moves by a_x y; stored transposed (w_b x h_a).
+        let shifts: Vec<f64> = (0..h_a).map(|r| margin + a_x * (cy_a - r as f64)).collect();
+        let b1t = buffer(&mut self.first, w_b * h_a);
+        shear_pass_into(a2.view(), w_b, &shifts, kernel, outside, true, b1t);
+        let b1t = ArrayView2::from_shape((w_b, h_a), &*b1t).expect("sized");
+        // y-shear: column c (x = c - ox) moves up by s_y x, i.e. by -s_y x in row index, onto
+        // the output's rows; stored transposed back (out_h x w_b).
+        let shifts: Vec<f64> = (0..w_b)
+            .map(|c| (cy_out - cy_a) - s_y * (c as f64 - ox))
+            .collect();
+        let b2 = buffer(&mut self.second, out_h * w_b);
+        shear_pass_into(b1t, out_h, &shifts, kernel, outside, true, b2);
+        let b2 = ArrayView2::from_shape((out_h, w_b), &*b2).expect("sized");
+        // x-shear again: row r (y = cy_out - r) onto the output's columns.
+        let shifts: Vec<f64> = (0..out_h)
+            .map(|r| (cx_out - ox) + a_x * (cy_out - r as f64))
+            .collect();
+        shear_pass_into(b2, out_w, &shifts, kernel, outside, false, out);
+        Ok(())
+    }
+}
+
+/// The size `(rows, cols)` of `h x w` image rotated by `deg` with `options`: the input's for
+/// [`Canvas::Same`], [`expanded_size`] for [`Canvas::Expand`].
+///
+/// ```
+/// use haarshift::rotate::{Canvas, RotateOptions, rotated_size};
+/// let expand = RotateOptions { canvas: Canvas::Expand, ..Default::default() };
+/// assert_eq!(rotated_size(30, 50, 90.0, &expand).unwrap(), (50, 30));
+/// assert_eq!(rotated_size(30, 50, 90.0, &RotateOptions::default()).unwrap(), (30, 50));
+/// ```
+pub fn rotated_size(
+    h: usize,
+    w: usize,
+    deg: f64,
+    options: &RotateOptions,
+) -> Result<(usize, usize)> {
+    Ok(match options.canvas {
+        Canvas::Same => {
+            reduce_angle(deg)?;
+            (h, w)
+        }
+        Canvas::Expand => expanded_size(h, w, deg)?,
+    })
 }
 
 /// Successive rotations of one plane on a persistent working grid, projected to pixels only
@@ -360,6 +514,9 @@ fn rotate_grid<T: Sample>(
 /// ```
 pub struct RotationChain<'k, T: Sample> {
     work: Array2<T>,
+    /// The previous working grid's memory, reused for the next rotation's output.
+    spare: Vec<T>,
+    workspace: RotationWorkspace<T>,
     exponent: u32,
     kernel: &'k dyn ShearKernel<T>,
     options: RotateOptions,
@@ -386,6 +543,8 @@ impl<'k, T: Sample> RotationChain<'k, T> {
         check_budget::<T>("the working grid", fine, options.memory_budget)?;
         Ok(RotationChain {
             work: grid::upsample_nearest(plane, exponent)?,
+            spare: Vec::new(),
+            workspace: RotationWorkspace::new(),
             exponent,
             kernel,
             options,
@@ -395,7 +554,21 @@ impl<'k, T: Sample> RotationChain<'k, T> {
     /// Rotates the working grid by `deg` (counter-clockwise as displayed).
     pub fn rotate(&mut self, deg: f64) -> Result<&mut Self> {
         let granule = 1usize << self.exponent;
-        self.work = rotate_grid(self.work.view(), deg, granule, self.kernel, &self.options)?;
+        let rotation = GridRotation::new(self.work.dim(), deg, granule, &self.options)?;
+        let (h, w) = rotation.out;
+        let mut out = std::mem::take(&mut self.spare);
+        out.resize(h * w, T::zero());
+        self.workspace.rotate_grid(
+            self.work.view(),
+            &rotation,
+            self.kernel,
+            &self.options,
+            &mut out,
+        )?;
+        let out = Array2::from_shape_vec((h, w), out).expect("sized");
+        self.spare = std::mem::replace(&mut self.work, out)
+            .into_raw_vec_and_offset()
+            .0;
         Ok(self)
     }
 
@@ -432,14 +605,7 @@ pub fn rotate_plane<T: Sample>(
     kernel: &dyn ShearKernel<T>,
     options: &RotateOptions,
 ) -> Result<Array2<T>> {
-    if options.supersample == 0 && kernel.grid_exponent() == 0 {
-        // The chain would copy the plane onto its (here identical) working grid first.
-        validate_plane(plane, options)?;
-        return rotate_grid(plane, deg, 1, kernel, options);
-    }
-    let mut chain = RotationChain::new(plane, kernel, *options)?;
-    chain.rotate(deg)?;
-    Ok(chain.finish())
+    RotationWorkspace::new().rotate_plane(plane, deg, kernel, options)
 }
 
 /// Below this alpha (as a fraction of opaque) a rotated pixel counts as fully transparent and
@@ -476,8 +642,9 @@ pub fn rotate_image<T: Sample>(
     let depth = image.depth();
     let opaque = depth.integer_max().unwrap_or(1.0);
     let alpha_plane = image.channels().count() - 1;
+    let mut workspace = RotationWorkspace::new();
     let rotated = match image.alpha() {
-        None => image.map_planes(|p| rotate_plane(p, deg, kernel, options))?,
+        None => image.map_planes(|p| workspace.rotate_plane(p, deg, kernel, options))?,
         Some(_) if is_pure_copy(image.height(), image.width(), deg, options.canvas)? => {
             // Nothing is interpolated: copy colour as it is (even under alpha 0), with a
             // transparent outside.
@@ -493,7 +660,7 @@ pub fn rotate_image<T: Sample>(
                     options
                 };
                 c += 1;
-                rotate_plane(p, deg, kernel, opts)
+                workspace.rotate_plane(p, deg, kernel, opts)
             })?
         }
         Some(alpha) => {
@@ -517,7 +684,7 @@ pub fn rotate_image<T: Sample>(
                 } else {
                     &p * &alpha * scale
                 };
-                planes.push(rotate_plane(p.view(), deg, kernel, &opts)?);
+                planes.push(workspace.rotate_plane(p.view(), deg, kernel, &opts)?);
             }
             let new_alpha = planes.pop().expect("alpha plane");
             let threshold = T::from_f64(TRANSPARENT * opaque);

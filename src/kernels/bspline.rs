@@ -2,8 +2,8 @@
 //! "Splines: a perfect fit for signal and image processing", 1999; the boundary handling of
 //! P. Thevenaz, T. Blu, M. Unser, "Interpolation revisited", 2000).
 
-use super::taps::{fir, split_shift, weights_into};
-use super::{Outside, RowGeometry, RowShifter, ShearKernel};
+use super::taps::{split_shift, weights_into};
+use super::{Outside, ROW_GROUP, RowGeometry, RowShifter, ShearKernel};
 use crate::{Error, Result, Sample};
 
 /// Interpolating B-spline of degree 3 or 5: the row is first turned into spline coefficients
@@ -138,9 +138,14 @@ pub fn bspline_value(degree: usize, x: f64) -> f64 {
     }
 }
 
-/// Turns samples into B-spline coefficients in place, treating the samples beyond the buffer
-/// as zero (callers extend the buffer by the horizon so that this truncation is invisible).
-fn prefilter<T: Sample>(c: &mut [T], poles: &[f64]) {
+/// Up to [`ROW_GROUP`] rows side by side: sample `i` of every row, one lane per row, so that
+/// the recursive filters, which are serial along a row, vectorise across rows.
+type Lanes<T> = [T; ROW_GROUP];
+
+/// Turns samples into B-spline coefficients in place (each lane a row), treating the samples
+/// beyond the buffer as zero (callers extend the buffer by the horizon so that this truncation
+/// is invisible).
+fn prefilter<T: Sample>(c: &mut [Lanes<T>], poles: &[f64]) {
     let n = c.len();
     if n < 2 {
         return;
@@ -148,19 +153,27 @@ fn prefilter<T: Sample>(c: &mut [T], poles: &[f64]) {
     // Gain: the product of (1 - z)(1 - 1/z) over the poles makes the filter's DC gain one.
     let gain: f64 = poles.iter().map(|z| (1.0 - z) * (1.0 - 1.0 / z)).product();
     let gain = T::from_f64(gain);
-    for v in c.iter_mut() {
+    for v in c.iter_mut().flatten() {
         *v *= gain;
     }
     for &z in poles {
         let zt = T::from_f64(z);
         for i in 1..n {
             let prev = c[i - 1];
-            c[i] += zt * prev;
+            for (v, p) in c[i].iter_mut().zip(prev) {
+                *v += zt * p;
+            }
         }
         // Anticausal start for a signal that is zero beyond the end: c-[n-1] = z/(z^2-1) c+[n-1].
-        c[n - 1] *= T::from_f64(z / (z * z - 1.0));
+        let start = T::from_f64(z / (z * z - 1.0));
+        for v in c[n - 1].iter_mut() {
+            *v *= start;
+        }
         for i in (0..n - 1).rev() {
-            c[i] = zt * (c[i + 1] - c[i]);
+            let next = c[i + 1];
+            for (v, x) in c[i].iter_mut().zip(next) {
+                *v = zt * (x - *v);
+            }
         }
     }
 }
@@ -169,25 +182,76 @@ struct BSplineShifter<'k, T> {
     spline: &'k BSpline,
     horizon: usize,
     outside: Outside,
-    weights: Vec<T>,
-    coefficients: Vec<T>,
+    /// Tap `t`'s weight for each lane.
+    weights: Vec<Lanes<T>>,
+    /// One row continued by the rule, before it goes into its lane.
+    extended: Vec<T>,
+    /// Samples, then coefficients, then shifted samples, lane by lane.
+    lanes: Vec<Lanes<T>>,
+}
+
+impl<T: Sample> BSplineShifter<'_, T> {
+    /// At most [`ROW_GROUP`] rows through the lanes.
+    fn shift_group(&mut self, rows: &[&[T]], shifts: &[f64], outs: &mut [&mut [T]]) {
+        let degree = self.spline.degree;
+        let taps = degree + 1;
+        let h = self.horizon;
+        let len_out = outs[0].len();
+        // Coefficients needed: positions -k - taps/2 .. + len_out + taps - 1, plus the horizon
+        // on each side for the filters to settle.
+        let len = len_out + taps - 1 + 2 * h;
+        self.lanes.resize(len, [T::zero(); ROW_GROUP]);
+        self.extended.resize(len, T::zero());
+        let mut column = [T::zero(); 6];
+        for (lane, (row, &shift)) in rows.iter().zip(shifts).enumerate() {
+            let (k, f) = split_shift(shift);
+            weights_into(|x| bspline_value(degree, x), f, false, &mut column[..taps]);
+            for (w, c) in self.weights.iter_mut().zip(column) {
+                w[lane] = c;
+            }
+            let lo = -k - (taps / 2) as isize - h as isize;
+            self.outside.extend_into(row, lo, &mut self.extended);
+            for (l, v) in self.lanes.iter_mut().zip(&self.extended) {
+                l[lane] = *v;
+            }
+        }
+        prefilter(&mut self.lanes, self.spline.poles);
+        // The FIR of `taps::fir`, lane-wise and in place: output n reads coefficients h + n
+        // onwards, never an output already written.
+        let (first, rest) = self.weights.split_first().expect("at least one tap");
+        for n in 0..len_out {
+            let mut acc = self.lanes[h + n];
+            for (a, w) in acc.iter_mut().zip(first) {
+                *a = *w * *a;
+            }
+            for (t, w) in rest.iter().enumerate() {
+                for ((a, w), c) in acc.iter_mut().zip(w).zip(&self.lanes[h + n + t + 1]) {
+                    *a += *w * *c;
+                }
+            }
+            self.lanes[n] = acc;
+        }
+        for (lane, out) in outs.iter_mut().enumerate() {
+            for (o, l) in out.iter_mut().zip(&self.lanes) {
+                *o = l[lane];
+            }
+        }
+    }
 }
 
 impl<T: Sample> RowShifter<T> for BSplineShifter<'_, T> {
     fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
-        let (k, f) = split_shift(shift);
-        let taps = self.weights.len();
-        let degree = self.spline.degree;
-        weights_into(|x| bspline_value(degree, x), f, false, &mut self.weights);
-        // Coefficients needed: positions -k - taps/2 .. + out.len() + taps - 1, plus the horizon
-        // on each side for the filters to settle.
-        let h = self.horizon;
-        let lo = -k - (taps / 2) as isize - h as isize;
-        self.coefficients
-            .resize(out.len() + taps - 1 + 2 * h, T::zero());
-        self.outside.extend_into(row, lo, &mut self.coefficients);
-        prefilter(&mut self.coefficients, self.spline.poles);
-        fir(&self.coefficients[h..], &self.weights, out);
+        self.shift_group(&[row], &[shift], &mut [out]);
+    }
+
+    fn shift_rows(&mut self, rows: &[&[T]], shifts: &[f64], outs: &mut [&mut [T]]) {
+        for ((rows, shifts), outs) in rows
+            .chunks(ROW_GROUP)
+            .zip(shifts.chunks(ROW_GROUP))
+            .zip(outs.chunks_mut(ROW_GROUP))
+        {
+            self.shift_group(rows, shifts, outs);
+        }
     }
 }
 
@@ -205,8 +269,9 @@ impl<T: Sample> ShearKernel<T> for BSpline {
             spline: self,
             horizon: self.horizon::<T>(),
             outside,
-            weights: vec![T::zero(); self.degree + 1],
-            coefficients: Vec::new(),
+            weights: vec![[T::zero(); ROW_GROUP]; self.degree + 1],
+            extended: Vec::new(),
+            lanes: Vec::new(),
         })
     }
 }

@@ -228,7 +228,33 @@ pub trait RowShifter<T: Sample>: Send {
     /// `out[n] = row(n - shift)` for `n` in `0..out.len()`; `row` and `out` may differ in
     /// length. `shift` is finite.
     fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]);
+
+    /// Shifts several rows of equal length, `outs[i][n] = rows[i](n - shifts[i])`, all `outs`
+    /// of equal length. The drivers hand out up to [`ROW_GROUP`] rows at a time; the default
+    /// shifts them one by one. A kernel whose work per row is a serial recursion (the
+    /// B-splines' prefilter) overrides it to run the rows side by side, one vector lane each.
+    ///
+    /// ```
+    /// use haarshift::kernels::{Outside, RowGeometry, ShearKernel, ShiftMethod};
+    /// let kernel = ShiftMethod::BSpline3.kernel::<f64>();
+    /// let geometry = RowGeometry { len_in: 3, len_out: 3, min_shift: 0.0, max_shift: 1.0 };
+    /// let mut worker = kernel.row_shifter(geometry, Outside::Fill(0.0));
+    /// let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
+    /// worker.shift_rows(&[&[1.0, 2.0, 3.0], &[4.0, 5.0, 6.0]], &[0.5, 0.25], &mut [&mut a, &mut b]);
+    /// let mut single = [0.0; 3];
+    /// worker.shift_row(&[4.0, 5.0, 6.0], 0.25, &mut single);
+    /// assert_eq!(b, single);
+    /// ```
+    fn shift_rows(&mut self, rows: &[&[T]], shifts: &[f64], outs: &mut [&mut [T]]) {
+        for ((row, &shift), out) in rows.iter().zip(shifts).zip(outs.iter_mut()) {
+            self.shift_row(row, shift, out);
+        }
+    }
 }
+
+/// How many rows the drivers pass to [`RowShifter::shift_rows`] at once: eight lanes of f32
+/// fill a 256-bit vector.
+pub const ROW_GROUP: usize = 8;
 
 named_enum! {
     /// The built-in kernels by their command-line names.

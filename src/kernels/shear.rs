@@ -5,7 +5,7 @@ use ndarray::{Array2, ArrayView2, Axis, CowArray};
 use rayon::prelude::*;
 
 use super::grid::{box_average, upsample_nearest};
-use super::{Outside, RowGeometry, RowShifter, ShearKernel};
+use super::{Outside, ROW_GROUP, RowGeometry, RowShifter, ShearKernel};
 use crate::{Error, Result, Sample, ensure_finite};
 
 /// Rows per parallel task when writing transposed: 32 output values per row segment (128 bytes
@@ -128,18 +128,35 @@ pub fn shift_plane<T: Sample>(
     Ok(out)
 }
 
-/// [`ensure_finite`] in one vectorised pass (`v * 0` is NaN exactly for NaN and infinities);
+/// [`ensure_finite`] in one vectorised, parallel pass (`v * 0` is NaN exactly for NaN and
+/// infinities; sixteen partial sums keep the additions independent so that they vectorise);
 /// the slower indexed search runs only to name the culprit.
 pub(crate) fn check_finite<T: Sample>(plane: ArrayView2<'_, T>) -> Result<()> {
-    let probe = plane.fold(T::zero(), |acc, v| acc + *v * T::zero());
-    if probe.is_nan() {
+    fn probe<T: Sample>(values: &[T]) -> bool {
+        let mut acc = [T::zero(); 16];
+        let mut chunks = values.chunks_exact(16);
+        for chunk in chunks.by_ref() {
+            for (a, v) in acc.iter_mut().zip(chunk) {
+                *a += *v * T::zero();
+            }
+        }
+        let tail = chunks
+            .remainder()
+            .iter()
+            .fold(T::zero(), |a, v| a + *v * T::zero());
+        (acc.iter().fold(tail, |a, v| a + *v)).is_nan()
+    }
+    let suspicious = match plane.as_slice() {
+        Some(values) => values.par_chunks(1 << 16).any(probe),
+        None => plane.rows().into_iter().any(|r| probe(&r.to_vec())),
+    };
+    if suspicious {
         ensure_finite(&plane)?;
     }
     Ok(())
 }
 
-/// [`shear_rows`] without validation; with `transposed`, the result is stored transposed
-/// (`len_out x rows`) through a tile per task, which is the blocked transpose fused in.
+/// [`shear_rows`] without validation, into a new array; see [`shear_pass_into`].
 pub(crate) fn shear_pass<T: Sample>(
     input: ArrayView2<'_, T>,
     len_out: usize,
@@ -148,8 +165,34 @@ pub(crate) fn shear_pass<T: Sample>(
     outside: Outside,
     transposed: bool,
 ) -> Array2<T> {
+    let rows = input.nrows();
+    let mut out = vec![T::zero(); rows * len_out];
+    shear_pass_into(
+        input, len_out, shifts, kernel, outside, transposed, &mut out,
+    );
+    let shape = if transposed {
+        (len_out, rows)
+    } else {
+        (rows, len_out)
+    };
+    Array2::from_shape_vec(shape, out).expect("sized above")
+}
+
+/// [`shear_rows`] without validation, writing every sample of `out` (`rows x len_out`, or
+/// `len_out x rows` with `transposed`, row-major). With `transposed` the rows go through a tile
+/// per task, which is the blocked transpose fused in.
+pub(crate) fn shear_pass_into<T: Sample>(
+    input: ArrayView2<'_, T>,
+    len_out: usize,
+    shifts: &[f64],
+    kernel: &dyn ShearKernel<T>,
+    outside: Outside,
+    transposed: bool,
+    out: &mut [T],
+) {
     let input = input.as_standard_layout();
     let (rows, len_in) = input.dim();
+    assert_eq!(out.len(), rows * len_out, "output sized for the pass");
     let src = input.as_slice().expect("standard layout");
     let geometry = RowGeometry {
         len_in,
@@ -157,31 +200,45 @@ pub(crate) fn shear_pass<T: Sample>(
         min_shift: shifts.iter().copied().fold(f64::INFINITY, f64::min),
         max_shift: shifts.iter().copied().fold(f64::NEG_INFINITY, f64::max),
     };
-    let shift_one = |shifter: &mut Box<dyn RowShifter<T> + '_>, r: usize, out: &mut [T]| {
-        let row = &src[r * len_in..(r + 1) * len_in];
-        let s = shifts[r];
-        if s.fract() == 0.0 {
-            outside.extend_into(row, -(s as isize), out);
-        } else {
-            shifter.shift_row(row, s, out);
+    // Rows `r0..` into `block` (whole rows of `len_out`): integer shifts are exact copies,
+    // the others go to the kernel together.
+    let shift_group = |shifter: &mut Box<dyn RowShifter<T> + '_>, r0: usize, block: &mut [T]| {
+        let mut rows: [&[T]; ROW_GROUP] = [&[]; ROW_GROUP];
+        let mut amounts = [0.0; ROW_GROUP];
+        let mut outs: [&mut [T]; ROW_GROUP] = Default::default();
+        let mut m = 0;
+        for (i, o) in block.chunks_exact_mut(len_out).enumerate() {
+            let r = r0 + i;
+            let row = &src[r * len_in..(r + 1) * len_in];
+            let s = shifts[r];
+            if s.fract() == 0.0 {
+                outside.extend_into(row, -(s as isize), o);
+            } else {
+                (rows[m], amounts[m], outs[m]) = (row, s, o);
+                m += 1;
+            }
+        }
+        if m > 0 {
+            shifter.shift_rows(&rows[..m], &amounts[..m], &mut outs[..m]);
         }
     };
+    // Few, large tasks: each one builds a worker (and a tile), which costs far more than a row.
+    let tasks = 4 * rayon::current_num_threads();
     if !transposed {
-        let mut out = Array2::zeros((rows, len_out));
-        out.as_slice_mut()
-            .expect("new array")
-            .par_chunks_mut(len_out)
+        out.par_chunks_mut(len_out * ROW_GROUP)
             .enumerate()
+            .with_min_len(rows.div_ceil(ROW_GROUP * tasks))
             .for_each_init(
                 || kernel.row_shifter(geometry, outside),
-                |shifter, (r, o)| shift_one(shifter, r, o),
+                |shifter, (g, block)| shift_group(shifter, g * ROW_GROUP, block),
             );
-        return out;
+        return;
     }
-    let mut out = Array2::zeros((len_out, rows));
+    let mut out = ndarray::ArrayViewMut2::from_shape((len_out, rows), out).expect("sized");
     out.axis_chunks_iter_mut(Axis(1), TILE)
         .into_par_iter()
         .enumerate()
+        .with_min_len(rows.div_ceil(TILE).div_ceil(tasks))
         .for_each_init(
             || {
                 let tile = vec![T::zero(); TILE * len_out];
@@ -190,13 +247,15 @@ pub(crate) fn shear_pass<T: Sample>(
             |(shifter, tile), (chunk, mut block)| {
                 let r0 = chunk * TILE;
                 let t = block.ncols();
-                for (i, o) in tile.chunks_exact_mut(len_out).take(t).enumerate() {
-                    shift_one(shifter, r0 + i, o);
+                for (g, group) in tile[..t * len_out]
+                    .chunks_mut(len_out * ROW_GROUP)
+                    .enumerate()
+                {
+                    shift_group(shifter, r0 + g * ROW_GROUP, group);
                 }
                 write_transposed(&tile[..t * len_out], len_out, &mut block);
             },
         );
-    out
 }
 
 /// Writes the `t x len` rows of `tile` into the `len x t` block, through a small square that
