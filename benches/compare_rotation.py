@@ -14,6 +14,7 @@ tests never need it.
 
 import argparse
 import json
+import os
 import pathlib
 import subprocess
 import time
@@ -21,7 +22,7 @@ import time
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-KERNELS = ["nearest", "linear", "keys", "bspline3", "bspline5", "lanczos3", "lanczos4", "fft"]
+KERNELS = ["nearest", "linear", "keys", "bspline3", "bspline5", "lanczos3", "lanczos4", "fft", "haar"]
 ANGLE = 30.0
 
 
@@ -49,13 +50,15 @@ def python_baselines(n, repeats):
     img = image(n)
     # OpenCV's angle is counter-clockwise as displayed, like haarshift's.
     m = cv2.getRotationMatrix2D(((n - 1) / 2, (n - 1) / 2), ANGLE, 1.0)
+    # Every call writes into one preallocated array, as the haarshift bench does.
+    dst = np.zeros_like(img)
     out = {}
     for name, flag in [("opencv cubic", cv2.INTER_CUBIC), ("opencv lanczos4", cv2.INTER_LANCZOS4)]:
         out[name] = best_time(
-            lambda: cv2.warpAffine(img, m, (n, n), flags=flag, borderValue=0), repeats
+            lambda: cv2.warpAffine(img, m, (n, n), dst=dst, flags=flag, borderValue=0), repeats
         )
     out["scipy order=3"] = best_time(
-        lambda: ndimage.rotate(img, ANGLE, reshape=False, order=3, mode="constant"),
+        lambda: ndimage.rotate(img, ANGLE, reshape=False, order=3, mode="constant", output=dst),
         max(3, repeats // 4),
     )
     return out
@@ -63,11 +66,12 @@ def python_baselines(n, repeats):
 
 def haarshift_times(n):
     out = {}
-    for k in KERNELS:
-        path = ROOT / "target" / "criterion" / "rotate" / k / str(n) / "new" / "estimates.json"
+    runs = [("rotate", k, k) for k in KERNELS] + [("rotate_one_shot", "keys", "keys one-shot")]
+    for group, k, label in runs:
+        path = ROOT / "target" / "criterion" / group / k / str(n) / "new" / "estimates.json"
         if path.exists():
             est = json.loads(path.read_text())
-            out[k] = est["median"]["point_estimate"] / 1e6
+            out[label] = est["median"]["point_estimate"] / 1e6
     return out
 
 
@@ -85,20 +89,23 @@ def main():
             cwd=ROOT,
             check=True,
         )
+    print(f"load average before the Python baselines: {os.getloadavg()}")
+    print("\n| size | method | ms | vs OpenCV cubic | vs OpenCV Lanczos-4 | vs scipy order=3 |")
+    print("|---|---|---|---|---|---|")
     for n in sizes:
         base = python_baselines(n, args.repeats)
         ours = haarshift_times(n)
-        print(f"\n{n}x{n} float32, rotate {ANGLE} degrees (median ms)")
+        if not ours:
+            print(f"(no criterion results for {n}: run with --run-cargo)")
         for name, ms in base.items():
-            print(f"  {name:18s} {ms:9.2f}")
-        print(f"  {'haarshift':18s} {'ms':>9s}  vs opencv cubic  vs opencv lanczos4  vs scipy order=3")
+            print(f"| {n}^2 | {name} | {ms:.2f} | | | |")
         for k, ms in ours.items():
             print(
-                f"  {k:18s} {ms:9.2f}  {ms / base['opencv cubic']:14.2f}x"
-                f"  {ms / base['opencv lanczos4']:17.2f}x  {base['scipy order=3'] / ms:13.1f}x faster"
+                f"| {n}^2 | haarshift {k} | {ms:.2f} | {ms / base['opencv cubic']:.2f}x"
+                f" | {ms / base['opencv lanczos4']:.2f}x"
+                f" | {base['scipy order=3'] / ms:.1f}x faster |"
             )
-        if not ours:
-            print("  (no criterion results: run with --run-cargo)")
+    print(f"\nload average after: {os.getloadavg()}")
 
 
 if __name__ == "__main__":

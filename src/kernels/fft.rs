@@ -26,6 +26,13 @@ const PAD: usize = 32;
 /// the result of a real row stays real; an integer shift is an exact copy (the drivers copy
 /// those rows, and the phase ramp is 1 at a zero fraction).
 ///
+/// With [`Outside::Boundary`]`(`[`BoundaryMode::Wrap`]`)` the row is one period of a periodic
+/// signal, and the window is the row itself (`P` = the row's length): the shift is then the
+/// exact band-limited shift of that periodic signal, so successive shifts compose (up to
+/// rounding, and up to the Nyquist term, which shifts as `cos(pi x)`).
+///
+/// [`BoundaryMode::Wrap`]: crate::BoundaryMode::Wrap
+///
 /// ```
 /// use haarshift::kernels::{FftShift, Outside, shear_rows};
 /// use ndarray::Array2;
@@ -65,6 +72,11 @@ impl<T: Sample + FftNum> FftShift<T> {
         let mut planner = self.planner.lock().unwrap_or_else(|e| e.into_inner());
         (planner.plan_fft_forward(len), planner.plan_fft_inverse(len))
     }
+}
+
+/// Whether rows are single periods of periodic signals (see [`FftShift`]).
+fn is_periodic(outside: Outside) -> bool {
+    outside == Outside::Boundary(crate::BoundaryMode::Wrap)
 }
 
 /// The smallest `2^a 3^b 5^c >= n`.
@@ -151,11 +163,16 @@ impl<'k, T: Sample + FftNum> FftShifter<'k, T> {
 impl<T: Sample + FftNum> RowShifter<T> for FftShifter<'_, T> {
     fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
         let (k, f) = split_shift(shift);
-        let (lo, needed) = window(row.len(), out.len(), k);
-        if needed > self.len {
-            *self = FftShifter::new(self.kernel, fast_len(needed), self.outside);
+        let periodic = is_periodic(self.outside);
+        let (lo, len) = if periodic {
+            (0, row.len())
+        } else {
+            let (lo, needed) = window(row.len(), out.len(), k);
+            (lo, fast_len(needed).max(self.len))
+        };
+        if len != self.len {
+            *self = FftShifter::new(self.kernel, len, self.outside);
         }
-        let len = self.len;
         self.outside.extend_into(row, lo, &mut self.window);
         self.forward
             .process_with_scratch(&mut self.window, &mut self.spectrum, &mut self.scratch)
@@ -165,9 +182,21 @@ impl<T: Sample + FftNum> RowShifter<T> for FftShifter<'_, T> {
             .process_with_scratch(&mut self.spectrum, &mut self.window, &mut self.scratch)
             .expect("DC and Nyquist bins are real");
         let scale = <T as Sample>::from_f64(1.0 / len as f64);
-        let start = (-k - lo) as usize;
-        for (o, v) in out.iter_mut().zip(&self.window[start..]) {
-            *o = *v * scale;
+        if periodic {
+            // out[n] = y(n - k - f): the window shifted by f, read from n - k modulo the period.
+            let start = (-k).rem_euclid(len as isize) as usize;
+            let period = self.window[start..]
+                .iter()
+                .chain(&self.window[..start])
+                .cycle();
+            for (o, v) in out.iter_mut().zip(period) {
+                *o = *v * scale;
+            }
+        } else {
+            let start = (-k - lo) as usize;
+            for (o, v) in out.iter_mut().zip(&self.window[start..]) {
+                *o = *v * scale;
+            }
         }
     }
 }
@@ -184,6 +213,9 @@ impl<T: Sample + FftNum> ShearKernel<T> for FftShift<T> {
     }
 
     fn row_shifter(&self, g: RowGeometry, outside: Outside) -> Box<dyn RowShifter<T> + '_> {
+        if is_periodic(outside) {
+            return Box::new(FftShifter::new(self, g.len_in, outside));
+        }
         // The window length grows away from k = 0 both ways, so the extremes bound it.
         let needed = |shift: f64| window(g.len_in, g.len_out, split_shift(shift).0).1;
         let len = needed(g.min_shift).max(needed(g.max_shift));

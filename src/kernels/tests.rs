@@ -259,7 +259,7 @@ fn bsplines_evaluate_the_densely_solved_interpolant() {
 }
 
 #[test]
-fn fft_is_the_trigonometric_interpolant_of_the_padded_window() {
+fn fft_is_the_trigonometric_interpolant_of_the_padded_window_or_the_period() {
     let kernel = FftShift::<f64>::new();
     let mut seen_odd = false;
     let mut seen_even = false;
@@ -268,8 +268,13 @@ fn fft_is_the_trigonometric_interpolant_of_the_padded_window() {
         |row, s, rule, len| {
             let k = s.floor() as isize;
             let f = s - k as f64;
-            let (lo, needed) = window(row.len(), len, k);
-            let p = fast_len(needed);
+            // With wrap the window is the row itself (one period); otherwise the padded window.
+            let (lo, p) = if rule == Outside::Boundary(BoundaryMode::Wrap) {
+                (0, row.len())
+            } else {
+                let (lo, needed) = window(row.len(), len, k);
+                (lo, fast_len(needed))
+            };
             seen_odd |= !p.is_multiple_of(2);
             seen_even |= p.is_multiple_of(2);
             let x: Vec<f64> = (0..p as isize).map(|m| rule.sample(row, lo + m)).collect();
@@ -459,4 +464,23 @@ fn grouped_rows_equal_single_rows() {
     let mut rng = StdRng::seed_from_u64(8);
     check::<f32>(&mut rng);
     check::<f64>(&mut rng);
+}
+
+/// With wrap, FFT shifts compose: sixteen shifts by 7.3 / 16 equal one by 7.3 for a row without
+/// a Nyquist component (the odd length has none).
+#[test]
+fn periodic_fft_shifts_compose() {
+    let kernel = FftShift::<f64>::new();
+    let mut rng = StdRng::seed_from_u64(9);
+    let row = Array2::from_shape_vec((1, 37), random_row(&mut rng, 37)).unwrap();
+    let wrap = Outside::Boundary(BoundaryMode::Wrap);
+    let once = shear_rows(row.view(), 37, &[7.3], &kernel, wrap).unwrap();
+    let mut chained = row.clone();
+    for _ in 0..16 {
+        chained = shear_rows(chained.view(), 37, &[7.3 / 16.0], &kernel, wrap).unwrap();
+    }
+    let err = (&once - &chained)
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(err < 1e-13, "{err}");
 }
