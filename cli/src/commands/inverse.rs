@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use haarshift::io::{CoefficientFile, ReadOptions, StoredCoefficients};
 use haarshift::{Result, SampleDepth};
 
-use super::{TransformFlags, choice, names, refuse_overwriting_input, write_and_report};
+use super::{ImageOutput, TransformFlags, choice, names};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -29,9 +29,8 @@ pub struct Args {
     /// Coefficient file (.npy, C x H x W or H x W) written by `haarshift transform`
     pub input: PathBuf,
 
-    /// Image to write; the format follows the extension: .png, .jpg, .tif, .exr, .hdr, .npy
-    #[arg(short, long, value_name = "OUTPUT")]
-    pub output: PathBuf,
+    #[command(flatten)]
+    pub output: ImageOutput,
 
     #[command(flatten)]
     pub transform: TransformFlags,
@@ -40,16 +39,11 @@ pub struct Args {
     /// f16/f32 for EXR; f32/f64 for .npy) [default: the depth recorded in the sidecar]
     #[arg(long, value_parser = choice::<SampleDepth>(names!(SampleDepth)))]
     pub depth: Option<SampleDepth>,
-
-    /// Replace the output if it exists
-    #[arg(long)]
-    pub force: bool,
 }
 
 pub fn run(args: Args) -> Result<()> {
     let sidecar = CoefficientFile::<f64>::sidecar_path(&args.input);
-    refuse_overwriting_input(&args.input, &[&args.output])?;
-    refuse_overwriting_input(&sidecar, &[&args.output])?;
+    args.output.refuse_overwriting(&[&args.input, &sidecar])?;
     let stored = StoredCoefficients::read(&args.input, &ReadOptions::default())?;
     if stored.metadata.is_none() {
         let (_, h, w) = stored.array.dim();
@@ -62,5 +56,5 @@ pub fn run(args: Args) -> Result<()> {
     }
     let coefficients = stored.resolve(&args.transform.request())?;
     let image = coefficients.inverse().map_err(|e| e.in_file(&args.input))?;
-    write_and_report(&image, &args.output, args.force, args.depth, "")
+    args.output.write(&image, args.depth, "")
 }

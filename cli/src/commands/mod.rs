@@ -74,28 +74,48 @@ impl TransformFlags {
     }
 }
 
-/// Writes `image` to `output` (atomically; replaced only with `force`; stored at `depth` when
-/// given) and prints `OUTPUT: W x H CHANNELS image` followed by `what` (", rotated by ...").
-pub fn write_and_report<T: haarshift::Sample>(
-    image: &haarshift::PlanarImage<T>,
-    output: &Path,
-    force: bool,
-    depth: Option<haarshift::SampleDepth>,
-    what: &str,
-) -> Result<()> {
-    let options = haarshift::io::WriteOptions {
-        force,
-        depth,
-        ..Default::default()
-    };
-    haarshift::io::write_image(image, output, options)?;
-    print(&format!(
-        "{}: {} x {} {} image{what}\n",
-        output.display(),
-        image.width(),
-        image.height(),
-        image.channels()
-    ))
+/// Where a command that makes one image writes it.
+#[derive(clap::Args, Debug)]
+pub struct ImageOutput {
+    /// Image to write; the format follows the extension: .png, .jpg, .tif, .exr, .hdr, .npy
+    #[arg(short, long, value_name = "OUTPUT")]
+    pub output: PathBuf,
+
+    /// Replace the output if it exists
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl ImageOutput {
+    /// Refuses an output that is the file `input` (or any of `inputs`).
+    pub fn refuse_overwriting(&self, inputs: &[&Path]) -> Result<()> {
+        inputs
+            .iter()
+            .try_for_each(|input| refuse_overwriting_input(input, &[&self.output]))
+    }
+
+    /// Writes `image` (atomically; replaced only with `--force`; stored at `depth` when given)
+    /// and prints `OUTPUT: W x H CHANNELS image` followed by `what` (", rotated by ...").
+    pub fn write<T: haarshift::Sample>(
+        &self,
+        image: &haarshift::PlanarImage<T>,
+        depth: Option<haarshift::SampleDepth>,
+        what: &str,
+    ) -> Result<()> {
+        let options = haarshift::io::WriteOptions {
+            force: self.force,
+            depth,
+            ..Default::default()
+        };
+        haarshift::io::write_image(image, &self.output, options)?;
+        print(&format!(
+            "{}: {} x {} {} image{what}\n",
+            self.output.display(),
+            image.width(),
+            image.height(),
+            image.channels()
+        ))
+    }
 }
 
 /// Writes `text` to standard output; a closed pipe (`haarshift info x | head -1`) is not an

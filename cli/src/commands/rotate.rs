@@ -8,7 +8,7 @@ use haarshift::rotate::{Canvas, RotateOptions, rotate_image};
 use haarshift::{BoundaryMode, Result, SampleDepth};
 
 use super::method::MethodFlags;
-use super::{choice, names, refuse_overwriting_input, write_and_report};
+use super::{ImageOutput, choice, names};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -46,9 +46,8 @@ pub struct Args {
     /// Image to rotate: PNG, JPEG, TIFF, OpenEXR, .hdr or a .npy array
     pub input: PathBuf,
 
-    /// Image to write; the format follows the extension
-    #[arg(short, long, value_name = "OUTPUT")]
-    pub output: PathBuf,
+    #[command(flatten)]
+    pub output: ImageOutput,
 
     /// Angle in degrees, counter-clockwise as displayed (negative: clockwise)
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
@@ -85,14 +84,10 @@ pub struct Args {
     /// f16/f32 for EXR; f32/f64 for .npy)
     #[arg(long, value_parser = choice::<SampleDepth>(names!(SampleDepth)))]
     pub depth: Option<SampleDepth>,
-
-    /// Replace the output if it exists
-    #[arg(long)]
-    pub force: bool,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    refuse_overwriting_input(&args.input, &[&args.output])?;
+    args.output.refuse_overwriting(&[&args.input])?;
     let (method, kernel_options) = args.method.resolve(ShiftMethod::BSpline3)?;
     let kernel = method.kernel_with::<f64>(&kernel_options)?;
     let options = RotateOptions {
@@ -107,5 +102,5 @@ pub fn run(args: Args) -> Result<()> {
     let image = read_image::<f64>(&args.input)?;
     let rotated = rotate_image(&image, args.angle, kernel.as_ref(), &options)?;
     let what = format!(", rotated by {} degrees with {}", args.angle, kernel.name());
-    write_and_report(&rotated, &args.output, args.force, args.depth, &what)
+    args.output.write(&rotated, args.depth, &what)
 }

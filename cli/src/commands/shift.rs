@@ -11,7 +11,7 @@ use haarshift::{BoundaryMode, Error, Result};
 use ndarray::{Array2, ArrayView2, s};
 
 use super::method::MethodFlags;
-use super::{choice, names, refuse_overwriting_input, write_and_report};
+use super::{ImageOutput, choice, names};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -47,9 +47,8 @@ pub struct Args {
     /// Image to shift: PNG, JPEG, TIFF, OpenEXR, .hdr or a .npy array
     pub input: PathBuf,
 
-    /// Image to write; the format follows the extension
-    #[arg(short, long, value_name = "OUTPUT")]
-    pub output: PathBuf,
+    #[command(flatten)]
+    pub output: ImageOutput,
 
     /// Columns to move by (positive: right)
     #[arg(long, value_name = "F", allow_negative_numbers = true)]
@@ -72,14 +71,10 @@ pub struct Args {
     /// [default: wrap]
     #[arg(long, value_parser = choice::<BoundaryMode>(names!(BoundaryMode)))]
     pub boundary: Option<BoundaryMode>,
-
-    /// Replace the output if it exists
-    #[arg(long)]
-    pub force: bool,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    refuse_overwriting_input(&args.input, &[&args.output])?;
+    args.output.refuse_overwriting(&[&args.input])?;
     let (method, options) = args.method.resolve(ShiftMethod::Haar)?;
     let boundary = args.boundary.unwrap_or(BoundaryMode::Wrap);
     let (dx, dy) = (args.dx, args.dy);
@@ -98,7 +93,7 @@ pub fn run(args: Args) -> Result<()> {
         image.map_planes(|p| shift_plane(p, dx, dy, kernel.as_ref(), outside))?
     };
     let what = format!(", shifted by ({dx}, {dy}) with {method}");
-    write_and_report(&shifted, &args.output, args.force, None, &what)
+    args.output.write(&shifted, None, &what)
 }
 
 /// One plane shifted in the Haar domain: compact (same size), or the retained `2^h`-finer
