@@ -104,31 +104,42 @@ pub(crate) fn window(len_in: usize, len_out: usize, k: isize) -> (isize, usize) 
     (lo, (hi - lo) as usize)
 }
 
-/// Multiplies the half spectrum of a length-`len` real signal by `e^{-2 pi i q f / len}`,
+/// Multiplies the half spectrum of a length-`len` real signal by `scale e^{-2 pi i q f / len}`,
 /// with the Nyquist bin (even `len`) shifted by `cos(pi f)` so the signal stays real.
+///
+/// The ramp is `seed_b * table_j` for bin `q = 64 b + j`: seeds from `sin_cos` every 64 bins
+/// and a table of the first 64 ramp values (by recurrence in f64, error far below `T`'s), so
+/// that the per-bin work is two independent complex products in `T`, which vectorise.
 pub(crate) fn apply_phase_ramp<T: Sample + FftNum>(
     spectrum: &mut [Complex<T>],
     len: usize,
     f: f64,
+    scale: f64,
 ) {
-    const RESEED: usize = 64;
+    const BLOCK: usize = 64;
     let even = len.is_multiple_of(2);
     let (ramped, nyquist) = spectrum.split_at_mut(if even { len / 2 } else { len / 2 + 1 });
     let step = -2.0 * PI * f / len as f64;
     let rot = Complex::new(step.cos(), step.sin());
-    for (block, chunk) in ramped.chunks_mut(RESEED).enumerate() {
-        // Re-seed the recurrence from sin/cos every few bins so its error stays at rounding.
-        let (s, c) = (step * (block * RESEED) as f64).sin_cos();
-        let mut w = Complex::new(c, s);
-        for v in chunk {
-            let x = Complex::new(v.re.as_f64(), v.im.as_f64()) * w;
-            *v = Complex::new(<T as Sample>::from_f64(x.re), <T as Sample>::from_f64(x.im));
-            w *= rot;
+    let mut table = [Complex::new(T::zero(), T::zero()); BLOCK];
+    let mut w = Complex::new(scale, 0.0);
+    for t in table.iter_mut() {
+        *t = Complex::new(<T as Sample>::from_f64(w.re), <T as Sample>::from_f64(w.im));
+        w *= rot;
+    }
+    for (block, chunk) in ramped.chunks_mut(BLOCK).enumerate() {
+        let (s, c) = (step * (block * BLOCK) as f64).sin_cos();
+        let seed = Complex::new(<T as Sample>::from_f64(c), <T as Sample>::from_f64(s));
+        for (v, t) in chunk.iter_mut().zip(&table) {
+            *v = *v * (seed * *t);
         }
     }
     ramped[0].im = T::zero();
     if let Some(v) = nyquist.first_mut() {
-        *v = Complex::new(v.re * <T as Sample>::from_f64((PI * f).cos()), T::zero());
+        *v = Complex::new(
+            v.re * <T as Sample>::from_f64((PI * f).cos() * scale),
+            T::zero(),
+        );
     }
 }
 
@@ -168,7 +179,15 @@ impl<T: Sample + FftNum> RowShifter<T> for FftShifter<'_, T> {
             (0, row.len())
         } else {
             let (lo, needed) = window(row.len(), out.len(), k);
-            (lo, fast_len(needed).max(self.len))
+            // Keep the current (larger) plan when the window fits.
+            (
+                lo,
+                if needed > self.len {
+                    fast_len(needed)
+                } else {
+                    self.len
+                },
+            )
         };
         if len != self.len {
             *self = FftShifter::new(self.kernel, len, self.outside);
@@ -177,11 +196,11 @@ impl<T: Sample + FftNum> RowShifter<T> for FftShifter<'_, T> {
         self.forward
             .process_with_scratch(&mut self.window, &mut self.spectrum, &mut self.scratch)
             .expect("buffer sizes come from the plan");
-        apply_phase_ramp(&mut self.spectrum, len, f);
+        // The inverse transform is unnormalised: its 1/len goes into the ramp.
+        apply_phase_ramp(&mut self.spectrum, len, f, 1.0 / len as f64);
         self.inverse
             .process_with_scratch(&mut self.spectrum, &mut self.window, &mut self.scratch)
             .expect("DC and Nyquist bins are real");
-        let scale = <T as Sample>::from_f64(1.0 / len as f64);
         if periodic {
             // out[n] = y(n - k - f): the window shifted by f, read from n - k modulo the period.
             let start = (-k).rem_euclid(len as isize) as usize;
@@ -190,13 +209,11 @@ impl<T: Sample + FftNum> RowShifter<T> for FftShifter<'_, T> {
                 .chain(&self.window[..start])
                 .cycle();
             for (o, v) in out.iter_mut().zip(period) {
-                *o = *v * scale;
+                *o = *v;
             }
         } else {
             let start = (-k - lo) as usize;
-            for (o, v) in out.iter_mut().zip(&self.window[start..]) {
-                *o = *v * scale;
-            }
+            out.copy_from_slice(&self.window[start..start + out.len()]);
         }
     }
 }
