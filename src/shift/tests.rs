@@ -9,6 +9,7 @@ use proptest::prelude::*;
 use super::dense::{self, shift_pyramid_in_strips};
 use super::*;
 use crate::Error;
+use crate::experiments::stability::chain::whole_shifts;
 use crate::transform::{Band, Band1d, Coefficients, Normalization, TransformSpec, haar1d, pyramid};
 
 const TOL: f64 = 1e-12;
@@ -189,18 +190,6 @@ fn bytes_image(h: usize, w: usize) -> Array2<f64> {
     Array2::from_shape_fn((h, w), |(i, j)| {
         ((i * 37 + j * j * 11 + i * j) % 256) as f64
     })
-}
-
-/// Deterministic pseudo-random whole shifts in `[-span, span)`, times `unit`.
-fn whole_shifts(count: usize, span: i64, unit: i64) -> Vec<(i64, i64)> {
-    let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state % (2 * span as u64)) as i64 - span
-    };
-    (0..count).map(|_| (next() * unit, next() * unit)).collect()
 }
 
 #[test]
