@@ -35,7 +35,7 @@ enum Command {
         #[command(subcommand)]
         command: commands::sphere::SphereCommand,
     },
-    /// Measure methods against ground truth: rotation cycle, shift chain, sphere
+    /// Measure methods against ground truth: rotation cycle, shift chain, sphere, stability
     Experiment {
         #[command(subcommand)]
         command: commands::experiment::ExperimentCommand,

@@ -164,3 +164,65 @@ fn shift_chain_with_integer_steps_is_exact_for_haar() {
         );
     }
 }
+
+#[test]
+fn stability_passes_every_check_and_writes_its_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    let camera = Path::new(env!("CARGO_MANIFEST_DIR")).join("../testdata/camera.png");
+    let json = dir.path().join("records.json");
+    let out = haarshift(&[
+        "experiment",
+        "stability",
+        "--quick",
+        "--image",
+        camera.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+        "--out-dir",
+        dir.path().to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let records: Vec<Value> =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(records.len() > 100, "{}", records.len());
+    assert!(stdout.contains(&format!("{n} of {n} checks passed", n = records.len())));
+    for r in &records {
+        for field in ["category", "check", "figure", "tolerance", "pass", "detail"] {
+            assert!(r.get(field).is_some(), "{field} missing in {r}");
+        }
+        assert_eq!(r["pass"], true, "{r}");
+    }
+    let find = |check: &str| records.iter().find(|r| r["check"] == check).unwrap();
+    let chain = find("whole shifts, 8-bit, average");
+    assert_eq!(chain["figure"], 0.0);
+    assert_eq!(chain["shifts"], 1000);
+    assert_eq!(find("NaN angle")["figure"], Value::Null);
+    // The CLI meters allocation: the refusals allocated (almost) nothing.
+    let refused = find("largest square within 4 GiB");
+    assert!(refused["figure"].as_f64().unwrap() < 1e6, "{refused}");
+    for file in ["stability.csv", "stability.json", "stability-drift.png"] {
+        assert!(dir.path().join(file).exists(), "{file}");
+    }
+}
+
+#[test]
+fn stability_refuses_a_small_photograph() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("small.png");
+    write_small_image(&image);
+    let out = haarshift(&[
+        "experiment",
+        "stability",
+        "--image",
+        image.to_str().unwrap(),
+        "--out-dir",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("at least 128x128"));
+}

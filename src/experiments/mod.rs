@@ -5,6 +5,7 @@
 //! * [`rotation_cycle`]: the seed's Table 2.2 protocol: rotate back to the start, measure.
 //! * [`kernel_cycle`]: the library's kernels in the rotation cycle; the default image set.
 //! * [`shift_chain`]: one shift against a chain of small ones (the seed's Table 3.1).
+//! * [`stability`]: the numerical extremes, each check with its figure, tolerance and verdict.
 //! * [`output`]: CSV, JSON and PNG files side by side, written atomically.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
 pub mod kernel_cycle;
@@ -13,4 +14,5 @@ pub mod pareto;
 pub mod plot;
 pub mod rotation_cycle;
 pub mod shift_chain;
+pub mod stability;
 pub mod table;

@@ -17,6 +17,10 @@
 //! 3. the approximation of the shifted image is transformed forward the remaining levels.
 //!
 //! The image never exists in main memory: coefficients are read once and written once.
+//!
+//! A whole shift first moves, without arithmetic, the bands of every fine level whose blocks
+//! divide it (see the [exactness rules](super#exactness)); only the remaining coarse block
+//! goes through the steps above.
 
 use ndarray::{Array1, Array2, ArrayView1, ArrayView2, ArrayViewMut1, ArrayViewMut2, Axis, s};
 use rayon::prelude::*;
@@ -55,6 +59,9 @@ pub struct ShiftWorkspace<T> {
     coarse_out: Vec<T>,
     /// 2D: per-task strip buffers.
     strips: Vec<StripBuffers<T>>,
+    /// 2D whole shifts: contiguous copies of the coarse block that is recomputed.
+    block_in: Vec<T>,
+    block_out: Vec<T>,
 }
 
 impl<T> Default for ShiftWorkspace<T> {
@@ -65,6 +72,8 @@ impl<T> Default for ShiftWorkspace<T> {
             coarse_in: Vec::new(),
             coarse_out: Vec::new(),
             strips: Vec::new(),
+            block_in: Vec::new(),
+            block_out: Vec::new(),
         }
     }
 }
@@ -140,12 +149,51 @@ pub(crate) fn shift_slice_in_place<T: Sample>(
     let n = data.len();
     haar1d::check_length(n, levels)?;
     let (q, frac) = shift.split(n)?;
+    let (data, levels, q) = if frac == 0 {
+        // Whole shift: the `t` finest levels (block sizes `2^s` dividing `q`) only move.
+        let t = rolled_levels(q, levels);
+        for s in 1..=t {
+            let len = n >> s;
+            data[len..2 * len].rotate_right(q >> s);
+        }
+        let coarse = n >> t;
+        if t == levels {
+            data[..coarse].rotate_right(q >> t);
+            return Ok(());
+        }
+        // The rest is the transform of the level-`t` approximation, shifted by `q / 2^t`.
+        (&mut data[..coarse], levels - t, q >> t)
+    } else {
+        (data, levels, q)
+    };
     let b = T::from_f64(shift.weight(frac));
     work.signal.clear();
     work.signal.extend_from_slice(data);
     haar1d::inverse_in_place(&mut work.signal, levels, norm, &mut work.scratch)?;
     gather_row(data, &work.signal, q, b);
     haar1d::forward_in_place(data, levels, norm, &mut work.scratch)
+}
+
+/// How many of the finest of `levels` levels a whole shift by `q` samples only permutes: those
+/// whose blocks (`2^s` samples at the `s`-th finest) divide `q`. There, the shifted
+/// coefficient at block `i` is the old one at block `i - q / 2^s` (periodically), because the
+/// shifted signal's block is exactly the old block moved: the module docs' exactness rule.
+fn rolled_levels(q: usize, levels: usize) -> usize {
+    (q.trailing_zeros() as usize).min(levels)
+}
+
+/// `dst[(r + dy) mod h][(c + dx) mod w] = src[r][c]`: a periodic 2D roll, copies only.
+fn roll_into<T: Copy>(src: ArrayView2<'_, T>, mut dst: ArrayViewMut2<'_, T>, dy: usize, dx: usize) {
+    let (h, w) = src.dim();
+    let (ky, kx) = (h - dy, w - dx);
+    dst.slice_mut(s![dy.., dx..])
+        .assign(&src.slice(s![..ky, ..kx]));
+    dst.slice_mut(s![dy.., ..dx])
+        .assign(&src.slice(s![..ky, kx..]));
+    dst.slice_mut(s![..dy, dx..])
+        .assign(&src.slice(s![ky.., ..kx]));
+    dst.slice_mut(s![..dy, ..dx])
+        .assign(&src.slice(s![ky.., kx..]));
 }
 
 /// Writes the transform of the shifted 1D signal into `out`, allocating nothing once `work`
@@ -434,11 +482,78 @@ pub fn shift_pyramid_into<T: Sample>(
     norm: Normalization,
     dx: GridShift,
     dy: GridShift,
-    out: ArrayViewMut2<'_, T>,
+    mut out: ArrayViewMut2<'_, T>,
     work: &mut ShiftWorkspace<T>,
 ) -> Result<()> {
-    let fine = strip_levels::<T>(coeffs.ncols(), levels);
-    shift_pyramid_in_strips(coeffs, levels, norm, (dx, dy), out, work, fine)
+    let (h, w) = coeffs.dim();
+    pyramid::check((h, w), levels)?;
+    check_output(out.dim(), out.is_standard_layout(), (h, w))?;
+    let (qy, fy) = dy.split(h)?;
+    let (qx, fx) = dx.split(w)?;
+    let t = if fy == 0 && fx == 0 {
+        rolled_levels(qy, levels).min(rolled_levels(qx, levels))
+    } else {
+        0
+    };
+    if t == 0 {
+        let fine = strip_levels::<T>(w, levels);
+        return shift_pyramid_in_strips(coeffs, levels, norm, (dx, dy), out, work, fine);
+    }
+    // Whole shift: the `t` finest levels' bands (blocks of `2^s x 2^s` dividing the shift)
+    // only move; see `rolled_levels`.
+    for s in 1..=t {
+        let (bh, bw) = (h >> s, w >> s);
+        let bands = [
+            s![..bh, bw..2 * bw],
+            s![bh..2 * bh, ..bw],
+            s![bh..2 * bh, bw..2 * bw],
+        ];
+        for band in bands {
+            roll_into(coeffs.slice(band), out.slice_mut(band), qy >> s, qx >> s);
+        }
+    }
+    let (ch, cw) = (h >> t, w >> t);
+    let (cy, cx) = (qy >> t, qx >> t);
+    if t == levels {
+        roll_into(
+            coeffs.slice(s![..ch, ..cw]),
+            out.slice_mut(s![..ch, ..cw]),
+            cy,
+            cx,
+        );
+        return Ok(());
+    }
+    // The top-left block is the transform of the level-`t` approximation, shifted by
+    // `(cx, cy)`: through the strip path on contiguous copies.
+    let mut block_in = std::mem::take(&mut work.block_in);
+    let mut block_out = std::mem::take(&mut work.block_out);
+    block_in.resize(ch * cw, T::zero());
+    block_out.resize(ch * cw, T::zero());
+    view2_mut(&mut block_in, ch, cw).assign(&coeffs.slice(s![..ch, ..cw]));
+    let shifted = shift_pyramid_in_strips(
+        view2(&block_in, ch, cw),
+        levels - t,
+        norm,
+        (GridShift::whole(cx as i64), GridShift::whole(cy as i64)),
+        view2_mut(&mut block_out, ch, cw),
+        work,
+        strip_levels::<T>(cw, levels - t),
+    );
+    out.slice_mut(s![..ch, ..cw])
+        .assign(&view2(&block_out, ch, cw));
+    (work.block_in, work.block_out) = (block_in, block_out);
+    shifted
+}
+
+/// Refuses an output that is not an `h x w` standard-layout array.
+fn check_output(dim: (usize, usize), standard: bool, (h, w): (usize, usize)) -> Result<()> {
+    if dim != (h, w) || !standard {
+        return Err(Error::shape(
+            &[dim.0, dim.1],
+            format!("output must be a {h}x{w} standard-layout array"),
+        ));
+    }
+    Ok(())
 }
 
 /// [`shift_pyramid_into`] with `fine` levels done inside strips (`fine <= levels`); exposed to
@@ -454,12 +569,7 @@ pub(crate) fn shift_pyramid_in_strips<T: Sample>(
 ) -> Result<()> {
     let (h, w) = coeffs.dim();
     pyramid::check((h, w), levels)?;
-    if out.dim() != (h, w) || !out.is_standard_layout() {
-        return Err(Error::shape(
-            &[out.nrows(), out.ncols()],
-            format!("output must be a {h}x{w} standard-layout array"),
-        ));
-    }
+    check_output(out.dim(), out.is_standard_layout(), (h, w))?;
     let (qy, fy) = dy.split(h)?;
     let (qx, fx) = dx.split(w)?;
     let coeffs = coeffs.as_standard_layout();

@@ -9,6 +9,7 @@ use proptest::prelude::*;
 use super::dense::{self, shift_pyramid_in_strips};
 use super::*;
 use crate::Error;
+use crate::experiments::stability::chain::whole_shifts;
 use crate::transform::{Band, Band1d, Coefficients, Normalization, TransformSpec, haar1d, pyramid};
 
 const TOL: f64 = 1e-12;
@@ -50,6 +51,14 @@ fn check_2d(c: ArrayView2<'_, f64>, levels: usize, norm: Normalization, dx: i64,
             c.dim()
         );
     }
+    // The public entry: bands whose blocks divide the shift are rolled, the rest in strips.
+    dense::shift_pyramid_into(c, levels, norm, dx, dy, out.view_mut(), &mut work).unwrap();
+    let err = max_diff(&out, &want);
+    assert!(
+        err < TOL,
+        "{:?} k={levels} {norm} {dx:?} {dy:?}: {err}",
+        c.dim()
+    );
     let query = ShiftQuery2d::new(c, levels, norm).unwrap();
     let all = query.coarse(dx, dy, levels).unwrap();
     let err = max_diff(&all, &want);
@@ -163,6 +172,112 @@ fn large_image_uses_the_coarse_stage_and_f32_matches() {
     let got32 = dense::shift_pyramid(c32.view(), levels, Normalization::Average, dx, dy).unwrap();
     let err = max_diff(&got32.mapv(f64::from), &want);
     assert!(err < 1e-4, "f32 error {err}");
+}
+
+/// `x` rolled periodically: `out[r][c] = x[r - dy][c - dx]`.
+fn roll_2d(x: ArrayView2<'_, f64>, dx: i64, dy: i64) -> Array2<f64> {
+    let (h, w) = (x.nrows() as i64, x.ncols() as i64);
+    Array2::from_shape_fn(x.dim(), |(r, c)| {
+        x[[
+            (r as i64 - dy).rem_euclid(h) as usize,
+            (c as i64 - dx).rem_euclid(w) as usize,
+        ]]
+    })
+}
+
+/// 8-bit values (integers 0..=255), irregular.
+fn bytes_image(h: usize, w: usize) -> Array2<f64> {
+    Array2::from_shape_fn((h, w), |(i, j)| {
+        ((i * 37 + j * j * 11 + i * j) % 256) as f64
+    })
+}
+
+#[test]
+fn whole_shifts_by_multiples_of_the_block_only_move_coefficients() {
+    // Arbitrary (non-dyadic) data: bit-exactness can only come from moving coefficients.
+    let x = image(32, 64, 3).mapv(|v| v * std::f64::consts::PI);
+    for &norm in Normalization::ALL {
+        for levels in 0..=5 {
+            let c = pyramid::forward(x.view(), levels, norm).unwrap();
+            let unit = 1i64 << levels;
+            let (dx, dy) = (3 * unit, -5 * unit);
+            let got = dense::shift_pyramid(
+                c.view(),
+                levels,
+                norm,
+                GridShift::whole(dx),
+                GridShift::whole(dy),
+            )
+            .unwrap();
+            let want = pyramid::forward(roll_2d(x.view(), dx, dy).view(), levels, norm).unwrap();
+            assert_eq!(got, want, "{norm} k={levels}");
+        }
+        // Shift (4, 12) with 5 levels: the two finest levels are rolled bit for bit, the
+        // coarse 8x16 block is recomputed.
+        let c = pyramid::forward(x.view(), 5, norm).unwrap();
+        let got =
+            dense::shift_pyramid(c.view(), 5, norm, GridShift::whole(4), GridShift::whole(12))
+                .unwrap();
+        let want = pyramid::forward(roll_2d(x.view(), 4, 12).view(), 5, norm).unwrap();
+        let fine_bands = |a: &Array2<f64>| {
+            let mut v = a.slice(s![8.., ..]).to_owned().into_raw_vec_and_offset().0;
+            v.extend(a.slice(s![..8, 16..]).iter());
+            v
+        };
+        assert_eq!(fine_bands(&got), fine_bands(&want), "{norm}");
+        assert!(max_diff(&got, &want) < TOL);
+    }
+    // 1D: a shift by a multiple of 2^levels permutes the whole transform.
+    let v = signal(64, 4).mapv(|v| v / 3.0);
+    for &norm in Normalization::ALL {
+        let c = haar1d::forward(v.view(), 3, norm).unwrap();
+        let got = dense::shift_signal(c.view(), 3, norm, GridShift::whole(-24)).unwrap();
+        let rolled = Array1::from_shape_fn(64, |i| v[(i + 24) % 64]);
+        assert_eq!(
+            got,
+            haar1d::forward(rolled.view(), 3, norm).unwrap(),
+            "{norm}"
+        );
+    }
+}
+
+#[test]
+fn chains_of_whole_shifts_are_bit_exact_where_the_arithmetic_is() {
+    // 8-bit data, average normalisation or the 2D orthonormal pyramid (factors 1/4 and 1/2):
+    // every intermediate is a short dyadic rational, so any chain equals one roll exactly.
+    let x = bytes_image(64, 32);
+    let shifts = whole_shifts(300, 70, 1);
+    let (tx, ty) = shifts
+        .iter()
+        .fold((0, 0), |(a, b), &(dx, dy)| (a + dx, b + dy));
+    for &norm in Normalization::ALL {
+        let spec = TransformSpec {
+            normalization: norm,
+            ..Default::default()
+        };
+        let mut c = spec.forward(x.view()).unwrap();
+        for &(dx, dy) in &shifts {
+            c = shift_image(&c, dx as f64, dy as f64, 0).unwrap();
+        }
+        let want = spec.forward(roll_2d(x.view(), tx, ty).view()).unwrap();
+        assert_eq!(c.as_array(), want.as_array(), "{norm}");
+    }
+    // Arbitrary floats, shifts by multiples of 2^levels: a pure permutation, any data.
+    let y = image(64, 32, 8).mapv(|v| v.exp());
+    let spec = TransformSpec {
+        levels: crate::transform::Levels::Count(3),
+        ..Default::default()
+    };
+    let shifts = whole_shifts(300, 9, 8);
+    let (tx, ty) = shifts
+        .iter()
+        .fold((0, 0), |(a, b), &(dx, dy)| (a + dx, b + dy));
+    let mut c = spec.forward(y.view()).unwrap();
+    for &(dx, dy) in &shifts {
+        c = shift_image(&c, dx as f64, dy as f64, 0).unwrap();
+    }
+    let want = spec.forward(roll_2d(y.view(), tx, ty).view()).unwrap();
+    assert_eq!(c.as_array(), want.as_array());
 }
 
 /// The compact fractional shift, computed independently in the pixel domain: periodic linear

@@ -19,6 +19,7 @@ use serde::Serialize;
 pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod sphere;
+pub mod stability;
 
 /// The experiments.
 #[derive(Subcommand)]
@@ -26,6 +27,7 @@ pub enum ExperimentCommand {
     RotationCycle(rotation_cycle::Args),
     ShiftChain(shift_chain::Args),
     Sphere(sphere::Args),
+    Stability(stability::Args),
 }
 
 /// Runs one experiment.
@@ -34,6 +36,7 @@ pub fn run(command: ExperimentCommand) -> Result<()> {
         ExperimentCommand::RotationCycle(args) => rotation_cycle::run(args),
         ExperimentCommand::ShiftChain(args) => shift_chain::run(args),
         ExperimentCommand::Sphere(args) => sphere::run(args),
+        ExperimentCommand::Stability(args) => stability::run(args),
     }
 }
 
