@@ -241,24 +241,44 @@ fn pad_with_mode<T: Sample>(
     Array2::from_shape_fn((rows.len(), cols.len()), |(r, c)| a[[rows[r], cols[c]]])
 }
 
-/// The quarter turns, the output size and whether shears are needed for `deg` on an `h x w`
-/// working grid with `granule` samples per pixel per axis (the expanded canvas is rounded in
-/// whole pixels).
+/// Everything about one rotation of an `h x w` working grid that does not need the samples:
+/// the quarter turns, the output size, and the shears' geometry, with the memory budget
+/// checked before anything is allocated. `granule` is the number of working samples per pixel
+/// per axis (the expanded canvas is rounded in whole pixels).
 struct GridRotation {
-    reduced: ReducedAngle,
+    quarter_turns: u8,
     out: (usize, usize),
-    sheared: bool,
+    /// `None` when the quarter turns alone give the output.
+    shears: Option<ShearGeometry>,
+}
+
+/// The three shears' amounts and the intermediate images' sizes.
+struct ShearGeometry {
+    /// The x-shear's factor `-tan(theta/2)` and the y-shear's `sin(theta)`.
+    a_x: f64,
+    s_y: f64,
+    /// Rows and columns of boundary-mode padding around the (quarter-turned) input.
+    pad: (usize, usize),
+    /// Columns of the intermediate images and the integer margin of the first shear.
+    w_b: usize,
+    margin: f64,
 }
 
 impl GridRotation {
-    fn new(dim: (usize, usize), deg: f64, granule: usize, options: &RotateOptions) -> Result<Self> {
+    fn new<T: Sample>(
+        dim: (usize, usize),
+        deg: f64,
+        granule: usize,
+        support_radius: usize,
+        options: &RotateOptions,
+    ) -> Result<Self> {
         let reduced = reduce_angle(deg)?;
         let (h1, w1) = if reduced.quarter_turns % 2 == 1 {
             (dim.1, dim.0)
         } else {
             dim
         };
-        let out = match options.canvas {
+        let (out_h, out_w) = match options.canvas {
             Canvas::Same => dim,
             Canvas::Expand => {
                 let (h, w) = expanded_size(h1 / granule, w1 / granule, reduced.residual_deg)?;
@@ -269,11 +289,64 @@ impl GridRotation {
                 )
             }
         };
-        Ok(GridRotation {
-            reduced,
-            out,
-            sheared: reduced.residual_deg != 0.0 || out != (h1, w1),
-        })
+        let mut rotation = GridRotation {
+            quarter_turns: reduced.quarter_turns,
+            out: (out_h, out_w),
+            shears: None,
+        };
+        if reduced.residual_deg == 0.0 && (out_h, out_w) == (h1, w1) {
+            return Ok(rotation);
+        }
+        let theta = reduced.residual_deg.to_radians();
+        let (a_x, s_y) = (-(theta / 2.0).tan(), theta.sin());
+        let (cx_out, cy_out) = ((out_w as f64 - 1.0) / 2.0, (out_h as f64 - 1.0) / 2.0);
+        let reach = support_radius.min(h1.max(w1)) as f64;
+
+        // With a boundary mode, the input is continued in 2D far enough that every position
+        // the output needs (its preimage plus the kernel's reach through three shears) lies
+        // inside.
+        let pad = match options.outside {
+            Outside::Boundary(mode) if mode != BoundaryMode::Zero => {
+                let (sin, cos) = (theta.sin().abs(), theta.cos().abs());
+                let pad = |half_extent: f64, centre: f64| {
+                    ((half_extent - centre).max(0.0) + 3.0 * reach + 2.0).ceil() as usize
+                };
+                let px = pad(cos * cx_out + sin * cy_out, (w1 as f64 - 1.0) / 2.0);
+                let py = pad(sin * cx_out + cos * cy_out, (h1 as f64 - 1.0) / 2.0);
+                check_budget::<T>(
+                    "padding for the boundary mode",
+                    ((h1 + 2 * py) * (w1 + 2 * px)) as u128,
+                    options.memory_budget,
+                )?;
+                (py, px)
+            }
+            _ => (0, 0),
+        };
+        let (h_a, w_a) = (h1 + 2 * pad.0, w1 + 2 * pad.1);
+        let (cx_a, cy_a) = ((w_a as f64 - 1.0) / 2.0, (h_a as f64 - 1.0) / 2.0);
+
+        // Columns of the two intermediate images (x in centred coordinates): what the last
+        // shear reads (x = X - a_x Y over the output) that the first shear can produce
+        // (x + a_x y over the input), plus the kernel's reach. Both ranges are symmetric
+        // about 0.
+        let need = cx_out + a_x.abs() * cy_out;
+        let content = cx_a + a_x.abs() * cy_a;
+        let half = need.min(content) + reach;
+        let margin = (half - cx_a).ceil(); // integer: keeps the first shift an exact integer at 0
+        let w_b = (half + cx_a + margin).floor() as usize + 1;
+        check_budget::<T>(
+            "the intermediate images of the rotation",
+            (h_a * w_a + w_b * h_a + out_h * w_b + out_h * out_w) as u128,
+            options.memory_budget,
+        )?;
+        rotation.shears = Some(ShearGeometry {
+            a_x,
+            s_y,
+            pad,
+            w_b,
+            margin,
+        });
+        Ok(rotation)
     }
 }
 
@@ -339,8 +412,15 @@ impl<T: Sample> RotationWorkspace<T> {
         kernel: &dyn ShearKernel<T>,
         options: &RotateOptions,
     ) -> Result<Array2<T>> {
-        let mut out = Array2::zeros(rotated_size(plane.nrows(), plane.ncols(), deg, options)?);
-        self.rotate_plane_into(plane, deg, kernel, options, out.view_mut())?;
+        if options.supersample > 0 || kernel.grid_exponent() > 0 {
+            return rotate_on_finer_grid(plane, deg, kernel, options);
+        }
+        validate_plane(plane, options)?;
+        let rotation =
+            GridRotation::new::<T>(plane.dim(), deg, 1, kernel.support_radius(), options)?;
+        let mut out = Array2::zeros(rotation.out);
+        let slice = out.as_slice_mut().expect("new array");
+        self.rotate_grid(plane, &rotation, kernel, options.outside, slice);
         Ok(out)
     }
 
@@ -360,24 +440,16 @@ impl<T: Sample> RotationWorkspace<T> {
                 format!("the rotated image is {}x{}", expected.0, expected.1),
             ));
         }
-        if options.supersample > 0 || kernel.grid_exponent() > 0 {
-            let mut chain = RotationChain::new(plane, kernel, *options)?;
-            chain.rotate(deg)?;
-            out.assign(&chain.finish());
+        if options.supersample > 0 || kernel.grid_exponent() > 0 || !out.is_standard_layout() {
+            out.assign(&self.rotate_plane(plane, deg, kernel, options)?);
             return Ok(());
         }
         validate_plane(plane, options)?;
-        let rotation = GridRotation::new(plane.dim(), deg, 1, options)?;
-        match out.as_slice_mut() {
-            Some(slice) => self.rotate_grid(plane, &rotation, kernel, options, slice),
-            None => {
-                let mut owned = Array2::zeros(expected);
-                let slice = owned.as_slice_mut().expect("new array");
-                self.rotate_grid(plane, &rotation, kernel, options, slice)?;
-                out.assign(&owned);
-                Ok(())
-            }
-        }
+        let rotation =
+            GridRotation::new::<T>(plane.dim(), deg, 1, kernel.support_radius(), options)?;
+        let slice = out.as_slice_mut().expect("standard layout");
+        self.rotate_grid(plane, &rotation, kernel, options.outside, slice);
+        Ok(())
     }
 
     /// Rotates the working-grid array `a` as `rotation` says into `out` (row-major, of the
@@ -387,66 +459,37 @@ impl<T: Sample> RotationWorkspace<T> {
         a: ArrayView2<'_, T>,
         rotation: &GridRotation,
         kernel: &dyn ShearKernel<T>,
-        options: &RotateOptions,
+        outside: Outside,
         out: &mut [T],
-    ) -> Result<()> {
-        let reduced = rotation.reduced;
-        let a1 = match reduced.quarter_turns {
+    ) {
+        let a1 = match rotation.quarter_turns {
             0 => CowArray::from(a),
             q => CowArray::from(quarter_turn(a, q)),
         };
-        let (h1, w1) = a1.dim();
-        let (out_h, out_w) = rotation.out;
-        if !rotation.sheared {
+        let Some(shears) = &rotation.shears else {
             out.copy_from_slice(a1.as_standard_layout().as_slice().expect("standard layout"));
-            return Ok(());
-        }
-        let theta = reduced.residual_deg.to_radians();
-        let (a_x, s_y) = (-(theta / 2.0).tan(), theta.sin());
-        let (cx_out, cy_out) = ((out_w as f64 - 1.0) / 2.0, (out_h as f64 - 1.0) / 2.0);
-        let reach = kernel.support_radius().min(h1.max(w1)) as f64;
-
-        // With a boundary mode, continue the input in 2D far enough that every position the
-        // output needs (its preimage plus the kernel's reach through three shears) lies inside.
-        let (a2, outside) = match options.outside {
-            Outside::Boundary(mode) if mode != BoundaryMode::Zero => {
-                let (sin, cos) = (theta.sin().abs(), theta.cos().abs());
-                let pad = |half_extent: f64, centre: f64| {
-                    ((half_extent - centre).max(0.0) + 3.0 * reach + 2.0).ceil() as usize
-                };
-                let px = pad(cos * cx_out + sin * cy_out, (w1 as f64 - 1.0) / 2.0);
-                let py = pad(sin * cx_out + cos * cy_out, (h1 as f64 - 1.0) / 2.0);
-                check_budget::<T>(
-                    "padding for the boundary mode",
-                    ((h1 + 2 * py) * (w1 + 2 * px)) as u128,
-                    options.memory_budget,
-                )?;
-                (
-                    CowArray::from(pad_with_mode(a1.view(), py, px, mode)),
-                    Outside::Boundary(mode),
-                )
-            }
+            return;
+        };
+        let (out_h, out_w) = rotation.out;
+        let (a2, outside) = match outside {
+            Outside::Boundary(mode) if mode != BoundaryMode::Zero => (
+                CowArray::from(pad_with_mode(a1.view(), shears.pad.0, shears.pad.1, mode)),
+                outside,
+            ),
             Outside::Boundary(_) => (a1, Outside::Fill(0.0)),
             fill => (a1, fill),
         };
         let (h_a, w_a) = a2.dim();
         let (cx_a, cy_a) = ((w_a as f64 - 1.0) / 2.0, (h_a as f64 - 1.0) / 2.0);
-
-        // Columns of the two intermediate images (x in centred coordinates): what the last
-        // shear reads (x = X - a_x Y over the output) that the first shear can produce
-        // (x + a_x y over the input), plus the kernel's reach. Both ranges are symmetric
-        // about 0.
-        let need = cx_out + a_x.abs() * cy_out;
-        let content = cx_a + a_x.abs() * cy_a;
-        let half = need.min(content) + reach;
-        let margin = (half - cx_a).ceil(); // integer: keeps the first shift an exact integer at 0
+        let (cx_out, cy_out) = ((out_w as f64 - 1.0) / 2.0, (out_h as f64 - 1.0) / 2.0);
+        let ShearGeometry {
+            a_x,
+            s_y,
+            w_b,
+            margin,
+            ..
+        } = *shears;
         let ox = cx_a + margin;
-        let w_b = (half + ox).floor() as usize + 1;
-        check_budget::<T>(
-            "the intermediate images of the rotation",
-            (h_a * w_a + w_b * h_a + out_h * w_b + out_h * out_w) as u128,
-            options.memory_budget,
-        )?;
 
         // x-shear: row r (y = cy_a - r) of A moves by a_x y; stored transposed (w_b x h_a).
         let shifts: Vec<f64> = (0..h_a).map(|r| margin + a_x * (cy_a - r as f64)).collect();
@@ -466,8 +509,19 @@ impl<T: Sample> RotationWorkspace<T> {
             .map(|r| (cx_out - ox) + a_x * (cy_out - r as f64))
             .collect();
         shear_pass_into(b2, out_w, &shifts, kernel, outside, false, out);
-        Ok(())
     }
+}
+
+/// One rotation on the `2^(supersample + grid exponent)`-finer grid, box-averaged back.
+fn rotate_on_finer_grid<T: Sample>(
+    plane: ArrayView2<'_, T>,
+    deg: f64,
+    kernel: &dyn ShearKernel<T>,
+    options: &RotateOptions,
+) -> Result<Array2<T>> {
+    let mut chain = RotationChain::new(plane, kernel, *options)?;
+    chain.rotate(deg)?;
+    Ok(chain.finish())
 }
 
 /// The size `(rows, cols)` of `h x w` image rotated by `deg` with `options`: the input's for
@@ -554,7 +608,13 @@ impl<'k, T: Sample> RotationChain<'k, T> {
     /// Rotates the working grid by `deg` (counter-clockwise as displayed).
     pub fn rotate(&mut self, deg: f64) -> Result<&mut Self> {
         let granule = 1usize << self.exponent;
-        let rotation = GridRotation::new(self.work.dim(), deg, granule, &self.options)?;
+        let rotation = GridRotation::new::<T>(
+            self.work.dim(),
+            deg,
+            granule,
+            self.kernel.support_radius(),
+            &self.options,
+        )?;
         let (h, w) = rotation.out;
         let mut out = std::mem::take(&mut self.spare);
         out.resize(h * w, T::zero());
@@ -562,9 +622,9 @@ impl<'k, T: Sample> RotationChain<'k, T> {
             self.work.view(),
             &rotation,
             self.kernel,
-            &self.options,
+            self.options.outside,
             &mut out,
-        )?;
+        );
         let out = Array2::from_shape_vec((h, w), out).expect("sized");
         self.spare = std::mem::replace(&mut self.work, out)
             .into_raw_vec_and_offset()
