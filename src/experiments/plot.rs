@@ -27,6 +27,33 @@ fn plot_error(e: impl std::fmt::Display) -> Error {
     Error::parameter("plot", e.to_string())
 }
 
+/// Draws one chart into an RGB image: the white canvas, the caption and the label areas are
+/// set up here, and `draw` builds the axes and series on the chart builder it is given.
+fn render_chart(
+    title: &str,
+    x_label_area: u32,
+    right_margin: u32,
+    draw: impl FnOnce(&mut ChartBuilder<'_, '_, BitMapBackend<'_>>) -> Result<()>,
+) -> Result<RgbImage> {
+    register_bundled_font();
+    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut builder = ChartBuilder::on(&root);
+        builder
+            .caption(title, ("sans-serif", 26))
+            .margin(20)
+            .margin_right(right_margin)
+            .x_label_area_size(x_label_area)
+            .y_label_area_size(70);
+        draw(&mut builder)?;
+        root.present().map_err(plot_error)?;
+    }
+    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
+        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+}
+
 /// A labelled point of a scatter plot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LabeledPoint {
@@ -96,19 +123,10 @@ pub fn log_log_scatter(
     points: &[LabeledPoint],
     frontier: &[LabeledPoint],
 ) -> Result<RgbImage> {
-    register_bundled_font();
     let x_range = log_range(points.iter().map(|p| p.x))?;
     let y_range = log_range(points.iter().map(|p| p.y))?;
-    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 26))
-            .margin(20)
-            .margin_right(150)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
+    render_chart(title, 50, 150, |builder| {
+        let mut chart = builder
             .build_cartesian_2d(log_axis(x_range), log_axis(y_range))
             .map_err(plot_error)?;
         chart
@@ -132,10 +150,8 @@ pub fn log_log_scatter(
                     + Text::new(p.label.clone(), (8, -8), ("sans-serif", 14))
             }))
             .map_err(plot_error)?;
-        root.present().map_err(plot_error)?;
-    }
-    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
-        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+        Ok(())
+    })
 }
 
 /// One named series of values, one per category, for [`category_points`]; `None` marks a
@@ -163,22 +179,14 @@ pub fn category_points(
     categories: &[String],
     series: &[Series],
 ) -> Result<RgbImage> {
-    register_bundled_font();
     let y_range = log_range(
         series
             .iter()
             .flat_map(|s| s.values.iter().flatten().copied()),
     )?;
     let n = categories.len().max(1);
-    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 26))
-            .margin(20)
-            .x_label_area_size(90)
-            .y_label_area_size(70)
+    render_chart(title, 90, 20, |builder| {
+        let mut chart = builder
             .build_cartesian_2d(-0.5f64..n as f64 - 0.5, log_axis(y_range))
             .map_err(plot_error)?;
         chart
@@ -221,10 +229,8 @@ pub fn category_points(
             .label_font(("sans-serif", 14))
             .draw()
             .map_err(plot_error)?;
-        root.present().map_err(plot_error)?;
-    }
-    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
-        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+        Ok(())
+    })
 }
 
 #[cfg(test)]
