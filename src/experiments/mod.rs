@@ -5,6 +5,7 @@
 //! * [`rotation_cycle`]: the seed's Table 2.2 protocol: rotate back to the start, measure.
 //! * [`kernel_cycle`]: the library's kernels in the rotation cycle; the default image set.
 //! * [`shift_chain`]: one shift against a chain of small ones (the seed's Table 3.1).
+//! * [`tradeoff`]: every kernel and parameter through the rotation cycle; Pareto frontiers.
 //! * [`output`]: CSV, JSON and PNG files side by side, written atomically.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
 pub mod kernel_cycle;
@@ -14,3 +15,4 @@ pub mod plot;
 pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod table;
+pub mod tradeoff;

@@ -19,6 +19,7 @@ use serde::Serialize;
 pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod sphere;
+pub mod tradeoff;
 
 /// The experiments.
 #[derive(Subcommand)]
@@ -26,6 +27,7 @@ pub enum ExperimentCommand {
     RotationCycle(rotation_cycle::Args),
     ShiftChain(shift_chain::Args),
     Sphere(sphere::Args),
+    Tradeoff(tradeoff::Args),
 }
 
 /// Runs one experiment.
@@ -34,6 +36,7 @@ pub fn run(command: ExperimentCommand) -> Result<()> {
         ExperimentCommand::RotationCycle(args) => rotation_cycle::run(args),
         ExperimentCommand::ShiftChain(args) => shift_chain::run(args),
         ExperimentCommand::Sphere(args) => sphere::run(args),
+        ExperimentCommand::Tradeoff(args) => tradeoff::run(args),
     }
 }
 
@@ -224,9 +227,13 @@ pub fn cycle_table(records: &[CycleRecord]) -> Table {
             significant(r.psnr, 4),
             significant(r.max_error, 3),
             significant(r.seconds, 2),
-            r.peak_bytes
-                .map_or_else(String::new, |b| significant(b as f64 / 1e6, 3)),
+            peak_megabytes(r.peak_bytes),
         ]);
     }
     table
+}
+
+/// A peak heap figure for a table: megabytes to 3 digits, blank when not measured.
+pub fn peak_megabytes(bytes: Option<u64>) -> String {
+    bytes.map_or_else(String::new, |b| significant(b as f64 / 1e6, 3))
 }
