@@ -18,6 +18,17 @@ fn haarshift(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// Runs the binary and asserts that it succeeded; returns its standard output.
+fn haarshift_ok(args: &[&str]) -> String {
+    let out = haarshift(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 /// A 40x24 gray test image with integer values (exactly representable in 8 bits).
 fn small_image() -> Array2<f64> {
     Array2::from_shape_fn((24, 40), |(i, j)| ((i * 7 + j * 13) % 256) as f64)
@@ -46,13 +57,7 @@ fn run_json(dir: &Path, extra: &[&str]) -> Vec<Value> {
         "--force",
     ];
     args.extend_from_slice(extra);
-    let out = haarshift(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = haarshift_ok(&args);
     assert!(stdout.contains("protocol: luma"), "{stdout}");
     assert!(out_dir.join("rotation-cycle.csv").exists());
     serde_json::from_str::<Value>(&std::fs::read_to_string(json).unwrap())
@@ -131,7 +136,7 @@ fn shift_chain_with_integer_steps_is_exact_for_haar() {
     let image = dir.path().join("small.png");
     write_small_image(&image);
     let json = dir.path().join("chain.json");
-    let out = haarshift(&[
+    haarshift_ok(&[
         "experiment",
         "shift-chain",
         image.to_str().unwrap(),
@@ -148,11 +153,6 @@ fn shift_chain_with_integer_steps_is_exact_for_haar() {
         "--out-dir",
         dir.path().join("r").to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let records: Vec<Value> =
         serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
     assert_eq!(records.len(), 2);
@@ -225,4 +225,156 @@ fn stability_refuses_a_small_photograph() {
     ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("at least 128x128"));
+}
+
+/// `q` dominates `p` on (cost, error): no worse in both, better in one.
+fn dominates(q: (f64, f64), p: (f64, f64)) -> bool {
+    q.0 <= p.0 && q.1 <= p.1 && (q.0 < p.0 || q.1 < p.1)
+}
+
+#[test]
+fn tradeoff_sweeps_every_parameter_and_flags_the_frontiers() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("small.png");
+    write_small_image(&image);
+    let json = dir.path().join("runs.json");
+    let out_dir = dir.path().join("r");
+    let stdout = haarshift_ok(&[
+        "experiment",
+        "tradeoff",
+        image.to_str().unwrap(),
+        "--methods",
+        "linear,fft,haar",
+        "--max-precision",
+        "1",
+        "--max-retained-precision",
+        "1",
+        "--max-supersample",
+        "1",
+        "--steps",
+        "6",
+        "--json",
+        json.to_str().unwrap(),
+        "--out-dir",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("9 configurations, 1 images"), "{stdout}");
+    assert!(stdout.contains("small.png (24)"), "{stdout}");
+
+    // Per image and configuration: the issue's fields, parameters in their own fields.
+    let runs: Vec<Value> = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    let configs: Vec<(String, Value, Value, u64)> = runs
+        .iter()
+        .map(|r| {
+            for field in [
+                "image",
+                "rms",
+                "psnr",
+                "max_error",
+                "seconds",
+                "peak_bytes",
+                "time_frontier",
+                "memory_frontier",
+            ] {
+                assert!(r.get(field).is_some(), "missing {field} in {r}");
+            }
+            assert_eq!(r["image"], "small.png");
+            assert_eq!(r["crop"], 24);
+            (
+                r["method"].as_str().unwrap().to_owned(),
+                r["precision"].clone(),
+                r["retain"].clone(),
+                r["supersample"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    let (n, t, f) = (Value::Null, Value::Bool(true), Value::Bool(false));
+    let h = |v: u32| Value::from(v);
+    let want = vec![
+        ("linear".into(), n.clone(), n.clone(), 0),
+        ("linear".into(), n.clone(), n.clone(), 1),
+        ("fft".into(), n.clone(), n.clone(), 0),
+        ("fft".into(), n.clone(), n.clone(), 1),
+        ("haar".into(), h(0), f.clone(), 0),
+        ("haar".into(), h(0), f.clone(), 1),
+        ("haar".into(), h(1), f.clone(), 0),
+        ("haar".into(), h(1), f.clone(), 1),
+        ("haar".into(), h(1), t.clone(), 0),
+    ];
+    assert_eq!(configs, want);
+
+    // The summary: one image, so its figures are the run's; flags by brute force.
+    let summary: Vec<Value> =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("tradeoff.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary.len(), runs.len());
+    let figure = |v: &Value, key: &str| v[key].as_f64().unwrap();
+    let by_time: Vec<(f64, f64)> = summary
+        .iter()
+        .map(|p| (figure(p, "total_seconds"), figure(p, "mean_rms")))
+        .collect();
+    let by_memory: Vec<(f64, f64)> = summary
+        .iter()
+        .map(|p| (figure(p, "peak_bytes"), figure(p, "mean_rms")))
+        .collect();
+    for (i, (p, r)) in summary.iter().zip(&runs).enumerate() {
+        assert_eq!(p["images"], 1);
+        assert_eq!(figure(p, "mean_rms"), figure(r, "rms"));
+        assert_eq!(figure(p, "total_seconds"), figure(r, "seconds"));
+        assert_eq!(p["peak_bytes"], r["peak_bytes"]);
+        for (flag, points) in [("time_frontier", &by_time), ("memory_frontier", &by_memory)] {
+            let undominated = !points.iter().any(|&q| dominates(q, points[i]));
+            let first = points[..i].iter().all(|&q| q != points[i]);
+            assert_eq!(p[flag], Value::Bool(undominated && first), "{flag} {p}");
+            assert_eq!(p[flag], r[flag], "{flag}: the run carries its point's flag");
+        }
+    }
+    assert!(by_time.iter().all(|&(s, rms)| s > 0.0 && rms > 0.0));
+    // The most accurate configuration is on both frontiers.
+    let best = (0..summary.len())
+        .min_by(|&a, &b| by_time[a].1.total_cmp(&by_time[b].1))
+        .unwrap();
+    assert_eq!(
+        (
+            &summary[best]["time_frontier"],
+            &summary[best]["memory_frontier"]
+        ),
+        (&t, &t)
+    );
+
+    for file in [
+        "tradeoff.csv",
+        "tradeoff-runs.csv",
+        "tradeoff-runs.json",
+        "tradeoff-rms-time.png",
+        "tradeoff-rms-memory.png",
+    ] {
+        let bytes = std::fs::read(out_dir.join(file)).unwrap();
+        assert!(bytes.len() > 100, "{file}");
+        if file.ends_with(".png") {
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{file}");
+        }
+    }
+    let csv = std::fs::read_to_string(out_dir.join("tradeoff.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + summary.len());
+}
+
+#[test]
+fn tradeoff_refuses_an_empty_grid_and_a_bad_size() {
+    for extra in [
+        &[
+            "--methods",
+            "haar-retained",
+            "--max-retained-precision",
+            "0",
+        ][..],
+        &["--size", "2"][..],
+        &["--size", "big"][..],
+    ] {
+        let mut args = vec!["experiment", "tradeoff"];
+        args.extend_from_slice(extra);
+        let out = haarshift(&args);
+        assert!(!out.status.success(), "{extra:?}");
+        assert!(!out.stderr.is_empty());
+    }
 }

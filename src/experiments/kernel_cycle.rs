@@ -120,6 +120,34 @@ impl NamedPlane {
             plane: luma(&image),
         })
     }
+
+    /// The centred `side x side` crop (each axis cropped only where it is longer than
+    /// `side`), under the same name: the rotation-cycle protocol then works on a crop of side
+    /// `min(side, height, width)`, the cheaper run the trade-off experiment makes by default.
+    ///
+    /// ```
+    /// use haarshift::experiments::kernel_cycle::NamedPlane;
+    /// use ndarray::Array2;
+    /// let p = NamedPlane { name: "p".into(), plane: Array2::from_shape_fn((4, 6), |(i, j)| (10 * i + j) as f64) };
+    /// let c = p.centre_crop(2).unwrap();
+    /// assert_eq!(c.plane, ndarray::array![[12.0, 13.0], [22.0, 23.0]]);
+    /// assert_eq!(p.centre_crop(5).unwrap().plane.dim(), (4, 5));
+    /// ```
+    pub fn centre_crop(&self, side: usize) -> Result<NamedPlane> {
+        if side == 0 {
+            return Err(Error::parameter("crop size", "must be at least 1"));
+        }
+        let (h, w) = self.plane.dim();
+        let (ch, cw) = (h.min(side), w.min(side));
+        let (top, left) = ((h - ch) / 2, (w - cw) / 2);
+        Ok(NamedPlane {
+            name: self.name.clone(),
+            plane: self
+                .plane
+                .slice(ndarray::s![top..top + ch, left..left + cw])
+                .to_owned(),
+        })
+    }
 }
 
 /// The synthetic images of the default set: a 300x200 zone plate (non-square, rising to

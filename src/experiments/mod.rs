@@ -6,6 +6,7 @@
 //! * [`kernel_cycle`]: the library's kernels in the rotation cycle; the default image set.
 //! * [`shift_chain`]: one shift against a chain of small ones (the seed's Table 3.1).
 //! * [`stability`]: the numerical extremes, each check with its figure, tolerance and verdict.
+//! * [`tradeoff`]: every kernel and parameter through the rotation cycle; Pareto frontiers.
 //! * [`output`]: CSV, JSON and PNG files side by side, written atomically.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
 pub mod kernel_cycle;
@@ -16,3 +17,4 @@ pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod stability;
 pub mod table;
+pub mod tradeoff;

@@ -27,6 +27,33 @@ fn plot_error(e: impl std::fmt::Display) -> Error {
     Error::parameter("plot", e.to_string())
 }
 
+/// Draws one chart into an RGB image: the white canvas, the caption and the label areas are
+/// set up here, and `draw` builds the axes and series on the chart builder it is given.
+fn render_chart(
+    title: &str,
+    x_label_area: u32,
+    right_margin: u32,
+    draw: impl FnOnce(&mut ChartBuilder<'_, '_, BitMapBackend<'_>>) -> Result<()>,
+) -> Result<RgbImage> {
+    register_bundled_font();
+    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut builder = ChartBuilder::on(&root);
+        builder
+            .caption(title, ("sans-serif", 26))
+            .margin(20)
+            .margin_right(right_margin)
+            .x_label_area_size(x_label_area)
+            .y_label_area_size(70);
+        draw(&mut builder)?;
+        root.present().map_err(plot_error)?;
+    }
+    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
+        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+}
+
 /// A labelled point of a scatter plot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LabeledPoint {
@@ -96,19 +123,10 @@ pub fn log_log_scatter(
     points: &[LabeledPoint],
     frontier: &[LabeledPoint],
 ) -> Result<RgbImage> {
-    register_bundled_font();
     let x_range = log_range(points.iter().map(|p| p.x))?;
     let y_range = log_range(points.iter().map(|p| p.y))?;
-    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 26))
-            .margin(20)
-            .margin_right(150)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
+    render_chart(title, 50, 150, |builder| {
+        let mut chart = builder
             .build_cartesian_2d(log_axis(x_range), log_axis(y_range))
             .map_err(plot_error)?;
         chart
@@ -126,16 +144,81 @@ pub fn log_log_scatter(
             .draw_series(LineSeries::new(sorted, RED.stroke_width(2)))
             .map_err(plot_error)?;
         chart
-            .draw_series(points.iter().map(|p| {
-                EmptyElement::at((p.x, p.y))
-                    + Circle::new((0, 0), 5, BLUE.filled())
-                    + Text::new(p.label.clone(), (8, -8), ("sans-serif", 14))
+            .draw_series(
+                points
+                    .iter()
+                    .map(|p| Circle::new((p.x, p.y), 5, BLUE.filled())),
+            )
+            .map_err(plot_error)?;
+        // Labels where they cover no other label or point; frontier points' labels first.
+        let style: TextStyle = ("sans-serif", 14).into();
+        let anchors: Vec<(i32, i32)> = points
+            .iter()
+            .map(|p| chart.backend_coord(&(p.x, p.y)))
+            .collect();
+        let sizes = points
+            .iter()
+            .map(|p| chart.plotting_area().estimate_text_size(&p.label, &style))
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(plot_error)?;
+        let mut order: Vec<usize> = (0..points.len()).collect();
+        order.sort_by_key(|&i| !frontier.contains(&points[i]));
+        let offsets = place_labels(&anchors, &sizes, &order);
+        chart
+            .draw_series(points.iter().zip(offsets).filter_map(|(p, offset)| {
+                offset.map(|o| EmptyElement::at((p.x, p.y)) + Text::new(p.label.clone(), o, &style))
             }))
             .map_err(plot_error)?;
-        root.present().map_err(plot_error)?;
+        Ok(())
+    })
+}
+
+/// Pixel offsets (from the point to the label's top-left corner) at which each label is
+/// tried: to the right (level with the point, one line above, one line below), then the same
+/// to the left; the three heights do not overlap.
+fn label_spots(w: i32, h: i32) -> [(i32, i32); 6] {
+    let (right, left) = (8, -8 - w);
+    let level = -h / 2;
+    let (above, below) = (level - h, level + h);
+    [
+        (right, level),
+        (right, above),
+        (right, below),
+        (left, level),
+        (left, above),
+        (left, below),
+    ]
+}
+
+/// Where to draw each label of points at pixel positions `anchors` with text sizes `sizes`:
+/// for each point in `order`, the first of [`label_spots`] whose box overlaps neither a label
+/// placed before it nor any point's marker; `None` (no label) when every spot is taken.
+fn place_labels(
+    anchors: &[(i32, i32)],
+    sizes: &[(u32, u32)],
+    order: &[usize],
+) -> Vec<Option<(i32, i32)>> {
+    type Box2 = (i32, i32, i32, i32);
+    let overlaps = |a: Box2, b: Box2| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+    let markers: Vec<Box2> = anchors
+        .iter()
+        .map(|&(x, y)| (x - 5, y - 5, x + 6, y + 6))
+        .collect();
+    let mut placed: Vec<Box2> = Vec::new();
+    let mut offsets = vec![None; anchors.len()];
+    for &i in order {
+        let (x, y) = anchors[i];
+        let (w, h) = (sizes[i].0 as i32, sizes[i].1 as i32);
+        let free = label_spots(w, h).into_iter().find(|&(dx, dy)| {
+            let b = (x + dx, y + dy, x + dx + w, y + dy + h);
+            !placed.iter().chain(&markers).any(|&o| overlaps(b, o))
+        });
+        if let Some((dx, dy)) = free {
+            placed.push((x + dx, y + dy, x + dx + w, y + dy + h));
+            offsets[i] = Some((dx, dy));
+        }
     }
-    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
-        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+    offsets
 }
 
 /// One named series of values, one per category, for [`category_points`]; `None` marks a
@@ -163,22 +246,14 @@ pub fn category_points(
     categories: &[String],
     series: &[Series],
 ) -> Result<RgbImage> {
-    register_bundled_font();
     let y_range = log_range(
         series
             .iter()
             .flat_map(|s| s.values.iter().flatten().copied()),
     )?;
     let n = categories.len().max(1);
-    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 26))
-            .margin(20)
-            .x_label_area_size(90)
-            .y_label_area_size(70)
+    render_chart(title, 90, 20, |builder| {
+        let mut chart = builder
             .build_cartesian_2d(-0.5f64..n as f64 - 0.5, log_axis(y_range))
             .map_err(plot_error)?;
         chart
@@ -221,10 +296,8 @@ pub fn category_points(
             .label_font(("sans-serif", 14))
             .draw()
             .map_err(plot_error)?;
-        root.present().map_err(plot_error)?;
-    }
-    RgbImage::from_raw(WIDTH, HEIGHT, buffer)
-        .ok_or_else(|| plot_error("plot buffer has the wrong size"))
+        Ok(())
+    })
 }
 
 #[cfg(test)]
@@ -251,6 +324,36 @@ mod tests {
             .filter(|px| px.0[0] == px.0[1] && px.0[1] == px.0[2] && (30..200).contains(&px.0[0]))
             .count();
         assert!(grey > 200, "{grey} grey text pixels");
+    }
+
+    /// Labels never overlap each other or a marker; a lone point gets its first spot; a point
+    /// hidden under labels placed before it gets none.
+    #[test]
+    fn labels_are_placed_without_overlaps() {
+        let anchors = [(100, 100), (100, 100), (104, 112), (400, 300), (100, 100)];
+        let sizes = [(60, 14), (60, 14), (30, 14), (50, 14), (60, 14)];
+        let offsets = place_labels(&anchors, &sizes, &[3, 0, 1, 2, 4]);
+        assert_eq!(offsets[3], Some(label_spots(50, 14)[0]));
+        let boxes: Vec<(i32, i32, i32, i32)> = (0..5)
+            .filter_map(|i| {
+                let (dx, dy) = offsets[i]?;
+                let (x, y) = (anchors[i].0 + dx, anchors[i].1 + dy);
+                Some((x, y, x + sizes[i].0 as i32, y + sizes[i].1 as i32))
+            })
+            .collect();
+        for (k, a) in boxes.iter().enumerate() {
+            for b in &boxes[k + 1..] {
+                let disjoint = a.2 <= b.0 || b.2 <= a.0 || a.3 <= b.1 || b.3 <= a.1;
+                assert!(disjoint, "{a:?} overlaps {b:?}");
+            }
+            for &(x, y) in &anchors {
+                let clear = a.2 <= x - 5 || x + 6 <= a.0 || a.3 <= y - 5 || y + 6 <= a.1;
+                assert!(clear, "{a:?} covers the marker at {x},{y}");
+            }
+        }
+        // Three labels at one spot: two sides and three heights give room for all three.
+        assert!(offsets[0].is_some() && offsets[1].is_some() && offsets[4].is_some());
+        assert_ne!(offsets[0], offsets[1]);
     }
 
     #[test]

@@ -224,12 +224,12 @@ pub fn run_cycle(
 mod tests {
     use super::*;
 
-    /// A method that returns its input: the protocol must report exactly zero error.
-    struct Identity;
-    impl CycleMethod for Identity {
+    /// A test "method" that applies a closure to the plane instead of rotating it.
+    struct MapPlane<F>(&'static str, F);
+    impl<F: Fn(f64) -> f64 + Sync> CycleMethod for MapPlane<F> {
         fn spec(&self) -> MethodSpec {
             MethodSpec {
-                method: "identity".into(),
+                method: self.0.into(),
                 ..Default::default()
             }
         }
@@ -239,36 +239,22 @@ mod tests {
             _: f64,
             _: usize,
         ) -> Result<Array2<f64>> {
-            Ok(plane.to_owned())
+            Ok(plane.mapv(&self.1))
         }
     }
 
-    /// A method that adds a known constant: RMS and max error must be that constant.
-    struct AddConstant(f64);
-    impl CycleMethod for AddConstant {
-        fn spec(&self) -> MethodSpec {
-            MethodSpec {
-                method: "add".into(),
-                ..Default::default()
-            }
-        }
-        fn rotate_repeatedly(
-            &self,
-            plane: ArrayView2<'_, f64>,
-            _: f64,
-            _: usize,
-        ) -> Result<Array2<f64>> {
-            Ok(plane.mapv(|v| v + self.0))
-        }
-    }
+    /// Returns its input: the protocol must report exactly zero error.
+    const IDENTITY: MapPlane<fn(f64) -> f64> = MapPlane("identity", |v| v);
 
     #[test]
     fn identity_method_gives_zero_and_known_offsets_are_measured() {
         let plane = crate::patterns::zone_plate(40, 60).unwrap();
-        let r = run_cycle("zone", plane.view(), &Identity, 16, &NoMeter).unwrap();
+        let r = run_cycle("zone", plane.view(), &IDENTITY, 16, &NoMeter).unwrap();
         assert_eq!((r.rms, r.max_error, r.crop), (0.0, 0.0, 40));
         assert!(r.psnr.is_infinite());
-        let r = run_cycle("zone", plane.view(), &AddConstant(1.5), 16, &NoMeter).unwrap();
+        // Adding a known constant: RMS and max error must be that constant.
+        let add = MapPlane("add", |v| v + 1.5);
+        let r = run_cycle("zone", plane.view(), &add, 16, &NoMeter).unwrap();
         assert!((r.rms - 1.5).abs() < 1e-12 && (r.max_error - 1.5).abs() < 1e-12);
         assert!((r.psnr - 20.0 * (255.0f64 / 1.5).log10()).abs() < 1e-9);
     }
@@ -308,6 +294,6 @@ mod tests {
     #[test]
     fn rejects_zero_steps() {
         let plane = Array2::<f64>::zeros((8, 8));
-        assert!(run_cycle("z", plane.view(), &Identity, 0, &NoMeter).is_err());
+        assert!(run_cycle("z", plane.view(), &IDENTITY, 0, &NoMeter).is_err());
     }
 }

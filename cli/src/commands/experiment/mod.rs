@@ -20,6 +20,7 @@ pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod sphere;
 pub mod stability;
+pub mod tradeoff;
 
 /// The experiments.
 #[derive(Subcommand)]
@@ -28,6 +29,7 @@ pub enum ExperimentCommand {
     ShiftChain(shift_chain::Args),
     Sphere(sphere::Args),
     Stability(stability::Args),
+    Tradeoff(tradeoff::Args),
 }
 
 /// Runs one experiment.
@@ -37,6 +39,7 @@ pub fn run(command: ExperimentCommand) -> Result<()> {
         ExperimentCommand::ShiftChain(args) => shift_chain::run(args),
         ExperimentCommand::Sphere(args) => sphere::run(args),
         ExperimentCommand::Stability(args) => stability::run(args),
+        ExperimentCommand::Tradeoff(args) => tradeoff::run(args),
     }
 }
 
@@ -227,9 +230,13 @@ pub fn cycle_table(records: &[CycleRecord]) -> Table {
             significant(r.psnr, 4),
             significant(r.max_error, 3),
             significant(r.seconds, 2),
-            r.peak_bytes
-                .map_or_else(String::new, |b| significant(b as f64 / 1e6, 3)),
+            peak_megabytes(r.peak_bytes),
         ]);
     }
     table
+}
+
+/// A peak heap figure for a table: megabytes to 3 digits, blank when not measured.
+pub fn peak_megabytes(bytes: Option<u64>) -> String {
+    bytes.map_or_else(String::new, |b| significant(b as f64 / 1e6, 3))
 }
