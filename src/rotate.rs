@@ -376,10 +376,11 @@ pub struct RotationWorkspace<T> {
     second: Vec<T>,
 }
 
-/// The first `len` samples of `buffer`, grown (never shrunk) to hold them.
+/// The first `len` samples of `buffer`, replaced by a larger one when too small (its contents
+/// are scratch: a fresh zeroed allocation is `calloc`'s untouched pages, not a `memset`).
 fn buffer<T: Sample>(buffer: &mut Vec<T>, len: usize) -> &mut [T] {
     if buffer.len() < len {
-        buffer.resize(len, T::zero());
+        *buffer = vec![T::zero(); len];
     }
     &mut buffer[..len]
 }
@@ -617,7 +618,8 @@ impl<'k, T: Sample> RotationChain<'k, T> {
         )?;
         let (h, w) = rotation.out;
         let mut out = std::mem::take(&mut self.spare);
-        out.resize(h * w, T::zero());
+        buffer(&mut out, h * w);
+        out.truncate(h * w);
         self.workspace.rotate_grid(
             self.work.view(),
             &rotation,
