@@ -278,17 +278,13 @@ impl GridRotation {
         } else {
             dim
         };
-        let (out_h, out_w) = match options.canvas {
-            Canvas::Same => dim,
-            Canvas::Expand => {
-                let (h, w) = expanded_size(h1 / granule, w1 / granule, reduced.residual_deg)?;
-                let too_large = || Error::shape(&[h, w], "expanded canvas too large");
-                (
-                    h.checked_mul(granule).ok_or_else(too_large)?,
-                    w.checked_mul(granule).ok_or_else(too_large)?,
-                )
-            }
-        };
+        // Working grids are whole pixels of `granule x granule` samples, and so is the canvas.
+        let (h, w) = rotated_size(dim.0 / granule, dim.1 / granule, deg, options)?;
+        let too_large = || Error::shape(&[h, w], "rotated canvas too large");
+        let (out_h, out_w) = (
+            h.checked_mul(granule).ok_or_else(too_large)?,
+            w.checked_mul(granule).ok_or_else(too_large)?,
+        );
         let mut rotation = GridRotation {
             quarter_turns: reduced.quarter_turns,
             out: (out_h, out_w),
@@ -416,9 +412,7 @@ impl<T: Sample> RotationWorkspace<T> {
         if options.supersample > 0 || kernel.grid_exponent() > 0 {
             return rotate_on_finer_grid(plane, deg, kernel, options);
         }
-        validate_plane(plane, options)?;
-        let rotation =
-            GridRotation::new::<T>(plane.dim(), deg, 1, kernel.support_radius(), options)?;
+        let rotation = plan_on_pixels(plane, deg, kernel, options)?;
         let mut out = Array2::zeros(rotation.out);
         let slice = out.as_slice_mut().expect("new array");
         self.rotate_grid(plane, &rotation, kernel, options.outside, slice);
@@ -445,9 +439,7 @@ impl<T: Sample> RotationWorkspace<T> {
             out.assign(&self.rotate_plane(plane, deg, kernel, options)?);
             return Ok(());
         }
-        validate_plane(plane, options)?;
-        let rotation =
-            GridRotation::new::<T>(plane.dim(), deg, 1, kernel.support_radius(), options)?;
+        let rotation = plan_on_pixels(plane, deg, kernel, options)?;
         let slice = out.as_slice_mut().expect("standard layout");
         self.rotate_grid(plane, &rotation, kernel, options.outside, slice);
         Ok(())
@@ -511,6 +503,17 @@ impl<T: Sample> RotationWorkspace<T> {
             .collect();
         shear_pass_into(b2, out_w, &shifts, kernel, outside, false, out);
     }
+}
+
+/// Checks `plane` and `options` and plans its rotation on the pixel grid.
+fn plan_on_pixels<T: Sample>(
+    plane: ArrayView2<'_, T>,
+    deg: f64,
+    kernel: &dyn ShearKernel<T>,
+    options: &RotateOptions,
+) -> Result<GridRotation> {
+    validate_plane(plane, options)?;
+    GridRotation::new::<T>(plane.dim(), deg, 1, kernel.support_radius(), options)
 }
 
 /// One rotation on the `2^(supersample + grid exponent)`-finer grid, box-averaged back.

@@ -138,6 +138,9 @@ pub fn bspline_value(degree: usize, x: f64) -> f64 {
     }
 }
 
+/// Taps of the highest degree supported (the quintic).
+const MAX_TAPS: usize = 6;
+
 /// Up to [`ROW_GROUP`] rows side by side: sample `i` of every row, one lane per row, so that
 /// the recursive filters, which are serial along a row, vectorise across rows.
 type Lanes<T> = [T; ROW_GROUP];
@@ -202,7 +205,7 @@ impl<T: Sample> BSplineShifter<'_, T> {
         let len = len_out + taps - 1 + 2 * h;
         self.lanes.resize(len, [T::zero(); ROW_GROUP]);
         self.extended.resize(len, T::zero());
-        let mut column = [T::zero(); 6];
+        let mut column = [T::zero(); MAX_TAPS];
         for (lane, (row, &shift)) in rows.iter().zip(shifts).enumerate() {
             let (k, f) = split_shift(shift);
             weights_into(|x| bspline_value(degree, x), f, false, &mut column[..taps]);
