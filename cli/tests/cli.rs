@@ -1,8 +1,12 @@
 //! The `haarshift` binary end to end: exact round trips on the testdata photographs for every
 //! layout, normalisation and padding, and one clean line of error for every kind of bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use std::path::Path;
+use std::process::Output;
+
+use common::{haarshift, p, testdata, text};
 
 use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::transform::{Layout, Normalization};
@@ -17,27 +21,6 @@ const PHOTOS: [&str; 6] = [
     "coins.png",
     "chelsea.png",
 ];
-
-fn testdata(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../testdata")
-        .join(name)
-}
-
-fn haarshift(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_haarshift"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
 
 /// Runs and requires success.
 fn ok(args: &[&str]) -> Output {

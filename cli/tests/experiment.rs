@@ -1,7 +1,10 @@
 //! `haarshift experiment`: the command's figures against a computation made directly here.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+
+use common::haarshift;
 
 use haarshift::io::{WriteOptions, write_image};
 use haarshift::kernels::ShiftMethod;
@@ -10,13 +13,6 @@ use haarshift::rotate::{RotateOptions, RotationChain};
 use haarshift::{PlanarImage, SampleDepth};
 use ndarray::{Array2, s};
 use serde_json::Value;
-
-fn haarshift(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_haarshift"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 /// Runs the binary and asserts that it succeeded; returns its standard output.
 fn haarshift_ok(args: &[&str]) -> String {

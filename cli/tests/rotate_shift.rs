@@ -2,31 +2,17 @@
 //! shifts, the pixel-domain meaning of the Haar shift (bilinear at 1/2^h, and the retained
 //! finer image), round trips, sizes, channels and depths, and one clean line per error.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+use common::{haarshift, p, testdata};
 
 use haarshift::Channels::{Gray, Rgb};
 use haarshift::SampleDepth::{F64, U8, U16};
 use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::{Channels, PlanarImage, SampleDepth};
 use ndarray::{Array2, Array3};
-
-fn testdata(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../testdata")
-        .join(name)
-}
-
-fn haarshift(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_haarshift"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
 
 fn ok(args: &[&str]) {
     let out = haarshift(args);

@@ -1,8 +1,12 @@
 //! `haarshift sphere rotate` and `haarshift experiment sphere` end to end on the test map: the
 //! binary must give exactly what the library gives, write what it says, and fail in one line.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
+
+use common::{p, run_in, text};
 
 use haarshift::io::{CoefficientFile, WriteOptions, read_image, write_image};
 use haarshift::sphere::experiment::{self, STANDARD_ROTATIONS};
@@ -20,22 +24,6 @@ const MAP: &str = concat!(
 
 fn test_map() -> LatLongMap<f32> {
     LatLongMap::from_image(&read_image::<f32>(MAP).unwrap()).unwrap()
-}
-
-fn run_in(dir: Option<&Path>, args: &[&str]) -> Output {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_haarshift"));
-    if let Some(dir) = dir {
-        command.current_dir(dir);
-    }
-    command.args(args).output().expect("the binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
 }
 
 fn ok(args: &[&str]) -> Output {
