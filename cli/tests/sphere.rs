@@ -273,7 +273,7 @@ fn experiment_writes_csv_json_and_plot_with_the_library_numbers() {
     let csv = std::fs::read_to_string(out_dir.join("sphere.csv")).unwrap();
     let header = csv.lines().next().unwrap();
     assert!(
-        header.starts_with("map,method,yaw,pitch,roll,level,rms,"),
+        header.starts_with("map,method,yaw,pitch,roll,level,thesis_level,rms,"),
         "{header}"
     );
     assert!(
@@ -328,18 +328,45 @@ fn experiment_writes_csv_json_and_plot_with_the_library_numbers() {
     assert_ne!(got[6]["rms"], got[8]["rms"]);
 
     // Nothing is overwritten without --force, and the refusal comes before the work.
-    fails(&args, &["sphere.csv", "--force"]);
+    fails(&args, &["sphere-rms.png", "already exists", "--force"]);
     assert_eq!(parse(&records), got);
 }
 
 #[test]
-fn experiment_without_maps_outside_the_repository_asks_for_them() {
+fn experiment_without_maps_runs_the_embedded_map_from_any_directory() {
     let dir = tempfile::tempdir().unwrap();
-    fails_in(
-        Some(dir.path()),
-        &["experiment", "sphere"],
-        &["testdata/envmaps", "pass the maps"],
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_haarshift"))
+        .args([
+            "experiment",
+            "sphere",
+            "--methods",
+            "bilinear",
+            "--levels",
+            "full",
+        ])
+        .args(["--samples", "1"])
+        .current_dir(dir.path())
+        .env("TMPDIR", dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let rows = stdout
+        .lines()
+        .filter(|l| l.starts_with(&format!("| {MAP_NAME}")))
+        .count();
+    assert_eq!(rows, STANDARD_ROTATIONS.len() * 2, "{stdout}");
+    // The reports went to the scratch directory under TMPDIR, whose csv has those rows.
+    let csv = dir.path().join("haarshift/sphere/sphere.csv");
+    assert_eq!(
+        std::fs::read_to_string(csv).unwrap().lines().count(),
+        1 + rows
     );
+}
+
+#[test]
+fn experiment_refuses_bad_levels() {
+    let dir = tempfile::tempdir().unwrap();
     fails_in(
         Some(dir.path()),
         &["experiment", "sphere", MAP, "--levels", "full-9"],
@@ -350,7 +377,6 @@ fn experiment_without_maps_outside_the_repository_asks_for_them() {
         &["experiment", "sphere", "--levels", "fine"],
     );
     assert_eq!(usage.status.code(), Some(2));
-    assert!(!dir.path().join("results").exists());
 }
 
 #[test]

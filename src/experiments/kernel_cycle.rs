@@ -6,7 +6,9 @@ use std::path::Path;
 
 use ndarray::{Array2, ArrayView2};
 
-use super::rotation_cycle::{CycleMethod, CycleRecord, MemoryMeter, MethodSpec, luma, run_cycle};
+use super::rotation_cycle::{
+    CycleMethod, CycleRecord, CycleRun, MemoryMeter, MethodSpec, luma, run_cycle,
+};
 use crate::kernels::{KernelOptions, ShiftMethod};
 use crate::rotate::{RotateOptions, RotationChain};
 use crate::{Error, Result, patterns};
@@ -21,7 +23,7 @@ use crate::{Error, Result, patterns};
 /// use haarshift::kernels::{KernelOptions, ShiftMethod};
 /// let nearest = KernelCycle::new(ShiftMethod::Nearest, KernelOptions::default(), 0);
 /// let plane = haarshift::patterns::zone_plate(16, 16).unwrap();
-/// let r = run_cycle("zone", plane.view(), &nearest, 4, &NoMeter).unwrap();
+/// let r = run_cycle("zone", plane.view(), &nearest, 4, &NoMeter).unwrap().record;
 /// assert_eq!(r.rms, 0.0); // quarter turns are exact
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,6 +123,20 @@ impl NamedPlane {
         })
     }
 
+    /// Decodes the bytes of an image file held in memory (named `name`) and converts it to
+    /// luma by the protocol's weights.
+    pub fn from_memory(name: &str, bytes: &[u8]) -> Result<NamedPlane> {
+        let image = crate::io::read_image_from_memory::<f64>(
+            bytes,
+            name.as_ref(),
+            &crate::io::ReadOptions::default(),
+        )?;
+        Ok(NamedPlane {
+            name: name.to_owned(),
+            plane: luma(&image),
+        })
+    }
+
     /// The centred `side x side` crop (each axis cropped only where it is longer than
     /// `side`), under the same name: the rotation-cycle protocol then works on a crop of side
     /// `min(side, height, width)`, the cheaper run the trade-off experiment makes by default.
@@ -170,47 +186,79 @@ pub fn synthetic_images() -> Result<Vec<NamedPlane>> {
     ])
 }
 
-/// The default image set: every `.png` in `dir` (sorted by name) followed by
-/// [`synthetic_images`]. Errors when `dir` holds no PNG.
-pub fn default_images(dir: &Path) -> Result<Vec<NamedPlane>> {
-    let listing = std::fs::read_dir(dir).map_err(|source| Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let mut paths: Vec<_> = listing
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
-        .collect();
-    if paths.is_empty() {
-        return Err(Error::parameter(
-            "images",
-            format!("{} holds no PNG image", dir.display()),
-        ));
-    }
-    paths.sort();
-    let mut images = paths
+/// The photographs of the default image set, embedded in the library so that the
+/// experiments run from any directory (`testdata/SOURCES.md` has their sources and licences).
+pub const PHOTOGRAPHS: [(&str, &[u8]); 6] = [
+    (
+        "astronaut.png",
+        include_bytes!("../../testdata/astronaut.png"),
+    ),
+    ("brick.png", include_bytes!("../../testdata/brick.png")),
+    ("camera.png", include_bytes!("../../testdata/camera.png")),
+    ("chelsea.png", include_bytes!("../../testdata/chelsea.png")),
+    ("coins.png", include_bytes!("../../testdata/coins.png")),
+    ("text.png", include_bytes!("../../testdata/text.png")),
+];
+
+/// The default image set: the six [`PHOTOGRAPHS`] (sorted by name) followed by
+/// [`synthetic_images`].
+///
+/// ```
+/// let images = haarshift::experiments::kernel_cycle::default_images().unwrap();
+/// let names: Vec<&str> = images.iter().map(|i| i.name.as_str()).collect();
+/// assert_eq!(names[..3], ["astronaut.png", "brick.png", "camera.png"]);
+/// assert_eq!(images[2].plane.dim(), (512, 512));
+/// assert_eq!(images.len(), 8);
+/// ```
+pub fn default_images() -> Result<Vec<NamedPlane>> {
+    let mut images = PHOTOGRAPHS
         .iter()
-        .map(|p| NamedPlane::read(p))
+        .map(|&(name, bytes)| NamedPlane::from_memory(name, bytes))
         .collect::<Result<Vec<_>>>()?;
     images.extend(synthetic_images()?);
     Ok(images)
 }
 
+/// One of the embedded [`PHOTOGRAPHS`] by file name.
+///
+/// ```
+/// let camera = haarshift::experiments::kernel_cycle::default_photograph("camera.png").unwrap();
+/// assert_eq!(camera.plane.dim(), (512, 512));
+/// assert!(haarshift::experiments::kernel_cycle::default_photograph("cat.png").is_err());
+/// ```
+pub fn default_photograph(name: &str) -> Result<NamedPlane> {
+    let (name, bytes) = PHOTOGRAPHS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| {
+            let known: Vec<&str> = PHOTOGRAPHS.iter().map(|(n, _)| *n).collect();
+            Error::parameter(
+                "image",
+                format!(
+                    "{name} is not an embedded photograph ({})",
+                    known.join(", ")
+                ),
+            )
+        })?;
+    NamedPlane::from_memory(name, bytes)
+}
+
 /// Runs the protocol for every image and method, images outermost; `progress` is called after
-/// each run. Runs one at a time so that the wall time and peak memory of each are its own.
+/// each run with the whole run (record and canvases), whose record is kept. Runs one at a
+/// time so that the wall time and peak memory of each are its own.
 pub fn run_rotation_cycle(
     images: &[NamedPlane],
     methods: &[KernelCycle],
     steps: usize,
     meter: &dyn MemoryMeter,
-    mut progress: impl FnMut(&CycleRecord),
+    mut progress: impl FnMut(&CycleRun),
 ) -> Result<Vec<CycleRecord>> {
     let mut records = Vec::with_capacity(images.len() * methods.len());
     for image in images {
         for method in methods {
-            let record = run_cycle(&image.name, image.plane.view(), method, steps, meter)?;
-            progress(&record);
-            records.push(record);
+            let run = run_cycle(&image.name, image.plane.view(), method, steps, meter)?;
+            progress(&run);
+            records.push(run.record);
         }
     }
     Ok(records)

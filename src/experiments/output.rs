@@ -1,5 +1,8 @@
-//! Writing experiment results: CSV and JSON records and PNG plots side by side, every file
-//! written atomically and never over an existing one unless forced.
+//! Writing experiment results: CSV and JSON records, Markdown tables and PNG plots side by
+//! side, every file written atomically and never over an existing one unless forced.
+//!
+//! An experiment claims its [`ReportDir`] before it computes anything, so that a refusal to
+//! overwrite comes at once, not after minutes of work.
 
 use std::path::{Path, PathBuf};
 
@@ -8,6 +11,102 @@ use serde::Serialize;
 
 use crate::io::write_file_atomically;
 use crate::{Error, Result};
+
+/// The directory an experiment writes its reports to.
+///
+/// An experiment with stem `s` owns the files `s.*` and `s-*` in it. [`ReportDir::claim`],
+/// called before the experiment runs, refuses the run when one of them exists (unless
+/// forced) or when an input is one of them.
+///
+/// ```
+/// use haarshift::experiments::output::ReportDir;
+/// use haarshift::Error;
+/// let dir = tempfile::tempdir().unwrap();
+/// let reports = ReportDir::new(dir.path(), false);
+/// reports.claim("cycle", &[]).unwrap();
+/// std::fs::write(dir.path().join("cycle-rms.png"), b"old").unwrap();
+/// std::fs::write(dir.path().join("cycles.csv"), b"other").unwrap();
+/// let err = reports.claim("cycle", &[]).unwrap_err();
+/// assert!(matches!(err, Error::OutputExists { path } if path.ends_with("cycle-rms.png")));
+/// ReportDir::new(dir.path(), true).claim("cycle", &[]).unwrap();
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ReportDir {
+    dir: PathBuf,
+    force: bool,
+}
+
+impl ReportDir {
+    /// `dir`, where existing reports are replaced only when `force` is set.
+    pub fn new(dir: impl Into<PathBuf>, force: bool) -> Self {
+        ReportDir {
+            dir: dir.into(),
+            force,
+        }
+    }
+
+    /// The scratch directory `<temp>/haarshift/<experiment>` (the system's temporary
+    /// directory, `TMPDIR` on Unix), whose reports every run replaces.
+    ///
+    /// ```
+    /// let d = haarshift::experiments::output::ReportDir::scratch("shift-chain");
+    /// assert!(d.path().ends_with("haarshift/shift-chain"));
+    /// assert!(d.path().starts_with(std::env::temp_dir()));
+    /// ```
+    pub fn scratch(experiment: &str) -> Self {
+        ReportDir::new(
+            std::env::temp_dir().join("haarshift").join(experiment),
+            true,
+        )
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Whether existing reports are replaced.
+    pub fn force(&self) -> bool {
+        self.force
+    }
+
+    /// Creates the directory and checks that the reports of `stem` may be written: none
+    /// exists unless forced, and none is one of `inputs`. Call it before the work.
+    pub fn claim(&self, stem: &str, inputs: &[&Path]) -> Result<()> {
+        std::fs::create_dir_all(&self.dir).map_err(|source| Error::Io {
+            path: self.dir.clone(),
+            source,
+        })?;
+        let owned = |name: &str| {
+            name.strip_prefix(stem)
+                .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('-'))
+        };
+        let listing = std::fs::read_dir(&self.dir).map_err(|source| Error::Io {
+            path: self.dir.clone(),
+            source,
+        })?;
+        let mut mine: Vec<PathBuf> = listing
+            .filter_map(|e| e.ok())
+            .filter(|e| owned(&e.file_name().to_string_lossy()))
+            .map(|e| e.path())
+            .collect();
+        mine.sort();
+        for path in &mine {
+            for input in inputs {
+                crate::io::ensure_distinct_paths(input, path)?;
+            }
+        }
+        match mine.into_iter().next() {
+            Some(path) if !self.force => Err(Error::OutputExists { path }),
+            _ => Ok(()),
+        }
+    }
+
+    /// The writer of the reports named after `stem`.
+    pub fn writer(&self, stem: &str) -> ReportWriter {
+        ReportWriter::new(&self.dir, stem, self.force)
+    }
+}
 
 /// Where one experiment's files go: `<dir>/<stem>.csv`, `<dir>/<stem>.json`,
 /// `<dir>/<stem>-<plot>.png`.
@@ -55,6 +154,14 @@ impl ReportWriter {
     pub fn json<V: Serialize + ?Sized>(&self, value: &V) -> Result<PathBuf> {
         let path = self.path("", "json");
         write_json(&path, value, self.force)?;
+        Ok(path)
+    }
+
+    /// Writes `text` (a Markdown document: the experiment's parameters and its table) to
+    /// `<stem>.md` and returns the path.
+    pub fn markdown(&self, text: &str) -> Result<PathBuf> {
+        let path = self.path("", "md");
+        write_file_atomically(&path, self.force, |w| w.write_all(text.as_bytes()))?;
         Ok(path)
     }
 

@@ -300,6 +300,68 @@ pub fn category_points(
     })
 }
 
+/// A contact sheet of gray tiles with a label under each, `columns` tiles to a row: each
+/// tile's values (0..=255, clamped and rounded) are enlarged `zoom` times by pixel
+/// replication, so that interpolation blur and ringing stay visible as they are.
+///
+/// ```
+/// use haarshift::experiments::plot::labelled_tiles;
+/// let a = ndarray::Array2::from_elem((4, 6), 255.0);
+/// let b = ndarray::Array2::from_elem((4, 6), 0.0);
+/// let sheet = labelled_tiles(&[("white".into(), a.view()), ("black".into(), b.view())], 2, 3).unwrap();
+/// assert_eq!(sheet.width(), 2 * (6 * 3 + 8) + 8);
+/// assert_eq!(sheet.get_pixel(8 + 1, 8 + 1).0, [255, 255, 255]);
+/// assert_eq!(sheet.get_pixel(8 + 26 + 1, 8 + 1).0, [0, 0, 0]);
+/// ```
+pub fn labelled_tiles(
+    tiles: &[(String, ndarray::ArrayView2<'_, f64>)],
+    columns: usize,
+    zoom: usize,
+) -> Result<RgbImage> {
+    const GAP: usize = 8;
+    const LABEL: usize = 24;
+    let Some((_, first)) = tiles.first() else {
+        return Err(plot_error("no tiles to draw"));
+    };
+    let (th, tw) = first.dim();
+    if tiles.iter().any(|(_, t)| t.dim() != (th, tw)) || th * tw == 0 || columns * zoom == 0 {
+        return Err(plot_error(
+            "tiles must be non-empty and of one size, columns and zoom at least 1",
+        ));
+    }
+    let rows = tiles.len().div_ceil(columns);
+    let cell_w = tw * zoom + GAP;
+    let cell_h = th * zoom + LABEL + GAP;
+    let (width, height) = (columns * cell_w + GAP, rows * cell_h + GAP);
+    let size = |v: usize| u32::try_from(v).map_err(|_| plot_error("figure too large"));
+    let (width, height) = (size(width)?, size(height)?);
+    let mut sheet = RgbImage::from_pixel(width, height, image::Rgb([255, 255, 255]));
+    for (k, (_, tile)) in tiles.iter().enumerate() {
+        let (x0, y0) = (GAP + (k % columns) * cell_w, GAP + (k / columns) * cell_h);
+        for ((i, j), &v) in tile.indexed_iter() {
+            let g = v.clamp(0.0, 255.0).round() as u8;
+            for (di, dj) in (0..zoom).flat_map(|di| (0..zoom).map(move |dj| (di, dj))) {
+                let (x, y) = ((x0 + j * zoom + dj) as u32, (y0 + i * zoom + di) as u32);
+                sheet.put_pixel(x, y, image::Rgb([g, g, g]));
+            }
+        }
+    }
+    register_bundled_font();
+    let mut buffer = sheet.into_raw();
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+        for (k, (label, _)) in tiles.iter().enumerate() {
+            let x = (GAP + (k % columns) * cell_w) as i32;
+            let y = (GAP + (k / columns) * cell_h + th * zoom + 4) as i32;
+            root.draw_text(label, &("sans-serif", 15).into_font().color(&BLACK), (x, y))
+                .map_err(plot_error)?;
+        }
+        root.present().map_err(plot_error)?;
+    }
+    RgbImage::from_raw(width, height, buffer)
+        .ok_or_else(|| plot_error("figure buffer has the wrong size"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

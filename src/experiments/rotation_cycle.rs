@@ -188,6 +188,18 @@ pub fn measurement_mask(canvas: usize, m: usize) -> Result<Array2<bool>> {
     Ok(disk_mask(canvas, canvas, radius))
 }
 
+/// One run of the protocol: the record, and the canvas before and after the cycle (for
+/// figures such as [`crate::experiments::plot::labelled_tiles`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CycleRun {
+    /// The measured figures.
+    pub record: CycleRecord,
+    /// The padded canvas the cycle started from (step 3).
+    pub canvas: Array2<f64>,
+    /// The canvas after the cycle.
+    pub result: Array2<f64>,
+}
+
 /// Runs the protocol for one plane (already in luma) and one method.
 pub fn run_cycle(
     image_name: &str,
@@ -195,7 +207,7 @@ pub fn run_cycle(
     method: &dyn CycleMethod,
     steps: usize,
     meter: &dyn MemoryMeter,
-) -> Result<CycleRecord> {
+) -> Result<CycleRun> {
     if steps == 0 {
         return Err(Error::parameter("steps", "must be at least 1"));
     }
@@ -207,7 +219,7 @@ pub fn run_cycle(
     let seconds = start.elapsed().as_secs_f64();
     let peak_bytes = meter.peak_bytes();
     let stats = ErrorStats::between(result.view(), canvas.view(), Some(mask.view()), 255.0)?;
-    Ok(CycleRecord {
+    let record = CycleRecord {
         image: image_name.to_owned(),
         method: method.spec(),
         steps,
@@ -217,6 +229,11 @@ pub fn run_cycle(
         max_error: stats.max_error,
         seconds,
         peak_bytes,
+    };
+    Ok(CycleRun {
+        record,
+        canvas,
+        result,
     })
 }
 
@@ -249,12 +266,16 @@ mod tests {
     #[test]
     fn identity_method_gives_zero_and_known_offsets_are_measured() {
         let plane = crate::patterns::zone_plate(40, 60).unwrap();
-        let r = run_cycle("zone", plane.view(), &IDENTITY, 16, &NoMeter).unwrap();
+        let run = run_cycle("zone", plane.view(), &IDENTITY, 16, &NoMeter).unwrap();
+        assert_eq!(run.result, run.canvas);
+        let r = run.record;
         assert_eq!((r.rms, r.max_error, r.crop), (0.0, 0.0, 40));
         assert!(r.psnr.is_infinite());
         // Adding a known constant: RMS and max error must be that constant.
         let add = MapPlane("add", |v| v + 1.5);
-        let r = run_cycle("zone", plane.view(), &add, 16, &NoMeter).unwrap();
+        let r = run_cycle("zone", plane.view(), &add, 16, &NoMeter)
+            .unwrap()
+            .record;
         assert!((r.rms - 1.5).abs() < 1e-12 && (r.max_error - 1.5).abs() < 1e-12);
         assert!((r.psnr - 20.0 * (255.0f64 / 1.5).log10()).abs() < 1e-9);
     }

@@ -290,13 +290,15 @@ impl StoredCoefficients {
     /// Reads the `.npy` array (f32 or f64; `H x W` or `C x H x W` with `C` = 1 to 4) and the
     /// sidecar if it exists.
     pub fn read(path: &Path, options: &ReadOptions) -> Result<Self> {
-        let (array, _) = npy::read_array::<f64>(path, options, |shape| match shape {
-            [_, _] => Ok(()),
-            [c, _, _] if (1..=4).contains(c) => Ok(()),
-            _ => Err(format!(
-                "array of shape {shape:?} is not a coefficient file (expected H x W or C x H x W \
+        let (array, _) = npy::read_array::<f64>(&super::Source::File(path), options, |shape| {
+            match shape {
+                [_, _] => Ok(()),
+                [c, _, _] if (1..=4).contains(c) => Ok(()),
+                _ => Err(format!(
+                    "array of shape {shape:?} is not a coefficient file (expected H x W or C x H x W \
                  with C = 1 to 4)"
-            )),
+                )),
+            }
         })?;
         let array = if array.ndim() == 2 {
             array.insert_axis(Axis(0))

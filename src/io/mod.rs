@@ -63,7 +63,7 @@
 //! ```
 
 use std::fs::File;
-use std::io::Read;
+use std::io::{BufRead, Read, Seek};
 use std::path::Path;
 
 use ndarray::Array3;
@@ -160,9 +160,17 @@ impl FileFormat {
     /// assert_eq!(FileFormat::of_file(path.as_ref()).unwrap(), FileFormat::Png);
     /// ```
     pub fn of_file(path: &Path) -> Result<FileFormat> {
+        FileFormat::of_source(&Source::File(path))
+    }
+
+    /// The format of a source, recognised from its first bytes.
+    fn of_source(source: &Source<'_>) -> Result<FileFormat> {
+        let path = source.name();
         let mut head = Vec::with_capacity(16);
-        File::open(path)
-            .and_then(|f| f.take(16).read_to_end(&mut head))
+        source
+            .open()?
+            .take(16)
+            .read_to_end(&mut head)
             .map_err(|e| io_error(path, e))?;
         if head.is_empty() {
             return Err(format_reason(path, "file is empty"));
@@ -257,17 +265,89 @@ pub fn read_image<T: Sample>(path: impl AsRef<Path>) -> Result<PlanarImage<T>> {
 
 /// Reads an image or `.npy` array; the format is recognised from the file's content.
 pub fn read_image_with<T: Sample>(path: &Path, options: &ReadOptions) -> Result<PlanarImage<T>> {
-    let format = FileFormat::of_file(path)?;
+    read_source(&Source::File(path), options)
+}
+
+/// Reads an image or `.npy` array from bytes in memory (the content of a file, e.g. one
+/// embedded in a program with `include_bytes!`); `name` stands for the file in messages. The
+/// same formats, checks and errors as [`read_image_with`].
+///
+/// ```
+/// use haarshift::io::{read_image_from_memory, ReadOptions};
+/// let bytes = include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/coins.png"));
+/// let img = read_image_from_memory::<f32>(bytes, "coins.png".as_ref(), &ReadOptions::default()).unwrap();
+/// assert_eq!((img.height(), img.width()), (303, 384));
+/// let err = read_image_from_memory::<f32>(&bytes[..100], "cut.png".as_ref(), &ReadOptions::default());
+/// assert!(err.unwrap_err().to_string().starts_with("cut.png: "));
+/// ```
+pub fn read_image_from_memory<T: Sample>(
+    bytes: &[u8],
+    name: &Path,
+    options: &ReadOptions,
+) -> Result<PlanarImage<T>> {
+    read_source(&Source::Memory { name, bytes }, options)
+}
+
+fn read_source<T: Sample>(source: &Source<'_>, options: &ReadOptions) -> Result<PlanarImage<T>> {
+    let format = FileFormat::of_source(source)?;
     let image = match format {
-        FileFormat::Npy => npy::read(path, options)?,
-        FileFormat::Exr => openexr::read(path, options)?,
-        FileFormat::Tiff => tiff_codec::read(path, options)?,
+        FileFormat::Npy => npy::read(source, options)?,
+        FileFormat::Exr => openexr::read(source, options)?,
+        FileFormat::Tiff => tiff_codec::read(source, options)?,
         FileFormat::Png | FileFormat::Jpeg | FileFormat::Hdr => {
-            raster::read(path, format, options)?
+            raster::read(source, format, options)?
         }
     };
-    ensure_finite(&image.planes()).map_err(|e| e.in_file(path))?;
+    ensure_finite(&image.planes()).map_err(|e| e.in_file(source.name()))?;
     Ok(image)
+}
+
+/// Where a reader's bytes come from: a file, or a buffer in memory named for messages.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Source<'a> {
+    /// A file on disk.
+    File(&'a Path),
+    /// The bytes of a file, held in memory.
+    Memory {
+        /// What messages call it.
+        name: &'a Path,
+        /// Its content.
+        bytes: &'a [u8],
+    },
+}
+
+/// A buffered, seekable reader of a [`Source`].
+pub(crate) trait SourceReader: BufRead + Seek {}
+impl<R: BufRead + Seek> SourceReader for R {}
+
+impl<'a> Source<'a> {
+    /// The path that messages name.
+    pub(crate) fn name(&self) -> &'a Path {
+        match *self {
+            Source::File(path) | Source::Memory { name: path, .. } => path,
+        }
+    }
+
+    /// A reader positioned at the start.
+    pub(crate) fn open(&self) -> Result<Box<dyn SourceReader + 'a>> {
+        match *self {
+            Source::File(path) => {
+                let file = File::open(path).map_err(|e| io_error(path, e))?;
+                Ok(Box::new(std::io::BufReader::new(file)))
+            }
+            Source::Memory { bytes, .. } => Ok(Box::new(std::io::Cursor::new(bytes))),
+        }
+    }
+
+    /// The length in bytes.
+    pub(crate) fn len(&self) -> Result<u64> {
+        match *self {
+            Source::File(path) => std::fs::metadata(path)
+                .map(|m| m.len())
+                .map_err(|e| io_error(path, e)),
+            Source::Memory { bytes, .. } => Ok(bytes.len() as u64),
+        }
+    }
 }
 
 /// Writes `image` in the format of `path`'s extension; see the [module docs](self).

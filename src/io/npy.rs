@@ -1,19 +1,23 @@
 //! NumPy `.npy` float arrays: images as `H x W` or `H x W x C`, and the raw arrays of
 //! coefficient files.
 
-use std::io::{BufReader, Seek, Write};
+use std::io::{Seek, Write};
 use std::path::Path;
 
 use ndarray::{Array, ArrayD, IxDyn};
 use ndarray_npy::npy::header::Header;
 use ndarray_npy::{ReadNpyExt, WriteNpyExt};
 
-use super::{ReadOptions, check_size, format_reason, interleave, io_error, planar};
+use super::{ReadOptions, Source, check_size, format_reason, interleave, io_error, planar};
 use crate::{Error, PlanarImage, Result, Sample, SampleDepth};
 
 /// Reads an image stored as `H x W` (gray) or `H x W x C` (C = 1..=4) floats.
-pub(super) fn read<T: Sample>(path: &Path, options: &ReadOptions) -> Result<PlanarImage<T>> {
-    let (array, depth) = read_array::<T>(path, options, |shape| match shape {
+pub(super) fn read<T: Sample>(
+    source: &Source<'_>,
+    options: &ReadOptions,
+) -> Result<PlanarImage<T>> {
+    let path = source.name();
+    let (array, depth) = read_array::<T>(source, options, |shape| match shape {
         [_, _] => Ok(()),
         [_, _, c] if (1..=4).contains(c) => Ok(()),
         _ => Err(format!(
@@ -36,13 +40,13 @@ pub(super) fn read<T: Sample>(path: &Path, options: &ReadOptions) -> Result<Plan
 /// Reads a float32 or float64 array whose shape `accept` allows, after checking its size
 /// against the file's length and the memory limit; returns it with the depth it was stored in.
 pub(super) fn read_array<T: Sample>(
-    path: &Path,
+    source: &Source<'_>,
     options: &ReadOptions,
     accept: impl Fn(&[usize]) -> std::result::Result<(), String>,
 ) -> Result<(ArrayD<T>, SampleDepth)> {
-    let file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
-    let file_len = file.metadata().map_err(|e| io_error(path, e))?.len();
-    let mut reader = BufReader::new(file);
+    let path = source.name();
+    let file_len = source.len()?;
+    let mut reader = source.open()?;
     let header = Header::from_reader(&mut reader)
         .map_err(|e| format_reason(path, format!("invalid .npy header: {e}")))?;
     let data_start = reader.stream_position().map_err(|e| io_error(path, e))?;

@@ -1,7 +1,7 @@
 //! OpenEXR through the `exr` crate: f16 or f32 channels named `Y`, `Y A`, `R G B` or
 //! `R G B A` (a layer prefix such as `diffuse.R` is ignored).
 
-use std::io::{BufReader, Seek, Write};
+use std::io::{Seek, Write};
 use std::path::Path;
 
 use exr::prelude::{
@@ -10,7 +10,7 @@ use exr::prelude::{
 };
 use ndarray::{Array3, Axis};
 
-use super::{ReadOptions, check_size, format_reason, io_error, planar};
+use super::{ReadOptions, Source, check_size, format_reason, io_error, planar};
 use crate::{Channels, PlanarImage, Result, Sample, SampleDepth};
 
 /// The channel names of each layout, in plane order.
@@ -33,7 +33,11 @@ fn base_name(name: &exr::prelude::Text) -> String {
 }
 
 /// Reads the first layer of an OpenEXR file.
-pub(super) fn read<T: Sample>(path: &Path, options: &ReadOptions) -> Result<PlanarImage<T>> {
+pub(super) fn read<T: Sample>(
+    source: &Source<'_>,
+    options: &ReadOptions,
+) -> Result<PlanarImage<T>> {
+    let path = source.name();
     let exr_error = |e: exr::error::Error| match e {
         exr::error::Error::Io(e) if e.kind() != std::io::ErrorKind::UnexpectedEof => {
             io_error(path, e)
@@ -41,9 +45,8 @@ pub(super) fn read<T: Sample>(path: &Path, options: &ReadOptions) -> Result<Plan
         exr::error::Error::Io(_) => format_reason(path, "file is truncated"),
         other => format_reason(path, format!("invalid OpenEXR file: {other}")),
     };
-    let open = || std::fs::File::open(path).map_err(|e| io_error(path, e));
     // The header alone first: the sizes it promises are checked before any pixel buffer exists.
-    let meta = MetaData::read_from_buffered(BufReader::new(open()?), false).map_err(exr_error)?;
+    let meta = MetaData::read_from_buffered(source.open()?, false).map_err(exr_error)?;
     let header = meta
         .headers
         .iter()
@@ -95,7 +98,7 @@ pub(super) fn read<T: Sample>(path: &Path, options: &ReadOptions) -> Result<Plan
         .all_channels()
         .first_valid_layer()
         .all_attributes()
-        .from_buffered(BufReader::new(open()?))
+        .from_buffered(source.open()?)
         .map_err(exr_error)?;
     let layer = &image.layer_data;
     let (h, w) = (layer.size.height(), layer.size.width());

@@ -6,22 +6,24 @@ use std::path::Path;
 use image::{DynamicImage, ExtendedColorType, ImageDecoder, ImageEncoder, ImageError, ImageFormat};
 
 use super::{
-    FileFormat, ReadOptions, check_size, deinterleave, format_reason, interleave, io_error, planar,
+    FileFormat, ReadOptions, Source, check_size, deinterleave, format_reason, interleave, io_error,
+    planar,
 };
 use crate::{Channels, Error, PlanarImage, Result, Sample, SampleDepth};
 
 /// Decodes a PNG, JPEG or Radiance file.
 pub(super) fn read<T: Sample>(
-    path: &Path,
+    source: &Source<'_>,
     format: FileFormat,
     options: &ReadOptions,
 ) -> Result<PlanarImage<T>> {
+    let path = source.name();
     let image_format = match format {
         FileFormat::Png => ImageFormat::Png,
         FileFormat::Jpeg => ImageFormat::Jpeg,
         _ => ImageFormat::Hdr,
     };
-    let mut reader = image::ImageReader::open(path).map_err(|e| io_error(path, e))?;
+    let mut reader = image::ImageReader::new(source.open()?);
     reader.set_format(image_format);
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(options.memory_limit);

@@ -1,19 +1,25 @@
 //! TIFF through the `tiff` crate directly: unlike the `image` crate's TIFF support it reads and
 //! writes gray+alpha.
 
-use std::io::{BufReader, Seek, Write};
+use std::io::{Seek, Write};
 use std::path::Path;
 
 use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult};
 
 use super::raster::dimensions;
-use super::{ReadOptions, check_size, deinterleave, format_reason, interleave, io_error, planar};
+use super::{
+    ReadOptions, Source, check_size, deinterleave, format_reason, interleave, io_error, planar,
+};
 use crate::{Channels, Error, PlanarImage, Result, Sample, SampleDepth};
 
 /// Decodes the first image of a TIFF file: 8- or 16-bit integer or 32-bit float samples, with
 /// 1 to 4 channels.
-pub(super) fn read<T: Sample>(path: &Path, options: &ReadOptions) -> Result<PlanarImage<T>> {
+pub(super) fn read<T: Sample>(
+    source: &Source<'_>,
+    options: &ReadOptions,
+) -> Result<PlanarImage<T>> {
+    let path = source.name();
     let tiff_error = |e: tiff::TiffError| match e {
         tiff::TiffError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
             format_reason(path, "file is truncated")
@@ -22,10 +28,9 @@ pub(super) fn read<T: Sample>(path: &Path, options: &ReadOptions) -> Result<Plan
         tiff::TiffError::LimitsExceeded => format_reason(path, "image exceeds the memory limit"),
         other => format_reason(path, format!("invalid TIFF file: {other}")),
     };
-    let file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
     let mut limits = tiff::decoder::Limits::default();
     limits.decoding_buffer_size = usize::try_from(options.memory_limit).unwrap_or(usize::MAX);
-    let mut decoder = Decoder::new(BufReader::new(file))
+    let mut decoder = Decoder::new(source.open()?)
         .map_err(tiff_error)?
         .with_limits(limits);
     let (w, h) = decoder.dimensions().map_err(tiff_error)?;

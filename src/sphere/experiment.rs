@@ -40,6 +40,37 @@ pub const STANDARD_ROTATIONS: [(f64, f64, f64); 6] = [
     (40.0, -25.0, 60.0),
 ];
 
+/// The maps `haarshift experiment sphere` measures when none are given, embedded in the
+/// library so that it runs from any directory: `(name, .npy bytes)`
+/// (`testdata/envmaps/SOURCES.md` has their sources and licences).
+pub const DEFAULT_MAPS: [(&str, &[u8]); 1] = [(
+    "rooitou_park_256x128",
+    include_bytes!("../../testdata/envmaps/rooitou_park_256x128.npy"),
+)];
+
+/// The [`DEFAULT_MAPS`], decoded, as `(name, map)`.
+///
+/// ```
+/// let maps = haarshift::sphere::experiment::default_maps::<f32>().unwrap();
+/// assert_eq!(maps[0].0, "rooitou_park_256x128");
+/// assert_eq!((maps[0].1.height(), maps[0].1.width()), (128, 256));
+/// ```
+pub fn default_maps<T: Sample>() -> Result<Vec<(String, LatLongMap<T>)>> {
+    DEFAULT_MAPS
+        .iter()
+        .map(|&(name, bytes)| {
+            let file = format!("{name}.npy");
+            let image = crate::io::read_image_from_memory::<T>(
+                bytes,
+                file.as_ref(),
+                &crate::io::ReadOptions::default(),
+            )?;
+            let map = LatLongMap::from_image(&image).map_err(|e| e.in_file(file.as_ref()))?;
+            Ok((name.to_owned(), map))
+        })
+        .collect()
+}
+
 /// The solid-angle weighted RMS difference of two maps of the same shape.
 ///
 /// ```
@@ -181,8 +212,11 @@ pub struct Record {
     pub pitch: f64,
     /// Roll, degrees.
     pub roll: f64,
-    /// The finest detail level computed.
+    /// The finest detail level computed (bands `2^level x 2^(level+1)`).
     pub level: usize,
+    /// The same level in the thesis's numbering, where level `l` is a face `2^l` texels wide:
+    /// `level + 1`.
+    pub thesis_level: usize,
     /// The errors (see [`Comparison`]).
     #[serde(flatten)]
     pub comparison: Comparison,
@@ -199,7 +233,7 @@ pub struct Record {
 /// let f = LatLongMap::<f64>::from_fn(16, 1, |d, o| o[0] = 1.0 + d[0]).unwrap();
 /// let rows = run("smooth", &f, &[(0.0, 30.0, 0.0)], &[(Method::Haar, None), (Method::Bilinear, Some(2))], 4).unwrap();
 /// assert_eq!(rows.len(), 3);
-/// assert_eq!((rows[2].method, rows[2].level), (Method::Bilinear, 2));
+/// assert_eq!((rows[2].method, rows[2].level, rows[2].thesis_level), (Method::Bilinear, 2, 3));
 /// assert!(rows[1].comparison.rms < 0.05);
 /// ```
 pub fn run<T: Sample>(
@@ -231,6 +265,7 @@ pub fn run<T: Sample>(
             pitch,
             roll,
             level,
+            thesis_level: level + 1,
             comparison,
             seconds,
         };

@@ -87,11 +87,13 @@ pub struct ImageOutput {
 }
 
 impl ImageOutput {
-    /// Refuses an output that is the file `input` (or any of `inputs`).
+    /// Refuses, before any work, an output that is the file `input` (or any of `inputs`),
+    /// and an existing output without `--force`.
     pub fn refuse_overwriting(&self, inputs: &[&Path]) -> Result<()> {
         inputs
             .iter()
-            .try_for_each(|input| refuse_overwriting_input(input, &[&self.output]))
+            .try_for_each(|input| refuse_overwriting_input(input, &[&self.output]))?;
+        refuse_existing(&[&self.output], self.force)
     }
 
     /// Writes `image` (atomically; replaced only with `--force`; stored at `depth` when given)
@@ -127,6 +129,17 @@ pub fn print(text: &str) -> Result<()> {
             source: e,
         }),
         _ => Ok(()),
+    }
+}
+
+/// Refuses, before any work, the first of `outputs` that exists unless `force`: the write
+/// itself would refuse it too, but only after the computation.
+pub fn refuse_existing(outputs: &[&Path], force: bool) -> Result<()> {
+    match outputs.iter().find(|p| !force && p.exists()) {
+        Some(path) => Err(Error::OutputExists {
+            path: path.to_path_buf(),
+        }),
+        None => Ok(()),
     }
 }
 

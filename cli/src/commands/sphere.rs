@@ -7,7 +7,7 @@ use haarshift::io::{CoefficientFile, WriteOptions, read_image};
 use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
 use haarshift::{PlanarImage, Result, Sample, SampleDepth};
 
-use super::{choice, names, print, refuse_overwriting_input};
+use super::{choice, names, print, refuse_existing, refuse_overwriting_input};
 
 /// Operations on lat-long environment maps.
 #[derive(Subcommand, Debug)]
@@ -120,6 +120,7 @@ fn rotate(args: RotateArgs) -> Result<()> {
         &[&args.output]
     };
     refuse_overwriting_input(&args.input, outputs)?;
+    refuse_existing(outputs, args.force)?;
     let rotation = SphereRotation::from_degrees(args.yaw, args.pitch, args.roll)?;
     let options = SphereOptions {
         method: args.method,

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use haarshift::Result;
 use haarshift::io::{CoefficientFile, WriteOptions, read_image};
 
-use super::{TransformFlags, print, refuse_overwriting_input};
+use super::{TransformFlags, print, refuse_existing, refuse_overwriting_input};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -42,6 +42,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let sidecar = CoefficientFile::<f64>::sidecar_path(&args.output);
     refuse_overwriting_input(&args.input, &[&args.output, &sidecar])?;
+    refuse_existing(&[&args.output, &sidecar], args.force)?;
     let image = read_image::<f64>(&args.input)?;
     let spec = args.transform.request().spec();
     let coefficients =

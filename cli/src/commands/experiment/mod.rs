@@ -2,12 +2,12 @@
 //! Each prints its table to stdout and writes CSV, JSON and PNG files into `--out-dir`.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use clap::Subcommand;
 use haarshift::experiments::kernel_cycle::KernelCycle;
-use haarshift::experiments::output::{ReportWriter, write_json};
+use haarshift::experiments::output::{ReportDir, ReportWriter, write_json};
 use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
 use haarshift::experiments::rotation_cycle::{CycleRecord, MemoryMeter};
 use haarshift::experiments::table::{Table, significant};
@@ -15,6 +15,8 @@ use haarshift::kernels::{KernelOptions, ShiftMethod};
 use haarshift::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
+
+use crate::commands::refuse_overwriting_input;
 
 pub mod rotation_cycle;
 pub mod shift_chain;
@@ -69,12 +71,125 @@ pub struct OutputFlags {
     /// Also write the records (a JSON list) to this file
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
-    /// Directory for the CSV, JSON and PNG reports
-    #[arg(long, value_name = "DIR", default_value = "results")]
-    pub out_dir: PathBuf,
-    /// Replace existing report files
+    /// Directory for the reports: CSV, JSON, a Markdown table and PNG plots [default: the
+    /// scratch directory <temp>/haarshift/<experiment>, which every run overwrites]. In a
+    /// directory given here, reports of an earlier run stop the command before it computes
+    /// anything, unless --force
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
+    /// Replace existing report files in --out-dir, and the --json file
     #[arg(long)]
     pub force: bool,
+}
+
+impl OutputFlags {
+    /// Claims the report directory of `experiment` (the stem of its files) before the work:
+    /// refuses existing reports and an existing `--json` file unless `--force`, and any of
+    /// them that is one of `inputs`.
+    pub fn claim(&self, experiment: &'static str, inputs: &[PathBuf]) -> Result<Reports> {
+        let dir = match &self.out_dir {
+            Some(dir) => ReportDir::new(dir, self.force),
+            None => ReportDir::scratch(experiment),
+        };
+        let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+        dir.claim(experiment, &inputs)?;
+        if let Some(json) = &self.json {
+            refuse_overwriting_input_all(&inputs, json)?;
+            if !self.force && json.exists() {
+                return Err(Error::OutputExists { path: json.clone() });
+            }
+        }
+        Ok(Reports {
+            dir,
+            stem: experiment,
+            json: self.json.clone(),
+            force: self.force,
+        })
+    }
+}
+
+/// Refuses `output` when it is one of `inputs`.
+fn refuse_overwriting_input_all(inputs: &[&Path], output: &Path) -> Result<()> {
+    inputs
+        .iter()
+        .try_for_each(|input| refuse_overwriting_input(input, &[output]))
+}
+
+/// Where a claimed experiment writes: its directory, the stem of its files, `--json`.
+pub struct Reports {
+    /// The claimed directory.
+    pub dir: ReportDir,
+    /// The experiment's file stem.
+    pub stem: &'static str,
+    json: Option<PathBuf>,
+    force: bool,
+}
+
+impl Reports {
+    /// The writer of the experiment's main files (`<stem>.*`).
+    pub fn writer(&self) -> ReportWriter {
+        self.dir.writer(self.stem)
+    }
+
+    /// Writes `records` as CSV and JSON, `report` (the printed header and table) as Markdown,
+    /// `points` as the RMS-against-time plot, and `--json`; returns the lines naming the
+    /// files.
+    pub fn write<R: Serialize>(
+        &self,
+        report: &str,
+        records: &[R],
+        points: &[LabeledPoint],
+    ) -> Result<String> {
+        let writer = self.writer();
+        let mut written = vec![
+            writer.csv(records)?,
+            writer.json(records)?,
+            writer.markdown(&markdown_report(self.stem, report))?,
+        ];
+        if !points.is_empty() {
+            let plot = log_log_scatter(
+                &format!("{}: RMS against time", self.stem),
+                "seconds",
+                "RMS",
+                points,
+                &[],
+            )?;
+            written.push(writer.png("rms-time", &plot)?);
+        }
+        written.extend(self.write_json_flag(records)?);
+        Ok(wrote(&written))
+    }
+
+    /// Writes `records` to the `--json` file, if one was given, and returns its path.
+    pub fn write_json_flag<R: Serialize>(&self, records: &[R]) -> Result<Option<PathBuf>> {
+        let Some(path) = &self.json else {
+            return Ok(None);
+        };
+        write_json(path, records, self.force)?;
+        Ok(Some(path.clone()))
+    }
+}
+
+/// The Markdown file of a report: the command that made it, the printed header as a text
+/// block, then the table (every line starting with `|`).
+pub fn markdown_report(stem: &str, report: &str) -> String {
+    let command: Vec<String> = std::env::args().skip(1).collect();
+    let (table, header): (Vec<&str>, Vec<&str>) = report.lines().partition(|l| l.starts_with('|'));
+    let header = header.join("\n");
+    format!(
+        "# {stem}\n\nWritten by `haarshift {}`.\n\n```text\n{}\n```\n\n{}\n",
+        command.join(" "),
+        header.trim(),
+        table.join("\n")
+    )
+}
+
+/// `wrote PATH` lines for the files written.
+pub fn wrote(paths: &[PathBuf]) -> String {
+    paths
+        .iter()
+        .map(|p| format!("wrote {}\n", p.display()))
+        .collect()
 }
 
 /// The methods to compare and their parameters.
@@ -112,41 +227,6 @@ impl MethodFlags {
             self.precision, self.retained_precision
         )
     }
-}
-
-/// Writes `records` as CSV and JSON, `points` as the RMS-against-time plot, and `--json`;
-/// returns the lines naming the files.
-pub fn write_reports<R: Serialize>(
-    stem: &str,
-    records: &[R],
-    points: &[LabeledPoint],
-    output: &OutputFlags,
-) -> Result<String> {
-    std::fs::create_dir_all(&output.out_dir).map_err(|source| Error::Io {
-        path: output.out_dir.clone(),
-        source,
-    })?;
-    let writer = ReportWriter::new(&output.out_dir, stem, output.force);
-    let mut written = vec![writer.csv(records)?, writer.json(records)?];
-    if !points.is_empty() {
-        let plot = log_log_scatter(
-            &format!("{stem}: RMS against time"),
-            "seconds",
-            "RMS",
-            points,
-            &[],
-        )?;
-        written.push(writer.png("rms-time", &plot)?);
-    }
-    if let Some(path) = &output.json {
-        write_json(path, records, output.force)?;
-        written.push(path.clone());
-    }
-    Ok(written
-        .iter()
-        .map(|p| format!("\nwrote {}", p.display()))
-        .collect::<String>()
-        + "\n")
 }
 
 /// A progress bar on stderr when stderr is a terminal; hidden otherwise.

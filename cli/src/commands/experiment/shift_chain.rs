@@ -9,7 +9,7 @@ use haarshift::experiments::shift_chain::{ChainRecord, run_chain};
 use haarshift::experiments::table::{Table, significant};
 
 use super::rotation_cycle::load_images;
-use super::{MethodFlags, OutputFlags, progress_bar, write_reports};
+use super::{MethodFlags, OutputFlags, Reports, progress_bar};
 use crate::commands::print;
 
 const ABOUT: &str = "\
@@ -30,7 +30,7 @@ Examples:
 #[derive(clap::Args, Debug)]
 #[command(after_help = ABOUT)]
 pub struct Args {
-    /// Images to use [default: testdata/*.png and two synthetic patterns]
+    /// Images to use [default: the embedded photographs and two synthetic patterns]
     pub images: Vec<PathBuf>,
     /// Total shift in columns (right for positive)
     #[arg(long, default_value_t = 7.3, allow_negative_numbers = true)]
@@ -48,6 +48,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let reports = args.output.claim("shift-chain", &args.images)?;
     let methods = args.methods.methods(0)?;
     let images = load_images(&args.images)?;
     let bar = progress_bar(images.len() * methods.len());
@@ -78,8 +79,8 @@ pub fn run(args: Args) -> Result<()> {
         args.methods.describe(),
     );
     write!(text, "{}", chain_table(&records)).ok();
-    text.push_str(&write_chain_reports(&records, &args.output)?);
-    print(&text)
+    let written = write_chain_reports(&reports, &text, &records)?;
+    print(&format!("{text}\n{written}"))
 }
 
 fn label(r: &ChainRecord) -> String {
@@ -114,7 +115,7 @@ fn chain_table(records: &[ChainRecord]) -> Table {
     table
 }
 
-fn write_chain_reports(records: &[ChainRecord], output: &OutputFlags) -> Result<String> {
+fn write_chain_reports(reports: &Reports, report: &str, records: &[ChainRecord]) -> Result<String> {
     let points: Vec<LabeledPoint> = records
         .iter()
         .filter(|r| r.rms > 0.0 && r.seconds > 0.0)
@@ -124,5 +125,5 @@ fn write_chain_reports(records: &[ChainRecord], output: &OutputFlags) -> Result<
             y: r.rms,
         })
         .collect();
-    write_reports("shift-chain", records, &points, output)
+    reports.write(report, records, &points)
 }

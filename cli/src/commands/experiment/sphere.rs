@@ -1,25 +1,20 @@
 //! `haarshift experiment sphere`: each rotation method against the ground truth on real maps.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use haarshift::experiments::output::{ReportWriter, write_json};
 use haarshift::experiments::plot::{Series, category_points};
 use haarshift::experiments::table::{Table, significant};
 use haarshift::io::read_image;
-use haarshift::sphere::experiment::{self, Record, STANDARD_ROTATIONS};
+use haarshift::sphere::experiment::{self, Record, STANDARD_ROTATIONS, default_maps};
 use haarshift::sphere::{LatLongMap, Method};
 use haarshift::{Error, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::commands::{choice, names, print, refuse_overwriting_input};
-
-/// Where the maps are looked for when none are given, relative to the current directory.
-const DEFAULT_MAP_DIR: &str = "testdata/envmaps";
+use super::{OutputFlags, progress_bar, wrote};
+use crate::commands::{choice, names, print};
 
 const EXAMPLES: &str = "\
 Examples:
-  haarshift experiment sphere                       (the maps in testdata/envmaps/*.npy)
+  haarshift experiment sphere                       (the embedded rooitou_park_256x128 map)
   haarshift experiment sphere park.hdr studio.exr --out-dir results/envmaps --force
   haarshift experiment sphere --methods bilinear,haar --levels full,full-2,4 --samples 4
   haarshift experiment sphere --json sphere-records.json
@@ -34,25 +29,19 @@ coefficients (average normalisation); energy err, the relative change of the sol
 integral against the input map (a rotation preserves it); ms, the wall-clock time of the
 rotation. Maps are computed in single precision.
 
-Writes DIR/sphere.csv, DIR/sphere.json (the same records) and DIR/sphere-rms.png (rms per
-rotation, one marker colour per method and level); existing files are kept unless --force.";
+Writes DIR/sphere.csv, DIR/sphere.json (the same records), DIR/sphere.md (the table) and
+DIR/sphere-rms.png (rms per rotation, one marker colour per method and level).";
 
 /// Compare sphere rotation methods with the ground truth: table, CSV, JSON, plot.
 #[derive(clap::Args, Debug)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
     /// Lat-long maps (.hdr, .exr or .npy; 2:1, the height a power of two) [default: the
-    /// .npy files in testdata/envmaps/ under the current directory]
+    /// embedded 256x128 copy of rooitou_park (testdata/envmaps)]
     pub maps: Vec<PathBuf>,
 
-    /// Also write the JSON records (map, method, yaw, pitch, roll, level, rms, ...,
-    /// energy_error, seconds) to FILE
-    #[arg(long, value_name = "FILE")]
-    pub json: Option<PathBuf>,
-
-    /// Directory for sphere.csv, sphere.json and sphere-rms.png (created if missing)
-    #[arg(long, value_name = "DIR", default_value = "results")]
-    pub out_dir: PathBuf,
+    #[command(flatten)]
+    pub output: OutputFlags,
 
     /// Methods to compare with the reference, comma-separated
     #[arg(
@@ -70,7 +59,7 @@ pub struct Args {
         long,
         value_name = "LIST",
         value_delimiter = ',',
-        default_value = "full,full-2",
+        default_value = "full,full-1,full-2",
         value_parser = parse_level
     )]
     pub levels: Vec<LevelChoice>,
@@ -78,10 +67,6 @@ pub struct Args {
     /// Samples per axis and pixel of the reference (1 to 64)
     #[arg(long, value_name = "N", default_value_t = 8)]
     pub samples: usize,
-
-    /// Replace existing output files
-    #[arg(long)]
-    pub force: bool,
 }
 
 /// A level as given on the command line.
@@ -135,32 +120,15 @@ impl LevelChoice {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let paths = if args.maps.is_empty() {
-        default_maps()?
+    let reports = args.output.claim("sphere", &args.maps)?;
+    let maps = if args.maps.is_empty() {
+        default_maps::<f32>()?
     } else {
-        args.maps.clone()
+        args.maps
+            .iter()
+            .map(|p| load_map(p))
+            .collect::<Result<Vec<_>>>()?
     };
-    let report = ReportWriter::new(&args.out_dir, "sphere", args.force);
-    let outputs: Vec<PathBuf> = [
-        report.path("", "csv"),
-        report.path("", "json"),
-        report.path("-rms", "png"),
-    ]
-    .into_iter()
-    .chain(args.json.clone())
-    .collect();
-    let output_refs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
-    for path in &paths {
-        refuse_overwriting_input(path, &output_refs)?;
-    }
-    // Fail before the long computation, not after it.
-    if let Some(path) = outputs.iter().find(|p| !args.force && p.exists()) {
-        return Err(Error::OutputExists { path: path.clone() });
-    }
-    let maps = paths
-        .iter()
-        .map(|p| load_map(p))
-        .collect::<Result<Vec<_>>>()?;
 
     let combos: Vec<(Method, LevelChoice)> = args
         .methods
@@ -176,7 +144,7 @@ pub fn run(args: Args) -> Result<()> {
         .collect();
     let mut categories = Vec::new();
     let mut records: Vec<Record> = Vec::new();
-    let bar = progress_bar((maps.len() * STANDARD_ROTATIONS.len()) as u64);
+    let bar = progress_bar(maps.len() * STANDARD_ROTATIONS.len());
     for (name, map) in &maps {
         let finest = map.height().trailing_zeros().saturating_sub(1) as usize;
         let methods = combos
@@ -202,52 +170,19 @@ pub fn run(args: Args) -> Result<()> {
     }
     bar.finish_and_clear();
 
-    std::fs::create_dir_all(&args.out_dir).map_err(|e| Error::Io {
-        path: args.out_dir.clone(),
-        source: e,
-    })?;
-    let mut written = vec![report.csv(&records)?, report.json(&records)?];
+    let text = table(&records).to_string();
+    let mut written = reports.write(&text, &records, &[])?;
     if series.iter().flat_map(|s| &s.values).any(Option::is_some) {
         let title = format!(
             "Solid-angle weighted RMS against the reference ({0}x{0} samples per pixel)",
             args.samples
         );
         let plot = category_points(&title, "weighted RMS", &categories, &series)?;
-        written.push(report.png("rms", &plot)?);
+        written.push_str(&wrote(&[reports.writer().png("rms", &plot)?]));
     } else {
         eprintln!("haarshift: note: every method matched the reference exactly; no plot");
     }
-    if let Some(path) = &args.json {
-        write_json(path, &records, args.force)?;
-        written.push(path.clone());
-    }
-    let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
-    print(&format!(
-        "{}\nwrote {}\n",
-        table(&records),
-        names.join(", ")
-    ))
-}
-
-/// The .npy maps in [`DEFAULT_MAP_DIR`], sorted by name.
-fn default_maps() -> Result<Vec<PathBuf>> {
-    let none = || Error::InvalidParameter {
-        name: "maps",
-        reason: format!(
-            "none given and no .npy maps found in {DEFAULT_MAP_DIR}/ under the current \
-             directory: pass the maps to measure (e.g. `haarshift experiment sphere park.hdr`)"
-        ),
-    };
-    let entries = std::fs::read_dir(DEFAULT_MAP_DIR).map_err(|_| none())?;
-    let mut maps: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("npy")))
-        .collect();
-    maps.sort();
-    if maps.is_empty() {
-        return Err(none());
-    }
-    Ok(maps)
+    print(&format!("{text}\n{written}"))
 }
 
 /// A map file as `(name, map)`, the name being the file's stem.
@@ -284,6 +219,7 @@ fn table(records: &[Record]) -> Table {
         "roll",
         "method",
         "level",
+        "thesis level",
         "rms",
         "rms@level",
         "coef rms",
@@ -299,6 +235,7 @@ fn table(records: &[Record]) -> Table {
             r.roll.to_string(),
             r.method.to_string(),
             r.level.to_string(),
+            r.thesis_level.to_string(),
             significant(c.rms, 3),
             significant(c.rms_at_level, 3),
             significant(c.coefficient_rms, 3),
@@ -307,14 +244,4 @@ fn table(records: &[Record]) -> Table {
         ]);
     }
     t
-}
-
-/// A progress bar on standard error when it is a terminal, hidden otherwise.
-fn progress_bar(len: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let style = ProgressStyle::with_template("{bar:30} {pos}/{len} rotations  {msg}")
-        .unwrap_or_else(|_| ProgressStyle::default_bar());
-    ProgressBar::new(len).with_style(style)
 }

@@ -5,15 +5,14 @@ use std::fmt::Write;
 use std::path::PathBuf;
 
 use haarshift::Result;
-use haarshift::experiments::kernel_cycle::NamedPlane;
-use haarshift::experiments::output::ReportWriter;
+use haarshift::experiments::kernel_cycle::{NamedPlane, default_photograph};
 use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
 use haarshift::experiments::stability::{
     FAMILIES, StabilityConfig, StabilityRecord, StabilityReport, eight_bit, run_stability,
 };
 use haarshift::experiments::table::{Table, significant};
 
-use super::{OutputFlags, PeakMeter, progress_bar, write_reports};
+use super::{OutputFlags, PeakMeter, Reports, progress_bar};
 use crate::commands::print;
 
 const ABOUT: &str = "\
@@ -41,9 +40,10 @@ Examples:
 #[derive(clap::Args, Debug)]
 #[command(after_help = ABOUT)]
 pub struct Args {
-    /// The photograph (rounded to 8-bit values, at least 128x128)
-    #[arg(long, value_name = "FILE", default_value = "testdata/camera.png")]
-    pub image: PathBuf,
+    /// The photograph (rounded to 8-bit values, at least 128x128) [default: the embedded
+    /// camera.png]
+    #[arg(long, value_name = "FILE")]
+    pub image: Option<PathBuf>,
     /// Shorter chains: 10^3 whole and 10^2 fractional shifts instead of 10^4 and 10^3
     #[arg(long)]
     pub quick: bool,
@@ -52,7 +52,12 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let photo = NamedPlane::read(&args.image)?;
+    let inputs: Vec<PathBuf> = args.image.iter().cloned().collect();
+    let reports = args.output.claim("stability", &inputs)?;
+    let photo = match &args.image {
+        Some(path) => NamedPlane::read(path)?,
+        None => default_photograph("camera.png")?,
+    };
     let mut config = StabilityConfig::new(eight_bit(photo.plane.view()));
     if args.quick {
         config.integer_shifts = 1_000;
@@ -80,8 +85,8 @@ pub fn run(args: Args) -> Result<()> {
         report.records.len()
     )
     .ok();
-    text.push_str(&write_stability_reports(&report, &args.output)?);
-    print(&text)?;
+    let written = write_stability_reports(&reports, &text, &report)?;
+    print(&format!("{text}\n{written}"))?;
     if failures > 0 {
         eprintln!("haarshift: {failures} stability checks failed");
         std::process::exit(1);
@@ -120,8 +125,12 @@ fn stability_table(records: &[StabilityRecord]) -> Table {
 }
 
 /// CSV and JSON of the records (and `--json`), and the drift plot.
-fn write_stability_reports(report: &StabilityReport, output: &OutputFlags) -> Result<String> {
-    let mut text = write_reports("stability", &report.records, &[], output)?;
+fn write_stability_reports(
+    reports: &Reports,
+    printed: &str,
+    report: &StabilityReport,
+) -> Result<String> {
+    let mut text = reports.write(printed, &report.records, &[])?;
     let points: Vec<LabeledPoint> = report
         .drift
         .iter()
@@ -140,8 +149,12 @@ fn write_stability_reports(report: &StabilityReport, output: &OutputFlags) -> Re
             &points,
             &points,
         )?;
-        let writer = ReportWriter::new(&output.out_dir, "stability", output.force);
-        writeln!(text, "wrote {}", writer.png("drift", &plot)?.display()).ok();
+        writeln!(
+            text,
+            "wrote {}",
+            reports.writer().png("drift", &plot)?.display()
+        )
+        .ok();
     }
     Ok(text)
 }

@@ -4,7 +4,6 @@
 use std::fmt::Write;
 use std::path::PathBuf;
 
-use haarshift::experiments::output::ReportWriter;
 use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
 use haarshift::experiments::rotation_cycle::{CycleRecord, PROTOCOL};
 use haarshift::experiments::table::{Table, significant};
@@ -13,7 +12,7 @@ use haarshift::{Error, Result};
 use serde::Serialize;
 
 use super::rotation_cycle::{load_images, run_methods};
-use super::{OutputFlags, parse_methods, peak_megabytes, write_reports};
+use super::{OutputFlags, Reports, markdown_report, parse_methods, peak_megabytes, wrote};
 use crate::commands::print;
 
 const ABOUT: &str = "\
@@ -23,7 +22,7 @@ h = 1..=MAX_RETAINED_PRECISION (at s = 0: it already works on a 2^h-finer grid),
 configuration but retained Haar on a 2^s-finer grid for s = 0..=MAX_SUPERSAMPLE. Kernel sizes
 are kernels of their own (keys, bspline3/bspline5, lanczos3/lanczos4).
 
-Default images: those of rotation-cycle (every PNG in testdata/ and two synthetic patterns),
+Default images: those of rotation-cycle (the embedded photographs and two synthetic patterns),
 each cut to its centred 128x128 crop (--size), so that the default run takes a few minutes
 rather than the hours retained Haar at h = 2 and supersampling need on the full crops.
 
@@ -32,9 +31,9 @@ the largest peak heap of a single run (the runs are made one at a time). A confi
 the time frontier (T) when no other has both a lower or equal total time and a lower or equal
 mean RMS (one of them strictly), and on the memory frontier (M) likewise with peak heap.
 
-Writes DIR/tradeoff.csv and .json (one record per configuration, with the frontier flags),
-DIR/tradeoff-rms-time.png and DIR/tradeoff-rms-memory.png (log-log, frontier in red), and
-DIR/tradeoff-runs.csv and .json (one record per image and configuration, with its
+Writes DIR/tradeoff.csv, .json and .md (one record per configuration, with the frontier
+flags), DIR/tradeoff-rms-time.png and DIR/tradeoff-rms-memory.png (log-log, frontier in red),
+and DIR/tradeoff-runs.csv and .json (one record per image and configuration, with its
 configuration's frontier flags; --json FILE writes these too).
 
 Examples:
@@ -46,7 +45,7 @@ Examples:
 #[derive(clap::Args, Debug)]
 #[command(after_help = ABOUT)]
 pub struct Args {
-    /// Images to use [default: testdata/*.png and two synthetic patterns]
+    /// Images to use [default: the embedded photographs and two synthetic patterns]
     pub images: Vec<PathBuf>,
     /// Side of the centred crop each image is cut to first, or `full` for the protocol's own
     /// crop (the whole shorter side)
@@ -103,6 +102,7 @@ struct Run<'a> {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let reports = args.output.claim("tradeoff", &args.images)?;
     let grid = TradeoffGrid {
         max_precision: args.max_precision,
         max_retained_precision: args.max_retained_precision,
@@ -125,7 +125,7 @@ pub fn run(args: Args) -> Result<()> {
             .map(|image| image.centre_crop(side))
             .collect::<Result<_>>()?;
     }
-    let runs = run_methods(&images, &configs, args.steps as usize)?;
+    let runs = run_methods(&images, &configs, args.steps as usize, |_| {})?;
     let points = summarize(&runs);
 
     let crops: Vec<String> = images
@@ -152,8 +152,8 @@ pub fn run(args: Args) -> Result<()> {
         grid.describe(),
     );
     write!(text, "{}", tradeoff_table(&points)).ok();
-    text.push_str(&write_tradeoff_reports(&runs, &points, &args.output)?);
-    print(&text)
+    let written = write_tradeoff_reports(&reports, &text, &runs, &points)?;
+    print(&format!("{text}\n{written}"))
 }
 
 /// The summary as a table, frontier members marked.
@@ -187,12 +187,13 @@ fn tradeoff_table(points: &[TradeoffPoint]) -> Table {
     table
 }
 
-/// Writes the per-run reports (and `--json`), the summary and the two frontier plots;
+/// Writes the summary, the per-run reports (and `--json`) and the two frontier plots;
 /// returns the lines naming the files.
 fn write_tradeoff_reports(
+    reports: &Reports,
+    report: &str,
     runs: &[CycleRecord],
     points: &[TradeoffPoint],
-    output: &OutputFlags,
 ) -> Result<String> {
     let flagged: Vec<Run<'_>> = runs
         .iter()
@@ -207,9 +208,16 @@ fn write_tradeoff_reports(
             }
         })
         .collect();
-    let mut written = write_reports("tradeoff-runs", &flagged, &[], output)?;
-    let writer = ReportWriter::new(&output.out_dir, "tradeoff", output.force);
-    let mut files = vec![writer.csv(points)?, writer.json(points)?];
+    let writer = reports.writer();
+    let runs_writer = reports.dir.writer("tradeoff-runs");
+    let mut files = vec![
+        writer.csv(points)?,
+        writer.json(points)?,
+        writer.markdown(&markdown_report(reports.stem, report))?,
+        runs_writer.csv(&flagged)?,
+        runs_writer.json(&flagged)?,
+    ];
+    files.extend(reports.write_json_flag(&flagged)?);
     for axis in &COST_AXES {
         let placed: Vec<(&TradeoffPoint, LabeledPoint)> = points
             .iter()
@@ -239,10 +247,7 @@ fn write_tradeoff_reports(
         let plot = log_log_scatter(&title, axis.x_label, "mean RMS", &all, &frontier)?;
         files.push(writer.png(axis.file, &plot)?);
     }
-    for file in files {
-        writeln!(written, "wrote {}", file.display()).ok();
-    }
-    Ok(written)
+    Ok(wrote(&files))
 }
 
 /// A cost the error is plotted against, with its frontier.

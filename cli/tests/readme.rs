@@ -1,0 +1,125 @@
+//! The README's opening commands work out of the box: each `haarshift` command of its first
+//! code block runs, as written, in a copy of the repository's files (with `results/` as
+//! committed), twice, succeeds both times, prints its table and leaves `results/` alone.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const CARGO_RUN: &str = "cargo run --release -p haarshift-cli -- ";
+
+fn repository() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The `haarshift` arguments of every `cargo run` line in the README's first code block.
+fn opening_commands(readme: &str) -> Vec<Vec<String>> {
+    let block = readme
+        .split("```")
+        .nth(1)
+        .expect("the README has a code block");
+    block
+        .lines()
+        .filter_map(|line| line.trim().strip_prefix(CARGO_RUN))
+        .map(|args| args.split_whitespace().map(str::to_owned).collect())
+        .collect()
+}
+
+/// Copies `from` into `to`, recursively.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+/// Every file below `dir` with its content.
+fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut files = BTreeMap::new();
+    let mut pending = vec![dir.to_path_buf()];
+    while let Some(d) = pending.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                pending.push(path);
+            } else {
+                files.insert(path.clone(), std::fs::read(&path).unwrap());
+            }
+        }
+    }
+    files
+}
+
+#[test]
+fn the_opening_block_parses_into_haarshift_commands() {
+    let readme = "# x\n\n```sh\ncargo run --release -p haarshift-cli -- experiment a --b 1\n\
+                  cargo test --workspace --release\n```\n\n```sh\n\
+                  cargo run --release -p haarshift-cli -- later\n```\n";
+    assert_eq!(
+        opening_commands(readme),
+        vec![vec!["experiment", "a", "--b", "1"]]
+    );
+}
+
+#[test]
+fn the_readme_opening_commands_succeed_on_a_fresh_copy_and_when_run_again() {
+    let readme = std::fs::read_to_string(repository().join("README.md")).unwrap();
+    let commands = opening_commands(&readme);
+    assert!(
+        !commands.is_empty(),
+        "the README's first code block has no `{CARGO_RUN}` line"
+    );
+    let work = tempfile::tempdir().unwrap();
+    let clone = work.path().join("haarshift");
+    for dir in ["testdata", "results"] {
+        copy_tree(&repository().join(dir), &clone.join(dir));
+    }
+    std::fs::copy(repository().join("README.md"), clone.join("README.md")).unwrap();
+    let committed = snapshot(&clone.join("results"));
+    assert!(
+        !committed.is_empty(),
+        "results/ holds the committed reports"
+    );
+    // The scratch directory of the experiments goes under the test's own temporary directory.
+    let scratch = work.path().join("tmp");
+    std::fs::create_dir_all(&scratch).unwrap();
+    for args in &commands {
+        for attempt in ["first", "second"] {
+            let out = Command::new(env!("CARGO_BIN_EXE_haarshift"))
+                .args(args)
+                .current_dir(&clone)
+                .env("TMPDIR", &scratch)
+                .output()
+                .unwrap();
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                out.status.success(),
+                "`haarshift {}` failed on the {attempt} run: {stderr}",
+                args.join(" ")
+            );
+            assert!(
+                stdout.lines().any(|l| l.starts_with("|---")),
+                "`haarshift {}` printed no table on the {attempt} run:\n{stdout}",
+                args.join(" ")
+            );
+            if args[0] == "experiment" {
+                assert!(
+                    stdout.contains(&*scratch.to_string_lossy()),
+                    "an experiment's reports go to its scratch directory:\n{stdout}"
+                );
+            }
+        }
+    }
+    assert_eq!(
+        snapshot(&clone.join("results")),
+        committed,
+        "the README's commands changed the committed results/"
+    );
+}
