@@ -11,7 +11,7 @@
 //! | TIFF (`.tif`, `.tiff`) | yes | yes | u8, u16 (read also f32 RGB/RGBA) | gray, gray+alpha, RGB, RGBA |
 //! | OpenEXR (`.exr`) | yes | yes | f16, f32 | `Y`, `Y A`, `R G B`, `R G B A` |
 //! | Radiance (`.hdr`) | yes | yes (RGBE, lossy) | f32 | RGB |
-//! | NumPy (`.npy`) | yes | yes | f32, f64 | `H x W` (gray) or `H x W x C`, C = 1..=4 |
+//! | NumPy (`.npy`) | yes | yes | f32, f64 (read also f16) | `H x W` (gray) or `H x W x C`, C = 1..=4 |
 //!
 //! # Which format a file is
 //!
@@ -270,6 +270,29 @@ pub fn read_image_with<T: Sample>(path: &Path, options: &ReadOptions) -> Result<
     Ok(image)
 }
 
+/// Whether the file at `path` holds float64 samples (a float64 `.npy` array), which reading as
+/// f32 would round; every other file reads exactly as f32 (8- and 16-bit integers, f16 and
+/// f32 floats). Only the file's signature and header are read.
+///
+/// ```
+/// use haarshift::io::{holds_f64, write_image, WriteOptions};
+/// use haarshift::{PlanarImage, SampleDepth};
+/// use ndarray::Array2;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("a.npy");
+/// let image = PlanarImage::from_gray(Array2::<f64>::ones((2, 3)), SampleDepth::F64).unwrap();
+/// write_image(&image, &path, WriteOptions::default()).unwrap();
+/// assert!(holds_f64(&path).unwrap());
+/// let png = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/camera.png");
+/// assert!(!holds_f64(png.as_ref()).unwrap());
+/// ```
+pub fn holds_f64(path: &Path) -> Result<bool> {
+    Ok(match FileFormat::of_file(path)? {
+        FileFormat::Npy => npy::stored_depth(path)? == SampleDepth::F64,
+        _ => false,
+    })
+}
+
 /// Writes `image` in the format of `path`'s extension; see the [module docs](self).
 pub fn write_image<T: Sample>(
     image: &PlanarImage<T>,
@@ -365,15 +388,9 @@ fn interleave<T: Sample, P>(
         Some(max) => to_code(v.as_f64(), scale, max),
         None => v.as_f64(),
     };
-    let planes = image.planes();
-    let (c, h, w) = planes.dim();
-    let mut out = Vec::with_capacity(c * h * w);
-    for i in 0..h {
-        for j in 0..w {
-            out.extend((0..c).map(|k| convert(code(planes[[k, i, j]]))));
-        }
-    }
-    out
+    // The planes' axes (c, h, w) visited in the order h, w, c.
+    let pixels = image.planes().permuted_axes([1, 2, 0]);
+    pixels.iter().map(|&v| convert(code(v))).collect()
 }
 
 /// Planes `(c, h, w)` from interleaved samples, each converted to f64 by `to_f64`.
@@ -382,9 +399,14 @@ fn deinterleave<T: Sample, P: Copy>(
     (c, h, w): (usize, usize, usize),
     to_f64: impl Fn(P) -> f64,
 ) -> Array3<T> {
-    Array3::from_shape_fn((c, h, w), |(k, i, j)| {
-        T::from_f64(to_f64(data[(i * w + j) * c + k]))
-    })
+    let mut planes = Array3::zeros((c, h, w));
+    let pixels = ndarray::ArrayView3::from_shape((h, w, c), data)
+        .expect("the decoder's buffer holds h x w x c samples")
+        .permuted_axes([2, 0, 1]);
+    ndarray::Zip::from(&mut planes)
+        .and(pixels)
+        .for_each(|p, &v| *p = T::from_f64(to_f64(v)));
+    planes
 }
 
 /// Checks that decoding data of `shape` stays within `limit` when the decoder needs
