@@ -49,6 +49,7 @@ use ndarray::{Array2, ArrayView2, Axis, CowArray, s};
 use crate::kernels::shear::{check_finite, shear_pass_into};
 use crate::kernels::{Outside, ShearKernel, grid, transpose};
 use crate::named::named_enum;
+use crate::sample::round_to_code;
 use crate::{BoundaryMode, Error, PlanarImage, Result, Sample};
 
 named_enum! {
@@ -792,8 +793,7 @@ pub fn rotate_image<T: Sample>(
         }
     }
     if let Some(max) = depth.integer_max() {
-        let max = T::from_f64(max);
-        out.par_mapv_inplace(|v| v.round().max(T::zero()).min(max));
+        out.par_mapv_inplace(|v| round_to_code(v, max));
     }
     PlanarImage::new(out, image.channels(), depth)
 }

@@ -69,6 +69,7 @@ use std::path::Path;
 use ndarray::Array3;
 
 use crate::named::named_enum;
+use crate::sample::round_to_code;
 use crate::{Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
 mod atomic;
@@ -266,7 +267,10 @@ pub fn read_image_with<T: Sample>(path: &Path, options: &ReadOptions) -> Result<
             raster::read(path, format, options)?
         }
     };
-    ensure_finite(&image.planes()).map_err(|e| e.in_file(path))?;
+    // Integer samples are finite by construction.
+    if image.depth().integer_max().is_none() {
+        ensure_finite(&image.planes()).map_err(|e| e.in_file(path))?;
+    }
     Ok(image)
 }
 
@@ -372,13 +376,13 @@ fn depth_scale(from: SampleDepth, to: SampleDepth) -> f64 {
 /// Converts a sample to an integer code of `max` (255 or 65535): scale, round to nearest
 /// (ties away from zero), clamp.
 fn to_code(value: f64, scale: f64, max: f64) -> f64 {
-    (value * scale).round().clamp(0.0, max)
+    round_to_code(value * scale, max)
 }
 
 /// The planes of `image` as stored at `depth`, interleaved pixel by pixel (row-major, then
 /// channel), converted by `convert` from the f64 value (already rescaled and, for integer
 /// depths, rounded and clamped).
-fn interleave<T: Sample, P>(
+fn interleave<T: Sample, P: Copy + Default>(
     image: &PlanarImage<T>,
     depth: SampleDepth,
     convert: impl Fn(f64) -> P,
@@ -388,9 +392,19 @@ fn interleave<T: Sample, P>(
         Some(max) => to_code(v.as_f64(), scale, max),
         None => v.as_f64(),
     };
-    // The planes' axes (c, h, w) visited in the order h, w, c.
-    let pixels = image.planes().permuted_axes([1, 2, 0]);
-    pixels.iter().map(|&v| convert(code(v))).collect()
+    let planes = image.planes();
+    let planes = planes.as_standard_layout();
+    let (c, h, w) = planes.dim();
+    let n = h * w;
+    let samples = planes.as_slice().expect("standard layout");
+    // Plane by plane: reads in order, writes every c-th sample.
+    let mut out = vec![P::default(); c * n];
+    for (k, plane) in samples.chunks_exact(n).enumerate() {
+        for (o, &v) in out[k..].iter_mut().step_by(c).zip(plane) {
+            *o = convert(code(v));
+        }
+    }
+    out
 }
 
 /// Planes `(c, h, w)` from interleaved samples, each converted to f64 by `to_f64`.

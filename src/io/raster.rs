@@ -145,10 +145,12 @@ fn integer_bytes<T: Sample>(image: &PlanarImage<T>, depth: SampleDepth) -> Vec<u
     if depth == SampleDepth::U8 {
         interleave(image, depth, |v| v as u8)
     } else {
-        interleave(image, depth, |v| v as u16)
-            .into_iter()
-            .flat_map(u16::to_ne_bytes)
-            .collect()
+        let samples = interleave(image, depth, |v| v as u16);
+        let mut bytes = Vec::with_capacity(2 * samples.len());
+        for v in samples {
+            bytes.extend_from_slice(&v.to_ne_bytes());
+        }
+        bytes
     }
 }
 
