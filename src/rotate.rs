@@ -49,6 +49,7 @@ use ndarray::{Array2, ArrayView2, Axis, CowArray, s};
 use crate::kernels::shear::{check_finite, shear_pass_into};
 use crate::kernels::{Outside, ShearKernel, grid, transpose};
 use crate::named::named_enum;
+use crate::sample::round_to_code;
 use crate::{BoundaryMode, Error, PlanarImage, Result, Sample};
 
 named_enum! {
@@ -706,27 +707,44 @@ pub fn rotate_image<T: Sample>(
 ) -> Result<PlanarImage<T>> {
     let depth = image.depth();
     let opaque = depth.integer_max().unwrap_or(1.0);
-    let alpha_plane = image.channels().count() - 1;
+    let count = image.channels().count();
+    let alpha_plane = count - 1;
+    let (h, w) = rotated_size(image.height(), image.width(), deg, options)?;
+    check_budget::<T>(
+        "the rotated image",
+        (count * h * w) as u128,
+        options.memory_budget,
+    )?;
+    // Every plane is rotated straight into its place in the output; the intermediates are
+    // shared by all planes.
+    let mut out = ndarray::Array3::<T>::zeros((count, h, w));
     let mut workspace = RotationWorkspace::new();
-    let rotated = match image.alpha() {
-        None => image.map_planes(|p| workspace.rotate_plane(p, deg, kernel, options))?,
+    match image.alpha() {
+        None => {
+            for (p, o) in image.planes().outer_iter().zip(out.outer_iter_mut()) {
+                workspace.rotate_plane_into(p, deg, kernel, options, o)?;
+            }
+        }
         Some(_) if is_pure_copy(image.height(), image.width(), deg, options.canvas)? => {
             // Nothing is interpolated: copy colour as it is (even under alpha 0), with a
             // transparent outside.
-            let mut c = 0;
-            image.map_planes(|p| {
-                let transparent = RotateOptions {
-                    outside: Outside::Fill(0.0),
-                    ..*options
-                };
+            let transparent = RotateOptions {
+                outside: Outside::Fill(0.0),
+                ..*options
+            };
+            for (c, (p, o)) in image
+                .planes()
+                .outer_iter()
+                .zip(out.outer_iter_mut())
+                .enumerate()
+            {
                 let opts = if c == alpha_plane {
                     &transparent
                 } else {
                     options
                 };
-                c += 1;
-                workspace.rotate_plane(p, deg, kernel, opts)
-            })?
+                workspace.rotate_plane_into(p, deg, kernel, opts, o)?;
+            }
         }
         Some(alpha) => {
             let fill = match options.outside.validate()? {
@@ -742,20 +760,29 @@ pub fn rotate_image<T: Sample>(
                 outside: premultiplied_outside,
                 ..*options
             };
-            let mut planes: Vec<Array2<T>> = Vec::with_capacity(alpha_plane + 1);
-            for (c, p) in image.planes().outer_iter().enumerate() {
-                let p = if c == alpha_plane {
-                    p.to_owned()
-                } else {
-                    &p * &alpha * scale
-                };
-                planes.push(workspace.rotate_plane(p.view(), deg, kernel, &opts)?);
-            }
-            let new_alpha = planes.pop().expect("alpha plane");
+            let (mut colours, mut new_alpha) = out.view_mut().split_at(Axis(0), alpha_plane);
+            let mut new_alpha = new_alpha.index_axis_mut(Axis(0), 0);
+            workspace.rotate_plane_into(alpha, deg, kernel, &opts, new_alpha.view_mut())?;
+            let mut premultiplied = Array2::<T>::zeros(alpha.dim());
             let threshold = T::from_f64(TRANSPARENT * opaque);
             let (fill, opaque_t) = (T::from_f64(fill), T::from_f64(opaque));
-            for p in planes.iter_mut() {
-                ndarray::Zip::from(p).and(&new_alpha).par_for_each(|v, &a| {
+            for (p, mut o) in image
+                .color_planes()
+                .outer_iter()
+                .zip(colours.outer_iter_mut())
+            {
+                ndarray::Zip::from(&mut premultiplied)
+                    .and(p)
+                    .and(alpha)
+                    .par_for_each(|m, &v, &a| *m = v * a * scale);
+                workspace.rotate_plane_into(
+                    premultiplied.view(),
+                    deg,
+                    kernel,
+                    &opts,
+                    o.view_mut(),
+                )?;
+                ndarray::Zip::from(o).and(&new_alpha).par_for_each(|v, &a| {
                     *v = if a > threshold {
                         *v * opaque_t / a
                     } else {
@@ -763,20 +790,12 @@ pub fn rotate_image<T: Sample>(
                     };
                 });
             }
-            planes.push(new_alpha);
-            let views: Vec<ArrayView2<'_, T>> = planes.iter().map(|p| p.view()).collect();
-            let stacked = ndarray::stack(Axis(0), &views)
-                .map_err(|e| Error::shape(&[planes.len()], e.to_string()))?;
-            PlanarImage::new(stacked, image.channels(), depth)?
         }
-    };
-    Ok(match depth.integer_max() {
-        None => rotated,
-        Some(max) => {
-            let max = T::from_f64(max);
-            rotated.map_planes(|p| Ok(p.mapv(|v| v.round().max(T::zero()).min(max))))?
-        }
-    })
+    }
+    if let Some(max) = depth.integer_max() {
+        out.par_mapv_inplace(|v| round_to_code(v, max));
+    }
+    PlanarImage::new(out, image.channels(), depth)
 }
 
 #[cfg(test)]

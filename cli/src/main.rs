@@ -8,10 +8,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod commands;
+mod peak;
 
 /// Counts heap use, so that the experiments can report peak memory per run.
 #[global_allocator]
-static PEAK: peak_alloc::PeakAlloc = peak_alloc::PeakAlloc;
+static PEAK: peak::PeakAlloc = peak::PeakAlloc;
 
 /// Haar wavelet transforms of images, shifts and rotations computed directly on the
 /// coefficients.

@@ -169,11 +169,10 @@ impl<T: Sample> CoefficientFile<T> {
         let sidecar_path = Self::sidecar_path(path);
         let (h, w) = self.planes[0].as_array().dim();
         let shape = [self.planes.len(), h, w];
-        let data: Vec<f64> = self
+        let data = self
             .planes
             .iter()
-            .flat_map(|p| p.as_array().iter().map(|v| v.as_f64()).collect::<Vec<_>>())
-            .collect();
+            .flat_map(|p| p.as_array().into_iter().map(|v| v.as_f64()));
         let sidecar = Sidecar {
             format: SIDECAR_FORMAT.into(),
             version: SIDECAR_VERSION,
@@ -182,7 +181,7 @@ impl<T: Sample> CoefficientFile<T> {
         };
         let mut array_file = PendingFile::create(path, options.force)?;
         let mut sidecar_file = PendingFile::create(&sidecar_path, options.force)?;
-        npy::write_array(data, &shape, path, array_file.writer())?;
+        npy::write_samples(data, &shape, path, array_file.writer())?;
         serde_json::to_writer_pretty(&mut *sidecar_file.writer(), &sidecar)
             .map_err(|e| format_reason(&sidecar_path, e.to_string()))?;
         writeln!(sidecar_file.writer()).map_err(|e| io_error(&sidecar_path, e))?;

@@ -11,7 +11,7 @@
 //! | TIFF (`.tif`, `.tiff`) | yes | yes | u8, u16 (read also f32 RGB/RGBA) | gray, gray+alpha, RGB, RGBA |
 //! | OpenEXR (`.exr`) | yes | yes | f16, f32 | `Y`, `Y A`, `R G B`, `R G B A` |
 //! | Radiance (`.hdr`) | yes | yes (RGBE, lossy) | f32 | RGB |
-//! | NumPy (`.npy`) | yes | yes | f32, f64 | `H x W` (gray) or `H x W x C`, C = 1..=4 |
+//! | NumPy (`.npy`) | yes | yes | f32, f64 (read also f16) | `H x W` (gray) or `H x W x C`, C = 1..=4 |
 //!
 //! # Which format a file is
 //!
@@ -69,6 +69,7 @@ use std::path::Path;
 use ndarray::Array3;
 
 use crate::named::named_enum;
+use crate::sample::round_to_code;
 use crate::{Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
 mod atomic;
@@ -298,7 +299,10 @@ fn read_source<T: Sample>(source: &Source<'_>, options: &ReadOptions) -> Result<
             raster::read(source, format, options)?
         }
     };
-    ensure_finite(&image.planes()).map_err(|e| e.in_file(source.name()))?;
+    // Integer samples are finite by construction.
+    if image.depth().integer_max().is_none() {
+        ensure_finite(&image.planes()).map_err(|e| e.in_file(source.name()))?;
+    }
     Ok(image)
 }
 
@@ -348,6 +352,29 @@ impl<'a> Source<'a> {
             Source::Memory { bytes, .. } => Ok(bytes.len() as u64),
         }
     }
+}
+
+/// Whether the file at `path` holds float64 samples (a float64 `.npy` array), which reading as
+/// f32 would round; every other file reads exactly as f32 (8- and 16-bit integers, f16 and
+/// f32 floats). Only the file's signature and header are read.
+///
+/// ```
+/// use haarshift::io::{holds_f64, write_image, WriteOptions};
+/// use haarshift::{PlanarImage, SampleDepth};
+/// use ndarray::Array2;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("a.npy");
+/// let image = PlanarImage::from_gray(Array2::<f64>::ones((2, 3)), SampleDepth::F64).unwrap();
+/// write_image(&image, &path, WriteOptions::default()).unwrap();
+/// assert!(holds_f64(&path).unwrap());
+/// let png = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/camera.png");
+/// assert!(!holds_f64(png.as_ref()).unwrap());
+/// ```
+pub fn holds_f64(path: &Path) -> Result<bool> {
+    Ok(match FileFormat::of_file(path)? {
+        FileFormat::Npy => npy::stored_depth(path)? == SampleDepth::F64,
+        _ => false,
+    })
 }
 
 /// Writes `image` in the format of `path`'s extension; see the [module docs](self).
@@ -429,13 +456,13 @@ fn depth_scale(from: SampleDepth, to: SampleDepth) -> f64 {
 /// Converts a sample to an integer code of `max` (255 or 65535): scale, round to nearest
 /// (ties away from zero), clamp.
 fn to_code(value: f64, scale: f64, max: f64) -> f64 {
-    (value * scale).round().clamp(0.0, max)
+    round_to_code(value * scale, max)
 }
 
 /// The planes of `image` as stored at `depth`, interleaved pixel by pixel (row-major, then
 /// channel), converted by `convert` from the f64 value (already rescaled and, for integer
 /// depths, rounded and clamped).
-fn interleave<T: Sample, P>(
+fn interleave<T: Sample, P: Copy + Default>(
     image: &PlanarImage<T>,
     depth: SampleDepth,
     convert: impl Fn(f64) -> P,
@@ -446,11 +473,15 @@ fn interleave<T: Sample, P>(
         None => v.as_f64(),
     };
     let planes = image.planes();
+    let planes = planes.as_standard_layout();
     let (c, h, w) = planes.dim();
-    let mut out = Vec::with_capacity(c * h * w);
-    for i in 0..h {
-        for j in 0..w {
-            out.extend((0..c).map(|k| convert(code(planes[[k, i, j]]))));
+    let n = h * w;
+    let samples = planes.as_slice().expect("standard layout");
+    // Plane by plane: reads in order, writes every c-th sample.
+    let mut out = vec![P::default(); c * n];
+    for (k, plane) in samples.chunks_exact(n).enumerate() {
+        for (o, &v) in out[k..].iter_mut().step_by(c).zip(plane) {
+            *o = convert(code(v));
         }
     }
     out
@@ -462,9 +493,14 @@ fn deinterleave<T: Sample, P: Copy>(
     (c, h, w): (usize, usize, usize),
     to_f64: impl Fn(P) -> f64,
 ) -> Array3<T> {
-    Array3::from_shape_fn((c, h, w), |(k, i, j)| {
-        T::from_f64(to_f64(data[(i * w + j) * c + k]))
-    })
+    let mut planes = Array3::zeros((c, h, w));
+    let pixels = ndarray::ArrayView3::from_shape((h, w, c), data)
+        .expect("the decoder's buffer holds h x w x c samples")
+        .permuted_axes([2, 0, 1]);
+    ndarray::Zip::from(&mut planes)
+        .and(pixels)
+        .for_each(|p, &v| *p = T::from_f64(to_f64(v)));
+    planes
 }
 
 /// Checks that decoding data of `shape` stays within `limit` when the decoder needs

@@ -1,15 +1,21 @@
 //! NumPy `.npy` float arrays: images as `H x W` or `H x W x C`, and the raw arrays of
 //! coefficient files.
+//!
+//! Data is converted element by element as it streams through a small buffer, so reading
+//! and writing hold no copy of the whole array beyond the image itself.
 
-use std::io::{Seek, Write};
+use std::io::{BufReader, Read, Seek, Write};
 use std::path::Path;
 
-use ndarray::{Array, ArrayD, IxDyn};
-use ndarray_npy::npy::header::Header;
-use ndarray_npy::{ReadNpyExt, WriteNpyExt};
+use ndarray::{ArrayD, IxDyn, ShapeBuilder};
+use ndarray_npy::WritableElement;
+use ndarray_npy::npy::header::{Header, Layout};
 
-use super::{ReadOptions, Source, check_size, format_reason, interleave, io_error, planar};
+use super::{ReadOptions, Source, check_size, format_reason, io_error, planar};
 use crate::{Error, PlanarImage, Result, Sample, SampleDepth};
+
+/// Elements converted per buffer while streaming.
+const CHUNK: usize = 1 << 14;
 
 /// Reads an image stored as `H x W` (gray) or `H x W x C` (C = 1..=4) floats.
 pub(super) fn read<T: Sample>(
@@ -34,11 +40,59 @@ pub(super) fn read<T: Sample>(
         .into_dimensionality::<ndarray::Ix3>()
         .map_err(|e| format_reason(path, e.to_string()))?
         .permuted_axes([2, 0, 1]);
-    planar(path, planes.as_standard_layout().into_owned(), depth)
+    // One channel in C order is already planar: no copy.
+    let planes = if planes.is_standard_layout() {
+        planes
+    } else {
+        planes.as_standard_layout().into_owned()
+    };
+    planar(path, planes, depth)
 }
 
-/// Reads a float32 or float64 array whose shape `accept` allows, after checking its size
-/// against the file's length and the memory limit; returns it with the depth it was stored in.
+/// The stored element type of a `.npy` descriptor: depth, size in bytes, little-endian.
+fn element_type(descriptor: &str) -> Option<(SampleDepth, usize, bool)> {
+    let little = match descriptor.as_bytes().first()? {
+        b'<' => true,
+        b'>' => false,
+        b'=' => cfg!(target_endian = "little"),
+        _ => return None,
+    };
+    let (depth, size) = match &descriptor[1..] {
+        "f2" => (SampleDepth::F16, 2),
+        "f4" => (SampleDepth::F32, 4),
+        "f8" => (SampleDepth::F64, 8),
+        _ => return None,
+    };
+    Some((depth, size, little))
+}
+
+/// The depth of the samples in the `.npy` file at `path`, from its header.
+pub(super) fn stored_depth(path: &Path) -> Result<SampleDepth> {
+    let file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
+    Ok(read_header(path, &mut BufReader::new(file))?.1)
+}
+
+/// The header of the `.npy` file `reader` reads, and its element type.
+fn read_header(path: &Path, reader: &mut impl Read) -> Result<(Header, SampleDepth, usize, bool)> {
+    let header = Header::from_reader(reader)
+        .map_err(|e| format_reason(path, format!("invalid .npy header: {e}")))?;
+    let descriptor = header.type_descriptor.to_string();
+    let descriptor = descriptor.trim_matches(|c| c == '\'' || c == '"');
+    let (depth, size, little) = element_type(descriptor).ok_or_else(|| {
+        format_reason(
+            path,
+            format!(
+                "unsupported .npy element type {descriptor} (expected float16, float32 or \
+                 float64)"
+            ),
+        )
+    })?;
+    Ok((header, depth, size, little))
+}
+
+/// Reads a float16, float32 or float64 array whose shape `accept` allows, after checking its
+/// size against the file's length and the memory limit; returns it with the depth it was
+/// stored in.
 pub(super) fn read_array<T: Sample>(
     source: &Source<'_>,
     options: &ReadOptions,
@@ -47,27 +101,14 @@ pub(super) fn read_array<T: Sample>(
     let path = source.name();
     let file_len = source.len()?;
     let mut reader = source.open()?;
-    let header = Header::from_reader(&mut reader)
-        .map_err(|e| format_reason(path, format!("invalid .npy header: {e}")))?;
+    let (header, depth, size, little) = read_header(path, &mut reader)?;
     let data_start = reader.stream_position().map_err(|e| io_error(path, e))?;
-    let descriptor = header.type_descriptor.to_string();
-    let descriptor = descriptor.trim_matches(|c| c == '\'' || c == '"');
-    let (depth, element_size) = match descriptor {
-        "<f4" | ">f4" | "=f4" => (SampleDepth::F32, 4),
-        "<f8" | ">f8" | "=f8" => (SampleDepth::F64, 8),
-        other => {
-            return Err(format_reason(
-                path,
-                format!("unsupported .npy element type {other} (expected float32 or float64)"),
-            ));
-        }
-    };
     let shape = header.shape.clone();
     accept(&shape).map_err(|reason| format_reason(path, reason))?;
-    check_size::<T>(path, &shape, element_size, options.memory_limit)?;
+    check_size::<T>(path, &shape, size as u64, options.memory_limit)?;
     let needed = shape
         .iter()
-        .fold(element_size as u128, |n, &d| n.saturating_mul(d as u128));
+        .fold(size as u128, |n, &d| n.saturating_mul(d as u128));
     let available = u128::from(file_len.saturating_sub(data_start));
     if available < needed {
         return Err(format_reason(
@@ -77,18 +118,53 @@ pub(super) fn read_array<T: Sample>(
             ),
         ));
     }
-    reader.rewind().map_err(|e| io_error(path, e))?;
-    let npy_error =
-        |e: ndarray_npy::ReadNpyError| format_reason(path, format!("invalid .npy data: {e}"));
-    let array: ArrayD<T> = match depth {
-        SampleDepth::F32 => ArrayD::<f32>::read_npy(reader)
-            .map_err(npy_error)?
-            .mapv(|v| T::from_f64(f64::from(v))),
-        _ => ArrayD::<f64>::read_npy(reader)
-            .map_err(npy_error)?
-            .mapv(T::from_f64),
-    };
+    let count = shape.iter().product();
+    let data = match (depth, little) {
+        (SampleDepth::F16, true) => {
+            decode(&mut reader, count, |b| half::f16::from_le_bytes(b).to_f64())
+        }
+        (SampleDepth::F16, false) => {
+            decode(&mut reader, count, |b| half::f16::from_be_bytes(b).to_f64())
+        }
+        (SampleDepth::F32, true) => {
+            decode(&mut reader, count, |b| f64::from(f32::from_le_bytes(b)))
+        }
+        (SampleDepth::F32, false) => {
+            decode(&mut reader, count, |b| f64::from(f32::from_be_bytes(b)))
+        }
+        (_, true) => decode(&mut reader, count, f64::from_le_bytes),
+        (_, false) => decode(&mut reader, count, f64::from_be_bytes),
+    }
+    .map_err(|e| io_error(path, e))?;
+    let dim = IxDyn(&shape);
+    let array = if header.layout == Layout::Fortran {
+        ArrayD::from_shape_vec(dim.f(), data)
+    } else {
+        ArrayD::from_shape_vec(dim, data)
+    }
+    .map_err(|e| format_reason(path, e.to_string()))?;
     Ok((array, depth))
+}
+
+/// `count` elements of `N` bytes each from `reader`, each converted by `value` (exact for
+/// every stored type) and then to `T`.
+fn decode<T: Sample, const N: usize>(
+    reader: &mut impl Read,
+    count: usize,
+    value: impl Fn([u8; N]) -> f64,
+) -> std::io::Result<Vec<T>> {
+    let mut data = Vec::with_capacity(count);
+    let mut bytes = vec![0u8; CHUNK * N];
+    while data.len() < count {
+        let n = (count - data.len()).min(CHUNK);
+        reader.read_exact(&mut bytes[..n * N])?;
+        data.extend(
+            bytes[..n * N]
+                .chunks_exact(N)
+                .map(|b| T::from_f64(value(b.try_into().expect("N bytes")))),
+        );
+    }
+    Ok(data)
 }
 
 /// Writes an image as `H x W` (gray) or `H x W x C`, f64 at depth `F64` and f32 otherwise.
@@ -98,32 +174,51 @@ pub(super) fn write<T: Sample, W: Write>(
     path: &Path,
     out: &mut W,
 ) -> Result<()> {
-    let (c, h, w) = image.planes().dim();
+    let planes = image.planes();
+    let (c, h, w) = planes.dim();
     let shape = if c == 1 { vec![h, w] } else { vec![h, w, c] };
+    // Pixel by pixel, channel last: the planes' axes (c, h, w) visited in the order h, w, c.
+    let samples = planes.permuted_axes([1, 2, 0]);
     match depth {
-        SampleDepth::F64 => write_array(interleave(image, depth, |v| v), &shape, path, out),
-        _ => write_array(interleave(image, depth, |v| v as f32), &shape, path, out),
+        SampleDepth::F64 => write_samples(samples.iter().map(|v| v.as_f64()), &shape, path, out),
+        _ => write_samples(samples.iter().map(|v| v.as_f64() as f32), &shape, path, out),
     }
 }
 
-/// Writes row-major `data` of `shape` as a `.npy` array.
-pub(super) fn write_array<E, W>(
-    data: Vec<E>,
+/// Writes `samples` (row-major) as a `.npy` array of `shape`, streaming them through a small
+/// buffer.
+pub(super) fn write_samples<E, W>(
+    samples: impl Iterator<Item = E>,
     shape: &[usize],
     path: &Path,
     out: &mut W,
 ) -> Result<()>
 where
-    E: ndarray_npy::WritableElement,
+    E: WritableElement,
     W: Write,
 {
-    let array = Array::from_shape_vec(IxDyn(shape), data)
-        .map_err(|e| format_reason(path, e.to_string()))?;
-    array.write_npy(out).map_err(|e| match e {
-        ndarray_npy::WriteNpyError::Io(e) => io_error(path, e),
-        other => Error::Format {
-            path: path.to_path_buf(),
-            reason: format!("cannot write .npy: {other}"),
-        },
-    })
+    let header = Header {
+        type_descriptor: E::type_descriptor(),
+        layout: Layout::Standard,
+        shape: shape.to_vec(),
+    };
+    let npy_error = |e: String| Error::Format {
+        path: path.to_path_buf(),
+        reason: format!("cannot write .npy: {e}"),
+    };
+    header.write(&mut *out).map_err(|e| match e {
+        ndarray_npy::npy::header::WriteHeaderError::Io(e) => io_error(path, e),
+        other => npy_error(other.to_string()),
+    })?;
+    let mut chunk = Vec::with_capacity(CHUNK);
+    let mut samples = samples.peekable();
+    while samples.peek().is_some() {
+        chunk.clear();
+        chunk.extend(samples.by_ref().take(CHUNK));
+        E::write_slice(&chunk, &mut *out).map_err(|e| match e {
+            ndarray_npy::WriteDataError::Io(e) => io_error(path, e),
+            other => npy_error(other.to_string()),
+        })?;
+    }
+    Ok(())
 }

@@ -74,6 +74,35 @@ impl TransformFlags {
     }
 }
 
+/// The float type a command computes in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Compute {
+    /// Single precision: exact for 8- and 16-bit, f16 and f32 data, and twice as light.
+    F32,
+    /// Double precision.
+    F64,
+}
+
+/// `--compute`, shared by the commands that read an image and compute on it.
+#[derive(clap::Args, Debug)]
+pub struct ComputeFlag {
+    /// Float type to compute in: `f32` or `f64` [default: f64 for a float64 .npy input, f32
+    /// otherwise (8- and 16-bit, f16 and f32 data, which f32 holds exactly)]
+    #[arg(long, value_enum, value_name = "TYPE")]
+    pub compute: Option<Compute>,
+}
+
+impl ComputeFlag {
+    /// The float type given, or the one `input`'s samples need (read from its header).
+    pub fn resolve(&self, input: &Path) -> Result<Compute> {
+        match self.compute {
+            Some(compute) => Ok(compute),
+            None if haarshift::io::holds_f64(input)? => Ok(Compute::F64),
+            None => Ok(Compute::F32),
+        }
+    }
+}
+
 /// Where a command that makes one image writes it.
 #[derive(clap::Args, Debug)]
 pub struct ImageOutput {
@@ -117,6 +146,32 @@ impl ImageOutput {
             image.height(),
             image.channels()
         ))
+    }
+}
+
+/// A number as people read it, for echoing parameters: at most six significant digits, plain
+/// from 1e-4 up to 1e6 and in scientific notation outside (`30`, `-12.5`, `0.333333`,
+/// `1e308`, `2.5e-7`).
+pub fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        // -0 is the same angle or shift as 0.
+        return format!("{}", x + 0.0);
+    }
+    let trim = |s: &str| {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    let exponent = x.abs().log10().floor() as i32;
+    if (-4..6).contains(&exponent) {
+        let decimals = (5 - exponent).max(0) as usize;
+        trim(&format!("{x:.decimals$}"))
+    } else {
+        let scientific = format!("{x:.5e}");
+        let (mantissa, exponent) = scientific.split_once('e').expect("{:e} has an exponent");
+        format!("{}e{exponent}", trim(mantissa))
     }
 }
 

@@ -5,10 +5,10 @@ use std::path::PathBuf;
 use haarshift::io::read_image;
 use haarshift::kernels::{Outside, ShiftMethod};
 use haarshift::rotate::{Canvas, RotateOptions, rotate_image};
-use haarshift::{BoundaryMode, Result, SampleDepth};
+use haarshift::{BoundaryMode, Result, Sample, SampleDepth};
 
 use super::method::MethodFlags;
-use super::{ImageOutput, choice, names};
+use super::{Compute, ComputeFlag, ImageOutput, choice, names, number};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -84,12 +84,23 @@ pub struct Args {
     /// f16/f32 for EXR; f32/f64 for .npy)
     #[arg(long, value_parser = choice::<SampleDepth>(names!(SampleDepth)))]
     pub depth: Option<SampleDepth>,
+
+    #[command(flatten)]
+    pub compute: ComputeFlag,
 }
 
 pub fn run(args: Args) -> Result<()> {
     args.output.refuse_overwriting(&[&args.input])?;
+    match args.compute.resolve(&args.input)? {
+        Compute::F32 => rotate::<f32>(&args),
+        Compute::F64 => rotate::<f64>(&args),
+    }
+}
+
+/// Reads, rotates and writes in `T`.
+fn rotate<T: Sample>(args: &Args) -> Result<()> {
     let (method, kernel_options) = args.method.resolve(ShiftMethod::BSpline3)?;
-    let kernel = method.kernel_with::<f64>(&kernel_options)?;
+    let kernel = method.kernel_with::<T>(&kernel_options)?;
     let options = RotateOptions {
         canvas: args.canvas.unwrap_or_default(),
         outside: match args.boundary {
@@ -99,8 +110,14 @@ pub fn run(args: Args) -> Result<()> {
         supersample: args.supersample,
         ..Default::default()
     };
-    let image = read_image::<f64>(&args.input)?;
+    let image = read_image::<T>(&args.input)?;
     let rotated = rotate_image(&image, args.angle, kernel.as_ref(), &options)?;
-    let what = format!(", rotated by {} degrees with {}", args.angle, kernel.name());
+    drop(image);
+    let what = format!(
+        ", rotated by {} degrees with {} in {}",
+        number(args.angle),
+        kernel.name(),
+        T::NAME
+    );
     args.output.write(&rotated, args.depth, &what)
 }

@@ -7,11 +7,11 @@ use haarshift::io::read_image;
 use haarshift::kernels::{KernelOptions, Outside, ShiftMethod, shift_plane};
 use haarshift::shift::{RetainedImage, shift_image};
 use haarshift::transform::{TransformSpec, pyramid};
-use haarshift::{BoundaryMode, Error, Result};
+use haarshift::{BoundaryMode, Error, Result, Sample};
 use ndarray::{Array2, ArrayView2, s};
 
 use super::method::MethodFlags;
-use super::{ImageOutput, choice, names};
+use super::{Compute, ComputeFlag, ImageOutput, choice, names, number};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -71,14 +71,25 @@ pub struct Args {
     /// [default: wrap]
     #[arg(long, value_parser = choice::<BoundaryMode>(names!(BoundaryMode)))]
     pub boundary: Option<BoundaryMode>,
+
+    #[command(flatten)]
+    pub compute: ComputeFlag,
 }
 
 pub fn run(args: Args) -> Result<()> {
     args.output.refuse_overwriting(&[&args.input])?;
+    match args.compute.resolve(&args.input)? {
+        Compute::F32 => shift::<f32>(&args),
+        Compute::F64 => shift::<f64>(&args),
+    }
+}
+
+/// Reads, shifts and writes in `T`.
+fn shift<T: Sample>(args: &Args) -> Result<()> {
     let (method, options) = args.method.resolve(ShiftMethod::Haar)?;
     let boundary = args.boundary.unwrap_or(BoundaryMode::Wrap);
     let (dx, dy) = (args.dx, args.dy);
-    let image = read_image::<f64>(&args.input)?;
+    let image = read_image::<T>(&args.input)?;
     let shifted = if method == ShiftMethod::Haar {
         if boundary != BoundaryMode::Wrap {
             return Err(Error::InvalidParameter {
@@ -88,22 +99,28 @@ pub fn run(args: Args) -> Result<()> {
         }
         image.map_planes(|p| haar_shift(p, dx, dy, &options))?
     } else {
-        let kernel = method.kernel_with::<f64>(&options)?;
+        let kernel = method.kernel_with::<T>(&options)?;
         let outside = Outside::Boundary(boundary);
         image.map_planes(|p| shift_plane(p, dx, dy, kernel.as_ref(), outside))?
     };
-    let what = format!(", shifted by ({dx}, {dy}) with {method}");
+    drop(image);
+    let what = format!(
+        ", shifted by ({}, {}) with {method} in {}",
+        number(dx),
+        number(dy),
+        T::NAME
+    );
     args.output.write(&shifted, None, &what)
 }
 
 /// One plane shifted in the Haar domain: compact (same size), or the retained `2^h`-finer
 /// image.
-fn haar_shift(
-    plane: ArrayView2<'_, f64>,
+fn haar_shift<T: Sample>(
+    plane: ArrayView2<'_, T>,
     dx: f64,
     dy: f64,
     options: &KernelOptions,
-) -> Result<Array2<f64>> {
+) -> Result<Array2<T>> {
     let spec = TransformSpec {
         padding: BoundaryMode::Wrap,
         ..Default::default()

@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use haarshift::Result;
 use haarshift::io::{CoefficientFile, WriteOptions, read_image};
+use haarshift::{Result, Sample};
 
-use super::{TransformFlags, print, refuse_existing, refuse_overwriting_input};
+use super::{Compute, TransformFlags, print, refuse_existing, refuse_overwriting_input};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -37,13 +37,27 @@ pub struct Args {
     /// Replace the output and its sidecar if they exist
     #[arg(long)]
     pub force: bool,
+
+    /// Float type to compute in: `f64` or `f32` (faster; its rounding then shows in the
+    /// float64 coefficients) [default: f64, the coefficient file's type]
+    #[arg(long, value_enum, value_name = "TYPE")]
+    pub compute: Option<Compute>,
 }
 
 pub fn run(args: Args) -> Result<()> {
     let sidecar = CoefficientFile::<f64>::sidecar_path(&args.output);
     refuse_overwriting_input(&args.input, &[&args.output, &sidecar])?;
     refuse_existing(&[&args.output, &sidecar], args.force)?;
-    let image = read_image::<f64>(&args.input)?;
+    match args.compute.unwrap_or(Compute::F64) {
+        Compute::F32 => transform::<f32>(&args),
+        Compute::F64 => transform::<f64>(&args),
+    }
+}
+
+/// Reads, transforms and writes in `T`.
+fn transform<T: Sample>(args: &Args) -> Result<()> {
+    let sidecar = CoefficientFile::<T>::sidecar_path(&args.output);
+    let image = read_image::<T>(&args.input)?;
     let spec = args.transform.request().spec();
     let coefficients =
         CoefficientFile::forward(&image, &spec).map_err(|e| e.in_file(&args.input))?;
