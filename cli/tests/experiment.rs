@@ -4,7 +4,7 @@ mod common;
 
 use std::path::Path;
 
-use common::haarshift;
+use common::{fails_cleanly, haarshift, succeeds, text, usage_error};
 
 use haarshift::io::{WriteOptions, write_image};
 use haarshift::kernels::ShiftMethod;
@@ -14,15 +14,9 @@ use haarshift::{PlanarImage, SampleDepth};
 use ndarray::{Array2, s};
 use serde_json::Value;
 
-/// Runs the binary and asserts that it succeeded; returns its standard output.
+/// Runs the binary and requires success; returns its standard output.
 fn haarshift_ok(args: &[&str]) -> String {
-    let out = haarshift(args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
+    text(&succeeds(args).stdout)
 }
 
 /// A 40x24 gray test image with integer values (exactly representable in 8 bits).
@@ -211,16 +205,17 @@ fn stability_refuses_a_small_photograph() {
     let dir = tempfile::tempdir().unwrap();
     let image = dir.path().join("small.png");
     write_small_image(&image);
-    let out = haarshift(&[
-        "experiment",
-        "stability",
-        "--image",
-        image.to_str().unwrap(),
-        "--out-dir",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("at least 128x128"));
+    fails_cleanly(
+        &[
+            "experiment",
+            "stability",
+            "--image",
+            image.to_str().unwrap(),
+            "--out-dir",
+            dir.path().to_str().unwrap(),
+        ],
+        &["small.png", "at least 128x128"],
+    );
 }
 
 /// `q` dominates `p` on (cost, error): no worse in both, better in one.
@@ -357,20 +352,21 @@ fn tradeoff_sweeps_every_parameter_and_flags_the_frontiers() {
 
 #[test]
 fn tradeoff_refuses_an_empty_grid_and_a_bad_size() {
-    for extra in [
+    fails_cleanly(
         &[
+            "experiment",
+            "tradeoff",
             "--methods",
             "haar-retained",
             "--max-retained-precision",
             "0",
-        ][..],
-        &["--size", "2"][..],
-        &["--size", "big"][..],
-    ] {
-        let mut args = vec!["experiment", "tradeoff"];
-        args.extend_from_slice(extra);
-        let out = haarshift(&args);
-        assert!(!out.status.success(), "{extra:?}");
-        assert!(!out.stderr.is_empty());
+        ],
+        &["methods", "--max-retained-precision 0"],
+    );
+    for size in ["2", "big"] {
+        usage_error(
+            &["experiment", "tradeoff", "--size", size],
+            &["--size", size],
+        );
     }
 }

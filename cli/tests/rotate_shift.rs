@@ -6,7 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{haarshift, p, testdata};
+use common::{fails_cleanly, p, succeeds, testdata};
 
 use haarshift::Channels::{Gray, Rgb};
 use haarshift::SampleDepth::{F64, U8, U16};
@@ -14,29 +14,12 @@ use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::{Channels, PlanarImage, SampleDepth};
 use ndarray::{Array2, Array3};
 
-fn ok(args: &[&str]) {
-    let out = haarshift(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{args:?} failed: {err}");
-}
-
 /// `haarshift COMMAND INPUT -o OUT FLAGS...`, required to succeed; returns the output read back.
 fn run(command: &str, input: &Path, out: &Path, flags: &[&str]) -> PlanarImage<f64> {
     let mut args = vec![command, p(input), "-o", p(out)];
     args.extend_from_slice(flags);
-    ok(&args);
+    succeeds(&args);
     read_image::<f64>(out).unwrap()
-}
-
-/// Requires exit code 1 with exactly one `haarshift: ...` line containing `needle`, no panic.
-fn fails(args: &[&str], needle: &str) {
-    let out = haarshift(args);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-    assert_eq!(err.lines().count(), 1, "{args:?}: {err:?}");
-    assert!(err.starts_with("haarshift: "), "{err:?}");
-    assert!(err.contains(needle), "{err:?} lacks {needle:?}");
-    assert!(!err.contains("panicked"), "{err:?}");
 }
 
 /// Deterministic pseudo-random values in `0..max` (a 64-bit LCG), whole numbers.
@@ -106,7 +89,7 @@ fn quarter_turns_are_bit_exact_for_every_method_tried() {
                 .join(format!("small-{angle}-{}.png", flags.len()));
             let mut args = vec!["rotate", p(&small), "-o", p(&out), "--angle", angle];
             args.extend_from_slice(flags);
-            ok(&args);
+            succeeds(&args);
             let got = read_image::<f64>(&out).unwrap();
             for c in 0..3 {
                 let plane = small_image.plane(c).to_owned();
@@ -125,10 +108,10 @@ fn rotating_back_with_bspline5_restores_the_centre() {
     let common = ["--method", "bspline5", "--depth", "f64"];
     let mut args = vec!["rotate", p(&camera), "-o", p(&there), "--angle", "30"];
     args.extend_from_slice(&common);
-    ok(&args);
+    succeeds(&args);
     let mut args = vec!["rotate", p(&there), "-o", p(&back), "--angle", "-30"];
     args.extend_from_slice(&common);
-    ok(&args);
+    succeeds(&args);
     let input = read_image::<f64>(&camera).unwrap();
     let output = read_image::<f64>(&back).unwrap();
     assert_eq!((output.height(), output.width()), (512, 512));
@@ -210,9 +193,18 @@ fn rgba_keeps_alpha_and_colour_does_not_bleed_from_transparent_pixels() {
 
 #[test]
 fn sixteen_bit_png_stays_sixteen_bit() {
+    // A 16-bit ramp `1000 + 150 r + 100 c`: linear interpolation reproduces a linear function
+    // exactly, so inside the image every shear, and the rotation, is exact. The rotation by
+    // the definition: output pixel at (u, v) from the centre takes the input at
+    // (u cos t - v sin t, u sin t + v cos t) (counter-clockwise as displayed, y down).
     let dir = tempfile::tempdir().unwrap();
-    let (input, _) = write_noise(dir.path(), "deep.png", (16, 16), Gray, U16);
-    let out = dir.path().join("deep-10.png");
+    let n = 64;
+    let ramp = |r: f64, c: f64| 1000.0 + 150.0 * r + 100.0 * c;
+    let planes = Array3::from_shape_fn((1, n, n), |(_, r, c)| ramp(r as f64, c as f64));
+    let image = PlanarImage::new(planes, Gray, U16).unwrap();
+    let input = dir.path().join("ramp.png");
+    write_image(&image, &input, WriteOptions::default()).unwrap();
+    let out = dir.path().join("ramp-10.png");
     let got = run(
         "rotate",
         &input,
@@ -220,11 +212,28 @@ fn sixteen_bit_png_stays_sixteen_bit() {
         &["--angle", "10", "--method", "linear"],
     );
     assert_eq!(got.depth(), SampleDepth::U16);
-    assert!(
-        got.plane(0)
-            .iter()
-            .any(|&v| v > 255.0 && v != v.round() * 257.0)
-    );
+    let (sin, cos) = 10f64.to_radians().sin_cos();
+    let centre = (n as f64 - 1.0) / 2.0;
+    let mut inside = 0;
+    for r in 0..n {
+        for c in 0..n {
+            let (u, v) = (c as f64 - centre, r as f64 - centre);
+            if u * u + v * v > 20.0 * 20.0 {
+                continue;
+            }
+            let want = ramp(centre + u * sin + v * cos, centre + u * cos - v * sin);
+            let v = got.plane(0)[[r, c]];
+            // Rounded to the nearest 16-bit level of an f32 computation (the CLI works in f32
+            // for 16-bit input): half a level plus a few f32 ulps (0.0005 at 8000), where 8-bit
+            // quantisation would be off by ~128.
+            assert!((v - want).abs() <= 0.5 + 0.01, "({r}, {c}): {v} vs {want}");
+            inside += 1;
+        }
+    }
+    assert!(inside > 1200, "{inside} pixels checked");
+    // Not 8-bit levels scaled by 257 anywhere in the disc's rows.
+    let off_grid = got.plane(0).iter().filter(|&&v| v % 257.0 != 0.0).count();
+    assert!(off_grid > n * n / 2, "{off_grid} values off the 8-bit grid");
 }
 
 /// Reads a one-plane result.
@@ -237,7 +246,7 @@ fn integer_haar_shift_is_a_periodic_roll() {
     let dir = tempfile::tempdir().unwrap();
     let (input, image) = write_noise(dir.path(), "roll.png", (32, 16), Gray, U8);
     let out = dir.path().join("rolled.png");
-    ok(&["shift", p(&input), "-o", p(&out), "--dx", "3", "--dy", "-5"]);
+    succeeds(&["shift", p(&input), "-o", p(&out), "--dx", "3", "--dy", "-5"]);
     let x = image.plane(0);
     let expected = Array2::from_shape_fn((32, 16), |(r, c)| x[[(r + 5) % 32, (c + 16 - 3) % 16]]);
     assert_eq!(plane_of(&out), expected);
@@ -266,7 +275,7 @@ fn fractional_haar_shift_is_bilinear_at_the_rounded_shift_and_retained_box_avera
     let shift = ["--dx", "0.3", "--dy", "-0.7", "--precision", "2"];
     let mut args = vec!["shift", p(&input), "-o", p(&compact)];
     args.extend_from_slice(&shift);
-    ok(&args);
+    succeeds(&args);
     // 0.3 rounds to 1/4 and -0.7 to -3/4 on the quarter-pixel grid.
     let x = image.plane(0).to_owned();
     let expected = periodic_linear(&periodic_linear(&x, 0.25, 1), -0.75, 0);
@@ -279,7 +288,7 @@ fn fractional_haar_shift_is_bilinear_at_the_rounded_shift_and_retained_box_avera
     let retained = dir.path().join("retained.npy");
     let mut args = vec!["shift", p(&input), "-o", p(&retained), "--retain"];
     args.extend_from_slice(&shift);
-    ok(&args);
+    succeeds(&args);
     let fine = plane_of(&retained);
     assert_eq!(fine.dim(), (64, 128));
     let boxed = Array2::from_shape_fn((16, 32), |(r, c)| {
@@ -300,7 +309,7 @@ fn pixel_methods_shift_with_their_boundary() {
     let dir = tempfile::tempdir().unwrap();
     let (input, image) = write_noise(dir.path(), "pix.png", (10, 12), Gray, U8);
     let out = dir.path().join("pix-linear.png");
-    ok(&[
+    succeeds(&[
         "shift",
         p(&input),
         "-o",
@@ -331,8 +340,8 @@ fn bad_requests_fail_with_one_line() {
     let camera = testdata("camera.png");
     let out = dir.path().join("out.png");
     let (cam, o) = (p(&camera), p(&out));
-    fails(&["rotate", cam, "-o", o, "--angle", "NaN"], "angle");
-    fails(
+    fails_cleanly(&["rotate", cam, "-o", o, "--angle", "NaN"], &["angle"]);
+    fails_cleanly(
         &[
             "rotate",
             cam,
@@ -345,26 +354,29 @@ fn bad_requests_fail_with_one_line() {
             "--precision",
             "2",
         ],
-        "precision",
+        &["precision"],
     );
-    fails(
+    fails_cleanly(
         &[
             "shift", cam, "-o", o, "--dx", "1", "--method", "linear", "--retain",
         ],
-        "retain",
+        &["retain"],
     );
-    fails(
+    fails_cleanly(
         &["shift", cam, "-o", o, "--dx", "1", "--boundary", "zero"],
-        "periodic",
+        &["periodic"],
     );
-    fails(&["shift", cam, "-o", o, "--dx", "inf"], "shift");
+    fails_cleanly(&["shift", cam, "-o", o, "--dx", "inf"], &["shift"]);
     let missing = dir.path().join("missing.png");
-    fails(
+    fails_cleanly(
         &["rotate", p(&missing), "-o", o, "--angle", "5"],
-        "missing.png",
+        &["missing.png"],
     );
-    fails(&["shift", p(&missing), "-o", o, "--dx", "1"], "missing.png");
-    fails(
+    fails_cleanly(
+        &["shift", p(&missing), "-o", o, "--dx", "1"],
+        &["missing.png"],
+    );
+    fails_cleanly(
         &[
             "rotate",
             cam,
@@ -375,11 +387,17 @@ fn bad_requests_fail_with_one_line() {
             "--supersample",
             "100",
         ],
-        "supersample",
+        &["supersample"],
     );
     std::fs::write(&out, b"keep me").unwrap();
-    fails(&["rotate", cam, "-o", o, "--angle", "90"], "already exists");
-    fails(&["shift", cam, "-o", o, "--dx", "1"], "already exists");
+    fails_cleanly(
+        &["rotate", cam, "-o", o, "--angle", "90"],
+        &["already exists"],
+    );
+    fails_cleanly(&["shift", cam, "-o", o, "--dx", "1"], &["already exists"]);
     assert_eq!(std::fs::read(&out).unwrap(), b"keep me");
-    fails(&["rotate", cam, "-o", cam, "--angle", "90"], "camera.png");
+    fails_cleanly(
+        &["rotate", cam, "-o", cam, "--angle", "90"],
+        &["camera.png"],
+    );
 }

@@ -4,9 +4,8 @@
 mod common;
 
 use std::path::Path;
-use std::process::Output;
 
-use common::{p, run_in, text};
+use common::{fails_cleanly, fails_cleanly_in, p, succeeds, text, usage_error, usage_error_in};
 
 use haarshift::io::{CoefficientFile, WriteOptions, read_image, write_image};
 use haarshift::sphere::experiment::{self, STANDARD_ROTATIONS};
@@ -26,31 +25,6 @@ fn test_map() -> LatLongMap<f32> {
     LatLongMap::from_image(&read_image::<f32>(MAP).unwrap()).unwrap()
 }
 
-fn ok(args: &[&str]) -> Output {
-    let out = run_in(None, args);
-    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
-    out
-}
-
-/// Requires exit code 1 and one `haarshift: ...` line on stderr containing every needle.
-fn fails_in(dir: Option<&Path>, args: &[&str], needles: &[&str]) {
-    let out = run_in(dir, args);
-    let err = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-    assert_eq!(err.lines().count(), 1, "{args:?}: {err:?}");
-    assert!(
-        err.starts_with("haarshift: ") && !err.contains("panicked"),
-        "{err:?}"
-    );
-    for needle in needles {
-        assert!(err.contains(needle), "{err:?} lacks {needle:?}");
-    }
-}
-
-fn fails(args: &[&str], needles: &[&str]) {
-    fails_in(None, args, needles)
-}
-
 /// `sphere rotate INPUT -o OUTPUT FLAGS...`
 fn rotate(input: &str, output: &Path, flags: &[&str]) -> Vec<String> {
     ["sphere", "rotate", input, "-o", p(output)]
@@ -60,7 +34,7 @@ fn rotate(input: &str, output: &Path, flags: &[&str]) -> Vec<String> {
         .collect()
 }
 
-/// The arguments as the `&str`s `ok` and `fails` take.
+/// The arguments as the `&str`s the runners take.
 fn strs(args: &[String]) -> Vec<&str> {
     args.iter().map(String::as_str).collect()
 }
@@ -101,7 +75,7 @@ fn every_method_gives_exactly_what_the_library_gives() {
         );
         args.extend(["--method".into(), method.to_string()]);
         args.extend(level.map(|l| format!("--level={l}")));
-        let stdout = text(&ok(&strs(&args)).stdout);
+        let stdout = text(&succeeds(&strs(&args)).stdout);
         assert!(stdout.contains("256 x 128"), "{stdout}");
         let options = SphereOptions {
             method,
@@ -123,11 +97,11 @@ fn identity_and_whole_column_yaw_return_the_input_exactly() {
     for &method in Method::ALL {
         let out = dir.path().join(format!("identity-{method}.npy"));
         let flags = ["--method", method.name(), "--samples", "2"];
-        ok(&strs(&rotate(MAP, &out, &flags)));
+        succeeds(&strs(&rotate(MAP, &out, &flags)));
         assert_eq!(read_map(&out), map, "{method}");
         // 45 degrees is 32 of 256 columns: g(theta, phi) = f(theta, phi + 45 degrees).
         let out = dir.path().join(format!("yaw-{method}.npy"));
-        ok(&strs(&rotate(
+        succeeds(&strs(&rotate(
             MAP,
             &out,
             &["--method", method.name(), "--yaw", "45"],
@@ -144,8 +118,8 @@ fn coefficients_are_a_readable_npy_with_sidecar_that_inverts_to_the_pixels() {
     let flags = ["--pitch", "30", "--level", "5"];
     let mut args = rotate(MAP, &coeffs, &flags);
     args.push("--coefficients".into());
-    ok(&strs(&args));
-    ok(&strs(&rotate(MAP, &pixels, &flags)));
+    succeeds(&strs(&args));
+    succeeds(&strs(&rotate(MAP, &pixels, &flags)));
 
     let file = CoefficientFile::read(&coeffs).unwrap();
     let meta = file.metadata();
@@ -175,7 +149,7 @@ fn coefficients_are_a_readable_npy_with_sidecar_that_inverts_to_the_pixels() {
     assert!(fine.iter().all(|&v| v == 0.0));
 
     let restored = dir.path().join("restored.npy");
-    ok(&["inverse", p(&coeffs), "-o", p(&restored)]);
+    succeeds(&["inverse", p(&coeffs), "-o", p(&restored)]);
     let (a, b) = (read_map(&restored), read_map(&pixels));
     let worst = (&a.as_array() - &b.as_array())
         .iter()
@@ -232,14 +206,16 @@ fn bad_inputs_fail_with_one_line() {
         (rotate(MAP, Path::new(MAP), &["--force"]), vec!["input"]),
     ];
     for (args, needles) in &cases {
-        fails(&strs(args), needles);
+        fails_cleanly(&strs(args), needles);
     }
-    ok(&strs(&rotate(MAP, &out, &[])));
-    fails(&strs(&rotate(MAP, &out, &[])), &["out.npy", "--force"]);
-    ok(&strs(&rotate(MAP, &out, &["--force"])));
+    succeeds(&strs(&rotate(MAP, &out, &[])));
+    fails_cleanly(&strs(&rotate(MAP, &out, &[])), &["out.npy", "--force"]);
+    succeeds(&strs(&rotate(MAP, &out, &["--force"])));
     // Usage errors are clap's: exit code 2.
-    let usage = run_in(None, &strs(&rotate(MAP, &out, &["--method", "fft"])));
-    assert_eq!(usage.status.code(), Some(2));
+    usage_error(
+        &strs(&rotate(MAP, &out, &["--method", "fft"])),
+        &["--method", "fft"],
+    );
 }
 
 #[test]
@@ -262,7 +238,7 @@ fn experiment_writes_csv_json_and_plot_with_the_library_numbers() {
         "--json",
         p(&records),
     ];
-    let stdout = text(&ok(&args).stdout);
+    let stdout = text(&succeeds(&args).stdout);
     // One table row per rotation for the reference and each method at each level.
     let rows = stdout
         .lines()
@@ -328,7 +304,7 @@ fn experiment_writes_csv_json_and_plot_with_the_library_numbers() {
     assert_ne!(got[6]["rms"], got[8]["rms"]);
 
     // Nothing is overwritten without --force, and the refusal comes before the work.
-    fails(&args, &["sphere-rms.png", "already exists", "--force"]);
+    fails_cleanly(&args, &["sphere-rms.png", "already exists", "--force"]);
     assert_eq!(parse(&records), got);
 }
 
@@ -367,16 +343,16 @@ fn experiment_without_maps_runs_the_embedded_map_from_any_directory() {
 #[test]
 fn experiment_refuses_bad_levels() {
     let dir = tempfile::tempdir().unwrap();
-    fails_in(
+    fails_cleanly_in(
         Some(dir.path()),
         &["experiment", "sphere", MAP, "--levels", "full-9"],
         &["full-9", "0..=6"],
     );
-    let usage = run_in(
+    usage_error_in(
         Some(dir.path()),
         &["experiment", "sphere", "--levels", "fine"],
+        &["--levels", "fine"],
     );
-    assert_eq!(usage.status.code(), Some(2));
 }
 
 #[test]
@@ -411,7 +387,7 @@ fn help_states_the_conventions_and_explains_every_flag() {
         (["experiment", "sphere", "--help"], &experiment_needles[..]),
     ] {
         // Help is wrapped to the terminal: compare with whitespace collapsed.
-        let help = text(&ok(&command).stdout);
+        let help = text(&succeeds(&command).stdout);
         let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
         for needle in needles.iter().chain(&["Examples:", "--force"]) {
             assert!(

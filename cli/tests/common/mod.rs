@@ -1,4 +1,5 @@
-//! Helpers shared by the CLI integration tests: running the built binary and naming files.
+//! Helpers shared by the CLI integration tests: running the built binary, requiring success or
+//! a clean failure, and naming files.
 // Each test crate compiles this module and uses only some of it.
 #![allow(dead_code)]
 
@@ -24,6 +25,87 @@ pub fn run_in(dir: Option<&Path>, args: &[&str]) -> Output {
 /// Runs the `haarshift` binary with `args`.
 pub fn haarshift(args: &[&str]) -> Output {
     run_in(None, args)
+}
+
+/// Runs `haarshift ARGS` in `dir` (when given) and requires success; returns the output.
+pub fn succeeds_in(dir: Option<&Path>, args: &[&str]) -> Output {
+    let out = run_in(dir, args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed ({:?}): {}",
+        out.status.code(),
+        text(&out.stderr)
+    );
+    out
+}
+
+/// Runs `haarshift ARGS` and requires success; returns the output.
+pub fn succeeds(args: &[&str]) -> Output {
+    succeeds_in(None, args)
+}
+
+/// Runs `haarshift ARGS` in `dir` (when given) and requires a clean failure of the program
+/// (exit code 1): exactly one line on stderr, `haarshift: ...`, containing every needle (the
+/// file or flag at fault and the problem), no panic, nothing on stdout. Returns the line.
+pub fn fails_cleanly_in(dir: Option<&Path>, args: &[&str], needles: &[&str]) -> String {
+    failure(dir, args, 1, "haarshift: ", needles)
+}
+
+/// [`fails_cleanly_in`] in the current directory.
+pub fn fails_cleanly(args: &[&str], needles: &[&str]) -> String {
+    fails_cleanly_in(None, args, needles)
+}
+
+/// Runs `haarshift ARGS` and requires a usage error from the argument parser (exit code 2):
+/// its `error: ...` message first on stderr, containing every needle (the argument at fault),
+/// no panic, nothing on stdout. Returns the message (clap lists missing arguments on the lines
+/// after `error:`).
+pub fn usage_error_in(dir: Option<&Path>, args: &[&str], needles: &[&str]) -> String {
+    failure(dir, args, 2, "error: ", needles)
+}
+
+/// [`usage_error_in`] in the current directory.
+pub fn usage_error(args: &[&str], needles: &[&str]) -> String {
+    usage_error_in(None, args, needles)
+}
+
+/// The checks behind [`fails_cleanly_in`] and [`usage_error_in`]: exit `code` (a panic exits
+/// with 101), no panic text, the error first on stderr starting with `prefix` and holding every
+/// needle; exactly one line in all for the program's own errors (code 1).
+fn failure(dir: Option<&Path>, args: &[&str], code: i32, prefix: &str, needles: &[&str]) -> String {
+    assert!(
+        !needles.is_empty() && needles.iter().all(|n| !n.trim().is_empty()),
+        "an empty needle checks nothing: {needles:?}"
+    );
+    let out = run_in(dir, args);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+    for bad in ["panicked", "internal error", "RUST_BACKTRACE"] {
+        assert!(!err.contains(bad), "{args:?} panicked: {err}");
+    }
+    assert!(
+        out.stdout.is_empty(),
+        "{args:?} wrote to stdout: {}",
+        text(&out.stdout)
+    );
+    let message = if code == 1 {
+        assert_eq!(err.lines().count(), 1, "{args:?}: not one line: {err:?}");
+        err.trim_end().to_owned()
+    } else {
+        // clap: the message, then a blank line and the usage or the hint about --help.
+        err.split("\n\n").next().unwrap_or_default().to_owned()
+    };
+    assert!(
+        message.starts_with(prefix),
+        "{args:?}: {message:?} is not `{prefix}...`"
+    );
+    for needle in needles {
+        assert!(
+            message.contains(needle),
+            "{args:?}: {message:?} lacks {needle:?}"
+        );
+    }
+    message
 }
 
 /// Output bytes as text.

@@ -6,7 +6,7 @@
 
 use ndarray::{Array2, ArrayView2};
 
-use super::{Category, StabilityRecord, kernels, max_abs_diff, measure, peak};
+use super::{Category, StabilityRecord, Subject, kernels, max_abs_diff, measure, peak};
 use crate::kernels::ShearKernel;
 use crate::metrics::disk_mask;
 use crate::rotate::{RotateOptions, quarter_turn, reduce_angle, rotate_plane};
@@ -74,12 +74,15 @@ fn disk_diff(a: ArrayView2<'_, f64>, b: ArrayView2<'_, f64>, radius: f64) -> f64
     m
 }
 
-/// The angle checks on `image` (square) for each kernel of the experiment.
-pub fn checks(image: ArrayView2<'_, f64>) -> Vec<StabilityRecord> {
-    kernels::<f64>()
-        .iter()
-        .flat_map(|(name, kernel)| kernel_checks(image, name, kernel.as_ref()))
-        .collect()
+/// The angle checks on `image` (square) for each kernel of the experiment, from `subject`.
+pub fn checks(image: ArrayView2<'_, f64>, subject: &impl Subject) -> Vec<StabilityRecord> {
+    match kernels::<f64>(subject) {
+        Ok(kernels) => kernels
+            .iter()
+            .flat_map(|(name, kernel)| kernel_checks(image, name, kernel.as_ref()))
+            .collect(),
+        Err(e) => vec![measure(Category::Angle, "kernels", 0.0, || Err(e))],
+    }
 }
 
 /// The checks for one kernel.

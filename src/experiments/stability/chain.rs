@@ -3,9 +3,8 @@
 
 use ndarray::{Array2, ArrayView2};
 
-use super::{Category, StabilityRecord, max_abs_diff, measure, peak};
+use super::{Category, StabilityRecord, Subject, max_abs_diff, measure, peak};
 use crate::kernels::{Outside, ShiftMethod, shift_plane};
-use crate::shift::shift_image;
 use crate::transform::{Coefficients, Levels, Normalization, TransformSpec};
 use crate::{BoundaryMode, Result, Sample};
 
@@ -44,13 +43,14 @@ fn roll(x: ArrayView2<'_, f64>, dx: i64, dy: i64) -> Result<Array2<f64>> {
 /// Applies the chain to the transform of `x` and returns the final coefficients and those of
 /// `x` rolled by the chain's sum.
 fn run_whole_chain(
+    subject: &impl Subject,
     x: ArrayView2<'_, f64>,
     spec: &TransformSpec,
     shifts: &[(i64, i64)],
 ) -> Result<(Coefficients<f64>, Coefficients<f64>)> {
     let mut c = spec.forward(x)?;
     for &(dx, dy) in shifts {
-        c = shift_image(&c, dx as f64, dy as f64, 0)?;
+        c = subject.shift_image(&c, dx as f64, dy as f64, 0)?;
     }
     let (tx, ty) = shifts
         .iter()
@@ -61,16 +61,17 @@ fn run_whole_chain(
 
 /// The chain checks on `image` (8-bit, 128x128): `integer` whole shifts in four settings and
 /// `fractional` compact shifts in f32 against f64. Returns the records and the f32 drift
-/// after each logged number of shifts.
+/// after each logged number of shifts. The shifts are `subject`'s.
 pub fn checks(
     image: ArrayView2<'_, f64>,
     integer: usize,
     fractional: usize,
+    subject: &impl Subject,
 ) -> (Vec<StabilityRecord>, Vec<(usize, f64)>) {
     let exact = |name: &str, x: &Array2<f64>, spec: TransformSpec, unit: i64, what: &str| {
         let shifts = whole_shifts(integer, 100, unit);
         measure(Category::Shift, name, 0.0, || {
-            let (got, want) = run_whole_chain(x.view(), &spec, &shifts)?;
+            let (got, want) = run_whole_chain(subject, x.view(), &spec, &shifts)?;
             Ok((
                 max_abs_diff(got.as_array(), want.as_array()),
                 format!("{what}: max |chain - transform of the rolled image|"),
@@ -119,7 +120,7 @@ pub fn checks(
             1e-12,
             || {
                 let (got, want) =
-                    run_whole_chain(floats.view(), &TransformSpec::default(), &shifts)?;
+                    run_whole_chain(subject, floats.view(), &TransformSpec::default(), &shifts)?;
                 let drift = max_abs_diff(got.as_array(), want.as_array()) / peak(want.as_array());
                 Ok((
                     drift,
@@ -138,7 +139,7 @@ pub fn checks(
             "fractional shifts, f32 vs f64",
             fractional_tolerance(fractional),
             || {
-                drift = fractional_drift(image, fractional)?;
+                drift = fractional_drift(subject, image, fractional)?;
                 let last = drift.last().map_or(0.0, |d| d.1);
                 Ok((
                     last,
@@ -176,15 +177,19 @@ pub fn fractional_tolerance(k: usize) -> f64 {
 
 /// `(k, max |f32 chain - f64 chain| / peak)` after `k = 1, 2, 5, 10, 20, 50, ...` shifts and at
 /// the end.
-pub fn fractional_drift(image: ArrayView2<'_, f64>, count: usize) -> Result<Vec<(usize, f64)>> {
+pub fn fractional_drift(
+    subject: &impl Subject,
+    image: ArrayView2<'_, f64>,
+    count: usize,
+) -> Result<Vec<(usize, f64)>> {
     let spec = TransformSpec::default();
     let mut c64 = spec.forward(image)?;
     let mut c32 = spec.forward(image.mapv(|v| v as f32).view())?;
     let scale = peak(image);
     let mut out = Vec::new();
     for k in 1..=count {
-        c64 = shift_image(&c64, FRACTIONAL_STEP.0, FRACTIONAL_STEP.1, FRACTIONAL_H)?;
-        c32 = shift_image(&c32, FRACTIONAL_STEP.0, FRACTIONAL_STEP.1, FRACTIONAL_H)?;
+        c64 = subject.shift_image(&c64, FRACTIONAL_STEP.0, FRACTIONAL_STEP.1, FRACTIONAL_H)?;
+        c32 = subject.shift_image(&c32, FRACTIONAL_STEP.0, FRACTIONAL_STEP.1, FRACTIONAL_H)?;
         if logged(k) || k == count {
             let a = c64.inverse()?;
             let b = c32.inverse()?.mapv(|v| v.as_f64());
@@ -215,7 +220,7 @@ mod tests {
         let x = Array2::from_shape_fn((64, 64), |(i, j)| {
             ((i * 37 + j * j * 11 + i * j) % 256) as f64
         });
-        let (r, drift) = checks(x.view(), 200, 50);
+        let (r, drift) = checks(x.view(), 200, 50, &crate::experiments::stability::Library);
         assert!(r.iter().all(|r| r.pass), "{r:?}");
         for r in &r[..3] {
             assert_eq!(r.figure, Some(0.0), "{}", r.check);

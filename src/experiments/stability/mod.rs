@@ -33,6 +33,7 @@ use serde::{Deserialize, Serialize};
 use crate::experiments::rotation_cycle::MemoryMeter;
 use crate::kernels::{KernelOptions, ShearKernel, ShiftMethod};
 use crate::named::named_enum;
+use crate::transform::Coefficients;
 use crate::{Error, Result, Sample};
 
 pub mod angle;
@@ -199,6 +200,67 @@ pub(crate) fn expect_refusal(
     record
 }
 
+/// The code the experiment puts to the test: the shear kernels (through every rotation) and
+/// the compact Haar shift of an image's coefficients. [`Library`] is haarshift's own; the
+/// experiment's tests hand each family deliberately wrong ones and see it report failure, so
+/// that no check passes whatever the code does.
+///
+/// ```
+/// use haarshift::experiments::stability::{Library, Subject};
+/// use haarshift::kernels::{KernelOptions, ShiftMethod};
+/// let keys = Library.kernel::<f64>(ShiftMethod::Keys, &KernelOptions::default()).unwrap();
+/// assert!(keys.name().starts_with("keys"));
+/// ```
+pub trait Subject {
+    /// The kernel of `method` with `options` (as [`ShiftMethod::kernel_with`]).
+    fn kernel<T: Sample>(
+        &self,
+        method: ShiftMethod,
+        options: &KernelOptions,
+    ) -> Result<Box<dyn ShearKernel<T>>>;
+
+    /// `coeffs` shifted by `(dx, dy)` at precision `h` (as [`crate::shift::shift_image`]).
+    fn shift_image<T: Sample>(
+        &self,
+        coeffs: &Coefficients<T>,
+        dx: f64,
+        dy: f64,
+        h: u32,
+    ) -> Result<Coefficients<T>>;
+}
+
+/// haarshift's own kernels and Haar shift: what [`run_stability`] checks.
+///
+/// ```
+/// use haarshift::experiments::stability::{Library, Subject};
+/// use haarshift::transform::TransformSpec;
+/// let c = TransformSpec::default().forward(ndarray::array![[1.0, 2.0], [3.0, 4.0]].view()).unwrap();
+/// let shifted = Library.shift_image(&c, 1.0, 0.0, 0).unwrap().inverse().unwrap();
+/// assert_eq!(shifted, ndarray::array![[2.0, 1.0], [4.0, 3.0]]);
+/// ```
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Library;
+
+impl Subject for Library {
+    fn kernel<T: Sample>(
+        &self,
+        method: ShiftMethod,
+        options: &KernelOptions,
+    ) -> Result<Box<dyn ShearKernel<T>>> {
+        method.kernel_with(options)
+    }
+
+    fn shift_image<T: Sample>(
+        &self,
+        coeffs: &Coefficients<T>,
+        dx: f64,
+        dy: f64,
+        h: u32,
+    ) -> Result<Coefficients<T>> {
+        crate::shift::shift_image(coeffs, dx, dy, h)
+    }
+}
+
 /// What a refusal on memory grounds may allocate: 1 MiB.
 pub const REFUSAL_ALLOWANCE: u64 = 1 << 20;
 
@@ -291,20 +353,22 @@ pub fn run_stability(
         ));
     }
     let crop = |side: usize| centre_crop(config.photo.view(), side);
-    let mut records = angle::checks(crop(64).view());
+    let subject = &Library;
+    let mut records = angle::checks(crop(64).view(), subject);
     progress("angle");
-    records.extend(size::checks(crop(131).view(), meter));
+    records.extend(size::checks(crop(131).view(), meter, subject));
     progress("size");
-    records.extend(values::checks(crop(64).view()));
+    records.extend(values::checks(crop(64).view(), subject));
     progress("values");
     let (chain_records, drift) = chain::checks(
         crop(128).view(),
         config.integer_shifts,
         config.fractional_shifts,
+        subject,
     );
     records.extend(chain_records);
     progress("shift");
-    records.extend(precision::checks(crop(32).view(), meter));
+    records.extend(precision::checks(crop(32).view(), meter, subject));
     progress("precision");
     Ok(StabilityReport { records, drift })
 }
@@ -317,13 +381,17 @@ pub(crate) fn centre_crop(plane: ArrayView2<'_, f64>, side: usize) -> Array2<f64
     plane.slice(s![top..top + sh, left..left + sw]).to_owned()
 }
 
+/// A kernel with its name in the experiment's records.
+pub(crate) type NamedKernel<T> = (String, Box<dyn ShearKernel<T>>);
+
 /// The kernels the angle and value checks run: linear, Keys, cubic B-spline, FFT and compact
-/// Haar at `h = 3`.
-pub(crate) fn kernels<T: Sample>() -> Vec<(String, Box<dyn ShearKernel<T>>)> {
+/// Haar at `h = 3`, from `subject`.
+pub(crate) fn kernels<T: Sample>(subject: &impl Subject) -> Result<Vec<NamedKernel<T>>> {
     let haar = KernelOptions {
         precision: 3,
         ..Default::default()
     };
+    let default = KernelOptions::default();
     [
         ShiftMethod::Linear,
         ShiftMethod::Keys,
@@ -331,13 +399,9 @@ pub(crate) fn kernels<T: Sample>() -> Vec<(String, Box<dyn ShearKernel<T>>)> {
         ShiftMethod::Fft,
     ]
     .into_iter()
-    .map(|m| (m.name().to_owned(), m.kernel::<T>()))
-    .chain([(
-        "haar-compact".to_owned(),
-        ShiftMethod::Haar
-            .kernel_with::<T>(&haar)
-            .expect("h = 3 is a valid precision"),
-    )])
+    .map(|m| (m.name().to_owned(), m, &default))
+    .chain([("haar-compact".to_owned(), ShiftMethod::Haar, &haar)])
+    .map(|(name, method, options)| Ok((name, subject.kernel::<T>(method, options)?)))
     .collect()
 }
 
@@ -405,5 +469,146 @@ mod tests {
             )
             .is_err()
         );
+    }
+
+    /// A kernel that shifts every row `ERROR` samples further than asked: a bug of a thousandth
+    /// of a pixel.
+    struct Overshooting<T: Sample>(Box<dyn ShearKernel<T>>);
+
+    /// The extra shift of [`Overshooting`], in samples.
+    const ERROR: f64 = 1e-3;
+
+    impl<T: Sample> ShearKernel<T> for Overshooting<T> {
+        fn name(&self) -> String {
+            self.0.name()
+        }
+
+        fn support_radius(&self) -> usize {
+            self.0.support_radius() + 1
+        }
+
+        fn row_shifter(
+            &self,
+            geometry: crate::kernels::RowGeometry,
+            outside: crate::kernels::Outside,
+        ) -> Box<dyn crate::kernels::RowShifter<T> + '_> {
+            let wider = crate::kernels::RowGeometry {
+                max_shift: geometry.max_shift + 1.0,
+                ..geometry
+            };
+            Box::new(OvershootingRows(self.0.row_shifter(wider, outside)))
+        }
+    }
+
+    struct OvershootingRows<'a, T: Sample>(Box<dyn crate::kernels::RowShifter<T> + 'a>);
+
+    impl<T: Sample> crate::kernels::RowShifter<T> for OvershootingRows<'_, T> {
+        fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
+            self.0.shift_row(row, shift + ERROR, out);
+        }
+    }
+
+    /// The code under test with at most one deliberate fault: kernels that overshoot, or a
+    /// Haar shift that moves content one sample too far right.
+    enum Faulty {
+        None,
+        Kernel,
+        Shift,
+    }
+
+    impl Subject for Faulty {
+        fn kernel<T: Sample>(
+            &self,
+            method: ShiftMethod,
+            options: &KernelOptions,
+        ) -> Result<Box<dyn ShearKernel<T>>> {
+            let kernel = Library.kernel(method, options)?;
+            Ok(match self {
+                Faulty::Kernel => Box::new(Overshooting(kernel)),
+                Faulty::None | Faulty::Shift => kernel,
+            })
+        }
+
+        fn shift_image<T: Sample>(
+            &self,
+            coeffs: &Coefficients<T>,
+            dx: f64,
+            dy: f64,
+            h: u32,
+        ) -> Result<Coefficients<T>> {
+            let extra = match self {
+                Faulty::None | Faulty::Kernel => 0.0,
+                Faulty::Shift => 1.0,
+            };
+            Library.shift_image(coeffs, dx + extra, dy, h)
+        }
+    }
+
+    /// 8-bit values, irregular, `side x side`.
+    fn photo(side: usize) -> Array2<f64> {
+        Array2::from_shape_fn((side, side), |(i, j)| {
+            ((i * 37 + j * j * 11 + i * j) % 256) as f64
+        })
+    }
+
+    /// Requires `family` to pass every check on the library and to fail `must_fail` with
+    /// `fault`.
+    fn reports(fault: Faulty, must_fail: &str, family: impl Fn(&Faulty) -> Vec<StabilityRecord>) {
+        let library = family(&Faulty::None);
+        assert!(library.iter().all(|r| r.pass), "{library:?}");
+        let failures: Vec<String> = family(&fault)
+            .into_iter()
+            .filter(|r| !r.pass)
+            .map(|r| r.check)
+            .collect();
+        assert!(
+            failures.iter().any(|c| c == must_fail),
+            "{must_fail}: {failures:?}"
+        );
+    }
+
+    #[test]
+    fn the_angle_family_reports_a_kernel_that_overshoots() {
+        let x = photo(64);
+        reports(Faulty::Kernel, "1e-9 deg ~ identity", |s| {
+            angle::checks(x.view(), s)
+        });
+    }
+
+    #[test]
+    fn the_size_family_reports_a_wrong_shift() {
+        let (x, meter) = (photo(131), &crate::experiments::rotation_cycle::NoMeter);
+        reports(Faulty::Shift, "haar shift (3, -2)", |s| {
+            size::checks(x.view(), meter, s)
+        });
+    }
+
+    #[test]
+    fn the_values_family_reports_a_wrong_kernel_and_a_wrong_shift() {
+        let x = photo(64);
+        for (fault, must_fail) in [
+            (Faulty::Kernel, "impulse centroid rotates"),
+            (Faulty::Kernel, "scale 1e0 f64"),
+            (Faulty::Shift, "checkerboard: shift by 1 negates"),
+            (Faulty::Shift, "scale 1e0 f64"),
+        ] {
+            reports(fault, must_fail, |s| values::checks(x.view(), s));
+        }
+    }
+
+    #[test]
+    fn the_chain_family_reports_a_wrong_shift() {
+        let x = photo(64);
+        reports(Faulty::Shift, "whole shifts, 8-bit, average", |s| {
+            chain::checks(x.view(), 20, 5, s).0
+        });
+    }
+
+    #[test]
+    fn the_precision_family_reports_a_wrong_shift() {
+        let (x, meter) = (photo(32), &crate::experiments::rotation_cycle::NoMeter);
+        reports(Faulty::Shift, "compact h=3", |s| {
+            precision::checks(x.view(), meter, s)
+        });
     }
 }

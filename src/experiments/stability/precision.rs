@@ -6,9 +6,11 @@
 use ndarray::ArrayView2;
 
 use super::size::haar_against_pixels;
-use super::{Category, StabilityRecord, expect_error, expect_refusal, max_abs_diff, measure};
+use super::{
+    Category, StabilityRecord, Subject, expect_error, expect_refusal, max_abs_diff, measure,
+};
 use crate::experiments::rotation_cycle::MemoryMeter;
-use crate::shift::{DEFAULT_MEMORY_BUDGET, MAX_PRECISION, RetainedImage, shift_image};
+use crate::shift::{DEFAULT_MEMORY_BUDGET, MAX_PRECISION, RetainedImage};
 use crate::transform::TransformSpec;
 use crate::{Error, Result};
 
@@ -23,7 +25,12 @@ pub const COMPACT: [u32; 9] = [0, 1, 2, 3, 5, 8, 12, 16, MAX_PRECISION];
 pub const RETAINED: [u32; 5] = [0, 1, 2, 4, 7];
 
 /// The precision checks: compact on `image`, retained on its top-left 16x16 block.
-pub fn checks(image: ArrayView2<'_, f64>, meter: &dyn MemoryMeter) -> Vec<StabilityRecord> {
+/// The compact shift comes from `subject`.
+pub fn checks(
+    image: ArrayView2<'_, f64>,
+    meter: &dyn MemoryMeter,
+    subject: &impl Subject,
+) -> Vec<StabilityRecord> {
     let mut out: Vec<StabilityRecord> = COMPACT
         .iter()
         .map(|&h| {
@@ -32,7 +39,7 @@ pub fn checks(image: ArrayView2<'_, f64>, meter: &dyn MemoryMeter) -> Vec<Stabil
                 format!("compact h={h}"),
                 1e-12 * 255.0,
                 || {
-                    haar_against_pixels(image, SHIFT, h).map(|d| {
+                    haar_against_pixels(subject, image, SHIFT, h).map(|d| {
                         (
                             d,
                             "vs periodic bilinear interpolation at the rounded shift".into(),
@@ -53,7 +60,9 @@ pub fn checks(image: ArrayView2<'_, f64>, meter: &dyn MemoryMeter) -> Vec<Stabil
                 let c = c
                     .as_ref()
                     .map_err(|e| Error::parameter("image", e.to_string()))?;
-                shift_image(c, SHIFT.0, SHIFT.1, MAX_PRECISION + 1).map(|_| "shifted".into())
+                subject
+                    .shift_image(c, SHIFT.0, SHIFT.1, MAX_PRECISION + 1)
+                    .map(|_| "shifted".into())
             },
         )
         .with("precision", MAX_PRECISION + 1),
@@ -66,7 +75,7 @@ pub fn checks(image: ArrayView2<'_, f64>, meter: &dyn MemoryMeter) -> Vec<Stabil
                 format!("retained h={h}"),
                 1e-12 * 255.0,
                 || {
-                    retained_against_compact(small, h).map(|d| {
+                    retained_against_compact(subject, small, h).map(|d| {
                         (
                             d,
                             format!(
@@ -94,11 +103,11 @@ pub fn retained_bytes(side: usize, h: u32) -> u128 {
     2 * (side * side) as u128 * 4u128.pow(h) * 8
 }
 
-fn retained_against_compact(x: ArrayView2<'_, f64>, h: u32) -> Result<f64> {
+fn retained_against_compact(subject: &impl Subject, x: ArrayView2<'_, f64>, h: u32) -> Result<f64> {
     let c = TransformSpec::default().forward(x)?;
     let mut r = RetainedImage::new(&c, h)?;
     r.shift(SHIFT.0, SHIFT.1)?;
-    let compact = shift_image(&c, SHIFT.0, SHIFT.1, h)?;
+    let compact = subject.shift_image(&c, SHIFT.0, SHIFT.1, h)?;
     Ok(max_abs_diff(r.project().as_array(), compact.as_array()))
 }
 
@@ -140,11 +149,12 @@ fn retained_budget(x: ArrayView2<'_, f64>, meter: &dyn MemoryMeter) -> Stability
 mod tests {
     use super::*;
     use crate::experiments::rotation_cycle::NoMeter;
+    use crate::experiments::stability::Library;
 
     #[test]
     fn every_precision_matches_and_the_limits_are_refused() {
         let x = ndarray::Array2::from_shape_fn((32, 32), |(i, j)| ((i * 37 + j * 11) % 256) as f64);
-        let r = checks(x.view(), &NoMeter);
+        let r = checks(x.view(), &NoMeter, &Library);
         assert!(r.iter().all(|r| r.pass), "{:?}", r.iter().find(|r| !r.pass));
         assert_eq!(r.len(), COMPACT.len() + 1 + RETAINED.len() + 1);
         assert!(r[COMPACT.len()].detail.contains("above the maximum"));

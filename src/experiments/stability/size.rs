@@ -3,11 +3,12 @@
 
 use ndarray::{Array2, ArrayView2, s};
 
-use super::{Category, StabilityRecord, expect_refusal, max_abs_diff, measure, peak};
+use super::{Category, StabilityRecord, Subject, expect_refusal, max_abs_diff, measure, peak};
 use crate::experiments::rotation_cycle::MemoryMeter;
+use crate::kernels::KernelOptions;
 use crate::kernels::{Outside, ShiftMethod, shift_plane};
 use crate::rotate::{DEFAULT_MEMORY_BUDGET, RotateOptions, rotate_plane};
-use crate::shift::{GridShift, shift_image};
+use crate::shift::GridShift;
 use crate::transform::{TransformSpec, pad_to_power_of_two};
 use crate::{BoundaryMode, Error, Result};
 
@@ -26,14 +27,18 @@ pub const SHAPES: [(usize, usize); 7] = [
 pub const AFFORDABLE_BUDGET: u64 = 8 << 20;
 
 /// The size checks on sub-blocks of `image` (8-bit values, at least 131 on each side), and
-/// the budget checks.
-pub fn checks(image: ArrayView2<'_, f64>, meter: &dyn MemoryMeter) -> Vec<StabilityRecord> {
+/// the budget checks; the kernel and the Haar shift from `subject`.
+pub fn checks(
+    image: ArrayView2<'_, f64>,
+    meter: &dyn MemoryMeter,
+    subject: &impl Subject,
+) -> Vec<StabilityRecord> {
     let mut out = Vec::new();
     for (h, w) in SHAPES {
         let x = image.slice(s![..h.min(image.nrows()), ..w.min(image.ncols())]);
         let size = format!("{h}x{w}");
         out.extend(
-            shape_checks(x)
+            shape_checks(x, subject)
                 .into_iter()
                 .map(|r| r.with("size", size.as_str())),
         );
@@ -45,7 +50,7 @@ pub fn checks(image: ArrayView2<'_, f64>, meter: &dyn MemoryMeter) -> Vec<Stabil
 
 /// Round trip, a whole and a fractional Haar shift, and a rotation of a constant, for one
 /// shape.
-fn shape_checks(x: ArrayView2<'_, f64>) -> Vec<StabilityRecord> {
+fn shape_checks(x: ArrayView2<'_, f64>, subject: &impl Subject) -> Vec<StabilityRecord> {
     let spec = TransformSpec::default();
     let peak_x = peak(x).max(1.0);
     let round_trip = measure(Category::Size, "round trip", 0.0, || {
@@ -56,14 +61,15 @@ fn shape_checks(x: ArrayView2<'_, f64>) -> Vec<StabilityRecord> {
         ))
     });
     let whole = measure(Category::Size, "haar shift (3, -2)", 0.0, || {
-        haar_against_pixels(x, (3.0, -2.0), 0).map(|d| (d, "vs the periodic roll: exact".into()))
+        haar_against_pixels(subject, x, (3.0, -2.0), 0)
+            .map(|d| (d, "vs the periodic roll: exact".into()))
     });
     let fractional = measure(
         Category::Size,
         "haar shift (0.375, -1.25) h=3",
         1e-12 * peak_x,
         || {
-            haar_against_pixels(x, (0.375, -1.25), 3).map(|d| {
+            haar_against_pixels(subject, x, (0.375, -1.25), 3).map(|d| {
                 (
                     d,
                     "vs periodic bilinear interpolation of the padded image".into(),
@@ -77,7 +83,7 @@ fn shape_checks(x: ArrayView2<'_, f64>) -> Vec<StabilityRecord> {
             outside: Outside::Boundary(BoundaryMode::Edge),
             ..Default::default()
         };
-        let kernel = ShiftMethod::Keys.kernel::<f64>();
+        let kernel = subject.kernel::<f64>(ShiftMethod::Keys, &KernelOptions::default())?;
         let r = rotate_plane(c.view(), 30.0, kernel.as_ref(), &opts)?;
         Ok((
             max_abs_diff(r.view(), c.view()) / 0.1,
@@ -88,16 +94,33 @@ fn shape_checks(x: ArrayView2<'_, f64>) -> Vec<StabilityRecord> {
 }
 
 /// The largest difference between the compact Haar shift of `x` (padded to powers of two by
-/// the default transform) and the same shift made in the pixel domain: periodic bilinear
-/// interpolation (the linear kernel with wrapped rows) of the padded image at the shift
-/// rounded to `1/2^h`, cropped back.
+/// the default transform) and the same shift made in the pixel domain ([`pixel_shift`]).
 pub(crate) fn haar_against_pixels(
+    subject: &impl Subject,
     x: ArrayView2<'_, f64>,
     (dx, dy): (f64, f64),
     h: u32,
 ) -> Result<f64> {
     let spec = TransformSpec::default();
-    let got = shift_image(&spec.forward(x)?, dx, dy, h)?.inverse()?;
+    let got = subject
+        .shift_image(&spec.forward(x)?, dx, dy, h)?
+        .inverse()?;
+    Ok(max_abs_diff(
+        got.view(),
+        pixel_shift(x, (dx, dy), h)?.view(),
+    ))
+}
+
+/// What the compact Haar shift of `x` by `(dx, dy)` at precision `h` is by definition, in the
+/// pixel domain: periodic bilinear interpolation (the linear kernel with wrapped rows) of `x`
+/// padded to powers of two as the default transform pads it, at the shift rounded to
+/// `1/2^h`, cropped back to `x`'s size.
+pub(crate) fn pixel_shift(
+    x: ArrayView2<'_, f64>,
+    (dx, dy): (f64, f64),
+    h: u32,
+) -> Result<Array2<f64>> {
+    let spec = TransformSpec::default();
     let padded = pad_to_power_of_two(x, spec.padding)?;
     let (rx, ry) = (
         GridShift::new(dx, h)?.amount(),
@@ -112,7 +135,7 @@ pub(crate) fn haar_against_pixels(
         Outside::Boundary(BoundaryMode::Wrap),
     )?;
     let (rows, cols) = x.dim();
-    Ok(max_abs_diff(got.view(), want.slice(s![..rows, ..cols])))
+    Ok(want.slice(s![..rows, ..cols]).to_owned())
 }
 
 /// The bytes [`rotate_plane`] needs for an `n x n` f64 plane at 30 degrees with the linear
@@ -239,18 +262,23 @@ fn largest_within_default(meter: &dyn MemoryMeter) -> StabilityRecord {
 mod tests {
     use super::*;
     use crate::experiments::rotation_cycle::NoMeter;
+    use crate::experiments::stability::Library;
 
     #[test]
     fn every_shape_passes_exactly_where_the_data_is_exact() {
         let x = Array2::from_shape_fn((131, 131), |(i, j)| ((i * 37 + j * 11) % 256) as f64);
-        let r = shape_checks(x.slice(s![..13, ..17]));
+        let r = shape_checks(x.slice(s![..13, ..17]), &Library);
         assert_eq!(r.len(), 4);
         assert!(r.iter().all(|r| r.pass), "{r:?}");
         // Round trip and whole shift of 8-bit data: bit-exact.
         assert_eq!(r[0].figure, Some(0.0));
         assert_eq!(r[1].figure, Some(0.0));
         for (h, w) in [(1, 1), (1, 17), (17, 1)] {
-            assert!(shape_checks(x.slice(s![..h, ..w])).iter().all(|r| r.pass));
+            assert!(
+                shape_checks(x.slice(s![..h, ..w]), &Library)
+                    .iter()
+                    .all(|r| r.pass)
+            );
         }
     }
 

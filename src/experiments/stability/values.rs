@@ -3,52 +3,74 @@
 
 use ndarray::{Array2, ArrayView2};
 
-use super::{Category, StabilityRecord, expect_error, kernels, max_abs_diff, measure, peak};
+use super::size::pixel_shift;
+use super::{
+    Category, Library, StabilityRecord, Subject, expect_error, kernels, max_abs_diff, measure, peak,
+};
 use crate::kernels::{KernelOptions, Outside, ShiftMethod};
 use crate::rotate::{RotateOptions, rotate_plane};
-use crate::shift::{RetainedImage, shift_image};
+use crate::shift::RetainedImage;
 use crate::transform::{Band, TransformSpec, pyramid};
 use crate::{BoundaryMode, Error, Result, Sample};
 
 /// The scales of the scale checks: 1e-30 to 1e30 in steps of 1e10.
 pub const SCALES: [f64; 7] = [1e-30, 1e-20, 1e-10, 1.0, 1e10, 1e20, 1e30];
 
-/// The value checks on `image` (8-bit values, square).
-pub fn checks(image: ArrayView2<'_, f64>) -> Vec<StabilityRecord> {
+/// The value checks on `image` (8-bit values, square), of `subject`'s kernels and shift.
+pub fn checks(image: ArrayView2<'_, f64>, subject: &impl Subject) -> Vec<StabilityRecord> {
     let mut out = Vec::new();
     for scale in SCALES {
-        out.push(scaled::<f64>(image, scale));
-        out.push(scaled::<f32>(image, scale));
+        out.push(scaled::<f64>(subject, image, scale));
+        out.push(scaled::<f32>(subject, image, scale));
     }
-    out.push(subnormal::<f32>(image, 1e-40));
-    out.push(subnormal::<f64>(image, 1e-310));
-    out.extend(constants());
-    out.extend(impulses());
-    out.extend(checkerboard());
-    out.extend(non_finite());
+    out.push(subnormal::<f32>(subject, image, 1e-40));
+    out.push(subnormal::<f64>(subject, image, 1e-310));
+    out.extend(constants(subject));
+    out.extend(impulses(subject));
+    out.extend(checkerboard(subject));
+    out.extend(non_finite(subject));
     out
 }
 
+/// The compact Haar shift of the scale checks, and its precision.
+const SCALE_SHIFT: (f64, f64, u32) = (0.3, -0.7, 3);
+
 /// The three operations whose relative error must not depend on the scale: transform round
-/// trip, compact Haar shift by (0.3, -0.7) at h = 3, Keys rotation by 30 degrees. Each is
-/// compared with the same operation in f64 on the unscaled image, times the scale, relative to
-/// the scaled peak; all arithmetic of the comparison is in f64, so nothing squares the values.
-fn operations<T: Sample>(x: ArrayView2<'_, T>) -> Result<[Array2<T>; 3]> {
+/// trip, compact Haar shift by (0.3, -0.7) at h = 3, Keys rotation by 30 degrees, of
+/// `subject`.
+fn operations<T: Sample>(subject: &impl Subject, x: ArrayView2<'_, T>) -> Result<[Array2<T>; 3]> {
     let spec = TransformSpec::default();
     let c = spec.forward(x)?;
-    let keys = ShiftMethod::Keys.kernel::<T>();
+    let keys = subject.kernel::<T>(ShiftMethod::Keys, &KernelOptions::default())?;
+    let (dx, dy, h) = SCALE_SHIFT;
     Ok([
         c.inverse()?,
-        shift_image(&c, 0.3, -0.7, 3)?.inverse()?,
+        subject.shift_image(&c, dx, dy, h)?.inverse()?,
         rotate_plane(x, 30.0, keys.as_ref(), &RotateOptions::default())?,
     ])
 }
 
-/// The largest of the three operations' relative deviations at `scale` in `T`.
-fn relative_errors<T: Sample>(image: ArrayView2<'_, f64>, scale: f64) -> Result<[f64; 3]> {
-    let reference = operations(image)?;
+/// The largest of the three operations' relative deviations at `scale` in `T`, each against
+/// its right answer on the unscaled image in f64, times the scale: the image itself for the
+/// round trip, the shift's definition in the pixel domain ([`pixel_shift`]) for the Haar
+/// shift, and the library's Keys rotation for the rotation (which has no closed form, so at
+/// scale 1 in f64 that part compares the library with itself; the other two never do). All
+/// arithmetic of the comparison is in f64, relative to the scaled peak, so nothing squares
+/// the values.
+fn relative_errors<T: Sample>(
+    subject: &impl Subject,
+    image: ArrayView2<'_, f64>,
+    scale: f64,
+) -> Result<[f64; 3]> {
+    let (dx, dy, h) = SCALE_SHIFT;
+    let keys = Library.kernel::<f64>(ShiftMethod::Keys, &KernelOptions::default())?;
+    let reference = [
+        image.to_owned(),
+        pixel_shift(image, (dx, dy), h)?,
+        rotate_plane(image, 30.0, keys.as_ref(), &RotateOptions::default())?,
+    ];
     let x = image.mapv(|v| T::from_f64(v * scale));
-    let got = operations(x.view())?;
+    let got = operations(subject, x.view())?;
     let mut errors = [0.0; 3];
     for ((e, g), r) in errors.iter_mut().zip(&got).zip(&reference) {
         let want = r.mapv(|v| v * scale);
@@ -63,13 +85,17 @@ fn scale_tolerance<T: Sample>() -> f64 {
     64.0 * T::epsilon().as_f64()
 }
 
-fn scaled<T: Sample>(image: ArrayView2<'_, f64>, scale: f64) -> StabilityRecord {
+fn scaled<T: Sample>(
+    subject: &impl Subject,
+    image: ArrayView2<'_, f64>,
+    scale: f64,
+) -> StabilityRecord {
     measure(
         Category::Values,
         format!("scale {scale:e} {}", T::NAME),
         scale_tolerance::<T>(),
         || {
-            let [trip, shift, rotation] = relative_errors::<T>(image, scale)?;
+            let [trip, shift, rotation] = relative_errors::<T>(subject, image, scale)?;
             Ok((
                 trip.max(shift).max(rotation),
                 format!(
@@ -86,14 +112,18 @@ fn scaled<T: Sample>(image: ArrayView2<'_, f64>, scale: f64) -> StabilityRecord 
 /// Below the smallest normal number precision degrades gradually (subnormals keep a fixed
 /// absolute spacing). The check: the absolute error stays within 64 subnormal spacings, i.e.
 /// nothing flushes to zero or blows up; the relative error is reported.
-fn subnormal<T: Sample>(image: ArrayView2<'_, f64>, scale: f64) -> StabilityRecord {
+fn subnormal<T: Sample>(
+    subject: &impl Subject,
+    image: ArrayView2<'_, f64>,
+    scale: f64,
+) -> StabilityRecord {
     let spacing = T::min_positive_value().as_f64() * T::epsilon().as_f64();
     measure(
         Category::Values,
         format!("subnormal {scale:e} {}", T::NAME),
         64.0,
         || {
-            let [trip, shift, rotation] = relative_errors::<T>(image, scale)?;
+            let [trip, shift, rotation] = relative_errors::<T>(subject, image, scale)?;
             let worst = trip.max(shift).max(rotation);
             let absolute = worst * (scale * peak(image));
             Ok((
@@ -111,7 +141,7 @@ fn subnormal<T: Sample>(image: ArrayView2<'_, f64>, scale: f64) -> StabilityReco
 
 /// A constant image stays constant under a 30-degree rotation with the edge boundary, for
 /// every kernel (and both Haar modes): the weights of every kernel sum to one.
-fn constants() -> Vec<StabilityRecord> {
+fn constants(subject: &impl Subject) -> Vec<StabilityRecord> {
     let value = 0.1;
     let c = Array2::from_elem((33, 33), value);
     let opts = RotateOptions {
@@ -125,15 +155,11 @@ fn constants() -> Vec<StabilityRecord> {
     };
     let all = ShiftMethod::ALL
         .iter()
-        .map(|m| (m.name().to_owned(), m.kernel::<f64>()))
-        .chain([(
-            "haar-retained".to_owned(),
-            ShiftMethod::Haar
-                .kernel_with::<f64>(&retained)
-                .expect("valid options"),
-        )]);
-    all.map(|(name, kernel)| {
+        .map(|&m| (m.name().to_owned(), m, KernelOptions::default()))
+        .chain([("haar-retained".to_owned(), ShiftMethod::Haar, retained)]);
+    all.map(|(name, method, options)| {
         measure(Category::Values, "constant stays constant", 1e-12, || {
+            let kernel = subject.kernel::<f64>(method, &options)?;
             let r = rotate_plane(c.view(), 30.0, kernel.as_ref(), &opts)?;
             Ok((
                 max_abs_diff(r.view(), c.view()) / value,
@@ -153,7 +179,7 @@ fn constants() -> Vec<StabilityRecord> {
 /// not checked. The centroid lands where the rotation takes the impulse: exactly for kernels
 /// that reproduce linear functions; compact Haar rounds each of the three shears' shifts to
 /// `1/2^h`, which may move it by up to `3 / 2^(h+1)` pixels.
-fn impulses() -> Vec<StabilityRecord> {
+fn impulses(subject: &impl Subject) -> Vec<StabilityRecord> {
     let n = 129;
     let centre = (n / 2) as f64;
     let (right, up) = (7.0, 5.0);
@@ -162,8 +188,12 @@ fn impulses() -> Vec<StabilityRecord> {
     x[[(centre - up) as usize, (centre + right) as usize]] = 1.0;
     let (sin, cos) = 30f64.to_radians().sin_cos();
     let (want_x, want_y) = (cos * right - sin * up, sin * right + cos * up);
+    let kernels = match kernels::<f64>(subject) {
+        Ok(kernels) => kernels,
+        Err(e) => return vec![measure(Category::Values, "kernels", 0.0, || Err(e))],
+    };
     let mut out = Vec::new();
-    for (name, kernel) in kernels::<f64>() {
+    for (name, kernel) in kernels {
         let rotated = rotate_plane(x.view(), 30.0, kernel.as_ref(), &RotateOptions::default());
         let moments = rotated.as_ref().map(|r| {
             let (mut mass, mut mx, mut my) = (0.0, 0.0, 0.0);
@@ -226,7 +256,7 @@ fn impulses() -> Vec<StabilityRecord> {
 
 /// The Nyquist checkerboard `(-1)^(i+j)`: its transform is the finest diagonal band alone, a
 /// whole Haar shift by one pixel negates it, and a half-pixel compact shift averages it to 0.
-fn checkerboard() -> Vec<StabilityRecord> {
+fn checkerboard(subject: &impl Subject) -> Vec<StabilityRecord> {
     let n = 64;
     let x = Array2::from_shape_fn((n, n), |(i, j)| if (i + j) % 2 == 0 { 1.0 } else { -1.0 });
     let spec = TransformSpec::default();
@@ -256,7 +286,7 @@ fn checkerboard() -> Vec<StabilityRecord> {
             0.0,
             || {
                 let c = spec.forward(x.view())?;
-                let y = shift_image(&c, 1.0, 0.0, 0)?.inverse()?;
+                let y = subject.shift_image(&c, 1.0, 0.0, 0)?.inverse()?;
                 Ok((
                     max_abs_diff(y.view(), x.mapv(|v| -v).view()),
                     "max |shifted + x|".into(),
@@ -269,7 +299,7 @@ fn checkerboard() -> Vec<StabilityRecord> {
             0.0,
             || {
                 let c = spec.forward(x.view())?;
-                let y = shift_image(&c, 0.5, 0.0, 1)?.inverse()?;
+                let y = subject.shift_image(&c, 0.5, 0.0, 1)?.inverse()?;
                 Ok((
                     peak(y.view()),
                     "max |shifted|: linear interpolation halfway".into(),
@@ -280,11 +310,15 @@ fn checkerboard() -> Vec<StabilityRecord> {
 }
 
 /// Non-finite inputs and parameters: typed errors, never a result.
-fn non_finite() -> Vec<StabilityRecord> {
+fn non_finite(subject: &impl Subject) -> Vec<StabilityRecord> {
     let mut x = Array2::from_elem((8, 8), 1.0);
     let spec = TransformSpec::default();
     let c = spec.forward(x.view()).expect("finite input");
-    let keys = ShiftMethod::Keys.kernel::<f64>();
+    let keys = subject.kernel::<f64>(ShiftMethod::Keys, &KernelOptions::default());
+    let keys = || {
+        keys.as_ref()
+            .map_err(|e| Error::parameter("kernel", e.to_string()))
+    };
     let opts = RotateOptions::default();
     let non_finite = |e: &Error| matches!(e, Error::NonFinite { .. });
     let parameter = |e: &Error| matches!(e, Error::InvalidParameter { .. });
@@ -303,13 +337,17 @@ fn non_finite() -> Vec<StabilityRecord> {
             Category::Values,
             format!("{bad} pixel: rotate"),
             non_finite,
-            || rotate_plane(xv, 30.0, keys.as_ref(), &opts).map(describe),
+            || rotate_plane(xv, 30.0, keys()?.as_ref(), &opts).map(describe),
         ));
         out.push(expect_error(
             Category::Values,
             format!("{bad} shift"),
             parameter,
-            || shift_image(&c, bad, 0.0, 3).map(|c| describe(c.as_array().to_owned())),
+            || {
+                subject
+                    .shift_image(&c, bad, 0.0, 3)
+                    .map(|c| describe(c.as_array().to_owned()))
+            },
         ));
         out.push(expect_error(
             Category::Values,
@@ -324,7 +362,7 @@ fn non_finite() -> Vec<StabilityRecord> {
             Category::Values,
             format!("{bad} angle"),
             parameter,
-            || rotate_plane(c.as_array(), bad, keys.as_ref(), &opts).map(describe),
+            || rotate_plane(c.as_array(), bad, keys()?.as_ref(), &opts).map(describe),
         ));
     }
     out
@@ -337,7 +375,7 @@ mod tests {
     #[test]
     fn values_checks_pass_with_their_exact_figures() {
         let x = Array2::from_shape_fn((32, 32), |(i, j)| ((i * 37 + j * j * 11) % 256) as f64);
-        let r = checks(x.view());
+        let r = checks(x.view(), &Library);
         assert!(r.iter().all(|r| r.pass), "{:?}", r.iter().find(|r| !r.pass));
         let get = |name: &str| r.iter().find(|r| r.check == name).unwrap();
         // At scale 1 in f64 the compared computations are the same: exactly 0.

@@ -64,10 +64,12 @@ pub fn run(args: Args) -> Result<()> {
         config.fractional_shifts = 100;
     }
     let bar = progress_bar(FAMILIES);
+    // Its errors are about the photograph (too small): they name the file.
     let report = run_stability(&config, &PeakMeter::default(), |family| {
         bar.set_message(family.to_owned());
         bar.inc(1);
-    })?;
+    })
+    .map_err(|e| e.in_file(args.image.as_deref().unwrap_or(photo.name.as_ref())))?;
     bar.finish_and_clear();
     let failures = report.failures();
     let mut text = format!(
