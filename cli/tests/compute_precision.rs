@@ -14,21 +14,9 @@ use haarshift::rotate::{Canvas, RotateOptions, rotate_image};
 use haarshift::{Channels, PlanarImage, Sample, SampleDepth};
 use ndarray::Array3;
 
-/// Deterministic pseudo-random whole numbers in `0..max` (a 64-bit LCG).
-fn noise(len: usize, max: u64, seed: u64) -> Vec<f64> {
-    let mut state = seed.wrapping_add(1442695040888963407);
-    (0..len)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 33) % max) as f64
-        })
-        .collect()
-}
-
-/// A `channels` image of `h x w` at `depth`: noise, divided by 7 for float depths so that the
-/// values are not whole numbers.
+/// A `channels` image of `h x w` at `depth`: scrambled whole numbers over the depth's range
+/// (Fibonacci hashing of the index), divided by 7 for float depths so that the values are not
+/// whole numbers.
 fn image<T: Sample>(channels: Channels, h: usize, w: usize, depth: SampleDepth) -> PlanarImage<T> {
     let max = depth.integer_max().unwrap_or(1000.0) as u64 + 1;
     let scale = if depth.integer_max().is_some() {
@@ -37,9 +25,10 @@ fn image<T: Sample>(channels: Channels, h: usize, w: usize, depth: SampleDepth) 
         1.0 / 7.0
     };
     let c = channels.count();
-    let values = noise(c * h * w, max, 17)
-        .into_iter()
-        .map(|v| T::from_f64(v * scale));
+    let values = (0..(c * h * w) as u64).map(|i| {
+        let scrambled = (i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40) % max;
+        T::from_f64(scrambled as f64 * scale)
+    });
     let planes = Array3::from_shape_vec((c, h, w), values.collect()).unwrap();
     PlanarImage::new(planes, channels, depth).unwrap()
 }
