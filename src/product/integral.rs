@@ -191,26 +191,42 @@ impl<T: Sample, const C: usize> Walk<'_, T, C> {
         }
         for q in 0..4 {
             let base = self.active.len();
-            let mut child_cum = cum;
-            for k in start..end {
-                let (t, n) = self.active[k];
-                let node = &trees[t as usize].nodes()[n as usize];
-                match node.child(q) {
-                    Some(c) => self.active.push((t, c)),
-                    None => {
-                        let m = node.quadrant_mean(&self.signs[q]);
-                        for ch in 0..C {
-                            child_cum[ch] *= m[ch];
-                        }
-                    }
-                }
-            }
+            let child_cum = descend(trees, &mut self.active, start, q, &self.signs[q], cum);
             if self.active.len() - base >= 2 {
                 self.visit(base, level + 1, child_cum);
             }
             self.active.truncate(base);
         }
     }
+}
+
+/// Steps from the node whose functions are `active[start..]` into its quadrant `q`: pushes
+/// the functions that have a child there onto `active` and returns `cum` times the quadrant
+/// means of those that do not (constant below).
+#[inline(always)]
+pub(crate) fn descend<T: Sample, const C: usize>(
+    trees: &[&HaarTree<T, C>],
+    active: &mut Vec<(u32, u32)>,
+    start: usize,
+    q: usize,
+    signs: &[T; 3],
+    mut cum: [T; C],
+) -> [T; C] {
+    let end = active.len();
+    for k in start..end {
+        let (t, n) = active[k];
+        let node = &trees[t as usize].nodes()[n as usize];
+        match node.child(q) {
+            Some(c) => active.push((t, c)),
+            None => {
+                let m = node.quadrant_mean(signs);
+                for (c, m) in cum.iter_mut().zip(m) {
+                    *c *= m;
+                }
+            }
+        }
+    }
+    cum
 }
 
 /// `(1/4) sum_q prod_k m_k(X_q) - prod_k m_k(X)` for the nodes of one block (see the module

@@ -38,6 +38,7 @@
 //!   assumes, but the discrete orthonormal basis of a `2^n` face is that over `2^n`, so every
 //!   integral coefficient of `N` functions on pixels carries `2^((2 - N) n)` (stated in neither
 //!   seed).
+pub mod baseline;
 pub mod basis;
 pub mod coefficient;
 pub mod integral;
@@ -45,6 +46,7 @@ pub mod multiply;
 pub mod selection;
 pub mod transport;
 pub mod tree;
+pub mod triple;
 
 pub use integral::{Integral, IntegralOptions, product_integral};
 pub use selection::{FaceLayout, Selection};

@@ -16,7 +16,7 @@
 //! without the walk back up.
 
 use super::basis::wavelet_signs;
-use super::integral::{IntegralOptions, check_trees};
+use super::integral::{IntegralOptions, check_trees, descend};
 use super::transport::Transport;
 use super::tree::{HaarTree, Node, NodePosition};
 use crate::{Result, Sample};
@@ -180,20 +180,7 @@ impl<T: Sample, const C: usize> Builder<'_, T, C> {
         let mut next = first_child;
         for (q, sum) in sums.iter_mut().enumerate() {
             let base = self.active.len();
-            let mut child_cum = cum;
-            for k in start..end {
-                let (t, n) = self.active[k];
-                let node = &trees[t as usize].nodes()[n as usize];
-                match node.child(q) {
-                    Some(c) => self.active.push((t, c)),
-                    None => {
-                        let m = node.quadrant_mean(&self.signs[q]);
-                        for ch in 0..C {
-                            child_cum[ch] *= m[ch];
-                        }
-                    }
-                }
-            }
+            let child_cum = descend(trees, &mut self.active, start, q, &self.signs[q], cum);
             *sum = if self.active.len() > base {
                 let child_pos = NodePosition {
                     face: pos.face,

@@ -7,7 +7,9 @@ use rand::{Rng, SeedableRng};
 use super::*;
 
 mod algebra;
+mod fast_paths;
 mod integrals;
+mod trees;
 
 /// Random `(faces, S, S, C)` values in `[lo, hi)`.
 pub(super) fn random_faces(
