@@ -231,8 +231,11 @@ impl<T: Sample, const C: usize> DenseTransport<T, C> {
     }
 }
 
-/// Lanes of partial sums: lets the compiler vectorise the reduction.
+/// Partial sums per channel: lets the compiler vectorise the reduction.
 const LANES: usize = 8;
+
+/// Room for `LANES` nodes of up to 8 channels on the stack.
+const MAX_LANE_VALUES: usize = 64;
 
 /// The triple product integral over complete quadtrees, `O(M)`.
 ///
@@ -280,7 +283,7 @@ pub fn dense_triple_integral<T: Sample, const C: usize>(
             let len = (1usize << (2 * level)) * C;
             let range = start..start + len;
             let b = (s >> level) as f64;
-            let level_sum = level_excess(t, f, g, range, &mut [T::zero(); LANES]);
+            let level_sum = level_excess(t, f, g, range);
             for (ch, v) in level_sum.iter().enumerate() {
                 sum[ch] += b * b * v;
             }
@@ -290,40 +293,65 @@ pub fn dense_triple_integral<T: Sample, const C: usize>(
     Ok(sum)
 }
 
-/// The sum of the three-function excess over the nodes in `range`, per channel.
+/// The sum of the three-function excess over the nodes in `range` (element indices), per
+/// channel.
 fn level_excess<T: Sample, const C: usize>(
     t: &DenseFaces<T, C>,
     f: &DenseFaces<T, C>,
     g: &DenseFaces<T, C>,
     range: std::ops::Range<usize>,
-    lanes: &mut [T; LANES],
 ) -> [f64; C] {
-    let excess = |i: usize| {
-        let (m1, h1, v1, d1) = (t.mean[i], t.step[0][i], t.step[1][i], t.step[2][i]);
-        let (m2, h2, v2, d2) = (f.mean[i], f.step[0][i], f.step[1][i], f.step[2][i]);
-        let (m3, h3, v3, d3) = (g.mean[i], g.step[0][i], g.step[1][i], g.step[2][i]);
-        m1 * (h2 * h3 + v2 * v3 + d2 * d3)
-            + m2 * (h1 * h3 + v1 * v3 + d1 * d3)
-            + m3 * (h1 * h2 + v1 * v2 + d1 * d2)
-            + h1 * (v2 * d3 + d2 * v3)
-            + v1 * (h2 * d3 + d2 * h3)
-            + d1 * (h2 * v3 + v2 * h3)
-    };
-    let mut out = [0.0; C];
-    if C == 1 && range.len() >= LANES {
-        // One channel: LANES independent partial sums, vectorised.
-        lanes.fill(T::zero());
-        let whole = range.start + range.len() / LANES * LANES;
-        for base in (range.start..whole).step_by(LANES) {
-            for (k, lane) in lanes.iter_mut().enumerate() {
-                *lane += excess(base + k);
-            }
-        }
-        let tail: T = (whole..range.end).map(excess).sum();
-        out[0] = lanes.iter().map(|v| v.as_f64()).sum::<f64>() + tail.as_f64();
-        return out;
+    let n = range.len();
+    // Equal-length slices: the loop below runs without bounds checks.
+    fn cut<'a, T>(v: &'a [T], range: &std::ops::Range<usize>, n: usize) -> &'a [T] {
+        &v[range.clone()][..n]
     }
-    for i in range {
+    let cut = |v| cut(v, &range, n);
+    let (m1, h1, v1, d1) = (
+        cut(&t.mean),
+        cut(&t.step[0]),
+        cut(&t.step[1]),
+        cut(&t.step[2]),
+    );
+    let (m2, h2, v2, d2) = (
+        cut(&f.mean),
+        cut(&f.step[0]),
+        cut(&f.step[1]),
+        cut(&f.step[2]),
+    );
+    let (m3, h3, v3, d3) = (
+        cut(&g.mean),
+        cut(&g.step[0]),
+        cut(&g.step[1]),
+        cut(&g.step[2]),
+    );
+    let excess = |i: usize| {
+        m1[i] * (h2[i] * h3[i] + v2[i] * v3[i] + d2[i] * d3[i])
+            + m2[i] * (h1[i] * h3[i] + v1[i] * v3[i] + d1[i] * d3[i])
+            + m3[i] * (h1[i] * h2[i] + v1[i] * v2[i] + d1[i] * d2[i])
+            + h1[i] * (v2[i] * d3[i] + d2[i] * v3[i])
+            + v1[i] * (h2[i] * d3[i] + d2[i] * h3[i])
+            + d1[i] * (h2[i] * v3[i] + v2[i] * h3[i])
+    };
+    // Chunks of LANES whole nodes; element k of a chunk is channel k % C.
+    let chunk = if LANES * C <= MAX_LANE_VALUES {
+        LANES * C
+    } else {
+        C
+    };
+    let whole = n / chunk * chunk;
+    let mut buffer = [T::zero(); MAX_LANE_VALUES];
+    let lanes = &mut buffer[..chunk];
+    for base in (0..whole).step_by(chunk) {
+        for (k, lane) in lanes.iter_mut().enumerate() {
+            *lane += excess(base + k);
+        }
+    }
+    let mut out = [0.0; C];
+    for (k, lane) in lanes.iter().enumerate() {
+        out[k % C] += lane.as_f64();
+    }
+    for i in whole..n {
         out[i % C] += excess(i).as_f64();
     }
     out
