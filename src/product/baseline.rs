@@ -64,9 +64,9 @@ pub fn pixel_integral<T: Sample, const C: usize>(
 ///     WeightedPixels, baseline::pixel_integral_of_trees, product_integral};
 /// use ndarray::{Array3, Array4};
 /// let f = Array4::from_shape_fn((6, 4, 4, 1), |(k, i, j, _)| (k + i * j) as f64);
-/// let w = WeightedPixels::new(f.view(), Array3::ones((6, 4, 4)).view()).unwrap();
+/// let w = WeightedPixels::<f64, 1>::new(f.view(), Array3::ones((6, 4, 4)).view()).unwrap();
 /// let t = Transport::new(&w, FaceLayout::Stacked, Selection::Largest(20)).unwrap();
-/// let g = HaarTree::from_pixels(f.view(), FaceLayout::Stacked, Selection::Largest(9)).unwrap();
+/// let g = HaarTree::<f64, 1>::from_pixels(f.view(), FaceLayout::Stacked, Selection::Largest(9)).unwrap();
 /// let pixel = pixel_integral_of_trees(&t, &[&g]).unwrap().value[0];
 /// let tree = product_integral(&t, &[&g], IntegralOptions::default()).unwrap().value[0];
 /// assert!((pixel - tree).abs() < 1e-12 * pixel.abs());
@@ -95,9 +95,9 @@ pub fn pixel_integral_of_trees<T: Sample, const C: usize>(
 ///     WeightedPixels, baseline::pairwise_integral, product_integral};
 /// use ndarray::{Array3, Array4};
 /// let f = Array4::from_shape_fn((2, 8, 8, 1), |(k, i, j, _)| 1.0 + (k + i * j) as f64);
-/// let w = WeightedPixels::new(f.view(), Array3::ones((2, 8, 8)).view()).unwrap();
+/// let w = WeightedPixels::<f64, 1>::new(f.view(), Array3::ones((2, 8, 8)).view()).unwrap();
 /// let t = Transport::new(&w, FaceLayout::SideBySide, Selection::All).unwrap();
-/// let g = HaarTree::from_pixels(f.view(), FaceLayout::SideBySide, Selection::Largest(30)).unwrap();
+/// let g = HaarTree::<f64, 1>::from_pixels(f.view(), FaceLayout::SideBySide, Selection::Largest(30)).unwrap();
 /// let pairwise = pairwise_integral(&t, &[&g, &g, &g]).unwrap().value[0];
 /// let tree = product_integral(&t, &[&g, &g, &g], IntegralOptions::default()).unwrap().value[0];
 /// assert!((pairwise - tree).abs() < 1e-12 * tree.abs());

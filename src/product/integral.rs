@@ -59,9 +59,9 @@ pub struct Integral<const C: usize> {
 /// use ndarray::{Array3, Array4, Axis};
 /// let f = Array4::from_shape_fn((2, 4, 4, 1), |(k, i, j, _)| (1 + k + i * j) as f64);
 /// let g = Array4::from_shape_fn((2, 4, 4, 1), |(k, i, j, _)| (2 * k + i + j) as f64 - 3.0);
-/// let w = WeightedPixels::new(f.view(), Array3::ones((2, 4, 4)).view()).unwrap();
+/// let w = WeightedPixels::<f64, 1>::new(f.view(), Array3::ones((2, 4, 4)).view()).unwrap();
 /// let t = Transport::new(&w, FaceLayout::Stacked, Selection::All).unwrap();
-/// let g_tree = HaarTree::from_pixels(g.view(), FaceLayout::Stacked, Selection::All).unwrap();
+/// let g_tree = HaarTree::<f64, 1>::from_pixels(g.view(), FaceLayout::Stacked, Selection::All).unwrap();
 /// let i = product_integral(&t, &[&g_tree], IntegralOptions::default()).unwrap();
 /// let pixel: f64 = (&f * &g).sum();
 /// assert!((i.value[0] - pixel).abs() < 1e-12 * pixel.abs());

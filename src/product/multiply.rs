@@ -28,8 +28,8 @@ use crate::{Result, Sample};
 /// use ndarray::Array4;
 /// let f = Array4::from_shape_fn((1, 4, 4, 1), |(_, i, j, _)| (i + 2 * j) as f64);
 /// let g = Array4::from_shape_fn((1, 4, 4, 1), |(_, i, j, _)| 1.0 + (i * j) as f64);
-/// let tf = HaarTree::from_pixels(f.view(), FaceLayout::Stacked, Selection::All).unwrap();
-/// let tg = HaarTree::from_pixels(g.view(), FaceLayout::Stacked, Selection::All).unwrap();
+/// let tf = HaarTree::<f64, 1>::from_pixels(f.view(), FaceLayout::Stacked, Selection::All).unwrap();
+/// let tg = HaarTree::<f64, 1>::from_pixels(g.view(), FaceLayout::Stacked, Selection::All).unwrap();
 /// let fg = product(&[&tf, &tg]).unwrap().to_pixels().unwrap();
 /// assert!(fg.iter().zip((&f * &g).iter()).all(|(a, b)| (a - b).abs() < 1e-12));
 /// ```
@@ -44,9 +44,9 @@ pub fn product<T: Sample, const C: usize>(factors: &[&HaarTree<T, C>]) -> Result
 ///     WeightedPixels, multiply::weighted_product, product_integral};
 /// use ndarray::{Array3, Array4};
 /// let f = Array4::from_shape_fn((2, 4, 4, 1), |(k, i, j, _)| (k + i + 2 * j) as f64);
-/// let w = WeightedPixels::new(f.view(), Array3::from_elem((2, 4, 4), 0.5).view()).unwrap();
+/// let w = WeightedPixels::<f64, 1>::new(f.view(), Array3::from_elem((2, 4, 4), 0.5).view()).unwrap();
 /// let t = Transport::new(&w, FaceLayout::Stacked, Selection::All).unwrap();
-/// let g = HaarTree::from_pixels(f.view(), FaceLayout::Stacked, Selection::All).unwrap();
+/// let g = HaarTree::<f64, 1>::from_pixels(f.view(), FaceLayout::Stacked, Selection::All).unwrap();
 /// let tg = weighted_product(&t, &[&g]).unwrap();
 /// let direct = product_integral(&t, &[&g, &g], IntegralOptions::default()).unwrap();
 /// let reused = product_integral(&tg, &[&g], IntegralOptions::default()).unwrap();
