@@ -1,0 +1,346 @@
+//! Product integrals on real data: the rooitou park envmap, the visibility of bunny vertices
+//! (brute-force ray-triangle tests against `testdata/meshes/bunny.obj` in the setup) and a
+//! Phong-50 lobe, as cube maps of 6 x S^2 texels (nearest-texel lookups from the lat-long map:
+//! data preparation for timing only, not an accurate conversion; weights are the texel-centre
+//! solid angle `4 / (S^2 (1 + u^2 + v^2)^(3/2))`).
+//!
+//! Groups: `targets` (the speed targets, f32, one channel and RGB) and `scaling`
+//! (N = 3..6 functions, S = 32..256, 1 %..100 % kept: tree vs pixel domain vs pairwise).
+//! One core: run with `RAYON_NUM_THREADS=1`; `python3 benches/product_table.py` runs it and
+//! writes the tables under `results/product/`.
+
+use std::hint::black_box;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use haarshift::product::baseline::{pairwise_integral, pixel_integral, pixel_integral_of_trees};
+use haarshift::product::triple::{
+    DenseFaces, DenseTransport, dense_triple_integral, triple_integral,
+};
+use haarshift::product::{
+    FaceLayout, HaarTree, IntegralOptions, Selection, Transport, WeightedPixels, product_integral,
+};
+use haarshift::sphere::LatLongMap;
+use haarshift::sphere::latlong::angles;
+use ndarray::{Array3, Array4, Axis};
+
+/// Unit direction of texel `(i, j)` of cube face `f` (faces +X, -X, +Y, -Y, +Z, -Z).
+fn texel_direction(f: usize, i: usize, j: usize, s: usize) -> [f64; 3] {
+    let u = 2.0 * (j as f64 + 0.5) / s as f64 - 1.0;
+    let v = 2.0 * (i as f64 + 0.5) / s as f64 - 1.0;
+    let d = match f {
+        0 => [1.0, -v, -u],
+        1 => [-1.0, -v, u],
+        2 => [u, 1.0, v],
+        3 => [u, -1.0, -v],
+        4 => [u, -v, 1.0],
+        _ => [-u, -v, -1.0],
+    };
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    [d[0] / n, d[1] / n, d[2] / n]
+}
+
+fn cube_fn(s: usize, c: usize, f: impl Fn([f64; 3], &mut [f64]) + Sync) -> Array4<f64> {
+    let mut out = Array4::zeros((6, s, s, c));
+    let mut px = vec![0.0; c];
+    for face in 0..6 {
+        for i in 0..s {
+            for j in 0..s {
+                f(texel_direction(face, i, j, s), &mut px);
+                for ch in 0..c {
+                    out[[face, i, j, ch]] = px[ch];
+                }
+            }
+        }
+    }
+    out
+}
+
+fn solid_angles(s: usize) -> Array3<f64> {
+    Array3::from_shape_fn((6, s, s), |(_, i, j)| {
+        let u = 2.0 * (j as f64 + 0.5) / s as f64 - 1.0;
+        let v = 2.0 * (i as f64 + 0.5) / s as f64 - 1.0;
+        4.0 / ((s * s) as f64 * (1.0 + u * u + v * v).powf(1.5))
+    })
+}
+
+struct Mesh {
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[usize; 3]>,
+}
+
+fn bunny() -> Mesh {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/testdata/meshes/bunny.obj"
+    ))
+    .expect("bunny.obj");
+    let mut mesh = Mesh {
+        vertices: Vec::new(),
+        triangles: Vec::new(),
+    };
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let v: Vec<f64> = it.take(3).map(|x| x.parse().expect("number")).collect();
+                mesh.vertices.push([v[0], v[1], v[2]]);
+            }
+            Some("f") => {
+                let f: Vec<usize> = it
+                    .take(3)
+                    .map(|x| {
+                        x.split('/')
+                            .next()
+                            .unwrap()
+                            .parse::<usize>()
+                            .expect("index")
+                            - 1
+                    })
+                    .collect();
+                mesh.triangles.push([f[0], f[1], f[2]]);
+            }
+            _ => {}
+        }
+    }
+    mesh
+}
+
+/// Whether the ray `o + t d` (t > 1e-6) hits a triangle (Moller-Trumbore).
+fn occluded(mesh: &Mesh, o: [f64; 3], d: [f64; 3]) -> bool {
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    mesh.triangles.iter().any(|t| {
+        let (a, b, c) = (
+            mesh.vertices[t[0]],
+            mesh.vertices[t[1]],
+            mesh.vertices[t[2]],
+        );
+        let (e1, e2) = (sub(b, a), sub(c, a));
+        let p = cross(d, e2);
+        let det = dot(e1, p);
+        if det.abs() < 1e-12 {
+            return false;
+        }
+        let tv = sub(o, a);
+        let u = dot(tv, p) / det;
+        if !(0.0..=1.0).contains(&u) {
+            return false;
+        }
+        let q = cross(tv, e1);
+        let v = dot(d, q) / det;
+        if v < 0.0 || u + v > 1.0 {
+            return false;
+        }
+        dot(e2, q) / det > 1e-6
+    })
+}
+
+/// Visibility of bunny vertex `k` (1 where the ray escapes), nudged off the surface.
+fn visibility(mesh: &Mesh, k: usize, s: usize) -> Array4<f64> {
+    let centre = mesh.vertices.iter().fold([0.0; 3], |acc, v| {
+        [acc[0] + v[0], acc[1] + v[1], acc[2] + v[2]]
+    });
+    let n = mesh.vertices.len() as f64;
+    let p = mesh.vertices[k];
+    let out = [
+        p[0] - centre[0] / n,
+        p[1] - centre[1] / n,
+        p[2] - centre[2] / n,
+    ];
+    let len = (out[0] * out[0] + out[1] * out[1] + out[2] * out[2]).sqrt();
+    let o = [
+        p[0] + 1e-3 * out[0] / len,
+        p[1] + 1e-3 * out[1] / len,
+        p[2] + 1e-3 * out[2] / len,
+    ];
+    cube_fn(s, 1, |d, px| {
+        px[0] = if occluded(mesh, o, d) { 0.0 } else { 1.0 }
+    })
+}
+
+/// A Phong lobe of exponent 50 about a fixed reflection direction.
+fn phong(s: usize) -> Array4<f64> {
+    let r = [0.48, 0.6, 0.64];
+    cube_fn(s, 1, |d, px| {
+        px[0] = (d[0] * r[0] + d[1] * r[1] + d[2] * r[2]).max(0.0).powi(50)
+    })
+}
+
+fn envmap(s: usize, c: usize) -> Array4<f64> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/testdata/envmaps/rooitou_park_256x128.npy"
+    );
+    let data: Array3<f32> = ndarray_npy::read_npy(path).expect("test map");
+    let map = LatLongMap::new(data.mapv(f64::from)).expect("2:1 map");
+    cube_fn(s, c, |d, px| {
+        let (theta, phi) = angles(d);
+        let mut rgb = [0.0; 3];
+        map.bilinear(theta, phi, &mut rgb);
+        if c == 1 {
+            px[0] = (rgb[0] + rgb[1] + rgb[2]) / 3.0;
+        } else {
+            px.copy_from_slice(&rgb);
+        }
+    })
+}
+
+fn to32(a: &Array4<f64>) -> Array4<f32> {
+    a.mapv(|v| v as f32)
+}
+
+fn rgb(a: &Array4<f64>) -> Array4<f32> {
+    let a = to32(a);
+    ndarray::concatenate(Axis(3), &[a.view(), a.view(), a.view()]).expect("same shape")
+}
+
+const LAYOUT: FaceLayout = FaceLayout::Stacked;
+const ALL: IntegralOptions = IntegralOptions { finest_level: None };
+
+/// Transport (visibility x solid angle) and factors (envmap, Phong, more visibilities).
+struct Scene<const C: usize> {
+    weighted: WeightedPixels<f32, C>,
+    factors: Vec<Array4<f32>>,
+}
+
+fn scene<const C: usize>(mesh: &Mesh, s: usize, extra: usize) -> Scene<C> {
+    let widen = |a: &Array4<f64>| if C == 1 { to32(a) } else { rgb(a) };
+    let vis = widen(&visibility(mesh, 100, s));
+    let weights = solid_angles(s).mapv(|v| v as f32);
+    let env = if C == 1 {
+        to32(&envmap(s, 1))
+    } else {
+        to32(&envmap(s, 3))
+    };
+    let mut factors = vec![env, widen(&phong(s))];
+    for k in 0..extra {
+        factors.push(widen(&visibility(mesh, 400 + 300 * k, s)));
+    }
+    Scene {
+        weighted: WeightedPixels::new(vis.view(), weights.view()).expect("shapes"),
+        factors,
+    }
+}
+
+fn trees<const C: usize>(
+    sc: &Scene<C>,
+    keep: [Selection; 3],
+    rest: Selection,
+) -> (Transport<f32, C>, Vec<HaarTree<f32, C>>) {
+    let t = Transport::new(&sc.weighted, LAYOUT, keep[0]).expect("transport");
+    let f = sc
+        .factors
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            HaarTree::from_pixels(m.view(), LAYOUT, if k < 2 { keep[k + 1] } else { rest })
+                .expect("tree")
+        })
+        .collect();
+    (t, f)
+}
+
+fn targets_for<const C: usize>(c: &mut Criterion, mesh: &Mesh, label: &str) {
+    let sc = scene::<C>(mesh, 64, 0);
+    let mut group = c.benchmark_group(format!("targets_{label}"));
+    group.sample_size(30);
+    for (name, keep) in [
+        (
+            "200-70-70_total",
+            [
+                Selection::Largest(200),
+                Selection::Largest(70),
+                Selection::Largest(70),
+            ],
+        ),
+        (
+            "200-70-70_per_face",
+            [
+                Selection::LargestPerFace(200),
+                Selection::LargestPerFace(70),
+                Selection::LargestPerFace(70),
+            ],
+        ),
+        ("full", [Selection::All; 3]),
+    ] {
+        let (t, f) = trees(&sc, keep, Selection::All);
+        group.bench_function(BenchmarkId::new("triple", name), |b| {
+            b.iter(|| triple_integral(black_box(&t), &f[0], &f[1]).expect("ok"))
+        });
+        group.bench_function(BenchmarkId::new("general", name), |b| {
+            b.iter(|| product_integral(black_box(&t), &[&f[0], &f[1]], ALL).expect("ok"))
+        });
+        if name == "full" {
+            let (dt, d0, d1) = (
+                DenseTransport::from_transport(&t),
+                DenseFaces::from_tree(&f[0]),
+                DenseFaces::from_tree(&f[1]),
+            );
+            group.bench_function(BenchmarkId::new("dense", name), |b| {
+                b.iter(|| dense_triple_integral(black_box(&dt), &d0, &d1).expect("ok"))
+            });
+            let views: Vec<_> = sc.factors.iter().map(|m| m.view()).collect();
+            group.bench_function(BenchmarkId::new("pixel_stored", name), |b| {
+                b.iter(|| pixel_integral(black_box(&sc.weighted), &views).expect("ok"))
+            });
+        }
+    }
+    group.finish();
+}
+
+fn targets(c: &mut Criterion) {
+    let mesh = bunny();
+    targets_for::<1>(c, &mesh, "mono");
+    targets_for::<3>(c, &mesh, "rgb");
+}
+
+fn scaling(c: &mut Criterion) {
+    let mesh = bunny();
+    let sizes: Vec<usize> = std::env::var("PRODUCT_BENCH_SIZES")
+        .map(|v| v.split(',').map(|x| x.parse().expect("size")).collect())
+        .unwrap_or_else(|_| vec![32, 64, 128, 256]);
+    for s in sizes {
+        let sc = scene::<1>(&mesh, s, 3);
+        let details = 6 * (s * s - 1);
+        let mut group = c.benchmark_group(format!("scaling_6x{s}"));
+        group.sample_size(10);
+        for percent in [1usize, 5, 10, 100] {
+            let sel = if percent == 100 {
+                Selection::All
+            } else {
+                Selection::Largest(details * percent / 100)
+            };
+            let (t, f) = trees(&sc, [sel; 3], sel);
+            for n in 3..=6 {
+                let refs: Vec<&HaarTree<f32, 1>> = f[..n - 1].iter().collect();
+                let id = format!("N{n}_keep{percent}");
+                group.bench_function(BenchmarkId::new("tree", &id), |b| {
+                    b.iter(|| product_integral(black_box(&t), &refs, ALL).expect("ok"))
+                });
+                group.bench_function(BenchmarkId::new("pixel_inverse", &id), |b| {
+                    b.iter(|| pixel_integral_of_trees(black_box(&t), &refs).expect("ok"))
+                });
+                group.bench_function(BenchmarkId::new("pairwise", &id), |b| {
+                    b.iter(|| pairwise_integral(black_box(&t), &refs).expect("ok"))
+                });
+                if percent == 100 {
+                    let views: Vec<_> = sc.factors[..n - 1].iter().map(|m| m.view()).collect();
+                    group.bench_function(BenchmarkId::new("pixel_stored", &id), |b| {
+                        b.iter(|| pixel_integral(black_box(&sc.weighted), &views).expect("ok"))
+                    });
+                }
+            }
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, targets, scaling);
+criterion_main!(benches);
