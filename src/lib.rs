@@ -10,6 +10,9 @@
 //! * [`sphere`]: rotation of lat-long environment maps in pixels and directly in the 2D Haar
 //!   domain (the chain rule on detail coefficients), with a ground-truth reference and
 //!   bilinear/bicubic resampling to compare against.
+//! * [`product`]: integrals and products of several functions on sparse Haar quadtrees over
+//!   sets of square faces (the n-function product integral, the product, nonlinear
+//!   approximation, the weighting contract).
 //! * [`experiments`], [`metrics`], [`patterns`]: error-accumulation experiments, the error
 //!   measures they report, and the synthetic test patterns they use.
 //! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`]
@@ -32,6 +35,7 @@ pub mod metrics;
 mod named;
 pub mod patterns;
 mod planar_image;
+pub mod product;
 pub mod rotate;
 mod sample;
 pub mod shift;
