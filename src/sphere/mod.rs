@@ -37,13 +37,15 @@
 //! [`param`] (one [`Parameterization`] over lat-long, two `H x H` faces, and the cube map,
 //! six; texel directions, exact texel solid angles, [`SphereMap`]), [`cube`] (the cube map's
 //! faces, orientation and exact spherical-quadrilateral solid angles), [`convert`] (between
-//! parameterisations by solid-angle integration over each target texel).
+//! parameterisations by solid-angle integration over each target texel), [`integrate`] (the
+//! integral over the sphere of a product of maps, on their Haar trees).
 
 pub mod chain_rule;
 pub mod coefficients;
 pub mod convert;
 pub mod cube;
 pub mod experiment;
+pub mod integrate;
 pub mod latlong;
 pub mod param;
 pub mod reference;
