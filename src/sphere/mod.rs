@@ -32,11 +32,22 @@
 //! Conventions: [`latlong`] (map geometry, seam and poles), [`rotation`] (yaw, pitch, roll),
 //! [`coefficients`] (how a 2:1 map maps onto two square Haar pyramids side by side).
 //! Measurements: [`experiment`].
+//!
+//! **Square faces.** Product integrals work on functions stored as sets of square faces:
+//! [`param`] (one [`Parameterization`] over lat-long, two `H x H` faces, and the cube map,
+//! six; texel directions, exact texel solid angles, [`SphereMap`]), [`cube`] (the cube map's
+//! faces, orientation and exact spherical-quadrilateral solid angles), [`convert`] (between
+//! parameterisations by solid-angle integration over each target texel), [`integrate`] (the
+//! integral over the sphere of a product of maps, on their Haar trees).
 
 pub mod chain_rule;
 pub mod coefficients;
+pub mod convert;
+pub mod cube;
 pub mod experiment;
+pub mod integrate;
 pub mod latlong;
+pub mod param;
 pub mod reference;
 pub mod resample;
 pub mod rotation;
@@ -44,6 +55,7 @@ pub mod yaw;
 
 pub use coefficients::SphereCoefficients;
 pub use latlong::LatLongMap;
+pub use param::{ParamKind, Parameterization, SphereMap};
 pub use rotation::SphereRotation;
 
 use crate::named::named_enum;

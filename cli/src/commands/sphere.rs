@@ -4,8 +4,10 @@ use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
 use haarshift::io::{CoefficientFile, WriteOptions, read_image};
-use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
-use haarshift::{PlanarImage, Result, Sample, SampleDepth};
+use haarshift::product::Selection;
+use haarshift::sphere::integrate::{IntegralMethod, IntegrateOptions};
+use haarshift::sphere::{LatLongMap, Method, ParamKind, SphereOptions, SphereRotation, rotate_map};
+use haarshift::{Error, PlanarImage, Result, Sample, SampleDepth};
 
 use super::{choice, names, print, refuse_existing, refuse_overwriting_input};
 
@@ -13,11 +15,13 @@ use super::{choice, names, print, refuse_existing, refuse_overwriting_input};
 #[derive(Subcommand, Debug)]
 pub enum SphereCommand {
     Rotate(RotateArgs),
+    Integrate(IntegrateArgs),
 }
 
 pub fn run(command: SphereCommand) -> Result<()> {
     match command {
         SphereCommand::Rotate(args) => rotate(args),
+        SphereCommand::Integrate(args) => integrate(args),
     }
 }
 
@@ -173,4 +177,156 @@ fn rotate_image<T: Sample>(
         let out = rotated.map.to_image(image.depth())?;
         haarshift::io::write_image(&out, &args.output, write)
     }
+}
+
+const INTEGRATE_HELP: &str = "\
+The integral over the sphere of the product of the maps, computed on their Haar trees:
+  sum over texels of f_1(p) x f_2(p) x ... x solid_angle(p),
+the solid angle folded into the first map. Maps are lat-long (H x 2H, H a power of two; HDR,
+OpenEXR or .npy), all of one size; a 1-channel map multiplies every channel of the others.
+With --param latlong, no --keep and no --depth the result is exactly that pixel sum (to
+rounding); with --keep K each map keeps its K largest detail coefficients (orthonormal
+magnitudes, RGB by the root of the sum of squares, ties by index in the H x 2H Mallat array)
+plus its face scaling coefficients, and the result is the same sum over the pruned maps.
+
+Examples:
+  haarshift sphere integrate light.hdr visibility.npy brdf.exr
+  haarshift sphere integrate light.hdr visibility.npy --keep 200,70
+  haarshift sphere integrate light.hdr visibility.npy brdf.exr --param cube --resolution 64 --keep 1200 --per-face
+  haarshift sphere integrate a.npy b.npy --depth 4 --json result.json
+  haarshift sphere integrate a.npy b.npy c.npy --method triple --threshold 0.01";
+
+/// Integrate the product of lat-long maps over the sphere, on their Haar coefficients.
+#[derive(clap::Args, Debug)]
+#[command(after_help = INTEGRATE_HELP)]
+pub struct IntegrateArgs {
+    /// Two or more lat-long maps; the first carries the solid angle
+    #[arg(required = true, num_args = 2..)]
+    pub maps: Vec<PathBuf>,
+
+    /// Detail coefficients kept per map: one count for every map, or one per map (K1,K2,...)
+    #[arg(
+        long,
+        value_name = "K",
+        value_delimiter = ',',
+        conflicts_with = "threshold"
+    )]
+    pub keep: Vec<usize>,
+
+    /// Keep every detail coefficient of magnitude above T (orthonormal normalisation)
+    #[arg(long, value_name = "T")]
+    pub threshold: Option<f64>,
+
+    /// With --keep: K largest of each face rather than over the whole map
+    #[arg(long, requires = "keep")]
+    pub per_face: bool,
+
+    /// Visit detail levels 0..=D only (0 the coarsest; faces of side S have levels
+    /// 0..=log2(S)-1), as the sphere commands' --level [default: all]
+    #[arg(long, value_name = "D")]
+    pub depth: Option<usize>,
+
+    /// `latlong`: two H x H faces, the halves of the map. `cube`: six faces, each map
+    /// converted by solid-angle integration over each cube texel
+    #[arg(long, default_value = "latlong", value_parser = choice::<ParamKind>(names!(ParamKind)))]
+    pub param: ParamKind,
+
+    /// Working face side: lat-long N x 2N or cube 6 x N x N, a power of two [default: the
+    /// maps' height H for latlong, H / 2 for cube]
+    #[arg(long, value_name = "N")]
+    pub resolution: Option<usize>,
+
+    /// `tree`: the N-function tree traversal. `triple`: the three-function fast path (3 maps).
+    /// `pixel`: inverse transforms, then the pixel sum. `pairwise`: products of two
+    /// functions at a time ("recursive Haar")
+    #[arg(long, default_value = "tree", value_parser = choice::<IntegralMethod>(names!(IntegralMethod)))]
+    pub method: IntegralMethod,
+
+    /// Also write the results as JSON records (channel, integral, kept, visited, seconds,
+    /// method)
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+
+    /// Replace the JSON file if it exists
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// One line of `--json`.
+#[derive(serde::Serialize)]
+struct IntegralRecord {
+    channel: usize,
+    integral: f64,
+    kept: Vec<usize>,
+    visited: usize,
+    seconds: f64,
+    method: IntegralMethod,
+    param: ParamKind,
+}
+
+fn integrate(args: IntegrateArgs) -> Result<()> {
+    if let Some(json) = &args.json {
+        for m in &args.maps {
+            refuse_overwriting_input(m, &[json])?;
+        }
+        if json.exists() && !args.force {
+            return Err(Error::OutputExists { path: json.clone() });
+        }
+    }
+    let selections: Vec<Selection> = match (args.threshold, args.per_face) {
+        (Some(t), _) => vec![Selection::Threshold(t)],
+        (None, true) => args
+            .keep
+            .iter()
+            .map(|&k| Selection::LargestPerFace(k))
+            .collect(),
+        (None, false) => args.keep.iter().map(|&k| Selection::Largest(k)).collect(),
+    };
+    let maps = args
+        .maps
+        .iter()
+        .map(|path| {
+            let image = read_image::<f64>(path)?;
+            LatLongMap::from_image(&image).map_err(|e| e.in_file(path))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let options = IntegrateOptions {
+        param: args.param,
+        resolution: args.resolution,
+        selections,
+        depth: args.depth,
+        method: args.method,
+    };
+    let result = haarshift::sphere::integrate::integrate(&maps, &options)?;
+    let kept: Vec<String> = result.kept.iter().map(|k| k.to_string()).collect();
+    let mut text = String::new();
+    for (channel, value) in result.value.iter().enumerate() {
+        text += &format!("channel {channel}: integral {value:.17e}\n");
+    }
+    text += &format!(
+        "kept {} detail coefficients per map, visited {}, {:.6} s ({} method, {} param)\n",
+        kept.join(","),
+        result.visited,
+        result.seconds,
+        args.method,
+        args.param
+    );
+    if let Some(json) = &args.json {
+        let records: Vec<IntegralRecord> = result
+            .value
+            .iter()
+            .enumerate()
+            .map(|(channel, &integral)| IntegralRecord {
+                channel,
+                integral,
+                kept: result.kept.clone(),
+                visited: result.visited,
+                seconds: result.seconds,
+                method: args.method,
+                param: args.param,
+            })
+            .collect();
+        haarshift::experiments::output::write_json(json, &records, args.force)?;
+    }
+    print(&text)
 }

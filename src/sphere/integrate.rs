@@ -1,0 +1,380 @@
+//! The integral over the sphere of a product of lat-long maps, computed on their Haar trees:
+//! the glue between maps ([`LatLongMap`]), parameterisations ([`Parameterization`]) and the
+//! product algebra ([`crate::product`]).
+//!
+//! [`integrate`] brings every map into the chosen parameterisation and resolution (a lat-long
+//! map at its own height is only reshaped into its two faces; anything else goes through
+//! [`convert`](super::convert)), broadcasts one-channel maps over the channels of the others,
+//! folds each texel's solid angle into the **first** map (the [`Transport`], so the weight is
+//! applied exactly once), builds each map's tree with its [`Selection`], and integrates by the
+//! chosen [`IntegralMethod`]. With lat-long at the maps' own height, every coefficient kept
+//! and no depth limit, the result is `sum over pixels of prod_k f_k(p) x solid_angle(p)`.
+
+use std::time::Instant;
+
+use ndarray::{Array3, Array4};
+
+use super::LatLongMap;
+use super::convert::{Conversion, default_samples};
+use super::param::{ParamKind, Parameterization, SphereMap};
+use crate::named::named_enum;
+use crate::product::baseline::{pairwise_integral, pixel_integral_of_trees};
+use crate::product::triple::triple_integral;
+use crate::product::{
+    FaceLayout, HaarTree, IntegralOptions, Selection, Transport, WeightedPixels, product_integral,
+};
+use crate::{Error, Result};
+
+named_enum! {
+    /// How [`integrate`] computes the product integral.
+    #[derive(Default)]
+    pub enum IntegralMethod ("method") {
+        #[default]
+        /// The N-function tree traversal ([`product_integral`]).
+        Tree = "tree",
+        /// The three-function fast path on trees ([`triple_integral`]); exactly three maps.
+        Triple = "triple",
+        /// Inverse transforms of the (pruned) trees, then the weighted pixel sum.
+        Pixel = "pixel",
+        /// Products of two functions at a time, then an integral ("recursive Haar").
+        Pairwise = "pairwise",
+    }
+}
+
+/// What [`integrate`] does.
+///
+/// ```
+/// use haarshift::sphere::integrate::IntegrateOptions;
+/// let o = IntegrateOptions::default();
+/// assert!(o.resolution.is_none() && o.depth.is_none() && o.selections.is_empty());
+/// ```
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IntegrateOptions {
+    /// The parameterisation to integrate in.
+    pub param: ParamKind,
+    /// The face side: lat-long `N x 2N`, cube `6 x N x N` (`None`: the maps' height `H` for
+    /// lat-long, `H / 2` for the cube).
+    pub resolution: Option<usize>,
+    /// One selection for every map, or one per map (empty: keep everything).
+    pub selections: Vec<Selection>,
+    /// The finest detail level visited ([`IntegralOptions::finest_level`]); tree method only.
+    pub depth: Option<usize>,
+    /// The method.
+    pub method: IntegralMethod,
+}
+
+/// The result of [`integrate`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SphereIntegral {
+    /// The integral per channel.
+    pub value: Vec<f64>,
+    /// Detail coefficients kept per map (scaling coefficients not counted).
+    pub kept: Vec<usize>,
+    /// Tree nodes (pixels for [`IntegralMethod::Pixel`]) where the method did work.
+    pub visited: usize,
+    /// Seconds spent in the integral itself (trees already built).
+    pub seconds: f64,
+}
+
+/// The integral over the sphere of the product of `maps` (lat-long `H x 2H`, `H` a power of
+/// two, each of 1 or `C` channels), see the [module docs](self).
+///
+/// ```
+/// use haarshift::sphere::LatLongMap;
+/// use haarshift::sphere::integrate::{IntegrateOptions, integrate};
+/// use haarshift::sphere::latlong::pixel_solid_angle;
+/// let f = LatLongMap::<f64>::from_fn(8, 1, |d, out| out[0] = 1.0 + d[1]).unwrap();
+/// let g = LatLongMap::<f64>::from_fn(8, 3, |d, out| out.fill(2.0 + d[0])).unwrap();
+/// let got = integrate(&[f.clone(), g.clone()], &IntegrateOptions::default()).unwrap();
+/// let (fa, ga) = (f.as_array(), g.as_array());
+/// let mut want = 0.0;
+/// for i in 0..8 {
+///     for j in 0..16 {
+///         want += fa[[i, j, 0]] * ga[[i, j, 1]] * pixel_solid_angle(8, i);
+///     }
+/// }
+/// assert_eq!(got.value.len(), 3);
+/// assert!((got.value[1] - want).abs() < 1e-12 * want);
+/// ```
+pub fn integrate(maps: &[LatLongMap<f64>], options: &IntegrateOptions) -> Result<SphereIntegral> {
+    let channels = check_maps(maps)?;
+    let selections = per_map_selections(maps.len(), &options.selections)?;
+    if options.method == IntegralMethod::Triple && maps.len() != 3 {
+        return Err(Error::parameter(
+            "method",
+            format!("triple integrates exactly 3 maps, not {}", maps.len()),
+        ));
+    }
+    if options.depth.is_some() && options.method != IntegralMethod::Tree {
+        return Err(Error::parameter(
+            "depth",
+            format!(
+                "a depth limit applies to the tree method, not {}",
+                options.method
+            ),
+        ));
+    }
+    let h = maps[0].height();
+    let size = match (options.resolution, options.param) {
+        (Some(n), _) => n,
+        (None, ParamKind::LatLong) => h,
+        (None, ParamKind::Cube) => (h / 2).max(1),
+    };
+    let param = Parameterization::new(options.param, size)?;
+    let faces = face_arrays(maps, param, channels)?;
+    match channels {
+        1 => integrate_faces::<1>(&faces, param, &selections, options),
+        2 => integrate_faces::<2>(&faces, param, &selections, options),
+        3 => integrate_faces::<3>(&faces, param, &selections, options),
+        _ => integrate_faces::<4>(&faces, param, &selections, options),
+    }
+}
+
+/// Checks the maps: at least two, one height (a power of two), 1 or `C` channels with `C` at
+/// most 4; returns `C`.
+fn check_maps(maps: &[LatLongMap<f64>]) -> Result<usize> {
+    let Some(first) = maps.first() else {
+        return Err(Error::parameter("maps", "no map to integrate"));
+    };
+    let h = first.height();
+    if !h.is_power_of_two() {
+        return Err(Error::shape(
+            &[h, 2 * h],
+            format!("the map's height {h} is not a power of two"),
+        ));
+    }
+    for m in &maps[1..] {
+        if m.height() != h {
+            return Err(Error::shape(
+                &[m.height(), m.width()],
+                format!(
+                    "maps of different sizes: {} x {} and {} x {} (width x height)",
+                    first.width(),
+                    h,
+                    m.width(),
+                    m.height()
+                ),
+            ));
+        }
+    }
+    let channels = maps.iter().map(|m| m.channels()).max().unwrap_or(1);
+    if channels > 4
+        || maps
+            .iter()
+            .any(|m| m.channels() != 1 && m.channels() != channels)
+    {
+        let counts: Vec<usize> = maps.iter().map(|m| m.channels()).collect();
+        return Err(Error::parameter(
+            "channels",
+            format!("maps have {counts:?} channels: each must have 1 or the same 2 to 4"),
+        ));
+    }
+    Ok(channels)
+}
+
+/// One selection per map: `given` repeated when it has one, all kept when it is empty.
+fn per_map_selections(maps: usize, given: &[Selection]) -> Result<Vec<Selection>> {
+    match given.len() {
+        0 => Ok(vec![Selection::All; maps]),
+        1 => Ok(vec![given[0]; maps]),
+        n if n == maps => Ok(given.to_vec()),
+        n => Err(Error::parameter(
+            "keep",
+            format!("{n} counts given for {maps} maps (give one, or one per map)"),
+        )),
+    }
+}
+
+/// Each map in `param`, broadcast to `channels` channels, as a `(faces, S, S, C)` array.
+fn face_arrays(
+    maps: &[LatLongMap<f64>],
+    param: Parameterization,
+    channels: usize,
+) -> Result<Vec<Array4<f64>>> {
+    let h = maps[0].height();
+    let own = SphereMap::from_lat_long(&maps[0])?.param();
+    let conversion = if own == param {
+        None
+    } else {
+        Some(Conversion::new(own, param, default_samples(own, param))?)
+    };
+    maps.iter()
+        .map(|m| {
+            debug_assert_eq!(m.height(), h);
+            let map = SphereMap::from_lat_long(m)?;
+            let map = match &conversion {
+                Some(c) => c.apply(&map)?,
+                None => map,
+            };
+            let data = map.into_array();
+            if data.dim().3 == channels {
+                return Ok(data);
+            }
+            let (f, s, _, _) = data.dim();
+            Ok(data
+                .broadcast((f, s, s, channels))
+                .expect("one channel broadcasts")
+                .to_owned())
+        })
+        .collect()
+}
+
+/// The layout whose Mallat index breaks selection ties: lat-long faces side by side.
+fn layout(param: Parameterization) -> FaceLayout {
+    match param.kind() {
+        ParamKind::LatLong => FaceLayout::SideBySide,
+        ParamKind::Cube => FaceLayout::Stacked,
+    }
+}
+
+/// Trees and the integral, for `C` channels.
+fn integrate_faces<const C: usize>(
+    faces: &[Array4<f64>],
+    param: Parameterization,
+    selections: &[Selection],
+    options: &IntegrateOptions,
+) -> Result<SphereIntegral> {
+    let layout = layout(param);
+    let weights: Array3<f64> = param.solid_angles();
+    let weighted = WeightedPixels::<f64, C>::new(faces[0].view(), weights.view())?;
+    let transport = Transport::new(&weighted, layout, selections[0])?;
+    let trees = faces[1..]
+        .iter()
+        .zip(&selections[1..])
+        .map(|(f, &s)| HaarTree::<f64, C>::from_pixels(f.view(), layout, s))
+        .collect::<Result<Vec<_>>>()?;
+    let refs: Vec<&HaarTree<f64, C>> = trees.iter().collect();
+    let start = Instant::now();
+    let integral = match options.method {
+        IntegralMethod::Tree => product_integral(
+            &transport,
+            &refs,
+            IntegralOptions {
+                finest_level: options.depth,
+            },
+        )?,
+        IntegralMethod::Triple => triple_integral(&transport, refs[0], refs[1])?,
+        IntegralMethod::Pixel => pixel_integral_of_trees(&transport, &refs)?,
+        IntegralMethod::Pairwise => pairwise_integral(&transport, &refs)?,
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let mut kept = vec![transport.tree().kept()];
+    kept.extend(trees.iter().map(|t| t.kept()));
+    Ok(SphereIntegral {
+        value: integral.value.to_vec(),
+        kept,
+        visited: integral.visited,
+        seconds,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sphere::latlong::pixel_solid_angle;
+    use ndarray::Array3;
+
+    fn map(h: usize, channels: usize, seed: u64) -> LatLongMap<f64> {
+        // A deterministic pseudo-random positive map.
+        let mut x = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let data = Array3::from_shape_fn((h, 2 * h, channels), |_| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            0.1 + (x >> 11) as f64 / (1u64 << 53) as f64
+        });
+        LatLongMap::new(data).unwrap()
+    }
+
+    /// `sum over pixels of prod_k f_k(p) x solid_angle(p)` per channel, broadcasting one
+    /// channel: the contract, computed directly.
+    fn pixel_sum(maps: &[LatLongMap<f64>]) -> Vec<f64> {
+        let h = maps[0].height();
+        let c = maps.iter().map(|m| m.channels()).max().unwrap();
+        (0..c)
+            .map(|k| {
+                let mut sum = 0.0;
+                for i in 0..h {
+                    for j in 0..2 * h {
+                        let p: f64 = maps
+                            .iter()
+                            .map(|m| m.as_array()[[i, j, k.min(m.channels() - 1)]])
+                            .product();
+                        sum += p * pixel_solid_angle(h, i);
+                    }
+                }
+                sum
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_method_equals_the_pixel_sum_with_everything_kept() {
+        let maps = [map(16, 3, 1), map(16, 1, 2), map(16, 3, 3)];
+        let want = pixel_sum(&maps);
+        for &method in IntegralMethod::ALL {
+            let o = IntegrateOptions {
+                method,
+                ..Default::default()
+            };
+            let got = integrate(&maps, &o).unwrap();
+            for (g, w) in got.value.iter().zip(&want) {
+                assert!((g - w).abs() < 1e-12 * w, "{method}: {g} vs {w}");
+            }
+            assert_eq!(got.kept, vec![16 * 32 - 2; 3]);
+        }
+    }
+
+    #[test]
+    fn keeping_fewer_coefficients_changes_the_result() {
+        let maps = [map(16, 1, 4), map(16, 1, 5)];
+        let full = integrate(&maps, &IntegrateOptions::default()).unwrap();
+        let o = IntegrateOptions {
+            selections: vec![Selection::Largest(20)],
+            ..Default::default()
+        };
+        let pruned = integrate(&maps, &o).unwrap();
+        assert_eq!(pruned.kept, vec![20, 20]);
+        assert!((pruned.value[0] - full.value[0]).abs() > 1e-6 * full.value[0]);
+    }
+
+    #[test]
+    fn the_cube_integral_of_one_times_one_is_four_pi() {
+        let one = LatLongMap::<f64>::from_fn(16, 1, |_, o| o[0] = 1.0).unwrap();
+        for (param, resolution) in [(ParamKind::Cube, None), (ParamKind::Cube, Some(16))] {
+            let o = IntegrateOptions {
+                param,
+                resolution,
+                ..Default::default()
+            };
+            let got = integrate(&[one.clone(), one.clone()], &o).unwrap();
+            assert!((got.value[0] - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn bad_requests_are_errors() {
+        let (a, b) = (map(16, 1, 6), map(8, 1, 7));
+        let d = IntegrateOptions::default();
+        assert!(integrate(&[a.clone(), b], &d).is_err());
+        let three = IntegrateOptions {
+            method: IntegralMethod::Triple,
+            ..Default::default()
+        };
+        assert!(integrate(&[a.clone(), a.clone()], &three).is_err());
+        let deep = IntegrateOptions {
+            depth: Some(4),
+            ..Default::default()
+        };
+        assert!(integrate(&[a.clone(), a.clone()], &deep).is_err());
+        let many = IntegrateOptions {
+            selections: vec![Selection::Largest(16 * 32)],
+            ..Default::default()
+        };
+        assert!(integrate(&[a.clone(), a.clone()], &many).is_err());
+        let odd = LatLongMap::<f64>::from_fn(6, 1, |_, o| o[0] = 1.0).unwrap();
+        assert!(integrate(&[odd.clone(), odd], &d).is_err());
+    }
+}
