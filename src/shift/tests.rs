@@ -27,11 +27,29 @@ fn image(h: usize, w: usize, seed: u64) -> Array2<f64> {
     })
 }
 
-fn max_diff<'a>(a: impl IntoIterator<Item = &'a f64>, b: impl IntoIterator<Item = &'a f64>) -> f64 {
-    a.into_iter()
-        .zip(b)
+/// The largest absolute difference of two arrays; infinite when their shapes differ.
+fn max_diff<'a, D: ndarray::Dimension>(
+    a: impl ndarray::AsArray<'a, f64, D>,
+    b: impl ndarray::AsArray<'a, f64, D>,
+) -> f64 {
+    let (a, b) = (a.into(), b.into());
+    // Arrays of different shapes (an empty result among them) are infinitely far apart.
+    if a.shape() != b.shape() {
+        return f64::INFINITY;
+    }
+    a.iter()
+        .zip(b.iter())
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max)
+}
+
+#[test]
+fn max_diff_compares_shapes_before_values() {
+    let full = Array2::from_elem((2, 3), 1.0);
+    let empty = Array2::<f64>::zeros((0, 3));
+    assert_eq!(max_diff(&full, &empty), f64::INFINITY);
+    assert_eq!(max_diff(&full, full.view()), 0.0);
+    assert_eq!(max_diff(&full, &(&full + 0.25)), 0.25);
 }
 
 /// Checks dense (at every split between strip and coarse levels) and random access against
