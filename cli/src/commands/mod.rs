@@ -119,9 +119,7 @@ impl ImageOutput {
     /// Refuses, before any work, an output that is the file `input` (or any of `inputs`),
     /// and an existing output without `--force`.
     pub fn refuse_overwriting(&self, inputs: &[&Path]) -> Result<()> {
-        inputs
-            .iter()
-            .try_for_each(|input| refuse_overwriting_input(input, &[&self.output]))?;
+        refuse_output_among_inputs(inputs, &self.output)?;
         refuse_existing(&[&self.output], self.force)
     }
 
@@ -196,6 +194,13 @@ pub fn refuse_existing(outputs: &[&Path], force: bool) -> Result<()> {
         }),
         None => Ok(()),
     }
+}
+
+/// Refuses `output` when it is one of `inputs`.
+pub fn refuse_output_among_inputs(inputs: &[&Path], output: &Path) -> Result<()> {
+    inputs
+        .iter()
+        .try_for_each(|input| refuse_overwriting_input(input, &[output]))
 }
 
 /// Refuses `output` (and each of `others`, e.g. a sidecar) when it is the file `input`.

@@ -13,16 +13,10 @@ fn full_trees_equal_the_pixel_sum_for_n_2_to_6() {
                 .map(|k| random_faces(100 * n as u64 + k as u64, faces, s, 1, -1.0, 2.0))
                 .collect();
             let weights = random_weights(7, faces, s);
-            let (t, f) = trees_of::<1>(&weights, &maps, layout, Selection::All);
-            let refs: Vec<_> = f.iter().collect();
-            let got = product_integral(&t, &refs, ALL).unwrap();
-            let views: Vec<_> = maps.iter().map(|m| m.view()).collect();
-            let (want, scale) = pixel_oracle(&weights, &views);
-            assert_close(
-                &got.value,
-                &want,
-                &scale,
-                1e-12,
+            assert_full_integral_is_the_pixel_sum::<1>(
+                &weights,
+                &maps,
+                layout,
                 &format!("N = {n}, {faces} x {s}^2"),
             );
         }

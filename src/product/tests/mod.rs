@@ -70,6 +70,22 @@ pub(super) fn trees_of<const C: usize>(
     (t, factors)
 }
 
+/// Asserts that with full trees `product_integral` of `maps` (the first weighted by
+/// `weights`) equals the weighted pixel sum to 1e-12 relative to the sum of |products|.
+pub(super) fn assert_full_integral_is_the_pixel_sum<const C: usize>(
+    weights: &Array3<f64>,
+    maps: &[Array4<f64>],
+    layout: FaceLayout,
+    what: &str,
+) {
+    let (t, f) = trees_of::<C>(weights, maps, layout, Selection::All);
+    let refs: Vec<_> = f.iter().collect();
+    let got = product_integral(&t, &refs, IntegralOptions::default()).unwrap();
+    let views: Vec<_> = maps.iter().map(|m| m.view()).collect();
+    let (want, scale) = pixel_oracle(weights, &views);
+    assert_close(&got.value, &want, &scale, 1e-12, what);
+}
+
 /// Asserts `got` equals `want` to `tol` relative to `scale`, channel by channel.
 pub(super) fn assert_close(got: &[f64], want: &[f64], scale: &[f64], tol: f64, what: &str) {
     for ch in 0..want.len() {

@@ -238,16 +238,10 @@ fn real_envmap_products_equal_the_pixel_sum() {
         .map(|&k| turned(k))
         .collect();
     for n in 2..=6 {
-        let (t, f) = trees_of::<3>(&weights, &maps[..n], FaceLayout::SideBySide, Selection::All);
-        let refs: Vec<_> = f.iter().collect();
-        let got = product_integral(&t, &refs, IntegralOptions::default()).unwrap();
-        let views: Vec<_> = maps[..n].iter().map(|m| m.view()).collect();
-        let (want, scale) = pixel_oracle(&weights, &views);
-        assert_close(
-            &got.value,
-            &want,
-            &scale,
-            1e-12,
+        assert_full_integral_is_the_pixel_sum::<3>(
+            &weights,
+            &maps[..n],
+            FaceLayout::SideBySide,
             &format!("envmap, N = {n}"),
         );
     }

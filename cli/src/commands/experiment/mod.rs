@@ -16,7 +16,7 @@ use haarshift::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use crate::commands::refuse_overwriting_input;
+use crate::commands::refuse_output_among_inputs;
 
 pub mod rotation_cycle;
 pub mod shift_chain;
@@ -94,7 +94,7 @@ impl OutputFlags {
         let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
         dir.claim(experiment, &inputs)?;
         if let Some(json) = &self.json {
-            refuse_overwriting_input_all(&inputs, json)?;
+            refuse_output_among_inputs(&inputs, json)?;
             if !self.force && json.exists() {
                 return Err(Error::OutputExists { path: json.clone() });
             }
@@ -106,13 +106,6 @@ impl OutputFlags {
             force: self.force,
         })
     }
-}
-
-/// Refuses `output` when it is one of `inputs`.
-fn refuse_overwriting_input_all(inputs: &[&Path], output: &Path) -> Result<()> {
-    inputs
-        .iter()
-        .try_for_each(|input| refuse_overwriting_input(input, &[output]))
 }
 
 /// Where a claimed experiment writes: its directory, the stem of its files, `--json`.
