@@ -416,7 +416,7 @@ impl<T: Sample> RotationWorkspace<T> {
         let rotation = plan_on_pixels(plane, deg, kernel, options)?;
         let mut out = Array2::zeros(rotation.out);
         let slice = out.as_slice_mut().expect("new array");
-        self.rotate_grid(plane, &rotation, kernel, options.outside, slice);
+        self.rotate_grid(plane, &rotation, kernel, options.outside, slice)?;
         Ok(out)
     }
 
@@ -442,8 +442,7 @@ impl<T: Sample> RotationWorkspace<T> {
         }
         let rotation = plan_on_pixels(plane, deg, kernel, options)?;
         let slice = out.as_slice_mut().expect("standard layout");
-        self.rotate_grid(plane, &rotation, kernel, options.outside, slice);
-        Ok(())
+        self.rotate_grid(plane, &rotation, kernel, options.outside, slice)
     }
 
     /// Rotates the working-grid array `a` as `rotation` says into `out` (row-major, of the
@@ -455,14 +454,14 @@ impl<T: Sample> RotationWorkspace<T> {
         kernel: &dyn ShearKernel<T>,
         outside: Outside,
         out: &mut [T],
-    ) {
+    ) -> Result<()> {
         let a1 = match rotation.quarter_turns {
             0 => CowArray::from(a),
             q => CowArray::from(quarter_turn(a, q)),
         };
         let Some(shears) = &rotation.shears else {
             out.copy_from_slice(a1.as_standard_layout().as_slice().expect("standard layout"));
-            return;
+            return Ok(());
         };
         let (out_h, out_w) = rotation.out;
         let (a2, outside) = match outside {
@@ -488,7 +487,7 @@ impl<T: Sample> RotationWorkspace<T> {
         // x-shear: row r (y = cy_a - r) of A moves by a_x y; stored transposed (w_b x h_a).
         let shifts: Vec<f64> = (0..h_a).map(|r| margin + a_x * (cy_a - r as f64)).collect();
         let b1t = buffer(&mut self.first, w_b * h_a);
-        shear_pass_into(a2.view(), w_b, &shifts, kernel, outside, true, b1t);
+        shear_pass_into(a2.view(), w_b, &shifts, kernel, outside, true, b1t)?;
         let b1t = ArrayView2::from_shape((w_b, h_a), &*b1t).expect("sized");
         // y-shear: column c (x = c - ox) moves up by s_y x, i.e. by -s_y x in row index, onto
         // the output's rows; stored transposed back (out_h x w_b).
@@ -496,13 +495,13 @@ impl<T: Sample> RotationWorkspace<T> {
             .map(|c| (cy_out - cy_a) - s_y * (c as f64 - ox))
             .collect();
         let b2 = buffer(&mut self.second, out_h * w_b);
-        shear_pass_into(b1t, out_h, &shifts, kernel, outside, true, b2);
+        shear_pass_into(b1t, out_h, &shifts, kernel, outside, true, b2)?;
         let b2 = ArrayView2::from_shape((out_h, w_b), &*b2).expect("sized");
         // x-shear again: row r (y = cy_out - r) onto the output's columns.
         let shifts: Vec<f64> = (0..out_h)
             .map(|r| (cx_out - ox) + a_x * (cy_out - r as f64))
             .collect();
-        shear_pass_into(b2, out_w, &shifts, kernel, outside, false, out);
+        shear_pass_into(b2, out_w, &shifts, kernel, outside, false, out)
     }
 }
 
@@ -630,7 +629,7 @@ impl<'k, T: Sample> RotationChain<'k, T> {
             self.kernel,
             self.options.outside,
             &mut out,
-        );
+        )?;
         let out = Array2::from_shape_vec((h, w), out).expect("sized");
         self.spare = std::mem::replace(&mut self.work, out)
             .into_raw_vec_and_offset()

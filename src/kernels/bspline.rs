@@ -243,11 +243,12 @@ impl<T: Sample> BSplineShifter<'_, T> {
 }
 
 impl<T: Sample> RowShifter<T> for BSplineShifter<'_, T> {
-    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
+    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) -> Result<()> {
         self.shift_group(&[row], &[shift], &mut [out]);
+        Ok(())
     }
 
-    fn shift_rows(&mut self, rows: &[&[T]], shifts: &[f64], outs: &mut [&mut [T]]) {
+    fn shift_rows(&mut self, rows: &[&[T]], shifts: &[f64], outs: &mut [&mut [T]]) -> Result<()> {
         for ((rows, shifts), outs) in rows
             .chunks(ROW_GROUP)
             .zip(shifts.chunks(ROW_GROUP))
@@ -255,6 +256,7 @@ impl<T: Sample> RowShifter<T> for BSplineShifter<'_, T> {
         {
             self.shift_group(rows, shifts, outs);
         }
+        Ok(())
     }
 }
 

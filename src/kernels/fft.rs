@@ -9,7 +9,7 @@ use realfft::{ComplexToReal, FftNum, RealFftPlanner, RealToComplex};
 
 use super::taps::split_shift;
 use super::{Outside, RowGeometry, RowShifter, ShearKernel};
-use crate::Sample;
+use crate::{Result, Sample};
 
 /// Samples of padding beyond the content and the view on each side of the FFT window.
 const PAD: usize = 32;
@@ -172,7 +172,7 @@ impl<'k, T: Sample + FftNum> FftShifter<'k, T> {
 }
 
 impl<T: Sample + FftNum> RowShifter<T> for FftShifter<'_, T> {
-    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
+    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) -> Result<()> {
         let (k, f) = split_shift(shift);
         let periodic = is_periodic(self.outside);
         let (lo, len) = if periodic {
@@ -215,6 +215,7 @@ impl<T: Sample + FftNum> RowShifter<T> for FftShifter<'_, T> {
             let start = (-k - lo) as usize;
             out.copy_from_slice(&self.window[start..start + out.len()]);
         }
+        Ok(())
     }
 }
 

@@ -16,6 +16,7 @@
 //! A row is continued by the rotation's [`Outside`] rule into a power-of-two buffer with two
 //! samples of margin on each side, so the periodic Haar shift never wraps anything into view.
 
+use super::shear::check_shift;
 use super::{Outside, RowGeometry, RowShifter, ShearKernel};
 use crate::shift::{GridShift, MAX_PRECISION, ShiftWorkspace, dense::shift_slice_in_place};
 use crate::transform::{Normalization, haar1d};
@@ -36,7 +37,7 @@ use crate::{Error, Result, Sample};
 /// let g = RowGeometry { len_in: 4, len_out: 4, min_shift: 0.0, max_shift: 1.0 };
 /// let mut worker = ShearKernel::<f64>::row_shifter(&kernel, g, Outside::Fill(0.0));
 /// let mut out = [0.0; 4];
-/// worker.shift_row(&[0.0, 4.0, 8.0, 12.0], 0.25, &mut out);
+/// worker.shift_row(&[0.0, 4.0, 8.0, 12.0], 0.25, &mut out).unwrap();
 /// // Linear interpolation a quarter sample back.
 /// assert_eq!(out, [0.0, 3.0, 7.0, 11.0]);
 /// ```
@@ -111,11 +112,14 @@ struct HaarRowShifter<T> {
 }
 
 impl<T: Sample> RowShifter<T> for HaarRowShifter<T> {
-    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
+    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) -> Result<()> {
         // out[n] = row(n - s) with s = q + f, q whole: take buffer[b] = row(b - q - MARGIN), shift
-        // it by f in the Haar domain, and read out[n] = shifted[n + MARGIN].
+        // it by f in the Haar domain, and read out[n] = shifted[n + MARGIN]. A NaN, infinite or
+        // absurd shift has no whole part to place the row by: refused before anything is written.
+        check_shift(shift)?;
         let whole = shift.floor();
         let fraction = shift - whole;
+        let grid = GridShift::new(fraction, self.precision)?;
         let needed = (out.len() + 2 * MARGIN).next_power_of_two();
         if needed > self.buffer.len() {
             self.buffer.resize(needed, T::zero());
@@ -124,20 +128,14 @@ impl<T: Sample> RowShifter<T> for HaarRowShifter<T> {
         let lo = -(whole as isize) - MARGIN as isize;
         self.outside.extend_into(row, lo, &mut self.buffer);
         let norm = Normalization::Average;
-        // The buffer is a power of two long, the level count fits it, the fraction is finite
-        // and within [0, 1), and the precision was checked at construction: none can fail.
-        let grid =
-            GridShift::new(fraction, self.precision).expect("fraction and precision are valid");
-        let shifted =
-            haar1d::forward_in_place(&mut self.buffer, self.levels, norm, &mut self.scratch)
-                .and_then(|()| {
-                    shift_slice_in_place(&mut self.buffer, self.levels, norm, grid, &mut self.work)
-                })
-                .and_then(|()| {
-                    haar1d::inverse_in_place(&mut self.buffer, self.levels, norm, &mut self.scratch)
-                });
-        debug_assert!(shifted.is_ok());
+        // The buffer is a power of two long and the level count fits it; the shift module can
+        // still refuse a period too fine for exact step counts (`len * 2^h` above 2^53), which
+        // is passed on, never written as a wrong row.
+        haar1d::forward_in_place(&mut self.buffer, self.levels, norm, &mut self.scratch)?;
+        shift_slice_in_place(&mut self.buffer, self.levels, norm, grid, &mut self.work)?;
+        haar1d::inverse_in_place(&mut self.buffer, self.levels, norm, &mut self.scratch)?;
         out.copy_from_slice(&self.buffer[MARGIN..MARGIN + out.len()]);
+        Ok(())
     }
 }
 
@@ -172,7 +170,7 @@ mod tests {
                     let mut worker =
                         ShearKernel::<f64>::row_shifter(&kernel, g, Outside::Fill(0.0));
                     let mut out = vec![0.0; n];
-                    worker.shift_row(&x, s, &mut out);
+                    worker.shift_row(&x, s, &mut out).unwrap();
                     // Independent pixel-domain statement: linear interpolation, shift rounded
                     // to 1/2^h with ties up, zero outside.
                     let r = GridShift::new(s, h).unwrap().amount();
@@ -233,7 +231,7 @@ mod tests {
             };
             let mut worker = ShearKernel::<f64>::row_shifter(&kernel, g, Outside::Fill(0.0));
             let mut out = vec![0.0; 40];
-            worker.shift_row(&x, s, &mut out);
+            worker.shift_row(&x, s, &mut out).unwrap();
             let q = (s - s.floor() >= 0.5) as i64 + s.floor() as i64;
             for (m, &o) in out.iter().enumerate() {
                 let src = m as i64 - q;
@@ -244,6 +242,36 @@ mod tests {
                 };
                 assert!((o - want).abs() < 1e-11, "s={s} m={m}");
             }
+        }
+    }
+
+    /// A shift the kernel cannot place (NaN, infinite, beyond the drivers' limit) is an error
+    /// naming the shift, and the output row is left as it was: no panic and no wrong row. The
+    /// worker stays usable.
+    #[test]
+    fn refuses_a_shift_it_cannot_make_without_writing() {
+        let x = [1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0];
+        for retain in [false, true] {
+            let kernel = HaarShift::new(3, retain).unwrap();
+            let g = RowGeometry {
+                len_in: 8,
+                len_out: 8,
+                min_shift: 0.0,
+                max_shift: 1.0,
+            };
+            let mut worker = ShearKernel::<f32>::row_shifter(&kernel, g, Outside::Fill(0.0));
+            for s in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -2e15] {
+                let mut out = [-7.0f32; 8];
+                let err = worker.shift_row(&x, s, &mut out).unwrap_err();
+                assert!(
+                    matches!(err, Error::InvalidParameter { name: "shift", .. }),
+                    "retain={retain} s={s}: {err}"
+                );
+                assert_eq!(out, [-7.0; 8], "retain={retain} s={s}: the row was written");
+            }
+            let mut out = [0.0f32; 8];
+            worker.shift_row(&x, 2.0, &mut out).unwrap();
+            assert_eq!(out, [0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         }
     }
 
@@ -260,9 +288,74 @@ mod tests {
 #[cfg(test)]
 mod rotation_tests {
     use super::*;
-    use crate::kernels::Nearest;
-    use crate::rotate::{RotateOptions, RotationChain};
+    use crate::kernels::{Nearest, shear_rows, shift_plane};
+    use crate::rotate::{RotateOptions, RotationChain, RotationWorkspace};
     use ndarray::Array2;
+
+    /// A kernel whose every row shift fails, to see that the drivers pass a kernel's error on.
+    struct Refusing;
+    struct RefusingRows;
+
+    impl RowShifter<f64> for RefusingRows {
+        fn shift_row(&mut self, _: &[f64], _: f64, _: &mut [f64]) -> Result<()> {
+            Err(Error::parameter("shift", "refused on purpose"))
+        }
+    }
+
+    impl ShearKernel<f64> for Refusing {
+        fn name(&self) -> String {
+            "refusing".into()
+        }
+
+        fn support_radius(&self) -> usize {
+            1
+        }
+
+        fn row_shifter(&self, _: RowGeometry, _: Outside) -> Box<dyn RowShifter<f64> + '_> {
+            Box::new(RefusingRows)
+        }
+    }
+
+    /// Every driver (row shear, plane shift, one rotation, rotation into a buffer, a chain)
+    /// returns a kernel's error instead of an image: a failed Haar shift is never swallowed.
+    #[test]
+    fn drivers_return_a_kernel_error() {
+        let plane = Array2::from_shape_fn((9, 12), |(i, j)| (i * 12 + j) as f64);
+        let refused = |r: Result<()>, what: &str| match r {
+            Err(Error::InvalidParameter {
+                name: "shift",
+                reason,
+            }) => {
+                assert_eq!(reason, "refused on purpose", "{what}")
+            }
+            other => panic!("{what}: {other:?}"),
+        };
+        let fill = Outside::Fill(0.0);
+        refused(
+            shear_rows(plane.view(), 12, &[0.5; 9], &Refusing, fill).map(drop),
+            "shear_rows",
+        );
+        refused(
+            shift_plane(plane.view(), 0.5, 0.25, &Refusing, fill).map(drop),
+            "shift_plane",
+        );
+        let options = RotateOptions::default();
+        let mut workspace = RotationWorkspace::new();
+        refused(
+            workspace
+                .rotate_plane(plane.view(), 17.0, &Refusing, &options)
+                .map(drop),
+            "rotate_plane",
+        );
+        let size = crate::rotate::rotated_size(9, 12, 17.0, &options).unwrap();
+        let mut out = Array2::zeros(size);
+        refused(
+            workspace.rotate_plane_into(plane.view(), 17.0, &Refusing, &options, out.view_mut()),
+            "rotate_plane_into",
+        );
+        let mut chain = RotationChain::new(plane.view(), &Refusing, options).unwrap();
+        refused(chain.rotate(17.0).map(drop), "RotationChain::rotate");
+    }
 
     /// The statement in the module docs, end to end: a chain of rotations with the retained Haar
     /// kernel equals nearest neighbour on the 2^h-finer grid, box-averaged at the end.

@@ -176,11 +176,12 @@ pub struct RowGeometry {
 /// struct RoundHalfDown;
 /// struct Worker(Outside);
 /// impl RowShifter<f64> for Worker {
-///     fn shift_row(&mut self, row: &[f64], shift: f64, out: &mut [f64]) {
+///     fn shift_row(&mut self, row: &[f64], shift: f64, out: &mut [f64]) -> haarshift::Result<()> {
 ///         for (n, o) in out.iter_mut().enumerate() {
 ///             let x = n as f64 - shift;
 ///             *o = self.0.sample(row, (x - 0.5).ceil() as isize);
 ///         }
+///         Ok(())
 ///     }
 /// }
 /// impl ShearKernel<f64> for RoundHalfDown {
@@ -221,13 +222,15 @@ pub trait ShearKernel<T: Sample>: Send + Sync {
 /// let geometry = RowGeometry { len_in: 4, len_out: 4, min_shift: 0.0, max_shift: 1.0 };
 /// let mut worker = kernel.row_shifter(geometry, Outside::Fill(0.0));
 /// let mut out = [0.0; 4];
-/// worker.shift_row(&[1.0, 1.0, 1.0, 1.0], 0.25, &mut out);
+/// worker.shift_row(&[1.0, 1.0, 1.0, 1.0], 0.25, &mut out).unwrap();
 /// assert!((out[2] - 1.0).abs() < 1e-15);
 /// ```
 pub trait RowShifter<T: Sample>: Send {
     /// `out[n] = row(n - shift)` for `n` in `0..out.len()`; `row` and `out` may differ in
-    /// length. `shift` is finite.
-    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]);
+    /// length. The drivers pass finite shifts of at most `1e15`; a kernel that cannot make a
+    /// shift (the Haar kernel given a non-finite one, say) returns the error rather than
+    /// writing a wrong row, and the drivers pass it on.
+    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) -> Result<()>;
 
     /// Shifts several rows of equal length, `outs[i][n] = rows[i](n - shifts[i])`, all `outs`
     /// of equal length. The drivers hand out up to [`ROW_GROUP`] rows at a time; the default
@@ -240,15 +243,16 @@ pub trait RowShifter<T: Sample>: Send {
     /// let geometry = RowGeometry { len_in: 3, len_out: 3, min_shift: 0.0, max_shift: 1.0 };
     /// let mut worker = kernel.row_shifter(geometry, Outside::Fill(0.0));
     /// let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
-    /// worker.shift_rows(&[&[1.0, 2.0, 3.0], &[4.0, 5.0, 6.0]], &[0.5, 0.25], &mut [&mut a, &mut b]);
+    /// worker.shift_rows(&[&[1.0, 2.0, 3.0], &[4.0, 5.0, 6.0]], &[0.5, 0.25], &mut [&mut a, &mut b]).unwrap();
     /// let mut single = [0.0; 3];
-    /// worker.shift_row(&[4.0, 5.0, 6.0], 0.25, &mut single);
+    /// worker.shift_row(&[4.0, 5.0, 6.0], 0.25, &mut single).unwrap();
     /// assert_eq!(b, single);
     /// ```
-    fn shift_rows(&mut self, rows: &[&[T]], shifts: &[f64], outs: &mut [&mut [T]]) {
+    fn shift_rows(&mut self, rows: &[&[T]], shifts: &[f64], outs: &mut [&mut [T]]) -> Result<()> {
         for ((row, &shift), out) in rows.iter().zip(shifts).zip(outs.iter_mut()) {
-            self.shift_row(row, shift, out);
+            self.shift_row(row, shift, out)?;
         }
+        Ok(())
     }
 }
 

@@ -1,7 +1,7 @@
 //! Nearest-neighbour shift.
 
 use super::{Outside, RowGeometry, RowShifter, ShearKernel};
-use crate::Sample;
+use crate::{Result, Sample};
 
 /// Nearest neighbour: `out[n] = row(floor(n - shift + 1/2))` (halves round up), an integer
 /// shift by the rounded amount.
@@ -22,10 +22,11 @@ pub struct Nearest;
 struct NearestShifter(Outside);
 
 impl<T: Sample> RowShifter<T> for NearestShifter {
-    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
+    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) -> Result<()> {
         // floor(n - shift + 1/2) = n + floor(1/2 - shift): one offset for the whole row.
         let offset = (0.5 - shift).floor() as isize;
         self.0.extend_into(row, offset, out);
+        Ok(())
     }
 }
 

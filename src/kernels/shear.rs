@@ -29,10 +29,15 @@ fn validate(rows: usize, len_in: usize, len_out: usize, shifts: &[f64]) -> Resul
             format!("{} shifts for {rows} rows", shifts.len()),
         ));
     }
-    if let Some(s) = shifts.iter().find(|s| s.is_nan() || s.abs() > MAX_SHIFT) {
+    shifts.iter().try_for_each(|&s| check_shift(s))
+}
+
+/// Refuses a NaN shift or one beyond [`MAX_SHIFT`] (infinities included).
+pub(crate) fn check_shift(shift: f64) -> Result<()> {
+    if shift.is_nan() || shift.abs() > MAX_SHIFT {
         return Err(Error::parameter(
             "shift",
-            format!("{s} is not a finite shift of at most {MAX_SHIFT:e}"),
+            format!("{shift} is not a finite shift of at most {MAX_SHIFT:e}"),
         ));
     }
     Ok(())
@@ -62,14 +67,7 @@ pub fn shear_rows<T: Sample>(
     let (rows, len_in) = input.dim();
     validate(rows, len_in, len_out, shifts)?;
     check_finite(input)?;
-    Ok(shear_pass(
-        input,
-        len_out,
-        shifts,
-        kernel,
-        outside.validate()?,
-        false,
-    ))
+    shear_pass(input, len_out, shifts, kernel, outside.validate()?, false)
 }
 
 /// Shifts a whole plane by `(dx, dy)` pixels: `out[r][c] = plane(r - dy, c - dx)`, separably
@@ -110,7 +108,7 @@ pub fn shift_plane<T: Sample>(
         kernel,
         outside,
         true,
-    );
+    )?;
     let fine = shear_pass(
         columns.view(),
         fh,
@@ -118,7 +116,7 @@ pub fn shift_plane<T: Sample>(
         kernel,
         outside,
         true,
-    );
+    )?;
     let out = if e == 0 {
         fine
     } else {
@@ -164,23 +162,24 @@ pub(crate) fn shear_pass<T: Sample>(
     kernel: &dyn ShearKernel<T>,
     outside: Outside,
     transposed: bool,
-) -> Array2<T> {
+) -> Result<Array2<T>> {
     let rows = input.nrows();
     let mut out = vec![T::zero(); rows * len_out];
     shear_pass_into(
         input, len_out, shifts, kernel, outside, transposed, &mut out,
-    );
+    )?;
     let shape = if transposed {
         (len_out, rows)
     } else {
         (rows, len_out)
     };
-    Array2::from_shape_vec(shape, out).expect("sized above")
+    Ok(Array2::from_shape_vec(shape, out).expect("sized above"))
 }
 
 /// [`shear_rows`] without validation, writing every sample of `out` (`rows x len_out`, or
 /// `len_out x rows` with `transposed`, row-major). With `transposed` the rows go through a tile
-/// per task, which is the blocked transpose fused in.
+/// per task, which is the blocked transpose fused in. A kernel's error stops the pass and is
+/// returned (`out` is then partly written).
 pub(crate) fn shear_pass_into<T: Sample>(
     input: ArrayView2<'_, T>,
     len_out: usize,
@@ -189,7 +188,7 @@ pub(crate) fn shear_pass_into<T: Sample>(
     outside: Outside,
     transposed: bool,
     out: &mut [T],
-) {
+) -> Result<()> {
     let input = input.as_standard_layout();
     let (rows, len_in) = input.dim();
     assert_eq!(out.len(), rows * len_out, "output sized for the pass");
@@ -219,27 +218,28 @@ pub(crate) fn shear_pass_into<T: Sample>(
             }
         }
         if m > 0 {
-            shifter.shift_rows(&rows[..m], &amounts[..m], &mut outs[..m]);
+            shifter.shift_rows(&rows[..m], &amounts[..m], &mut outs[..m])?;
         }
+        Ok(())
     };
     // Few, large tasks: each one builds a worker (and a tile), which costs far more than a row.
     let tasks = 4 * rayon::current_num_threads();
     if !transposed {
-        out.par_chunks_mut(len_out * ROW_GROUP)
+        return out
+            .par_chunks_mut(len_out * ROW_GROUP)
             .enumerate()
             .with_min_len(rows.div_ceil(ROW_GROUP * tasks))
-            .for_each_init(
+            .try_for_each_init(
                 || kernel.row_shifter(geometry, outside),
                 |shifter, (g, block)| shift_group(shifter, g * ROW_GROUP, block),
             );
-        return;
     }
     let mut out = ndarray::ArrayViewMut2::from_shape((len_out, rows), out).expect("sized");
     out.axis_chunks_iter_mut(Axis(1), TILE)
         .into_par_iter()
         .enumerate()
         .with_min_len(rows.div_ceil(TILE).div_ceil(tasks))
-        .for_each_init(
+        .try_for_each_init(
             || {
                 let tile = vec![T::zero(); TILE * len_out];
                 (kernel.row_shifter(geometry, outside), tile)
@@ -251,11 +251,12 @@ pub(crate) fn shear_pass_into<T: Sample>(
                     .chunks_mut(len_out * ROW_GROUP)
                     .enumerate()
                 {
-                    shift_group(shifter, r0 + g * ROW_GROUP, group);
+                    shift_group(shifter, r0 + g * ROW_GROUP, group)?;
                 }
                 write_transposed(&tile[..t * len_out], len_out, &mut block);
+                Ok(())
             },
-        );
+        )
 }
 
 /// Writes the `t x len` rows of `tile` into the `len x t` block, through a small square that

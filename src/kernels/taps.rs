@@ -3,7 +3,7 @@
 //! shift is a short FIR filter with constant taps (vectorised).
 
 use super::{Outside, RowShifter};
-use crate::Sample;
+use crate::{Result, Sample};
 
 /// Splits `shift` into the integer `k = floor(shift)` and the fraction `f = shift - k` in
 /// `[0, 1)`; then `out[n] = row(n - k - f)`.
@@ -74,7 +74,7 @@ impl<T: Sample, F: Fn(f64) -> f64 + Send> TapShifter<T, F> {
 }
 
 impl<T: Sample, F: Fn(f64) -> f64 + Send> RowShifter<T> for TapShifter<T, F> {
-    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
+    fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) -> Result<()> {
         let (k, f) = split_shift(shift);
         weights_into(&self.value, f, self.normalise, &mut self.weights);
         let taps = self.weights.len();
@@ -82,6 +82,7 @@ impl<T: Sample, F: Fn(f64) -> f64 + Send> RowShifter<T> for TapShifter<T, F> {
         self.outside
             .extend_into(row, -k - (taps / 2) as isize, &mut self.extended);
         fir(&self.extended, &self.weights, out);
+        Ok(())
     }
 }
 

@@ -503,8 +503,8 @@ mod tests {
     struct OvershootingRows<'a, T: Sample>(Box<dyn crate::kernels::RowShifter<T> + 'a>);
 
     impl<T: Sample> crate::kernels::RowShifter<T> for OvershootingRows<'_, T> {
-        fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) {
-            self.0.shift_row(row, shift + ERROR, out);
+        fn shift_row(&mut self, row: &[T], shift: f64, out: &mut [T]) -> crate::Result<()> {
+            self.0.shift_row(row, shift + ERROR, out)
         }
     }
 
