@@ -196,4 +196,6 @@ pub fn shift_image<T: Sample>(
 }
 
 #[cfg(test)]
+mod f32_tests;
+#[cfg(test)]
 mod tests;
