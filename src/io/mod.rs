@@ -559,4 +559,6 @@ fn planar<T: Sample>(path: &Path, planes: Array3<T>, depth: SampleDepth) -> Resu
 }
 
 #[cfg(test)]
+mod foreign_tests;
+#[cfg(test)]
 mod tests;
