@@ -86,7 +86,8 @@ pub enum Error {
 
 /// `"path: "` when there is a path, else nothing.
 fn file_prefix(path: Option<&std::path::Path>) -> String {
-    path.map(|p| format!("{}: ", p.display())).unwrap_or_default()
+    path.map(|p| format!("{}: ", p.display()))
+        .unwrap_or_default()
 }
 
 impl From<crate::relight::SceneError> for Error {

@@ -216,12 +216,8 @@ impl Mesh {
         self.normals
             .append(Axis(0), other.normals.view())
             .expect("both are (V, 3)");
-        self.triangles.extend(
-            other
-                .triangles
-                .iter()
-                .map(|t| t.map(|i| i + offset)),
-        );
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| i + offset)));
     }
 
     /// The mesh with every position mapped by `position` and every normal by `normal` (then

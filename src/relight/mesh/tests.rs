@@ -13,23 +13,23 @@ fn testdata(name: &str) -> PathBuf {
 
 /// Writes `bytes` to `name` in a fresh directory and loads it.
 fn load_bytes(name: &str, bytes: &[u8]) -> Result<Mesh> {
+    load_in(name, bytes).0
+}
+
+/// [`load_bytes`] and the path it wrote.
+fn load_in(name: &str, bytes: &[u8]) -> (Result<Mesh>, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(name);
     std::fs::File::create(&path)
         .unwrap()
         .write_all(bytes)
         .unwrap();
-    Mesh::load(&path)
+    (Mesh::load(&path), path)
 }
 
-fn scene_error(r: Result<Mesh>) -> SceneError {
-    match r {
-        Err(Error::Scene {
-            path: Some(_),
-            source,
-        }) => source,
-        other => panic!("expected a scene error naming the file, got {other:?}"),
-    }
+/// The refusal of a mesh file, which must name the file.
+fn scene_error((result, path): (Result<Mesh>, PathBuf)) -> SceneError {
+    crate::relight::refusal_in(result, &path)
 }
 
 /// A square pyramid: apex 4 over the square 0..4, one quad base (two triangles when read).
@@ -42,7 +42,13 @@ const PYRAMID_POSITIONS: [[f32; 3]; 5] = [
     [0.0, 0.0, -1.0],
     [0.5, 1.0, -0.5],
 ];
-const PYRAMID_FACES: [&[i32]; 5] = [&[0, 3, 2, 1], &[0, 1, 4], &[1, 2, 4], &[2, 3, 4], &[3, 0, 4]];
+const PYRAMID_FACES: [&[i32]; 5] = [
+    &[0, 3, 2, 1],
+    &[0, 1, 4],
+    &[1, 2, 4],
+    &[2, 3, 4],
+    &[3, 0, 4],
+];
 
 /// The pyramid as binary PLY in the given byte order.
 fn pyramid_binary(big_endian: bool) -> Vec<u8> {
@@ -59,8 +65,20 @@ fn pyramid_binary(big_endian: bool) -> Vec<u8> {
         .to_string()
         .into_bytes();
     out.extend_from_slice(b"end_header\n");
-    let f32b = |x: f32| if big_endian { x.to_be_bytes() } else { x.to_le_bytes() };
-    let i32b = |x: i32| if big_endian { x.to_be_bytes() } else { x.to_le_bytes() };
+    let f32b = |x: f32| {
+        if big_endian {
+            x.to_be_bytes()
+        } else {
+            x.to_le_bytes()
+        }
+    };
+    let i32b = |x: i32| {
+        if big_endian {
+            x.to_be_bytes()
+        } else {
+            x.to_le_bytes()
+        }
+    };
     for p in PYRAMID_POSITIONS {
         p.iter().for_each(|&x| out.extend_from_slice(&f32b(x)));
     }
@@ -171,16 +189,16 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
         .unwrap()
         .to_string();
     assert_eq!(
-        scene_error(load_bytes("a.ply", no_faces.as_bytes())),
+        scene_error(load_in("a.ply", no_faces.as_bytes())),
         SceneError::NoFaces
     );
     assert_eq!(
-        scene_error(load_bytes("a.obj", b"v 0 0 0\nv 1 0 0\n")),
+        scene_error(load_in("a.obj", b"v 0 0 0\nv 1 0 0\n")),
         SceneError::NoFaces
     );
     let out_of_range = PYRAMID_ASCII.replace("3 3 0 4", "3 3 0 7");
     assert_eq!(
-        scene_error(load_bytes("a.ply", out_of_range.as_bytes())),
+        scene_error(load_in("a.ply", out_of_range.as_bytes())),
         SceneError::IndexOutOfRange {
             triangle: 5,
             index: 7,
@@ -188,19 +206,19 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
         }
     );
     assert!(matches!(
-        scene_error(load_bytes("a.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
+        scene_error(load_in("a.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
         SceneError::IndexOutOfRange { index: 3, .. }
     ));
     for bad in ["nan", "inf", "-inf"] {
         let obj = format!("v 0 0 0\nv 1 {bad} 0\nv 0 1 0\nf 1 2 3\n");
         assert!(matches!(
-            scene_error(load_bytes("a.obj", obj.as_bytes())),
+            scene_error(load_in("a.obj", obj.as_bytes())),
             SceneError::NonFinite { vertex: 1, .. }
         ));
     }
     let nan_ply = PYRAMID_ASCII.replace("0.5 1 -0.5", "0.5 nan -0.5");
     assert!(matches!(
-        scene_error(load_bytes("a.ply", nan_ply.as_bytes())),
+        scene_error(load_in("a.ply", nan_ply.as_bytes())),
         SceneError::NonFinite { vertex: 4, .. } | SceneError::Corrupt(_)
     ));
     // Truncated binary and ASCII files, a damaged header, garbage.
@@ -208,7 +226,7 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
     for cut in [bunny.len() - 1, bunny.len() / 2, 200, 20] {
         assert!(
             matches!(
-                scene_error(load_bytes("a.ply", &bunny[..cut])),
+                scene_error(load_in("a.ply", &bunny[..cut])),
                 SceneError::Corrupt(_)
             ),
             "cut at {cut}"
@@ -216,11 +234,11 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
     }
     let ascii_cut = &PYRAMID_ASCII[..PYRAMID_ASCII.len() - 10];
     assert!(matches!(
-        scene_error(load_bytes("a.ply", ascii_cut.as_bytes())),
+        scene_error(load_in("a.ply", ascii_cut.as_bytes())),
         SceneError::Corrupt(_)
     ));
     assert!(matches!(
-        scene_error(load_bytes("a.obj", b"v 0 zero 0\n")),
+        scene_error(load_in("a.obj", b"v 0 zero 0\n")),
         SceneError::Corrupt(_)
     ));
     assert!(matches!(
