@@ -3,15 +3,17 @@
 //! Visibility needs only the *any-hit* query ("stop at the first hit"), so the interface is one
 //! method, [`Occlusion::occluded`], and the rest of the crate never sees the BVH library.
 //!
-//! **The BVH: [`obvhs`].** Chosen by measurement (`tools/bvh-compare`, figures in the README's
-//! relighting section): on the bunny with its ground plane and on the 85,860-vertex cubes scene,
-//! one run, 2 cores, it traced occlusion rays several times faster than `bvh` 0.12 and
-//! `parry3d` 0.31. It builds a compressed 8-wide BVH (CWBVH, Ylitie et al. 2017) with PLOC and
-//! reinsertion, traverses four children at a time with SIMD and has an any-hit traversal
-//! (`ray_traverse_miss`) that returns at the first hit; its dependencies are small (`glam`,
-//! `bytemuck`, a radix sort), it is dual MIT/Apache licensed and released through 2025. `bvh`
-//! (binary BVH, SAH) only yields candidate shapes whose boxes the ray crosses; `parry3d` is a
-//! whole collision library (nalgebra, SIMD quad BVH) whose ray cast is a closest-hit query.
+//! **The BVH: [`obvhs`].** It builds a compressed 8-wide BVH (CWBVH, Ylitie et al. 2017) with
+//! PLOC and reinsertion, traverses four children at a time with SIMD and has an any-hit
+//! traversal (`ray_traverse_miss`) that returns at the first hit, which is the whole query
+//! here; its dependencies are small (`glam`, `bytemuck`, a radix sort), it is dual MIT/Apache
+//! licensed. The alternatives: `bvh` 0.12 (binary SAH BVH, nalgebra)
+//! only yields the candidate shapes whose boxes a ray crosses, and its triangle test culls back
+//! faces; `parry3d` 0.31 is a whole collision library (glamx, rkyv, spade and more) whose
+//! `TriMesh` answers rays through its general `RayCast` trait. `tools/bvh-compare` (its own workspace, so the
+//! candidates never enter this crate's build) traces the same occlusion rays through all three
+//! on the bunny with its ground plane and on the 85,860-vertex cubes scene and prints rays per
+//! second: `cd tools/bvh-compare && cargo run --release`.
 //!
 //! Rays are f32 (the BVH's precision). Zero-area triangles are left out of the BVH (no ray can
 //! hit one). A ray hits a triangle when the Moller-Trumbore test finds `0 <= t <= t_max`
