@@ -57,7 +57,10 @@ struct Tri {
 
 impl bvh::aabb::Bounded<f32, 3> for Tri {
     fn aabb(&self) -> bvh::aabb::Aabb<f32, 3> {
-        bvh::aabb::Aabb::empty().grow(&self.a).grow(&self.b).grow(&self.c)
+        bvh::aabb::Aabb::empty()
+            .grow(&self.a)
+            .grow(&self.b)
+            .grow(&self.c)
     }
 }
 
@@ -105,7 +108,8 @@ impl Occlusion for BvhCrate {
         self.bvh.traverse_iterator(&ray, &self.tris).any(|t| {
             let front = ray.intersects_triangle(&t.a, &t.b, &t.c).distance;
             let back = ray.intersects_triangle(&t.a, &t.c, &t.b).distance;
-            front.min(back) <= t_max
+            let t = front.min(back);
+            t.is_finite() && t <= t_max
         })
     }
 }
