@@ -66,12 +66,34 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
+    /// A scene (mesh, scene file or scene cache) is not usable; `path` names its file when
+    /// there is one.
+    #[error("{}{source}", file_prefix(path.as_deref()))]
+    Scene {
+        /// The file the problem was found in, if any.
+        path: Option<PathBuf>,
+        /// What is wrong.
+        #[source]
+        source: crate::relight::SceneError,
+    },
     /// The output file exists and the caller did not ask to replace it.
     #[error("{}: already exists (use --force to replace it)", path.display())]
     OutputExists {
         /// The existing file.
         path: PathBuf,
     },
+}
+
+/// `"path: "` when there is a path, else nothing.
+fn file_prefix(path: Option<&std::path::Path>) -> String {
+    path.map(|p| format!("{}: ", p.display()))
+        .unwrap_or_default()
+}
+
+impl From<crate::relight::SceneError> for Error {
+    fn from(source: crate::relight::SceneError) -> Self {
+        Error::Scene { path: None, source }
+    }
 }
 
 /// `Result` with [`Error`].
@@ -89,7 +111,14 @@ impl Error {
     /// ```
     pub fn in_file(self, path: &std::path::Path) -> Self {
         match self {
-            Error::Io { .. } | Error::Format { .. } | Error::OutputExists { .. } => self,
+            Error::Scene { path: None, source } => Error::Scene {
+                path: Some(path.to_path_buf()),
+                source,
+            },
+            Error::Io { .. }
+            | Error::Format { .. }
+            | Error::OutputExists { .. }
+            | Error::Scene { .. } => self,
             other => Error::Format {
                 path: path.to_path_buf(),
                 reason: other.to_string(),

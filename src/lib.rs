@@ -13,6 +13,8 @@
 //! * [`product`]: integrals and products of several functions on sparse Haar quadtrees over
 //!   sets of square faces (the n-function product integral, the product, nonlinear
 //!   approximation, the weighting contract).
+//! * [`relight`]: meshes and scenes lit by environment maps: ray casting, per-vertex visibility
+//!   precomputed into sparse Haar transport, the scene cache.
 //! * [`experiments`], [`metrics`], [`patterns`]: error-accumulation experiments, the error
 //!   measures they report, and the synthetic test patterns they use.
 //! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`]
@@ -36,6 +38,7 @@ mod named;
 pub mod patterns;
 mod planar_image;
 pub mod product;
+pub mod relight;
 pub mod rotate;
 mod sample;
 pub mod shift;

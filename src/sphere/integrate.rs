@@ -220,7 +220,7 @@ fn face_arrays(
 }
 
 /// The layout whose Mallat index breaks selection ties: lat-long faces side by side.
-fn layout(param: Parameterization) -> FaceLayout {
+pub(crate) fn layout(param: Parameterization) -> FaceLayout {
     match param.kind() {
         ParamKind::LatLong => FaceLayout::SideBySide,
         ParamKind::Cube => FaceLayout::Stacked,

@@ -1,0 +1,87 @@
+//! Times the visibility precomputation of a scene and reports rays per second, the transport's
+//! size and the method's working memory; run it under `/usr/bin/time -v` for the peak memory
+//! of the whole process.
+//!
+//! ```text
+//! cargo run --release --example relight_precompute -- SCENE PARAM RESOLUTION KEEP ORDER
+//!   SCENE       bunny (the bunny on its ground plane) | cubes (seed 002, 85,860 vertices)
+//!               | cylinder-and-bump | plane-with-sphere
+//!   PARAM       latlong | cube
+//!   RESOLUTION  face side: lat-long N x 2N, cube 6 x N x N
+//!   KEEP        visibility coefficients kept per vertex, or all
+//!   ORDER       vertex (rays through the BVH) | direction (seed 003's shadow maps, 2048^2)
+//! ```
+//!
+//! The README's figure: `cargo run --release --example relight_precompute -- cubes latlong 128 420 vertex`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use haarshift::product::Selection;
+use haarshift::relight::{
+    Generator, Mesh, SceneBvh, VisibilityOptions, add_ground_plane, direction_major, vertex_major,
+};
+use haarshift::sphere::{ParamKind, Parameterization};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() != 5 {
+        eprintln!("usage: relight_precompute SCENE PARAM RESOLUTION KEEP ORDER");
+        std::process::exit(2);
+    }
+    let mesh = match args[0].as_str() {
+        "bunny" => {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/meshes/bunny.ply");
+            let mut m = Mesh::load(&path)?;
+            add_ground_plane(&mut m);
+            m
+        }
+        "cubes" => Generator::Cubes {
+            count: 10,
+            cells: 10,
+            distance: 1.5,
+        }
+        .mesh()?,
+        "cylinder-and-bump" => Generator::CylinderAndBump {}.mesh()?,
+        "plane-with-sphere" => Generator::PlaneWithSphere {}.mesh()?,
+        other => return Err(format!("unknown scene {other}").into()),
+    };
+    let param = Parameterization::new(args[1].parse::<ParamKind>()?, args[2].parse()?)?;
+    let mut options = VisibilityOptions::new(param);
+    options.progress = true;
+    if args[3] != "all" {
+        options.keep = Selection::Largest(args[3].parse()?);
+    }
+    println!(
+        "scene {} ({} vertices, {} triangles), {} {} ({} directions), keep {}, order {}, {} threads",
+        args[0],
+        mesh.vertex_count(),
+        mesh.triangles().len(),
+        param.kind(),
+        param.face_size(),
+        param.texels(),
+        args[3],
+        args[4],
+        rayon::current_num_threads()
+    );
+    let start = Instant::now();
+    let bvh = SceneBvh::new(&mesh);
+    println!("bvh build: {:.3} s", start.elapsed().as_secs_f64());
+    let (set, report) = match args[4].as_str() {
+        "vertex" => vertex_major(&mesh, &bvh, &options)?,
+        "direction" => direction_major(&mesh, &options, 2048)?,
+        other => return Err(format!("unknown order {other}").into()),
+    };
+    println!(
+        "precompute: {:.1} s, {} rays, {:.2} M rays/s",
+        report.seconds,
+        report.rays,
+        report.rays as f64 / report.seconds / 1e6
+    );
+    println!(
+        "transport: {:.1} MB stored, working memory {:.1} MB",
+        set.stored_bytes() as f64 / 1e6,
+        report.working_bytes as f64 / 1e6
+    );
+    Ok(())
+}

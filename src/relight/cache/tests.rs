@@ -1,0 +1,148 @@
+use std::path::{Path, PathBuf};
+
+use super::*;
+use crate::relight::{Generator, Scene, SceneBvh, VisibilityOptions, vertex_major};
+
+fn made(cells: usize) -> SceneCache {
+    let scene = Scene::from_mesh(Generator::Sphere { cells }.mesh().unwrap(), true);
+    let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
+    let mut options = VisibilityOptions::new(param);
+    options.keep = Selection::Largest(10);
+    let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
+    let params = CacheParams {
+        param: "cube".into(),
+        resolution: 4,
+        keep: options.keep.into(),
+        samples: 1,
+        seed: 0,
+        order: "vertex".into(),
+        map_size: None,
+        ground_plane: true,
+    };
+    SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap()
+}
+
+fn written(cache: &SceneCache) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.hsr");
+    cache.write(&path, false).unwrap();
+    (dir, path)
+}
+
+fn refusal(path: &Path) -> SceneError {
+    crate::relight::refusal_in(SceneCache::read(path), path)
+}
+
+#[test]
+fn a_cache_reads_back_exactly() {
+    let cache = made(3);
+    let (_dir, path) = written(&cache);
+    let back = SceneCache::read(&path).unwrap();
+    assert_eq!(back, cache);
+    assert!(back.transport.stored_bytes() > 0);
+    // The transport trees are usable as they were.
+    assert_eq!(
+        back.transport.transport(5).unwrap(),
+        cache.transport.transport(5).unwrap()
+    );
+    // Never over an existing file without force; with it, replaced.
+    assert!(matches!(
+        cache.write(&path, false),
+        Err(Error::OutputExists { .. })
+    ));
+    assert!(cache.write(&path, true).is_ok());
+}
+
+#[test]
+fn a_flipped_byte_anywhere_is_refused() {
+    let (_dir, path) = written(&made(2));
+    let good = std::fs::read(&path).unwrap();
+    // Every byte of the checksum and header, then every 31st (in memory: the same parser).
+    let bytes = (12..400).chain((400..good.len()).step_by(31));
+    for k in bytes.chain([good.len() - 1]) {
+        let mut bad = good.clone();
+        bad[k] ^= 0x10;
+        assert!(
+            matches!(SceneCache::parse(&bad), Err(Error::Scene { source: SceneError::CacheCorrupt(r), .. }) if r == "checksum mismatch"),
+            "byte {k}"
+        );
+    }
+    let mut bad = good.clone();
+    bad[100] ^= 0x01;
+    std::fs::write(&path, &bad).unwrap();
+    assert_eq!(
+        refusal(&path),
+        SceneError::CacheCorrupt("checksum mismatch".into())
+    );
+    let mut bad = good.clone();
+    bad[3] ^= 1;
+    std::fs::write(&path, &bad).unwrap();
+    assert!(matches!(refusal(&path), SceneError::CacheCorrupt(r) if r.contains("not a")));
+}
+
+#[test]
+fn a_truncated_file_is_refused() {
+    let (_dir, path) = written(&made(2));
+    let good = std::fs::read(&path).unwrap();
+    for cut in [0, 5, 16, 23, 40, good.len() / 2, good.len() - 1] {
+        std::fs::write(&path, &good[..cut]).unwrap();
+        assert!(
+            matches!(refusal(&path), SceneError::CacheCorrupt(_)),
+            "cut at {cut}"
+        );
+    }
+}
+
+#[test]
+fn another_version_is_refused_with_both_versions_named() {
+    let (_dir, path) = written(&made(2));
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[8..12].copy_from_slice(&(CACHE_VERSION + 1).to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let e = refusal(&path);
+    assert_eq!(
+        e,
+        SceneError::CacheVersion {
+            found: CACHE_VERSION + 1,
+            expected: CACHE_VERSION
+        }
+    );
+    assert!(e.to_string().contains("compute it again"));
+}
+
+#[test]
+fn a_cache_of_another_scene_is_refused() {
+    let cache = made(2);
+    let (_dir, path) = written(&cache);
+    assert!(SceneCache::read_for(&path, &cache.mesh).is_ok());
+    let other = made(3).mesh;
+    assert!(matches!(
+        SceneCache::read_for(&path, &other),
+        Err(Error::Scene {
+            source: SceneError::CacheMismatch(_),
+            ..
+        })
+    ));
+    // A moved vertex is another scene too.
+    let mut moved = cache.mesh.clone();
+    moved.append(&made(2).mesh);
+    assert_ne!(scene_hash(&moved), scene_hash(&cache.mesh));
+}
+
+#[test]
+fn inconsistent_parts_are_refused() {
+    let cache = made(2);
+    let mut params = cache.params.clone();
+    params.resolution = 8;
+    assert!(
+        SceneCache::new(
+            params,
+            cache.mesh.clone(),
+            cache.albedo.clone(),
+            cache.transport.clone()
+        )
+        .is_err()
+    );
+    let short = cache.albedo.slice(ndarray::s![1.., ..]).to_owned();
+    assert!(SceneCache::new(cache.params.clone(), cache.mesh, short, cache.transport).is_err());
+}

@@ -1,0 +1,62 @@
+//! What can be wrong with a scene: its mesh, its scene file or its cache.
+//!
+//! [`SceneError`] names the problem; [`crate::Error::Scene`] adds the file it was found in (when
+//! there is one), so the CLI prints one line such as
+//! `bunny.ply: triangle 12 refers to vertex 2000 but there are 1839 vertices`.
+
+/// A problem with a scene's content: a mesh, a scene file or a scene cache.
+///
+/// ```
+/// use haarshift::relight::SceneError;
+/// let e = SceneError::NoFaces;
+/// assert_eq!(e.to_string(), "the mesh has no triangles");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// The mesh has no triangles (a point cloud, or faces that all failed to parse).
+    #[error("the mesh has no triangles")]
+    NoFaces,
+    /// A triangle names a vertex the mesh does not have.
+    #[error("triangle {triangle} refers to vertex {index} but there are {vertices} vertices")]
+    IndexOutOfRange {
+        /// The triangle, 0-based.
+        triangle: usize,
+        /// The vertex index it names, 0-based.
+        index: u64,
+        /// Vertices in the mesh.
+        vertices: usize,
+    },
+    /// A vertex position or normal is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite {what} ({value})")]
+    NonFinite {
+        /// The vertex, 0-based.
+        vertex: usize,
+        /// `position` or `normal`.
+        what: &'static str,
+        /// The offending component.
+        value: f64,
+    },
+    /// The file cannot be parsed: truncated, corrupt, or a layout that is not a triangle mesh.
+    #[error("not a readable mesh: {0}")]
+    Corrupt(String),
+    /// The scene file is not valid (bad JSON, unknown key, bad value).
+    #[error("invalid scene file: {0}")]
+    SceneFile(String),
+    /// The cache file is damaged: its checksum does not match, or it is cut short.
+    #[error("scene cache is damaged ({0}); compute it again")]
+    CacheCorrupt(String),
+    /// The cache file was written by another version of the format.
+    #[error(
+        "scene cache has format version {found}, this build reads version {expected}; compute it again"
+    )]
+    CacheVersion {
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads and writes.
+        expected: u32,
+    },
+    /// The cache file was made for another scene or with other parameters.
+    #[error("scene cache was made for another scene ({0}); compute it again")]
+    CacheMismatch(String),
+}

@@ -1,0 +1,58 @@
+//! All-frequency relighting: meshes and scenes, ray casting, per-vertex visibility and
+//! transport precomputation, and the scene cache.
+//!
+//! | file | idea |
+//! |---|---|
+//! | [`error`] | [`SceneError`]: what can be wrong with a mesh, a scene file or a cache |
+//! | [`mesh`] | [`Mesh`]: OBJ and PLY in, vertex normals |
+//! | [`scene`] | the ground plane, procedural generators, the JSON scene file ([`Scene`]) |
+//! | [`raycast`] | [`Occlusion`], the any-hit query, answered by [`SceneBvh`] |
+//! | [`shadowmap`] | [`ShadowMap`], seed 003's orthographic depth buffer along one direction |
+//! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
+//! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
+//! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
+//!
+//! Conventions are the sphere module's: world Y up, right-handed, directions as in
+//! [`sphere::latlong`](crate::sphere::latlong), rotations `R = Rz(roll) Ry(yaw) Rx(pitch)`.
+//! The transport is the one factor of a product integral that carries the texel solid angle
+//! ([`crate::product::Transport`]).
+pub mod cache;
+pub mod error;
+pub mod mesh;
+pub mod raycast;
+pub mod scene;
+pub mod shadowmap;
+pub mod transport;
+pub mod visibility;
+
+pub use cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
+pub use error::SceneError;
+pub use mesh::{Bounds, Mesh};
+pub use raycast::{Occlusion, SceneBvh};
+pub use scene::{
+    CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
+    add_ground_plane,
+};
+pub use shadowmap::ShadowMap;
+pub use transport::TransportSet;
+pub use visibility::{
+    PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major,
+};
+
+/// The [`SceneError`] of a refusal that names the file `path`; panics on anything else.
+#[cfg(test)]
+pub(crate) fn refusal_in<T: std::fmt::Debug>(
+    result: crate::Result<T>,
+    path: &std::path::Path,
+) -> SceneError {
+    match result {
+        Err(crate::Error::Scene {
+            path: Some(p),
+            source,
+        }) if p == path => source,
+        other => panic!(
+            "expected a scene error naming {}, got {other:?}",
+            path.display()
+        ),
+    }
+}

@@ -1,0 +1,68 @@
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use super::*;
+use crate::relight::{Scene, add_ground_plane};
+
+fn bunny_on_ground() -> Mesh {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
+    let mut mesh = Mesh::load(path.as_ref()).unwrap();
+    add_ground_plane(&mut mesh);
+    mesh
+}
+
+/// The oracle: every triangle tested, the same intersection routine.
+fn brute_force(bvh: &SceneBvh, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
+    let ray = Ray::new(
+        Vec3A::from_array(origin),
+        Vec3A::from_array(direction),
+        0.0,
+        t_max,
+    );
+    bvh.triangles.iter().any(|t| {
+        let hit = t.intersect(&ray);
+        hit.is_finite() && hit <= t_max
+    })
+}
+
+#[test]
+fn bvh_answers_as_testing_every_triangle() {
+    let mesh = bunny_on_ground();
+    let bvh = SceneBvh::new(&mesh);
+    assert_eq!(bvh.triangles.len(), mesh.triangles().len()); // none degenerate here
+    let b = mesh.bounds();
+    let mut rng = StdRng::seed_from_u64(11);
+    let mut hits = 0;
+    for k in 0..20_000 {
+        let origin: [f32; 3] = std::array::from_fn(|i| {
+            // Half the rays start near vertices (the visibility case), half anywhere.
+            if k % 2 == 0 {
+                let v = (k / 2) % mesh.vertex_count();
+                (mesh.positions()[[v, i]] + 1e-3 * mesh.normals()[[v, i]]) as f32
+            } else {
+                rng.random_range(b.min[i]..=b.max[i]) as f32
+            }
+        });
+        let d: [f32; 3] = std::array::from_fn(|_| rng.random_range(-1.0f32..1.0));
+        let len = d.iter().map(|x| x * x).sum::<f32>().sqrt();
+        let d = d.map(|x| x / len);
+        let t_max = if k % 3 == 0 { 2.0 } else { f32::INFINITY };
+        let want = brute_force(&bvh, origin, d, t_max);
+        assert_eq!(bvh.occluded(origin, d, t_max), want, "ray {k}");
+        hits += usize::from(want);
+    }
+    // Both outcomes are well represented.
+    assert!((4_000..16_000).contains(&hits), "{hits}");
+}
+
+#[test]
+fn degenerate_triangles_never_occlude() {
+    let positions = ndarray::array![[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]];
+    let mesh = Mesh::new(positions, vec![[0, 1, 2], [0, 0, 1]], None).unwrap();
+    let bvh = SceneBvh::new(&mesh);
+    assert!(bvh.triangles.is_empty());
+    assert!(!bvh.occluded([0.5, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
+    // A scene built the usual way is unaffected by such triangles.
+    let scene = Scene::from_mesh(mesh, true);
+    assert!(SceneBvh::new(&scene.mesh).occluded([0.5, 2.0, 0.0], [0.0, -1.0, 0.0], 10.0));
+}

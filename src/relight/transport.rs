@@ -1,0 +1,181 @@
+//! Per-vertex transport, stored sparse: what the precomputation makes and the cache keeps.
+//!
+//! For vertex `v` the transport is the function on the sphere's texels
+//! `T_v(t) = V(v, t) max(0, n_v . w_t) dOmega_t` (seed 001 eq. 3.9: visibility x cosine, with
+//! the texel solid angle folded in, [`crate::product::Transport`]), Haar-transformed
+//! (orthonormal, face by face) and truncated to the coefficients a [`Selection`] keeps. Only the
+//! kept non-zero coefficients are stored: for each vertex a run of `(index, value)` pairs, all
+//! vertices in three flat arrays (offsets, indices, values), no allocation per vertex. The
+//! index of a coefficient is its row-major position in the `(faces, S, S)` Mallat array (face
+//! after face, each face a full-depth pyramid of
+//! [`transform::pyramid`](crate::transform::pyramid)); the face's scaling coefficient is at
+//! `(face, 0, 0)`.
+
+use ndarray::{Array3, Array4, ArrayView3, Axis};
+
+use crate::product::{HaarTree, Selection, Transport, WeightedPixels};
+use crate::sphere::Parameterization;
+use crate::sphere::integrate::layout;
+use crate::{Error, Result};
+
+/// The sparse transport of every vertex; see the [module docs](self).
+///
+/// ```
+/// use haarshift::product::Selection;
+/// use haarshift::relight::TransportSet;
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use ndarray::Array3;
+/// let param = Parameterization::new(ParamKind::LatLong, 4).unwrap();
+/// let mut set = TransportSet::new(param, Selection::Largest(3));
+/// // One vertex that sees every texel with cosine 1: its transport is the solid angle.
+/// set.push(Array3::ones((2, 4, 4)).view()).unwrap();
+/// let t = set.transport(0).unwrap();
+/// let total: f32 = t.tree().to_pixels().unwrap().sum();
+/// assert!((total - 4.0 * std::f32::consts::PI).abs() < 1e-5);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransportSet {
+    param: Parameterization,
+    keep: Selection,
+    weights: Array3<f32>,
+    offsets: Vec<u64>,
+    indices: Vec<u32>,
+    values: Vec<f32>,
+}
+
+impl TransportSet {
+    /// An empty set for `param`, truncating each vertex's transport with `keep`.
+    pub fn new(param: Parameterization, keep: Selection) -> Self {
+        TransportSet {
+            param,
+            keep,
+            weights: param.solid_angles().mapv(|w| w as f32),
+            offsets: vec![0],
+            indices: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+
+    /// The set from stored parts (the cache): checked for consistency.
+    pub(crate) fn from_parts(
+        param: Parameterization,
+        keep: Selection,
+        offsets: Vec<u64>,
+        indices: Vec<u32>,
+        values: Vec<f32>,
+    ) -> Result<Self> {
+        let texels = param.texels() as u32;
+        let consistent = offsets.first() == Some(&0)
+            && offsets.windows(2).all(|w| w[0] <= w[1])
+            && offsets.last().copied() == Some(indices.len() as u64)
+            && indices.len() == values.len()
+            && indices.iter().all(|&i| i < texels)
+            && values.iter().all(|v| v.is_finite());
+        if !consistent {
+            return Err(Error::parameter(
+                "transport",
+                "offsets, indices and values do not describe sparse trees of this resolution",
+            ));
+        }
+        Ok(TransportSet {
+            weights: param.solid_angles().mapv(|w| w as f32),
+            param,
+            keep,
+            offsets,
+            indices,
+            values,
+        })
+    }
+
+    /// Encodes one more vertex from its unweighted values `V x max(0, n . w)`, `(faces, S, S)`:
+    /// weighted by the solid angles, transformed, truncated, stored.
+    pub fn push(&mut self, values: ArrayView3<'_, f32>) -> Result<()> {
+        let (indices, coefficients) = encode(values, self.weights.view(), self.param, self.keep)?;
+        self.extend(&indices, &coefficients);
+        Ok(())
+    }
+
+    /// Appends one vertex's already encoded coefficients.
+    pub(crate) fn extend(&mut self, indices: &[u32], values: &[f32]) {
+        self.indices.extend_from_slice(indices);
+        self.values.extend_from_slice(values);
+        self.offsets.push(self.indices.len() as u64);
+    }
+
+    /// The parameterisation the transport is sampled in.
+    pub fn param(&self) -> Parameterization {
+        self.param
+    }
+
+    /// The truncation applied to each vertex.
+    pub fn keep(&self) -> Selection {
+        self.keep
+    }
+
+    /// Vertices stored.
+    pub fn vertex_count(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Vertex `v`'s stored coefficients: Mallat indices and values.
+    pub fn coefficients(&self, v: usize) -> (&[u32], &[f32]) {
+        let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
+        (&self.indices[a..b], &self.values[a..b])
+    }
+
+    /// The flat arrays: per-vertex offsets (`V + 1`), indices, values.
+    pub(crate) fn parts(&self) -> (&[u64], &[u32], &[f32]) {
+        (&self.offsets, &self.indices, &self.values)
+    }
+
+    /// Bytes held by the coefficient arrays.
+    pub fn stored_bytes(&self) -> usize {
+        self.offsets.len() * 8 + self.indices.len() * 4 + self.values.len() * 4
+    }
+
+    /// Vertex `v`'s transport as a tree for [`product_integral`](crate::product::product_integral).
+    pub fn transport(&self, v: usize) -> Result<Transport<f32, 1>> {
+        if v >= self.vertex_count() {
+            return Err(Error::parameter(
+                "vertex",
+                format!("{v}: there are {} vertices", self.vertex_count()),
+            ));
+        }
+        let s = self.param.face_size();
+        let mut dense = Array4::<f32>::zeros((self.param.faces(), s, s, 1));
+        let flat = dense.as_slice_mut().expect("fresh array is contiguous");
+        let (indices, values) = self.coefficients(v);
+        for (&i, &c) in indices.iter().zip(values) {
+            flat[i as usize] = c;
+        }
+        // Threshold 0 keeps exactly the stored (non-zero) coefficients.
+        let tree = HaarTree::from_coefficients(
+            dense.view(),
+            layout(self.param),
+            Selection::Threshold(0.0),
+        )?;
+        Ok(Transport::from_weighted_tree(tree))
+    }
+}
+
+/// Weights `values` by `weights`, transforms, keeps what `keep` picks: the non-zero kept
+/// coefficients with their Mallat indices.
+pub(crate) fn encode(
+    values: ArrayView3<'_, f32>,
+    weights: ArrayView3<'_, f32>,
+    param: Parameterization,
+    keep: Selection,
+) -> Result<(Vec<u32>, Vec<f32>)> {
+    let pixels = WeightedPixels::<f32, 1>::new(values.insert_axis(Axis(3)), weights)?;
+    let transport = Transport::new(&pixels, layout(param), keep)?;
+    let coefficients = transport.tree().to_coefficients();
+    let mut indices = Vec::new();
+    let mut kept = Vec::new();
+    for (i, &c) in coefficients.iter().enumerate() {
+        if c != 0.0 {
+            indices.push(i as u32);
+            kept.push(c);
+        }
+    }
+    Ok((indices, kept))
+}
