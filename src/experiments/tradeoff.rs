@@ -122,7 +122,8 @@ impl TradeoffGrid {
     /// use haarshift::experiments::tradeoff::TradeoffGrid;
     /// assert!(TradeoffGrid::default().validate().is_ok());
     /// let grid = TradeoffGrid { max_supersample: 99, ..Default::default() };
-    /// assert!(grid.validate().is_err());
+    /// let err = grid.validate();
+    /// assert!(matches!(err, Err(haarshift::Error::InvalidParameter { name: "supersample", .. })));
     /// ```
     pub fn validate(&self) -> Result<()> {
         if self.max_supersample > MAX_SUPERSAMPLE {
@@ -379,13 +380,18 @@ mod tests {
             max_supersample: s,
         };
         assert!(grid(20, 20, 8).validate().is_ok());
-        for bad in [
-            grid(21, 0, 0),
-            grid(0, 21, 0),
-            grid(0, 0, 9),
-            grid(u32::MAX, 1, 1),
+        for (bad, name) in [
+            (grid(21, 0, 0), "precision"),
+            (grid(0, 21, 0), "precision"),
+            (grid(0, 0, 9), "supersample"),
+            (grid(u32::MAX, 1, 1), "precision"),
         ] {
-            assert!(bad.validate().is_err(), "{bad:?}");
+            assert_err!(
+                bad.validate(),
+                InvalidParameter { .. },
+                name,
+                "above the maximum"
+            );
         }
     }
 

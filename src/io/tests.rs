@@ -446,7 +446,12 @@ fn existing_outputs_are_kept_unless_forced_and_no_temporary_files_remain() {
     assert_eq!(read_image::<f64>(&path).unwrap(), second);
     // A failing write (JPEG with alpha) leaves nothing behind.
     let rgba = pattern(Channels::Rgba, SampleDepth::U8, 2, 2);
-    assert!(write_image(&rgba, dir.path().join("x.jpg"), forced).is_err());
+    assert_err!(
+        write_image(&rgba, dir.path().join("x.jpg"), forced),
+        Format { .. },
+        "x.jpg",
+        "alpha channel"
+    );
     let names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -485,7 +490,12 @@ fn reading_leaves_the_input_untouched_and_outputs_may_not_be_inputs() {
     );
     assert_eq!(before, after);
 
-    assert!(ensure_distinct_paths(&path, &path).is_err());
+    assert_err!(
+        ensure_distinct_paths(&path, &path),
+        Io { .. },
+        "in.tif",
+        "is the input file"
+    );
     #[cfg(unix)]
     {
         let link = dir.path().join("link.tif");
@@ -494,7 +504,12 @@ fn reading_leaves_the_input_untouched_and_outputs_may_not_be_inputs() {
         assert_names(&err, &link, "is the input file");
         let hard = dir.path().join("hard.tif");
         std::fs::hard_link(&path, &hard).unwrap();
-        assert!(ensure_distinct_paths(&path, &hard).is_err());
+        assert_err!(
+            ensure_distinct_paths(&path, &hard),
+            Io { .. },
+            "hard.tif",
+            "is the input file"
+        );
     }
     assert!(ensure_distinct_paths(&path, &dir.path().join("new.tif")).is_ok());
 }

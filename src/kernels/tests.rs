@@ -363,14 +363,42 @@ fn shear_rows_rejects_bad_input() {
     let rows = array![[1.0, 2.0]];
     let run =
         |shifts: &[f64], len_out, rule| shear_rows(rows.view(), len_out, shifts, k.as_ref(), rule);
-    assert!(run(&[f64::NAN], 2, Outside::Fill(0.0)).is_err());
-    assert!(run(&[f64::INFINITY], 2, Outside::Fill(0.0)).is_err());
-    assert!(run(&[1e300], 2, Outside::Fill(0.0)).is_err());
-    assert!(run(&[0.5, 0.5], 2, Outside::Fill(0.0)).is_err());
-    assert!(run(&[0.5], 0, Outside::Fill(0.0)).is_err());
-    assert!(run(&[0.5], 2, Outside::Fill(f64::NAN)).is_err());
+    assert_err!(
+        run(&[f64::NAN], 2, Outside::Fill(0.0)),
+        InvalidParameter { name: "shift", .. },
+        "NaN is not a finite shift"
+    );
+    assert_err!(
+        run(&[f64::INFINITY], 2, Outside::Fill(0.0)),
+        InvalidParameter { name: "shift", .. },
+        "inf is not a finite shift"
+    );
+    assert_err!(
+        run(&[1e300], 2, Outside::Fill(0.0)),
+        InvalidParameter { name: "shift", .. },
+        "at most 1e15"
+    );
+    assert_err!(
+        run(&[0.5, 0.5], 2, Outside::Fill(0.0)),
+        InvalidShape { .. },
+        "2 shifts for 1 rows"
+    );
+    assert_err!(
+        run(&[0.5], 0, Outside::Fill(0.0)),
+        InvalidShape { .. },
+        "rows must not be empty"
+    );
+    assert_err!(
+        run(&[0.5], 2, Outside::Fill(f64::NAN)),
+        InvalidParameter { name: "fill", .. },
+        "NaN"
+    );
     let nan = array![[1.0, f64::NAN]];
-    assert!(shear_rows(nan.view(), 2, &[0.5], k.as_ref(), Outside::Fill(0.0)).is_err());
+    assert_err!(
+        shear_rows(nan.view(), 2, &[0.5], k.as_ref(), Outside::Fill(0.0)),
+        NonFinite { .. },
+        "NaN at index [0, 1]"
+    );
     // Far shifts are fine and give the outside.
     let far = run(&[1e12 + 0.5], 2, Outside::Fill(3.0)).unwrap();
     assert_eq!(far, array![[3.0, 3.0]]);

@@ -77,7 +77,11 @@ fn angles_reduce_exactly() {
     let r = reduce_angle(1e300).unwrap();
     assert!(r.residual_deg.abs() <= 45.0 && r.quarter_turns < 4);
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        assert!(reduce_angle(bad).is_err());
+        assert_err!(
+            reduce_angle(bad),
+            InvalidParameter { name: "angle", .. },
+            "not a finite number of degrees"
+        );
     }
 }
 
@@ -279,12 +283,28 @@ fn tiny_and_degenerate_images() {
     assert_eq!(r.dim(), (1, 9));
     assert_eq!(r[[0, 4]], 4.0, "the centre pixel stays");
     let empty = Array2::<f64>::zeros((0, 4));
-    assert!(rotate_plane(empty.view(), 10.0, k.as_ref(), &RotateOptions::default()).is_err());
+    assert_err!(
+        rotate_plane(empty.view(), 10.0, k.as_ref(), &RotateOptions::default()),
+        InvalidShape { .. },
+        "image is empty"
+    );
     let nan = array![[1.0, f64::NAN]];
-    assert!(rotate_plane(nan.view(), 10.0, k.as_ref(), &RotateOptions::default()).is_err());
-    assert!(rotate_plane(one.view(), f64::NAN, k.as_ref(), &RotateOptions::default()).is_err());
+    assert_err!(
+        rotate_plane(nan.view(), 10.0, k.as_ref(), &RotateOptions::default()),
+        NonFinite { .. },
+        "index [0, 1]"
+    );
+    assert_err!(
+        rotate_plane(one.view(), f64::NAN, k.as_ref(), &RotateOptions::default()),
+        InvalidParameter { name: "angle", .. },
+        "NaN"
+    );
     let bad_fill = options(Canvas::Same, Outside::Fill(f64::INFINITY));
-    assert!(rotate_plane(one.view(), 10.0, k.as_ref(), &bad_fill).is_err());
+    assert_err!(
+        rotate_plane(one.view(), 10.0, k.as_ref(), &bad_fill),
+        InvalidParameter { name: "fill", .. },
+        "inf"
+    );
 }
 
 #[test]
@@ -334,7 +354,14 @@ fn supersampling_is_validated_and_exact_on_quarter_turns() {
         supersample: MAX_SUPERSAMPLE + 1,
         ..Default::default()
     };
-    assert!(rotate_plane(p.view(), 10.0, k.as_ref(), &too_fine).is_err());
+    assert_err!(
+        rotate_plane(p.view(), 10.0, k.as_ref(), &too_fine),
+        InvalidParameter {
+            name: "supersample",
+            ..
+        },
+        "at most 8"
+    );
     let small_budget = RotateOptions {
         memory_budget: 1000,
         ..Default::default()

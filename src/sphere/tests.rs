@@ -198,12 +198,26 @@ fn selected_coefficients_equal_the_recursive_ones() {
         row: 0,
         column: 0,
     };
-    assert!(rotate_selected(&f, &r, &[scaling]).is_err());
+    assert_err!(
+        rotate_selected(&f, &r, &[scaling]),
+        InvalidParameter {
+            name: "coefficient",
+            ..
+        },
+        "not a detail coefficient"
+    );
     let outside = CoefficientIndex {
         level: 4,
         ..requests[0]
     };
-    assert!(rotate_selected(&f, &r, &[outside]).is_err());
+    assert_err!(
+        rotate_selected(&f, &r, &[outside]),
+        InvalidParameter {
+            name: "coefficient",
+            ..
+        },
+        "level: 4"
+    );
 }
 
 /// Largest error of the chain-rule derivatives `-V / delta` and `-U / delta` of a rotated
@@ -348,9 +362,20 @@ fn coefficient_files_hold_the_generic_pyramid_of_each_channel() {
     assert!(err < 1e-12, "{err}");
     // Five channels have no image layout.
     let five = LatLongMap::<f64>::from_fn(2, 5, |_, o| o.fill(1.0)).unwrap();
-    assert!(five.to_image(crate::SampleDepth::F64).is_err());
+    assert_err!(
+        five.to_image(crate::SampleDepth::F64),
+        InvalidParameter {
+            name: "channels",
+            ..
+        },
+        "5 channels"
+    );
     let square = image.map_planes(|p| Ok(p.slice(ndarray::s![.., ..16]).to_owned()));
-    assert!(LatLongMap::from_image(&square.unwrap()).is_err());
+    assert_err!(
+        LatLongMap::from_image(&square.unwrap()),
+        InvalidShape { .. },
+        "twice as wide as it is high"
+    );
 }
 
 #[test]
@@ -406,23 +431,52 @@ fn bad_input_is_an_error() {
         level: Some(4),
         ..Default::default()
     };
-    assert!(rotate_map(&f, &r, &too_deep).is_err());
+    assert_err!(
+        rotate_map(&f, &r, &too_deep),
+        InvalidParameter { name: "level", .. },
+        "detail levels 0..=3"
+    );
     let odd = LatLongMap::<f64>::from_fn(12, 1, |_, o| o[0] = 1.0).unwrap();
-    assert!(rotate_map(&odd, &r, &SphereOptions::default()).is_err());
+    assert_err!(
+        rotate_map(&odd, &r, &SphereOptions::default()),
+        InvalidShape { .. },
+        "[12, 24]",
+        "power of two"
+    );
     let few = SphereOptions {
         method: Method::Reference,
         reference_samples: 0,
         ..Default::default()
     };
-    assert!(rotate_map(&f, &r, &few).is_err());
-    assert!(SphereRotation::from_degrees(0.0, f64::INFINITY, 0.0).is_err());
-    assert!(
-        SphereRotation::from_matrix([[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]).is_err()
+    assert_err!(
+        rotate_map(&f, &r, &few),
+        InvalidParameter {
+            name: "samples",
+            ..
+        },
+        "0 samples per axis"
+    );
+    assert_err!(
+        SphereRotation::from_degrees(0.0, f64::INFINITY, 0.0),
+        InvalidParameter { name: "pitch", .. },
+        "inf degrees"
+    );
+    assert_err!(
+        SphereRotation::from_matrix([[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+        InvalidParameter {
+            name: "rotation",
+            ..
+        },
+        "not a rotation matrix"
     );
     let mut nan = f.clone().into_array();
     nan[[3, 4, 0]] = f64::NAN;
-    assert!(LatLongMap::new(nan).is_err());
-    assert!(LatLongMap::<f64>::from_fn(0, 1, |_, _| ()).is_err());
+    assert_err!(LatLongMap::new(nan), NonFinite { .. }, "index [3, 4, 0]");
+    assert_err!(
+        LatLongMap::<f64>::from_fn(0, 1, |_, _| ()),
+        InvalidShape { .. },
+        "1 to 2^20 rows"
+    );
 }
 
 /// The pixel of an `h`-row map that contains direction `d`.

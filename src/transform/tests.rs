@@ -235,13 +235,15 @@ fn rejects_empty_non_finite_and_impossible_levels() {
         deep.forward(Array2::<f64>::zeros((4, 8)).view()),
         Err(Error::InvalidParameter { .. })
     ));
-    assert!(
+    assert_err!(
         pyramid::forward(
             Array2::<f64>::zeros((3, 4)).view(),
             0,
             Normalization::Average
-        )
-        .is_err()
+        ),
+        InvalidShape { .. },
+        "[3, 4]",
+        "powers of two"
     );
 }
 
@@ -261,9 +263,21 @@ fn band_accessors_find_the_documented_places() {
         );
         assert_eq!(c.get(Band::Diagonal, l, n, 0), None);
     }
-    assert!(c.band(Band::Horizontal, 3).is_err());
-    assert!(c.band(Band::Scaling, 1).is_err());
-    assert!(c.separable_band(Band1d::Scaling, Band1d::Scaling).is_err());
+    assert_err!(
+        c.band(Band::Horizontal, 3),
+        InvalidParameter { name: "level", .. },
+        "detail level 3"
+    );
+    assert_err!(
+        c.band(Band::Scaling, 1),
+        InvalidParameter { name: "level", .. },
+        "level 0 only"
+    );
+    assert_err!(
+        c.separable_band(Band1d::Scaling, Band1d::Scaling),
+        InvalidParameter { name: "band", .. },
+        "separable layout"
+    );
 }
 
 #[test]
@@ -276,12 +290,20 @@ fn from_parts_checks_consistency() {
         original_shape: [3, 9],
         ..info
     };
-    assert!(Coefficients::from_parts(data.clone(), wrong).is_err());
+    assert_err!(
+        Coefficients::from_parts(data.clone(), wrong),
+        InvalidShape { .. },
+        "original image of 3x9"
+    );
     let deep = TransformInfo {
         levels: [5, 5],
         ..info
     };
-    assert!(Coefficients::from_parts(data, deep).is_err());
+    assert_err!(
+        Coefficients::from_parts(data, deep),
+        InvalidParameter { name: "levels", .. },
+        "[5, 5] do not fit"
+    );
 }
 
 proptest! {
