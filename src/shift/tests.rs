@@ -189,7 +189,8 @@ fn large_image_uses_the_coarse_stage_and_f32_matches() {
     let c32 = c.mapv(|v| v as f32);
     let got32 = dense::shift_pyramid(c32.view(), levels, Normalization::Average, dx, dy).unwrap();
     let err = max_diff(&got32.mapv(f64::from), &want);
-    assert!(err < 1e-4, "f32 error {err}");
+    // Measured 6.9e-7 (f32 rounding of values about 1); bound 4x.
+    assert!(err < 3e-6, "f32 error {err}");
 }
 
 /// `x` rolled periodically: `out[r][c] = x[r - dy][c - dx]`.
@@ -677,7 +678,8 @@ fn sparse_queries_agree_with_the_dense_shift() {
     let dense = dense::shift_pyramid(c.view(), 6, norm, dx, dy).unwrap();
     let query = ShiftQuery2d::new(c.view(), 6, norm).unwrap();
     let coarse = query.coarse(dx, dy, 3).unwrap();
-    assert!(max_diff(&coarse, dense.slice(s![..8, ..16])) < 1e-10);
+    // Measured 9.8e-15; bound 10x.
+    assert!(max_diff(&coarse, dense.slice(s![..8, ..16])) < 1e-13);
     let which = [
         (Band::Scaling, 0, 0, 1),
         (Band::Diagonal, 5, 31, 63),
@@ -694,7 +696,8 @@ fn sparse_queries_agree_with_the_dense_shift() {
     let (dx, dy) = (GridShift::whole(-40), GridShift::whole(16));
     let dense = dense::shift_pyramid(c.view(), 6, norm, dx, dy).unwrap();
     let block = low.coarse(dx, dy, 3).unwrap();
-    assert!(max_diff(&block, dense.slice(s![..8, ..16])) < 1e-10);
+    // Measured 1.3e-15; bound 75x (TOL).
+    assert!(max_diff(&block, dense.slice(s![..8, ..16])) < TOL);
     assert_err!(
         low.coefficient(GridShift::whole(4), dy, Band::Scaling, 0, 0, 0),
         InvalidParameter { name: "shift", .. },
