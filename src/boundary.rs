@@ -91,6 +91,13 @@ mod tests {
         for &m in BoundaryMode::ALL {
             assert_eq!(m.name().parse::<BoundaryMode>().unwrap(), m);
         }
-        assert!("mirror".parse::<BoundaryMode>().is_err());
+        assert_err!(
+            "mirror".parse::<BoundaryMode>(),
+            InvalidParameter {
+                name: "boundary mode",
+                ..
+            },
+            "unknown value \"mirror\""
+        );
     }
 }

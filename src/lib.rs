@@ -28,6 +28,10 @@
 //! in the `average` normalisation.
 #![warn(missing_docs)]
 
+#[cfg(test)]
+#[macro_use]
+mod test_support;
+
 mod boundary;
 mod error;
 pub mod experiments;

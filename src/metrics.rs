@@ -139,9 +139,17 @@ mod tests {
     #[test]
     fn rejects_mismatched_shapes_and_empty_masks() {
         let a = array![[1.0, 2.0]];
-        assert!(ErrorStats::between(a.view(), array![[1.0]].view(), None, 1.0).is_err());
+        assert_err!(
+            ErrorStats::between(a.view(), array![[1.0]].view(), None, 1.0),
+            InvalidShape { .. },
+            "one shape"
+        );
         let none = array![[false, false]];
-        assert!(ErrorStats::between(a.view(), a.view(), Some(none.view()), 1.0).is_err());
+        assert_err!(
+            ErrorStats::between(a.view(), a.view(), Some(none.view()), 1.0),
+            InvalidParameter { name: "mask", .. },
+            "selects no samples"
+        );
     }
 
     #[test]

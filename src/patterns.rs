@@ -83,6 +83,15 @@ mod tests {
         assert!((mean - 127.5).abs() < 3.0, "mean {mean}");
         // On the +x axis just above it (small positive angle): white; just below: black.
         assert_eq!(s[[63, 120]], 0.0); // y = -0.5 < 0: angle slightly negative
-        assert!(siemens_star(0, 4, 3).is_err() && siemens_star(4, 4, 0).is_err());
+        assert_err!(
+            siemens_star(0, 4, 3),
+            InvalidShape { .. },
+            "pattern is empty"
+        );
+        assert_err!(
+            siemens_star(4, 4, 0),
+            InvalidParameter { name: "spokes", .. },
+            "at least 1"
+        );
     }
 }

@@ -123,7 +123,8 @@ pub struct ReducedAngle {
 /// use haarshift::rotate::reduce_angle;
 /// let r = reduce_angle(-180.0).unwrap();
 /// assert_eq!((r.quarter_turns, r.residual_deg), (2, 0.0));
-/// assert!(reduce_angle(f64::NAN).is_err());
+/// let nan = reduce_angle(f64::NAN);
+/// assert!(matches!(nan, Err(haarshift::Error::InvalidParameter { name: "angle", .. })));
 /// ```
 pub fn reduce_angle(deg: f64) -> Result<ReducedAngle> {
     if !deg.is_finite() {

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{haarshift, p, text};
+use common::{p, succeeds_with_stdout};
 
 use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::kernels::{Outside, ShiftMethod, shift_plane};
@@ -40,13 +40,6 @@ fn save<T: Sample>(dir: &Path, name: &str, image: &PlanarImage<T>) -> std::path:
     path
 }
 
-/// Runs `haarshift ARGS`, requires success and returns standard output.
-fn ok(args: &[&str]) -> String {
-    let out = haarshift(args);
-    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
-    text(&out.stdout)
-}
-
 /// The library's keys rotation by 30 degrees (expanded canvas) of the file at `path`, in `T`.
 fn library_rotation<T: Sample>(path: &Path) -> PlanarImage<T> {
     let kernel = ShiftMethod::Keys.kernel::<T>();
@@ -78,7 +71,7 @@ fn rotate(input: &Path, output: &Path, extra: &[&str]) -> String {
         "expand",
     ];
     args.extend_from_slice(extra);
-    ok(&args)
+    succeeds_with_stdout(&args)
 }
 
 /// Whether two images differ in at least one sample.
@@ -174,7 +167,7 @@ fn shift_computes_in_f32_for_f32_files() {
     let flags = ["--method", "keys", "--dx", "0.3", "--dy", "-1.7"];
     let mut args = vec!["shift", p(&input), "-o", p(&out)];
     args.extend_from_slice(&flags);
-    let said = ok(&args);
+    let said = succeeds_with_stdout(&args);
     assert!(
         said.contains("shifted by (0.3, -1.7) with keys in f32"),
         "{said}"
@@ -228,7 +221,7 @@ fn float16_npy_reads_the_values_it_stores() {
 
         // Through the command line (f32, exact for half values): angle 0 copies them.
         let out = dir.path().join(format!("out-{little_endian}.npy"));
-        ok(&["rotate", p(&path), "-o", p(&out), "--angle", "0"]);
+        succeeds_with_stdout(&["rotate", p(&path), "-o", p(&out), "--angle", "0"]);
         let written = read_image::<f64>(&out).unwrap();
         assert_eq!(written.depth(), SampleDepth::F32);
         assert_eq!(written.plane(0).iter().copied().collect::<Vec<_>>(), values);
@@ -253,12 +246,12 @@ fn echoed_numbers_are_short() {
         ("-0", "0"),
     ] {
         let out = dir.path().join(format!("out{angle}.png"));
-        let said = ok(&["rotate", p(&input), "-o", p(&out), "--angle", angle]);
+        let said = succeeds_with_stdout(&["rotate", p(&input), "-o", p(&out), "--angle", angle]);
         let expected = format!("rotated by {shown} degrees");
         assert!(said.contains(&expected), "{said} lacks {expected}");
     }
     let out = dir.path().join("shifted.png");
-    let said = ok(&[
+    let said = succeeds_with_stdout(&[
         "shift",
         p(&input),
         "-o",

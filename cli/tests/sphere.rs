@@ -154,7 +154,8 @@ fn coefficients_are_a_readable_npy_with_sidecar_that_inverts_to_the_pixels() {
     let worst = (&a.as_array() - &b.as_array())
         .iter()
         .fold(0.0f32, |m, v| m.max(v.abs()));
-    assert!(worst < 1e-3, "inverse differs from the pixels by {worst}");
+    // Measured 1.2e-4 (2^-13: one f32 ulp of the largest values); bound 4x.
+    assert!(worst < 5e-4, "inverse differs from the pixels by {worst}");
 }
 
 #[test]

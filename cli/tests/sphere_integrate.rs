@@ -6,7 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{haarshift, p, text};
+use common::{fails_cleanly, p, succeeds_with_stdout};
 
 use haarshift::io::{WriteOptions, write_image};
 use haarshift::transform::{Normalization, pyramid};
@@ -89,12 +89,6 @@ fn integrals(stdout: &str) -> Vec<f64> {
         .collect()
 }
 
-fn run_ok(args: &[&str]) -> String {
-    let out = haarshift(args);
-    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
-    text(&out.stdout)
-}
-
 fn close(got: f64, want: f64, tolerance: f64) -> bool {
     (got - want).abs() <= tolerance * want.abs()
 }
@@ -112,7 +106,7 @@ fn the_printed_integral_is_the_pixel_sum_with_solid_angles() {
         let mut args = vec!["sphere", "integrate"];
         args.extend(paths.iter().map(|q| p(q)));
         args.extend(["--method", method]);
-        let got = integrals(&run_ok(&args));
+        let got = integrals(&succeeds_with_stdout(&args));
         assert_eq!(got.len(), 3, "{method}");
         for (c, &g) in got.iter().enumerate() {
             let want = pixel_sum(&maps, c);
@@ -138,8 +132,13 @@ fn keep_is_the_pixel_sum_of_the_pruned_maps() {
     let fk = pruned(&weighted, k);
     let gk = pruned(&g.index_axis(ndarray::Axis(0), 0).to_owned(), k);
     let want: f64 = (&fk * &gk).sum();
-    let full = integrals(&run_ok(&["sphere", "integrate", p(&fp), p(&gp)]))[0];
-    let got = integrals(&run_ok(&[
+    let full = integrals(&succeeds_with_stdout(&[
+        "sphere",
+        "integrate",
+        p(&fp),
+        p(&gp),
+    ]))[0];
+    let got = integrals(&succeeds_with_stdout(&[
         "sphere",
         "integrate",
         p(&fp),
@@ -153,7 +152,7 @@ fn keep_is_the_pixel_sum_of_the_pruned_maps() {
         "--keep {k} left the integral at {full}"
     );
     let json = dir.path().join("r.json");
-    run_ok(&[
+    succeeds_with_stdout(&[
         "sphere",
         "integrate",
         p(&fp),
@@ -170,18 +169,6 @@ fn keep_is_the_pixel_sum_of_the_pruned_maps() {
     assert!(records[0]["visited"].as_u64().unwrap() > 0);
 }
 
-/// Requires exit code 1 and one `haarshift: ...` line on stderr containing `needle`.
-fn fails(args: &[&str], needle: &str) {
-    let out = haarshift(args);
-    let err = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-    assert_eq!(err.lines().count(), 1, "{args:?}: {err:?}");
-    assert!(
-        err.starts_with("haarshift: ") && err.contains(needle),
-        "{args:?}: {err}"
-    );
-}
-
 #[test]
 fn bad_requests_fail_in_one_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -193,14 +180,23 @@ fn bad_requests_fail_in_one_line() {
     let nan = dir.path().join("nan.npy");
     ndarray_npy_write(&nan, &nan_planes);
     let (a, b, odd) = (p(&a), p(&b), p(&odd));
-    fails(&["sphere", "integrate", a, b], "different sizes");
-    fails(&["sphere", "integrate", odd, odd], "not a power of two");
-    fails(&["sphere", "integrate", a, a, "--keep", "512"], "only 510");
-    fails(&["sphere", "integrate", a, a, "--depth", "4"], "level 4");
-    fails(&["sphere", "integrate", a, p(&nan)], "nan.npy");
-    fails(
+    fails_cleanly(&["sphere", "integrate", a, b], &["different sizes"]);
+    fails_cleanly(&["sphere", "integrate", odd, odd], &["not a power of two"]);
+    fails_cleanly(
+        &["sphere", "integrate", a, a, "--keep", "512"],
+        &["keep", "only 510"],
+    );
+    fails_cleanly(
+        &["sphere", "integrate", a, a, "--depth", "4"],
+        &["depth", "level 4"],
+    );
+    fails_cleanly(
+        &["sphere", "integrate", a, p(&nan)],
+        &["nan.npy", "non-finite"],
+    );
+    fails_cleanly(
         &["sphere", "integrate", a, a, "--method", "triple"],
-        "exactly 3",
+        &["method", "exactly 3"],
     );
 }
 

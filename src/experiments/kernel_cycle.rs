@@ -224,7 +224,8 @@ pub fn default_images() -> Result<Vec<NamedPlane>> {
 /// ```
 /// let camera = haarshift::experiments::kernel_cycle::default_photograph("camera.png").unwrap();
 /// assert_eq!(camera.plane.dim(), (512, 512));
-/// assert!(haarshift::experiments::kernel_cycle::default_photograph("cat.png").is_err());
+/// let cat = haarshift::experiments::kernel_cycle::default_photograph("cat.png");
+/// assert!(matches!(cat, Err(haarshift::Error::InvalidParameter { name: "image", .. })));
 /// ```
 pub fn default_photograph(name: &str) -> Result<NamedPlane> {
     let (name, bytes) = PHOTOGRAPHS

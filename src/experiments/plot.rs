@@ -425,11 +425,19 @@ mod tests {
             x: 0.0,
             y: 1.0,
         }];
-        assert!(log_log_scatter("t", "x", "y", &pts, &[]).is_err());
+        assert_err!(
+            log_log_scatter("t", "x", "y", &pts, &[]),
+            InvalidParameter { name: "plot", .. },
+            "positive, finite"
+        );
         let s = Series {
             name: "s".into(),
             values: vec![None],
         };
-        assert!(category_points("t", "y", &["a".into()], &[s]).is_err());
+        assert_err!(
+            category_points("t", "y", &["a".into()], &[s]),
+            InvalidParameter { name: "plot", .. },
+            "positive, finite"
+        );
     }
 }

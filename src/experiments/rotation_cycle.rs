@@ -300,7 +300,14 @@ mod tests {
             .filter(|(a, b)| a * a + b * b <= 9.0)
             .count();
         assert_eq!(mask.iter().filter(|&&v| v).count(), direct);
-        assert!(measurement_mask(6, 3).is_err());
+        assert_err!(
+            measurement_mask(6, 3),
+            InvalidParameter {
+                name: "image size",
+                ..
+            },
+            "no pixels to measure"
+        );
     }
 
     #[test]
@@ -315,6 +322,10 @@ mod tests {
     #[test]
     fn rejects_zero_steps() {
         let plane = Array2::<f64>::zeros((8, 8));
-        assert!(run_cycle("z", plane.view(), &IDENTITY, 0, &NoMeter).is_err());
+        assert_err!(
+            run_cycle("z", plane.view(), &IDENTITY, 0, &NoMeter),
+            InvalidParameter { name: "steps", .. },
+            "at least 1"
+        );
     }
 }

@@ -92,7 +92,8 @@ impl PendingFile {
 /// let input = dir.path().join("in.png");
 /// std::fs::write(&input, b"x").unwrap();
 /// let same = dir.path().join(".").join("in.png");
-/// assert!(ensure_distinct_paths(&input, &same).is_err());
+/// let err = ensure_distinct_paths(&input, &same).unwrap_err();
+/// assert!(err.to_string().ends_with("in.png: is the input file; choose a different output"));
 /// assert!(ensure_distinct_paths(&input, &dir.path().join("out.png")).is_ok());
 /// ```
 pub fn ensure_distinct_paths(input: &Path, output: &Path) -> Result<()> {
@@ -135,7 +136,8 @@ fn is_same_file(a: &Path, b: &Path) -> bool {
 /// let path = dir.path().join("notes.txt");
 /// haarshift::io::write_file_atomically(&path, false, |w| w.write_all(b"hello")).unwrap();
 /// assert_eq!(std::fs::read(&path).unwrap(), b"hello");
-/// assert!(haarshift::io::write_file_atomically(&path, false, |w| w.write_all(b"again")).is_err());
+/// let again = haarshift::io::write_file_atomically(&path, false, |w| w.write_all(b"again"));
+/// assert!(matches!(again, Err(haarshift::Error::OutputExists { .. })));
 /// ```
 pub fn write_file_atomically(
     path: &Path,

@@ -155,13 +155,15 @@ fn jpeg_is_eight_bit_close_and_refuses_alpha() {
     let back = roundtrip(&eight, &dir.path().join("a.jpg"));
     assert_eq!(back.depth(), SampleDepth::U8);
     let err = max_abs_diff(&back, &eight);
-    assert!(err <= 6.0, "max error {err}");
+    // Measured 1 code value (1 for 16-bit input, 0 for gray); bound 3 (the decoder may take
+    // another SIMD path, and round differently, on another machine).
+    assert!(err <= 3.0, "max error {err}");
 
     // 16-bit input is scaled to 8 bits.
     let sixteen = smooth(257.0, SampleDepth::U16);
     let back16 = roundtrip(&sixteen, &dir.path().join("b.jpeg"));
     assert_eq!(back16.depth(), SampleDepth::U8);
-    assert!(max_abs_diff(&back16, &eight) <= 6.0);
+    assert!(max_abs_diff(&back16, &eight) <= 3.0);
 
     let gray = PlanarImage::new(
         eight.planes().slice(ndarray::s![..1, .., ..]).to_owned(),
@@ -171,7 +173,7 @@ fn jpeg_is_eight_bit_close_and_refuses_alpha() {
     .unwrap();
     let back_gray = roundtrip(&gray, &dir.path().join("g.jpg"));
     assert_eq!(back_gray.channels(), Channels::Gray);
-    assert!(max_abs_diff(&back_gray, &gray) <= 6.0);
+    assert!(max_abs_diff(&back_gray, &gray) <= 3.0);
 
     let rgba = pattern(Channels::Rgba, SampleDepth::U8, 4, 4);
     let err = write_image(&rgba, dir.path().join("c.jpg"), WriteOptions::default()).unwrap_err();
@@ -446,7 +448,12 @@ fn existing_outputs_are_kept_unless_forced_and_no_temporary_files_remain() {
     assert_eq!(read_image::<f64>(&path).unwrap(), second);
     // A failing write (JPEG with alpha) leaves nothing behind.
     let rgba = pattern(Channels::Rgba, SampleDepth::U8, 2, 2);
-    assert!(write_image(&rgba, dir.path().join("x.jpg"), forced).is_err());
+    assert_err!(
+        write_image(&rgba, dir.path().join("x.jpg"), forced),
+        Format { .. },
+        "x.jpg",
+        "alpha channel"
+    );
     let names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -485,7 +492,12 @@ fn reading_leaves_the_input_untouched_and_outputs_may_not_be_inputs() {
     );
     assert_eq!(before, after);
 
-    assert!(ensure_distinct_paths(&path, &path).is_err());
+    assert_err!(
+        ensure_distinct_paths(&path, &path),
+        Io { .. },
+        "in.tif",
+        "is the input file"
+    );
     #[cfg(unix)]
     {
         let link = dir.path().join("link.tif");
@@ -494,7 +506,12 @@ fn reading_leaves_the_input_untouched_and_outputs_may_not_be_inputs() {
         assert_names(&err, &link, "is the input file");
         let hard = dir.path().join("hard.tif");
         std::fs::hard_link(&path, &hard).unwrap();
-        assert!(ensure_distinct_paths(&path, &hard).is_err());
+        assert_err!(
+            ensure_distinct_paths(&path, &hard),
+            Io { .. },
+            "hard.tif",
+            "is the input file"
+        );
     }
     assert!(ensure_distinct_paths(&path, &dir.path().join("new.tif")).is_ok());
 }
@@ -522,7 +539,8 @@ fn coefficient_files_restore_images_exactly_for_every_layout_norm_and_padding() 
                     assert_eq!(back, coeffs, "stored exactly");
                     let restored = back.inverse().unwrap();
                     assert_eq!(restored.depth(), SampleDepth::U16);
-                    assert!(max_abs_diff(&restored, &image) < 1e-9);
+                    // Measured at most 7.3e-11 (values up to 65535); bound 4x.
+                    assert!(max_abs_diff(&restored, &image) < 3e-10);
                     let png = path.with_extension("png");
                     write_image(&restored, &png, WriteOptions::default()).unwrap();
                     assert_eq!(read_image::<f64>(&png).unwrap(), image);

@@ -61,7 +61,8 @@ impl BSpline {
     /// ```
     /// use haarshift::kernels::BSpline;
     /// assert_eq!(BSpline::new(5).unwrap(), BSpline::quintic());
-    /// assert!(BSpline::new(4).is_err());
+    /// let quartic = BSpline::new(4);
+    /// assert!(matches!(quartic, Err(haarshift::Error::InvalidParameter { name: "spline degree", .. })));
     /// ```
     pub fn new(degree: usize) -> Result<Self> {
         match degree {

@@ -277,7 +277,14 @@ mod tests {
 
     #[test]
     fn rejects_absurd_precision_and_names_its_mode() {
-        assert!(HaarShift::new(MAX_PRECISION + 1, false).is_err());
+        assert_err!(
+            HaarShift::new(MAX_PRECISION + 1, false),
+            InvalidParameter {
+                name: "precision",
+                ..
+            },
+            "above the maximum of 20"
+        );
         assert_eq!(
             ShearKernel::<f32>::name(&HaarShift::new(3, true).unwrap()),
             "haar(h=3, retained)"

@@ -35,7 +35,8 @@ pub fn keys_value(a: f64, x: f64) -> f64 {
 /// let ramp = array![[0.0f64, 1.0, 2.0, 3.0, 4.0, 5.0]];
 /// let out = shear_rows(ramp.view(), 6, &[0.5], &keys, Outside::Fill(0.0)).unwrap();
 /// assert!((out[[0, 3]] - 2.5).abs() < 1e-12);
-/// assert!(Keys::new(f64::NAN).is_err());
+/// let nan = Keys::new(f64::NAN);
+/// assert!(matches!(nan, Err(haarshift::Error::InvalidParameter { name: "keys a", .. })));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Keys {

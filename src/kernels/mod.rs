@@ -99,7 +99,8 @@ impl Outside {
     ///
     /// ```
     /// use haarshift::kernels::Outside;
-    /// assert!(Outside::Fill(f64::NAN).validate().is_err());
+    /// let nan = Outside::Fill(f64::NAN).validate();
+    /// assert!(matches!(nan, Err(haarshift::Error::InvalidParameter { name: "fill", .. })));
     /// assert!(Outside::Fill(1.0).validate().is_ok());
     /// ```
     pub fn validate(self) -> Result<Self> {
@@ -268,7 +269,8 @@ named_enum! {
     /// let m: ShiftMethod = "bspline3".parse().unwrap();
     /// assert_eq!(m, ShiftMethod::BSpline3);
     /// assert_eq!(m.kernel::<f32>().name(), "bspline3");
-    /// assert!("cubic".parse::<ShiftMethod>().is_err());
+    /// let err = "cubic".parse::<ShiftMethod>().unwrap_err();
+    /// assert!(err.to_string().contains("unknown value \"cubic\" (expected one of: nearest,"));
     /// ```
     pub enum ShiftMethod ("shift method") {
         /// Nearest neighbour.

@@ -78,7 +78,8 @@ impl FaceLayout {
 /// ```
 /// use haarshift::product::Selection;
 /// assert_eq!(Selection::Largest(200).limit(1000).unwrap(), Some(200));
-/// assert!(Selection::Largest(2000).limit(1000).is_err());
+/// let too_many = Selection::Largest(2000).limit(1000);
+/// assert!(matches!(too_many, Err(haarshift::Error::InvalidParameter { name: "keep", .. })));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Selection {

@@ -9,7 +9,9 @@ use crate::{Error, Result};
 /// faithfully in f32 (24-bit mantissa).
 ///
 /// ```
-/// assert!(haarshift::shift::GridShift::new(0.5, haarshift::shift::MAX_PRECISION + 1).is_err());
+/// use haarshift::{Error, shift::{GridShift, MAX_PRECISION}};
+/// let finer = GridShift::new(0.5, MAX_PRECISION + 1);
+/// assert!(matches!(finer, Err(Error::InvalidParameter { name: "precision", .. })));
 /// ```
 pub const MAX_PRECISION: u32 = 20;
 
@@ -29,7 +31,8 @@ pub const MAX_PRECISION: u32 = 20;
 /// assert_eq!(GridShift::new(0.125, 2).unwrap().amount(), 0.25); // tie: up
 /// assert_eq!(GridShift::new(-0.125, 2).unwrap().amount(), 0.0); // tie: up, not away from 0
 /// assert_eq!(GridShift::new(-1.125, 2).unwrap().amount(), -1.0); // = -1 + round(-0.125)
-/// assert!(GridShift::new(f64::NAN, 0).is_err());
+/// let nan = GridShift::new(f64::NAN, 0);
+/// assert!(matches!(nan, Err(haarshift::Error::InvalidParameter { name: "shift", .. })));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridShift {
@@ -197,7 +200,14 @@ mod tests {
         assert_eq!(GridShift::new(1e300, 0).unwrap().split(8).unwrap(), (0, 0));
         assert_eq!(GridShift::whole(-9).split(8).unwrap(), (7, 0));
         assert_eq!(GridShift::new(2.5, 1).unwrap().split(2).unwrap(), (0, 1));
-        assert!(GridShift::new(1.0, 20).unwrap().split(1 << 40).is_err());
+        assert_err!(
+            GridShift::new(1.0, 20).unwrap().split(1 << 40),
+            InvalidParameter {
+                name: "precision",
+                ..
+            },
+            "too fine for a period"
+        );
     }
 
     #[test]

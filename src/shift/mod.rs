@@ -162,7 +162,8 @@ use crate::{Result, Sample};
 /// assert_eq!(moved, array![[2.0, 3.0, 4.0, 1.0], [6.0, 7.0, 8.0, 5.0]]);
 /// let half = shift_image(&c, 0.5, 0.0, 1).unwrap().inverse().unwrap();
 /// assert_eq!(half.row(0), ndarray::aview1(&[2.5, 1.5, 2.5, 3.5]));
-/// assert!(shift_image(&c, f64::INFINITY, 0.0, 0).is_err());
+/// let inf = shift_image(&c, f64::INFINITY, 0.0, 0);
+/// assert!(matches!(inf, Err(haarshift::Error::InvalidParameter { name: "shift", .. })));
 /// ```
 pub fn shift_image<T: Sample>(
     coeffs: &Coefficients<T>,

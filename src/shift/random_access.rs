@@ -141,7 +141,8 @@ impl ShiftQuery1d {
     /// let s = GridShift::whole(-192); // 3 * 64
     /// let (a, b) = (coarse.coefficient(s, Band1d::Detail(2), 1), full.coefficient(s, Band1d::Detail(2), 1));
     /// assert!((a.unwrap() - b.unwrap()).abs() < 1e-9);
-    /// assert!(coarse.coefficient(GridShift::whole(1), Band1d::Detail(2), 1).is_err());
+    /// let off_grid = coarse.coefficient(GridShift::whole(1), Band1d::Detail(2), 1); // not a multiple of 64
+    /// assert!(matches!(off_grid, Err(haarshift::Error::InvalidParameter { name: "shift", .. })));
     /// ```
     pub fn with_resolution<T: Sample>(
         coeffs: ArrayView1<'_, T>,

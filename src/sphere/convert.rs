@@ -387,7 +387,21 @@ mod tests {
     #[test]
     fn bad_sample_counts_are_errors() {
         let f = rooitou();
-        assert!(convert(&f, param(ParamKind::Cube, 4), 0).is_err());
-        assert!(convert(&f, param(ParamKind::Cube, 4), 65).is_err());
+        assert_err!(
+            convert(&f, param(ParamKind::Cube, 4), 0),
+            InvalidParameter {
+                name: "samples",
+                ..
+            },
+            "0 cells per axis"
+        );
+        assert_err!(
+            convert(&f, param(ParamKind::Cube, 4), 65),
+            InvalidParameter {
+                name: "samples",
+                ..
+            },
+            "65 cells per axis"
+        );
     }
 }

@@ -387,23 +387,43 @@ mod tests {
     fn bad_requests_are_errors() {
         let (a, b) = (map(16, 1, 6), map(8, 1, 7));
         let d = IntegrateOptions::default();
-        assert!(integrate(&[a.clone(), b], &d).is_err());
+        assert_err!(
+            integrate(&[a.clone(), b], &d),
+            InvalidShape { .. },
+            "different sizes"
+        );
         let three = IntegrateOptions {
             method: IntegralMethod::Triple,
             ..Default::default()
         };
-        assert!(integrate(&[a.clone(), a.clone()], &three).is_err());
+        assert_err!(
+            integrate(&[a.clone(), a.clone()], &three),
+            InvalidParameter { name: "method", .. },
+            "exactly 3 maps"
+        );
         let deep = IntegrateOptions {
             depth: Some(4),
             ..Default::default()
         };
-        assert!(integrate(&[a.clone(), a.clone()], &deep).is_err());
+        assert_err!(
+            integrate(&[a.clone(), a.clone()], &deep),
+            InvalidParameter { name: "depth", .. },
+            "detail level 4"
+        );
         let many = IntegrateOptions {
             selections: vec![Selection::Largest(16 * 32)],
             ..Default::default()
         };
-        assert!(integrate(&[a.clone(), a.clone()], &many).is_err());
+        assert_err!(
+            integrate(&[a.clone(), a.clone()], &many),
+            InvalidParameter { name: "keep", .. },
+            "only 510 details"
+        );
         let odd = LatLongMap::<f64>::from_fn(6, 1, |_, o| o[0] = 1.0).unwrap();
-        assert!(integrate(&[odd.clone(), odd], &d).is_err());
+        assert_err!(
+            integrate(&[odd.clone(), odd], &d),
+            InvalidShape { .. },
+            "height 6 is not a power of two"
+        );
     }
 }

@@ -120,7 +120,8 @@ impl<T: Sample> LatLongMap<T> {
     /// use haarshift::sphere::LatLongMap;
     /// use ndarray::Array3;
     /// assert!(LatLongMap::new(Array3::<f32>::zeros((4, 8, 3))).is_ok());
-    /// assert!(LatLongMap::new(Array3::<f32>::zeros((4, 4, 3))).is_err());
+    /// let square = LatLongMap::new(Array3::<f32>::zeros((4, 4, 3)));
+    /// assert!(matches!(square, Err(haarshift::Error::InvalidShape { .. })));
     /// ```
     pub fn new(data: Array3<T>) -> Result<Self> {
         let (h, w, c) = data.dim();

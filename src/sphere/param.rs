@@ -47,7 +47,8 @@ const MAX_FACE_SIZE: usize = 1 << 15;
 /// assert_eq!((p.faces(), p.face_size(), p.texels()), (6, 16, 1536));
 /// let total: f64 = p.solid_angles().sum();
 /// assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-12);
-/// assert!(Parameterization::new(ParamKind::LatLong, 12).is_err()); // not a power of two
+/// let twelve = Parameterization::new(ParamKind::LatLong, 12); // not a power of two
+/// assert!(matches!(twelve, Err(haarshift::Error::InvalidParameter { name: "resolution", .. })));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Parameterization {
@@ -225,7 +226,8 @@ impl<T: Sample> SphereMap<T> {
     /// use ndarray::Array4;
     /// let p = Parameterization::new(ParamKind::Cube, 2).unwrap();
     /// assert!(SphereMap::new(p, Array4::<f32>::zeros((6, 2, 2, 3))).is_ok());
-    /// assert!(SphereMap::new(p, Array4::<f32>::zeros((2, 2, 2, 3))).is_err());
+    /// let two_faces = SphereMap::new(p, Array4::<f32>::zeros((2, 2, 2, 3)));
+    /// assert!(matches!(two_faces, Err(haarshift::Error::InvalidShape { .. })));
     /// ```
     pub fn new(param: Parameterization, data: Array4<T>) -> Result<Self> {
         let (f, s, s2, c) = data.dim();
@@ -455,19 +457,54 @@ mod tests {
     #[test]
     fn bad_shapes_and_values_are_errors() {
         let p = Parameterization::new(ParamKind::Cube, 2).unwrap();
-        assert!(SphereMap::new(p, Array4::<f64>::zeros((6, 2, 4, 1))).is_err());
-        assert!(SphereMap::new(p, Array4::<f64>::zeros((6, 2, 2, 0))).is_err());
+        assert_err!(
+            SphereMap::new(p, Array4::<f64>::zeros((6, 2, 4, 1))),
+            InvalidShape { .. },
+            "[6, 2, 4, 1]",
+            "(6, 6, 6, 1 to 64 channels)"
+        );
+        assert_err!(
+            SphereMap::new(p, Array4::<f64>::zeros((6, 2, 2, 0))),
+            InvalidShape { .. },
+            "[6, 2, 2, 0]",
+            "(6, 6, 6, 1 to 64 channels)"
+        );
         let mut nan = Array4::<f64>::zeros((6, 2, 2, 1));
         nan[[3, 1, 0, 0]] = f64::NAN;
         assert!(matches!(
             SphereMap::new(p, nan),
             Err(Error::NonFinite { .. })
         ));
-        assert!(Parameterization::new(ParamKind::Cube, 0).is_err());
-        assert!(Parameterization::new(ParamKind::Cube, 1 << 16).is_err());
+        assert_err!(
+            Parameterization::new(ParamKind::Cube, 0),
+            InvalidParameter {
+                name: "resolution",
+                ..
+            },
+            "0: a face side must be a power of two"
+        );
+        assert_err!(
+            Parameterization::new(ParamKind::Cube, 1 << 16),
+            InvalidParameter {
+                name: "resolution",
+                ..
+            },
+            "65536: a face side"
+        );
         let odd = LatLongMap::<f64>::from_fn(3, 1, |_, o| o[0] = 1.0).unwrap();
-        assert!(SphereMap::from_lat_long(&odd).is_err());
+        assert_err!(
+            SphereMap::from_lat_long(&odd),
+            InvalidParameter {
+                name: "resolution",
+                ..
+            },
+            "3: a face side"
+        );
         let cube = SphereMap::<f64>::from_fn(p, 1, |_, o| o[0] = 1.0).unwrap();
-        assert!(cube.to_lat_long().is_err());
+        assert_err!(
+            cube.to_lat_long(),
+            InvalidParameter { name: "param", .. },
+            "not a lat-long map"
+        );
     }
 }

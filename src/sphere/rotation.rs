@@ -52,7 +52,8 @@ impl SphereRotation {
     /// let r = SphereRotation::from_degrees(0.0, 90.0, 0.0).unwrap(); // pitch: +Y goes to +Z
     /// let q = r.apply([0.0, 1.0, 0.0]);
     /// assert!((q[2] - 1.0).abs() < 1e-15);
-    /// assert!(SphereRotation::from_degrees(f64::NAN, 0.0, 0.0).is_err());
+    /// let nan = SphereRotation::from_degrees(f64::NAN, 0.0, 0.0);
+    /// assert!(matches!(nan, Err(haarshift::Error::InvalidParameter { name: "yaw", .. })));
     /// ```
     pub fn from_degrees(yaw: f64, pitch: f64, roll: f64) -> Result<Self> {
         for (name, v) in [("yaw", yaw), ("pitch", pitch), ("roll", roll)] {
@@ -80,7 +81,8 @@ impl SphereRotation {
     /// ```
     /// use haarshift::sphere::SphereRotation;
     /// let swap = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]; // a reflection
-    /// assert!(SphereRotation::from_matrix(swap).is_err());
+    /// let err = SphereRotation::from_matrix(swap).unwrap_err();
+    /// assert!(err.to_string().contains("not a rotation matrix") && err.to_string().contains("det = -1"));
     /// let ok = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
     /// assert!(SphereRotation::from_matrix(ok).is_ok());
     /// ```

@@ -109,7 +109,8 @@ fn whole_column_yaws_are_exact_shifts() {
     assert_eq!(r.whole_column_yaw(w), None);
     let g = rotate_map(&f, &r, &options(Method::Haar)).unwrap();
     let err = max_abs_diff(&g.map.into_array(), &f.roll_columns(1).into_array());
-    assert!(err < 1e-3, "{err}");
+    // Measured 2.2e-6 (the step's slope times 1e-4 of a column); bound 4.5x.
+    assert!(err < 1e-5, "{err}");
 }
 
 #[test]
@@ -198,12 +199,26 @@ fn selected_coefficients_equal_the_recursive_ones() {
         row: 0,
         column: 0,
     };
-    assert!(rotate_selected(&f, &r, &[scaling]).is_err());
+    assert_err!(
+        rotate_selected(&f, &r, &[scaling]),
+        InvalidParameter {
+            name: "coefficient",
+            ..
+        },
+        "not a detail coefficient"
+    );
     let outside = CoefficientIndex {
         level: 4,
         ..requests[0]
     };
-    assert!(rotate_selected(&f, &r, &[outside]).is_err());
+    assert_err!(
+        rotate_selected(&f, &r, &[outside]),
+        InvalidParameter {
+            name: "coefficient",
+            ..
+        },
+        "level: 4"
+    );
 }
 
 /// Largest error of the chain-rule derivatives `-V / delta` and `-U / delta` of a rotated
@@ -241,7 +256,9 @@ fn derivative_error(h: usize, rotation: &SphereRotation) -> f64 {
 fn chain_rule_derivatives_converge_at_second_order() {
     // Maps of 64x32, 128x64 and 256x128: the largest error anywhere on the sphere (poles
     // included) must fall by about 4 per doubling. Measured: errors 5.1e-3, 1.3e-3, 3.3e-4
-    // (ratios 3.8, 4.1) for the compound rotation, ratios 3.7 and 3.8 for pitch 90.
+    // (rates 1.92 and 2.02 in log2) for the compound rotation, 4.8e-3, 1.3e-3, 3.3e-4 (rates
+    // 1.90 and 1.94) for pitch 90. Bounds: rate above 1.8 (second order is 2); the finest
+    // error below 7e-4 (2x).
     for rotation in [
         compound(),
         SphereRotation::from_degrees(0.0, 90.0, 0.0).unwrap(),
@@ -254,21 +271,28 @@ fn chain_rule_derivatives_converge_at_second_order() {
             let rate = (pair[0] / pair[1]).log2();
             assert!(rate > 1.8, "errors {errors:?}: rate {rate}");
         }
-        assert!(errors[2] < 2e-3, "{errors:?}");
+        assert!(errors[2] < 7e-4, "{errors:?}");
     }
 }
 
 #[test]
 fn rotating_there_and_back_returns_the_map() {
     // Smooth map, 128 x 256, values about 0.2 to 2: each leg costs a second-order error.
-    // Measured weighted RMS: reference 2.0e-4, bilinear 1.2e-4, bicubic 1.9e-7, haar 9.5e-5.
+    // Measured weighted RMS: reference 2.0e-4, bilinear 1.25e-4, bicubic 1.9e-7, haar 9.5e-5;
+    // bounds 2x each (a bicubic that fell back to bilinear would be 600x over its bound).
     let f = harmonic_map(128, 1);
     let r = compound();
     for &method in Method::ALL {
         let there = rotate_map(&f, &r, &options(method)).unwrap();
         let back = rotate_map(&there.map, &r.inverse(), &options(method)).unwrap();
         let rms = weighted_rms(&back.map, &f).unwrap();
-        assert!(rms < 4e-4, "{method}: {rms}");
+        let bound = match method {
+            Method::Reference => 4e-4,
+            Method::Bilinear => 2.5e-4,
+            Method::Bicubic => 4e-7,
+            Method::Haar => 2e-4,
+        };
+        assert!(rms < bound, "{method}: {rms}");
     }
 }
 
@@ -279,14 +303,20 @@ fn smooth_maps_rotate_accurately_and_keep_their_energy() {
     let exact = LatLongMap::<f64>::from_fn(64, 1, |d, out| out[0] = harmonic(r.apply(d))).unwrap();
     // Measured weighted RMS against the exact rotated function: reference 4.3e-4 (it
     // averages over pixels, the exact map is point-sampled), bilinear 2.7e-4, bicubic 2.6e-6,
-    // haar 2.0e-4. Energy: 4e-5, 8e-5, -3e-6 and 3e-15.
+    // haar 2.0e-4; bounds 1.4x for the reference, 2x for the others. Energy: 4.1e-5, 8.3e-5,
+    // -2.8e-6 and 3e-15; bounds 2.5x, 2.4x, 2.1x and 1e-14.
     for &method in Method::ALL {
         let g = rotate_map(&f, &r, &options(method)).unwrap();
         let rms = weighted_rms(&g.map, &exact).unwrap();
-        assert!(rms < 6e-4, "{method}: {rms}");
+        let (rms_bound, energy_bound) = match method {
+            Method::Reference => (6e-4, 1e-4),
+            Method::Bilinear => (5.5e-4, 2e-4),
+            Method::Bicubic => (5.5e-6, 6e-6),
+            Method::Haar => (4e-4, 1e-14),
+        };
+        assert!(rms < rms_bound, "{method}: {rms}");
         let energy = relative_energy_error(&g.map, &f);
-        let bound = if method == Method::Haar { 1e-14 } else { 1e-3 };
-        assert!(energy.abs() < bound, "{method}: energy {energy}");
+        assert!(energy.abs() < energy_bound, "{method}: energy {energy}");
     }
 }
 
@@ -348,9 +378,20 @@ fn coefficient_files_hold_the_generic_pyramid_of_each_channel() {
     assert!(err < 1e-12, "{err}");
     // Five channels have no image layout.
     let five = LatLongMap::<f64>::from_fn(2, 5, |_, o| o.fill(1.0)).unwrap();
-    assert!(five.to_image(crate::SampleDepth::F64).is_err());
+    assert_err!(
+        five.to_image(crate::SampleDepth::F64),
+        InvalidParameter {
+            name: "channels",
+            ..
+        },
+        "5 channels"
+    );
     let square = image.map_planes(|p| Ok(p.slice(ndarray::s![.., ..16]).to_owned()));
-    assert!(LatLongMap::from_image(&square.unwrap()).is_err());
+    assert_err!(
+        LatLongMap::from_image(&square.unwrap()),
+        InvalidShape { .. },
+        "twice as wide as it is high"
+    );
 }
 
 #[test]
@@ -364,7 +405,8 @@ fn lookups_are_exact_at_centres_and_continue_over_seam_and_poles() {
         f.bicubic(t, p, &mut v);
         assert!((v[0] - f.as_array()[[i, j, 0]]).abs() < 1e-14);
     }
-    // Between the first row and the pole, on the seam: interpolation across both.
+    // Between the first row and the pole, on the seam: interpolation across both. Measured
+    // worst errors: bilinear 3.5e-4, bicubic 3.2e-6; bounds 2x and 3x.
     let step = PI / 64.0;
     for (theta, phi) in [
         (0.1 * step, 0.01),
@@ -374,13 +416,13 @@ fn lookups_are_exact_at_centres_and_continue_over_seam_and_poles() {
         let want = harmonic(direction(theta, phi));
         f.bilinear(theta, phi, &mut v);
         assert!(
-            (v[0] - want).abs() < 2e-3,
+            (v[0] - want).abs() < 7e-4,
             "bilinear {theta} {phi}: {}",
             v[0] - want
         );
         f.bicubic(theta, phi, &mut v);
         assert!(
-            (v[0] - want).abs() < 2e-3,
+            (v[0] - want).abs() < 1e-5,
             "bicubic {theta} {phi}: {}",
             v[0] - want
         );
@@ -395,7 +437,8 @@ fn f32_agrees_with_f64() {
     let a = rotate_map(&f, &r, &options(Method::Haar)).unwrap();
     let b = rotate_map(&f32map, &r, &options(Method::Haar)).unwrap();
     let err = max_abs_diff(&a.map.into_array(), &b.map.into_array().mapv(|v| v as f64));
-    assert!(err < 1e-5, "{err}");
+    // Measured 5.7e-7 (f32 rounding of values about 1); bound 3.5x.
+    assert!(err < 2e-6, "{err}");
 }
 
 #[test]
@@ -406,23 +449,52 @@ fn bad_input_is_an_error() {
         level: Some(4),
         ..Default::default()
     };
-    assert!(rotate_map(&f, &r, &too_deep).is_err());
+    assert_err!(
+        rotate_map(&f, &r, &too_deep),
+        InvalidParameter { name: "level", .. },
+        "detail levels 0..=3"
+    );
     let odd = LatLongMap::<f64>::from_fn(12, 1, |_, o| o[0] = 1.0).unwrap();
-    assert!(rotate_map(&odd, &r, &SphereOptions::default()).is_err());
+    assert_err!(
+        rotate_map(&odd, &r, &SphereOptions::default()),
+        InvalidShape { .. },
+        "[12, 24]",
+        "power of two"
+    );
     let few = SphereOptions {
         method: Method::Reference,
         reference_samples: 0,
         ..Default::default()
     };
-    assert!(rotate_map(&f, &r, &few).is_err());
-    assert!(SphereRotation::from_degrees(0.0, f64::INFINITY, 0.0).is_err());
-    assert!(
-        SphereRotation::from_matrix([[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]).is_err()
+    assert_err!(
+        rotate_map(&f, &r, &few),
+        InvalidParameter {
+            name: "samples",
+            ..
+        },
+        "0 samples per axis"
+    );
+    assert_err!(
+        SphereRotation::from_degrees(0.0, f64::INFINITY, 0.0),
+        InvalidParameter { name: "pitch", .. },
+        "inf degrees"
+    );
+    assert_err!(
+        SphereRotation::from_matrix([[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+        InvalidParameter {
+            name: "rotation",
+            ..
+        },
+        "not a rotation matrix"
     );
     let mut nan = f.clone().into_array();
     nan[[3, 4, 0]] = f64::NAN;
-    assert!(LatLongMap::new(nan).is_err());
-    assert!(LatLongMap::<f64>::from_fn(0, 1, |_, _| ()).is_err());
+    assert_err!(LatLongMap::new(nan), NonFinite { .. }, "index [3, 4, 0]");
+    assert_err!(
+        LatLongMap::<f64>::from_fn(0, 1, |_, _| ()),
+        InvalidShape { .. },
+        "1 to 2^20 rows"
+    );
 }
 
 /// The pixel of an `h`-row map that contains direction `d`.
@@ -480,14 +552,14 @@ fn real_map_energy_within_tolerance() {
     // reference keeps energy to the accuracy of its quadrature; the Haar method exactly (by
     // its choice of scaling coefficients); one-sample methods miss or double-count part of
     // the sun. Measured at pitch 30: reference 1.4e-4, haar 1.4e-8 (f32), bilinear 3.1e-3,
-    // bicubic -1.5e-3.
+    // bicubic -1.5e-3. Bounds about 2x (the Haar one 7x: an f32 sum over the map).
     let f = rooitou();
     let r = SphereRotation::from_degrees(0.0, 30.0, 0.0).unwrap();
     for (method, bound) in [
-        (Method::Reference, 1e-3),
-        (Method::Haar, 1e-6),
-        (Method::Bilinear, 1e-2),
-        (Method::Bicubic, 1e-2),
+        (Method::Reference, 3e-4),
+        (Method::Haar, 1e-7),
+        (Method::Bilinear, 6e-3),
+        (Method::Bicubic, 3e-3),
     ] {
         let g = rotate_map(&f, &r, &options(method)).unwrap();
         let e = relative_energy_error(&g.map, &f);

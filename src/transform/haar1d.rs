@@ -222,10 +222,28 @@ mod tests {
     #[test]
     fn rejects_bad_lengths_and_levels() {
         let mut s = Vec::new();
-        assert!(forward_in_place(&mut [1.0f64; 3], 1, Normalization::Average, &mut s).is_err());
-        assert!(forward_in_place(&mut [0.0f64; 0], 0, Normalization::Average, &mut s).is_err());
-        assert!(forward_in_place(&mut [1.0f64; 4], 3, Normalization::Average, &mut s).is_err());
+        assert_err!(
+            forward_in_place(&mut [1.0f64; 3], 1, Normalization::Average, &mut s),
+            InvalidShape { .. },
+            "[3]",
+            "power of two"
+        );
+        assert_err!(
+            forward_in_place(&mut [0.0f64; 0], 0, Normalization::Average, &mut s),
+            InvalidShape { .. },
+            "[0]",
+            "non-zero power of two"
+        );
+        assert_err!(
+            forward_in_place(&mut [1.0f64; 4], 3, Normalization::Average, &mut s),
+            InvalidParameter { name: "levels", .. },
+            "at most 2"
+        );
         let mut s32: Vec<f32> = Vec::new();
-        assert!(inverse_in_place(&mut [1.0f32; 4], 3, Normalization::Average, &mut s32).is_err());
+        assert_err!(
+            inverse_in_place(&mut [1.0f32; 4], 3, Normalization::Average, &mut s32),
+            InvalidParameter { name: "levels", .. },
+            "at most 2"
+        );
     }
 }

@@ -108,7 +108,8 @@ named_enum! {
 /// assert_eq!("full".parse::<Levels>().unwrap(), Levels::Full);
 /// assert_eq!("3".parse::<Levels>().unwrap(), Levels::Count(3));
 /// assert_eq!(Levels::Count(3).resolve(9).unwrap(), 3);
-/// assert!(Levels::Count(10).resolve(9).is_err());
+/// let too_many = Levels::Count(10).resolve(9).unwrap_err();
+/// assert_eq!(too_many.to_string(), "invalid levels: 10 levels requested but this size allows at most 9");
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]

@@ -44,6 +44,11 @@ pub fn succeeds(args: &[&str]) -> Output {
     succeeds_in(None, args)
 }
 
+/// Runs `haarshift ARGS`, requires success and returns standard output as text.
+pub fn succeeds_with_stdout(args: &[&str]) -> String {
+    text(&succeeds(args).stdout)
+}
+
 /// Runs `haarshift ARGS` in `dir` (when given) and requires a clean failure of the program
 /// (exit code 1): exactly one line on stderr, `haarshift: ...`, containing every needle (the
 /// file or flag at fault and the problem), no panic, nothing on stdout. Returns the line.

@@ -461,13 +461,14 @@ mod tests {
             drift: vec![],
         };
         assert_eq!(report.failures(), 1);
-        assert!(
+        assert_err!(
             run_stability(
                 &StabilityConfig::new(Array2::zeros((64, 64))),
                 &crate::experiments::rotation_cycle::NoMeter,
                 |_| {}
-            )
-            .is_err()
+            ),
+            InvalidShape { .. },
+            "at least 128x128"
         );
     }
 

@@ -186,6 +186,14 @@ fn mismatched_trees_are_an_error() {
         Selection::All,
     )
     .unwrap();
-    assert!(product_integral(&t, &[&other], ALL).is_err());
-    assert!(product(&[t.tree(), &other]).is_err());
+    assert_err!(
+        product_integral(&t, &[&other], ALL),
+        InvalidShape { .. },
+        "different faces"
+    );
+    assert_err!(
+        product(&[t.tree(), &other]),
+        InvalidShape { .. },
+        "different faces"
+    );
 }

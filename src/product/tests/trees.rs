@@ -132,9 +132,24 @@ fn stacked_selection_and_threshold_follow_the_rule() {
     // Per face: each face keeps its own K.
     let t = full.select(Selection::LargestPerFace(2)).unwrap();
     assert_eq!(t.kept(), 12);
-    assert!(full.select(Selection::Largest(91)).is_err());
-    assert!(full.select(Selection::LargestPerFace(16)).is_err());
-    assert!(full.select(Selection::Threshold(f64::NAN)).is_err());
+    assert_err!(
+        full.select(Selection::Largest(91)),
+        InvalidParameter { name: "keep", .. },
+        "only 90 details"
+    );
+    assert_err!(
+        full.select(Selection::LargestPerFace(16)),
+        InvalidParameter { name: "keep", .. },
+        "a face has 15"
+    );
+    assert_err!(
+        full.select(Selection::Threshold(f64::NAN)),
+        InvalidParameter {
+            name: "threshold",
+            ..
+        },
+        "NaN"
+    );
 }
 
 #[test]
@@ -157,39 +172,53 @@ fn rgb_selection_ranks_by_the_sum_of_squares() {
 #[test]
 fn bad_inputs_are_errors_not_panics() {
     let ok = Array4::<f64>::zeros((2, 4, 4, 1));
-    assert!(
+    assert_err!(
         HaarTree::<f64, 1>::from_pixels(
             Array4::zeros((2, 4, 8, 1)).view(),
             FaceLayout::Stacked,
             Selection::All
-        )
-        .is_err()
+        ),
+        InvalidShape { .. },
+        "[2, 4, 8, 1]",
+        "S a power of two"
     );
-    assert!(
+    assert_err!(
         HaarTree::<f64, 1>::from_pixels(
             Array4::zeros((2, 3, 3, 1)).view(),
             FaceLayout::Stacked,
             Selection::All
-        )
-        .is_err()
+        ),
+        InvalidShape { .. },
+        "[2, 3, 3, 1]",
+        "S a power of two"
     );
-    assert!(
-        HaarTree::<f64, 3>::from_pixels(ok.view(), FaceLayout::Stacked, Selection::All).is_err()
+    assert_err!(
+        HaarTree::<f64, 3>::from_pixels(ok.view(), FaceLayout::Stacked, Selection::All),
+        InvalidShape { .. },
+        "(faces >= 1, S, S, 3)"
     );
-    assert!(
+    assert_err!(
         HaarTree::<f64, 1>::from_pixels(
             Array4::zeros((0, 4, 4, 1)).view(),
             FaceLayout::Stacked,
             Selection::All
-        )
-        .is_err()
+        ),
+        InvalidShape { .. },
+        "[0, 4, 4, 1]",
+        "faces >= 1"
     );
     let mut nan = ok.clone();
     nan[[1, 2, 3, 0]] = f64::NAN;
-    assert!(
-        HaarTree::<f64, 1>::from_pixels(nan.view(), FaceLayout::Stacked, Selection::All).is_err()
+    assert_err!(
+        HaarTree::<f64, 1>::from_pixels(nan.view(), FaceLayout::Stacked, Selection::All),
+        NonFinite { .. },
+        "index [1, 2, 3, 0]"
     );
-    assert!(WeightedPixels::<f64, 1>::new(ok.view(), Array3::zeros((2, 4, 2)).view()).is_err());
+    assert_err!(
+        WeightedPixels::<f64, 1>::new(ok.view(), Array3::zeros((2, 4, 2)).view()),
+        InvalidShape { .. },
+        "weights must be (2, 4, 4)"
+    );
     // A 1x1 face has no details: fine.
     let tiny = HaarTree::<f64, 1>::from_pixels(
         Array4::from_elem((6, 1, 1, 1), 2.0).view(),
