@@ -10,6 +10,8 @@
 //! * [`sphere`]: rotation of lat-long environment maps in pixels and directly in the 2D Haar
 //!   domain (the chain rule on detail coefficients), with a ground-truth reference and
 //!   bilinear/bicubic resampling to compare against.
+//! * [`relight`]: lighting from environment maps, the rasteriser and animations for
+//!   relighting meshes.
 //! * [`product`]: integrals and products of several functions on sparse Haar quadtrees over
 //!   sets of square faces (the n-function product integral, the product, nonlinear
 //!   approximation, the weighting contract).
@@ -36,6 +38,7 @@ mod named;
 pub mod patterns;
 mod planar_image;
 pub mod product;
+pub mod relight;
 pub mod rotate;
 mod sample;
 pub mod shift;
