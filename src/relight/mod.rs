@@ -11,3 +11,4 @@
 //! [`crate::sphere::latlong`], rotations `g(p) = f(R p)` with `R = Rz(roll) Ry(yaw) Rx(pitch)`.
 
 pub mod environment;
+pub mod raster;
