@@ -10,5 +10,6 @@
 //! Conventions are the sphere module's: world Y up, right-handed, directions as in
 //! [`crate::sphere::latlong`], rotations `g(p) = f(R p)` with `R = Rz(roll) Ry(yaw) Rx(pitch)`.
 
+pub mod animation;
 pub mod environment;
 pub mod raster;
