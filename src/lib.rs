@@ -14,7 +14,8 @@
 //!   sets of square faces (the n-function product integral, the product, nonlinear
 //!   approximation, the weighting contract).
 //! * [`relight`]: meshes and scenes lit by environment maps: ray casting, per-vertex visibility
-//!   precomputed into sparse Haar transport, the scene cache.
+//!   precomputed into sparse Haar transport, the scene cache, the lighting, the rasteriser and
+//!   animations.
 //! * [`experiments`], [`metrics`], [`patterns`]: error-accumulation experiments, the error
 //!   measures they report, and the synthetic test patterns they use.
 //! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`]

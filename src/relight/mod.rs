@@ -1,5 +1,5 @@
 //! All-frequency relighting: meshes and scenes, ray casting, per-vertex visibility and
-//! transport precomputation, and the scene cache.
+//! transport precomputation, the scene cache, the lighting, and images of the result.
 //!
 //! | file | idea |
 //! |---|---|
@@ -11,14 +11,21 @@
 //! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
+//! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
+//! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
+//! | [`animation`] | frames into an animated GIF |
 //!
 //! Conventions are the sphere module's: world Y up, right-handed, directions as in
-//! [`sphere::latlong`](crate::sphere::latlong), rotations `R = Rz(roll) Ry(yaw) Rx(pitch)`.
+//! [`sphere::latlong`](crate::sphere::latlong), rotations `g(p) = f(R p)` with
+//! `R = Rz(roll) Ry(yaw) Rx(pitch)`.
 //! The transport is the one factor of a product integral that carries the texel solid angle
 //! ([`crate::product::Transport`]).
+pub mod animation;
 pub mod cache;
+pub mod environment;
 pub mod error;
 pub mod mesh;
+pub mod raster;
 pub mod raycast;
 pub mod scene;
 pub mod shadowmap;

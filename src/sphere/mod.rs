@@ -38,13 +38,15 @@
 //! six; texel directions, exact texel solid angles, [`SphereMap`]), [`cube`] (the cube map's
 //! faces, orientation and exact spherical-quadrilateral solid angles), [`convert`] (between
 //! parameterisations by solid-angle integration over each target texel), [`integrate`] (the
-//! integral over the sphere of a product of maps, on their Haar trees).
+//! integral over the sphere of a product of maps, on their Haar trees), [`harmonics`] (real
+//! spherical harmonics: evaluation, projection, reconstruction, the Lambertian convolution).
 
 pub mod chain_rule;
 pub mod coefficients;
 pub mod convert;
 pub mod cube;
 pub mod experiment;
+pub mod harmonics;
 pub mod integrate;
 pub mod latlong;
 pub mod param;
