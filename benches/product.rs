@@ -1,13 +1,15 @@
 //! Product integrals on real data: the rooitou park envmap, the visibility of bunny vertices
 //! (brute-force ray-triangle tests against `testdata/meshes/bunny.obj` in the setup) and a
-//! Phong-50 lobe, as cube maps of 6 x S^2 texels (nearest-texel lookups from the lat-long map:
-//! data preparation for timing only, not an accurate conversion; weights are the texel-centre
-//! solid angle `4 / (S^2 (1 + u^2 + v^2)^(3/2))`).
+//! Phong-50 lobe, sampled at the texel centres of a cube map (6 x S^2) or a lat-long map
+//! (H x 2H) of the library's parameterisations (bilinear lookups in the lat-long envmap: data
+//! preparation for timing only); weights are the texels' exact solid angles.
 //!
 //! Groups: `targets` (the speed targets, f32, one channel and RGB) and `scaling`
-//! (N = 3..6 functions, S = 32..256, 1 %..100 % kept: tree vs pixel domain vs pairwise).
-//! One core: run with `RAYON_NUM_THREADS=1`; `python3 benches/product_table.py` runs it and
-//! writes the tables under `results/product/`.
+//! (N = 3..6 functions; cube S = 32..256 and lat-long H = 64..256; 1 %..100 % kept: tree vs
+//! pixel domain vs pairwise), each benchmark short (10 samples, 0.5 s) so that the whole table
+//! runs in minutes. One core: run with `RAYON_NUM_THREADS=1`; `python3
+//! benches/product_table.py --run-cargo` runs it and writes the tables under
+//! `results/product/`.
 
 use std::hint::black_box;
 
@@ -19,48 +21,14 @@ use haarshift::product::triple::{
 use haarshift::product::{
     FaceLayout, HaarTree, IntegralOptions, Selection, Transport, WeightedPixels, product_integral,
 };
-use haarshift::sphere::LatLongMap;
 use haarshift::sphere::latlong::angles;
+use haarshift::sphere::{LatLongMap, ParamKind, Parameterization, SphereMap};
 use ndarray::{Array3, Array4, Axis};
+use std::time::Duration;
 
-/// Unit direction of texel `(i, j)` of cube face `f` (faces +X, -X, +Y, -Y, +Z, -Z).
-fn texel_direction(f: usize, i: usize, j: usize, s: usize) -> [f64; 3] {
-    let u = 2.0 * (j as f64 + 0.5) / s as f64 - 1.0;
-    let v = 2.0 * (i as f64 + 0.5) / s as f64 - 1.0;
-    let d = match f {
-        0 => [1.0, -v, -u],
-        1 => [-1.0, -v, u],
-        2 => [u, 1.0, v],
-        3 => [u, -1.0, -v],
-        4 => [u, -v, 1.0],
-        _ => [-u, -v, -1.0],
-    };
-    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    [d[0] / n, d[1] / n, d[2] / n]
-}
-
-fn cube_fn(s: usize, c: usize, f: impl Fn([f64; 3], &mut [f64]) + Sync) -> Array4<f64> {
-    let mut out = Array4::zeros((6, s, s, c));
-    let mut px = vec![0.0; c];
-    for face in 0..6 {
-        for i in 0..s {
-            for j in 0..s {
-                f(texel_direction(face, i, j, s), &mut px);
-                for ch in 0..c {
-                    out[[face, i, j, ch]] = px[ch];
-                }
-            }
-        }
-    }
-    out
-}
-
-fn solid_angles(s: usize) -> Array3<f64> {
-    Array3::from_shape_fn((6, s, s), |(_, i, j)| {
-        let u = 2.0 * (j as f64 + 0.5) / s as f64 - 1.0;
-        let v = 2.0 * (i as f64 + 0.5) / s as f64 - 1.0;
-        4.0 / ((s * s) as f64 * (1.0 + u * u + v * v).powf(1.5))
-    })
+/// `f(direction, channels_out)` at every texel centre of `p`, `(faces, S, S, c)`.
+fn sample(p: Parameterization, c: usize, f: impl Fn([f64; 3], &mut [f64]) + Sync) -> Array4<f64> {
+    SphereMap::from_fn(p, c, f).expect("finite").into_array()
 }
 
 struct Mesh {
@@ -143,7 +111,7 @@ fn occluded(mesh: &Mesh, o: [f64; 3], d: [f64; 3]) -> bool {
 }
 
 /// Visibility of bunny vertex `k` (1 where the ray escapes), nudged off the surface.
-fn visibility(mesh: &Mesh, k: usize, s: usize) -> Array4<f64> {
+fn visibility(mesh: &Mesh, k: usize, param: Parameterization) -> Array4<f64> {
     let centre = mesh.vertices.iter().fold([0.0; 3], |acc, v| {
         [acc[0] + v[0], acc[1] + v[1], acc[2] + v[2]]
     });
@@ -160,27 +128,27 @@ fn visibility(mesh: &Mesh, k: usize, s: usize) -> Array4<f64> {
         p[1] + 1e-3 * out[1] / len,
         p[2] + 1e-3 * out[2] / len,
     ];
-    cube_fn(s, 1, |d, px| {
+    sample(param, 1, |d, px| {
         px[0] = if occluded(mesh, o, d) { 0.0 } else { 1.0 }
     })
 }
 
 /// A Phong lobe of exponent 50 about a fixed reflection direction.
-fn phong(s: usize) -> Array4<f64> {
+fn phong(p: Parameterization) -> Array4<f64> {
     let r = [0.48, 0.6, 0.64];
-    cube_fn(s, 1, |d, px| {
+    sample(p, 1, |d, px| {
         px[0] = (d[0] * r[0] + d[1] * r[1] + d[2] * r[2]).max(0.0).powi(50)
     })
 }
 
-fn envmap(s: usize, c: usize) -> Array4<f64> {
+fn envmap(p: Parameterization, c: usize) -> Array4<f64> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/testdata/envmaps/rooitou_park_256x128.npy"
     );
     let data: Array3<f32> = ndarray_npy::read_npy(path).expect("test map");
     let map = LatLongMap::new(data.mapv(f64::from)).expect("2:1 map");
-    cube_fn(s, c, |d, px| {
+    sample(p, c, |d, px| {
         let (theta, phi) = angles(d);
         let mut rgb = [0.0; 3];
         map.bilinear(theta, phi, &mut rgb);
@@ -201,31 +169,35 @@ fn rgb(a: &Array4<f64>) -> Array4<f32> {
     ndarray::concatenate(Axis(3), &[a.view(), a.view(), a.view()]).expect("same shape")
 }
 
-const LAYOUT: FaceLayout = FaceLayout::Stacked;
 const ALL: IntegralOptions = IntegralOptions { finest_level: None };
 
 /// Transport (visibility x solid angle) and factors (envmap, Phong, more visibilities).
 struct Scene<const C: usize> {
     weighted: WeightedPixels<f32, C>,
     factors: Vec<Array4<f32>>,
+    layout: FaceLayout,
 }
 
-fn scene<const C: usize>(mesh: &Mesh, s: usize, extra: usize) -> Scene<C> {
+fn scene<const C: usize>(mesh: &Mesh, p: Parameterization, extra: usize) -> Scene<C> {
     let widen = |a: &Array4<f64>| if C == 1 { to32(a) } else { rgb(a) };
-    let vis = widen(&visibility(mesh, 100, s));
-    let weights = solid_angles(s).mapv(|v| v as f32);
+    let vis = widen(&visibility(mesh, 100, p));
+    let weights = p.solid_angles().mapv(|v| v as f32);
     let env = if C == 1 {
-        to32(&envmap(s, 1))
+        to32(&envmap(p, 1))
     } else {
-        to32(&envmap(s, 3))
+        to32(&envmap(p, 3))
     };
-    let mut factors = vec![env, widen(&phong(s))];
+    let mut factors = vec![env, widen(&phong(p))];
     for k in 0..extra {
-        factors.push(widen(&visibility(mesh, 400 + 300 * k, s)));
+        factors.push(widen(&visibility(mesh, 400 + 300 * k, p)));
     }
     Scene {
         weighted: WeightedPixels::new(vis.view(), weights.view()).expect("shapes"),
         factors,
+        layout: match p.kind() {
+            ParamKind::LatLong => FaceLayout::SideBySide,
+            ParamKind::Cube => FaceLayout::Stacked,
+        },
     }
 }
 
@@ -234,13 +206,13 @@ fn trees<const C: usize>(
     keep: [Selection; 3],
     rest: Selection,
 ) -> (Transport<f32, C>, Vec<HaarTree<f32, C>>) {
-    let t = Transport::new(&sc.weighted, LAYOUT, keep[0]).expect("transport");
+    let t = Transport::new(&sc.weighted, sc.layout, keep[0]).expect("transport");
     let f = sc
         .factors
         .iter()
         .enumerate()
         .map(|(k, m)| {
-            HaarTree::from_pixels(m.view(), LAYOUT, if k < 2 { keep[k + 1] } else { rest })
+            HaarTree::from_pixels(m.view(), sc.layout, if k < 2 { keep[k + 1] } else { rest })
                 .expect("tree")
         })
         .collect();
@@ -248,9 +220,11 @@ fn trees<const C: usize>(
 }
 
 fn targets_for<const C: usize>(c: &mut Criterion, mesh: &Mesh, label: &str) {
-    let sc = scene::<C>(mesh, 64, 0);
+    let sc = scene::<C>(mesh, param(ParamKind::Cube, 64), 0);
     let mut group = c.benchmark_group(format!("targets_{label}"));
     group.sample_size(30);
+    group.warm_up_time(Duration::from_millis(300));
+    group.measurement_time(Duration::from_secs(1));
     for (name, keep) in [
         (
             "200-70-70_total",
@@ -301,16 +275,38 @@ fn targets(c: &mut Criterion) {
     targets_for::<3>(c, &mesh, "rgb");
 }
 
+fn param(kind: ParamKind, size: usize) -> Parameterization {
+    Parameterization::new(kind, size).expect("a power of two")
+}
+
+/// Sizes from the environment variable `name` (comma-separated), or `default`.
+fn sizes(name: &str, default: &[usize]) -> Vec<usize> {
+    std::env::var(name)
+        .map(|v| {
+            v.split(',')
+                .filter(|x| !x.is_empty())
+                .map(|x| x.parse().expect("size"))
+                .collect()
+        })
+        .unwrap_or_else(|_| default.to_vec())
+}
+
 fn scaling(c: &mut Criterion) {
     let mesh = bunny();
-    let sizes: Vec<usize> = std::env::var("PRODUCT_BENCH_SIZES")
-        .map(|v| v.split(',').map(|x| x.parse().expect("size")).collect())
-        .unwrap_or_else(|_| vec![32, 64, 128, 256]);
-    for s in sizes {
-        let sc = scene::<1>(&mesh, s, 3);
-        let details = 6 * (s * s - 1);
-        let mut group = c.benchmark_group(format!("scaling_6x{s}"));
+    let cube = sizes("PRODUCT_BENCH_SIZES", &[32, 64, 128, 256]);
+    let latlong = sizes("PRODUCT_BENCH_LATLONG", &[64, 128, 256]);
+    let params = cube
+        .into_iter()
+        .map(|s| param(ParamKind::Cube, s))
+        .chain(latlong.into_iter().map(|h| param(ParamKind::LatLong, h)));
+    for p in params {
+        let (s, faces) = (p.face_size(), p.faces());
+        let sc = scene::<1>(&mesh, p, 3);
+        let details = faces * (s * s - 1);
+        let mut group = c.benchmark_group(format!("scaling_{}{s}", p.kind()));
         group.sample_size(10);
+        group.warm_up_time(Duration::from_millis(200));
+        group.measurement_time(Duration::from_millis(500));
         for percent in [1usize, 5, 10, 100] {
             let sel = if percent == 100 {
                 Selection::All

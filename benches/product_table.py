@@ -6,8 +6,8 @@ writes results/product/targets.md and results/product/scaling.md. With --run-car
 runs the bench on one core (RAYON_NUM_THREADS=1) with short measurement times. The machine's
 load (from /proc/loadavg) is recorded with the tables.
 
-    python3 benches/product_table.py --run-cargo            # everything (long)
-    python3 benches/product_table.py --run-cargo --sizes 32,64
+    python3 benches/product_table.py --run-cargo            # everything, one run
+    python3 benches/product_table.py --run-cargo --sizes 32,64 --latlong 64
 """
 
 import argparse
@@ -58,11 +58,12 @@ def targets_table():
     return "\n".join(lines)
 
 
-def scaling_table(sizes):
-    lines = ["| faces | N | kept | tree | pixel (inverse incl.) | pairwise | pixel (stored maps) | pixel-inverse / tree | pairwise / tree | pixel-stored / tree |",
+def scaling_table(params):
+    lines = ["| map | N | kept | tree | pixel (inverse incl.) | pairwise | pixel (stored maps) | pixel-inverse / tree | pairwise / tree | pixel-stored / tree |",
              "|---|---|---|---|---|---|---|---|---|---|"]
-    for s in sizes:
-        group = f"scaling_6x{s}"
+    for kind, s in params:
+        group = f"scaling_{kind}{s}"
+        label = f"cube 6 x {s}^2" if kind == "cube" else f"lat-long {s} x {2 * s}"
         stored = {n: median_ns(group, "pixel_stored", f"N{n}_keep100") for n in range(3, 7)}
         for n in range(3, 7):
             for p in [1, 5, 10, 100]:
@@ -70,7 +71,7 @@ def scaling_table(sizes):
                 tree, inv, pair = (median_ns(group, m, case) for m in ["tree", "pixel_inverse", "pairwise"])
                 if tree is None:
                     continue
-                lines.append(f"| 6 x {s}^2 | {n} | {p} % | {fmt(tree)} | {fmt(inv)} | {fmt(pair)} | {fmt(stored[n])} | "
+                lines.append(f"| {label} | {n} | {p} % | {fmt(tree)} | {fmt(inv)} | {fmt(pair)} | {fmt(stored[n])} | "
                              f"{ratio(tree, inv)} | {ratio(tree, pair)} | {ratio(tree, stored[n])} |")
     return "\n".join(lines)
 
@@ -78,17 +79,17 @@ def scaling_table(sizes):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--run-cargo", action="store_true")
-    ap.add_argument("--sizes", default="32,64,128,256")
+    ap.add_argument("--sizes", default="32,64,128,256", help="cube face sides S (6 x S^2)")
+    ap.add_argument("--latlong", default="64,128,256", help="lat-long heights H (H x 2H)")
     ap.add_argument("--skip-targets", action="store_true")
     args = ap.parse_args()
-    sizes = [int(s) for s in args.sizes.split(",")]
+    params = [("cube", int(s)) for s in args.sizes.split(",") if s] + [("latlong", int(h)) for h in args.latlong.split(",") if h]
     load_before = open("/proc/loadavg").read().split()[:3]
     if args.run_cargo:
-        env = dict(os.environ, RAYON_NUM_THREADS="1", PRODUCT_BENCH_SIZES=args.sizes)
-        brief = ["--warm-up-time", "0.5", "--measurement-time", "2"]
-        if not args.skip_targets:
-            subprocess.run(["cargo", "bench", "--bench", "product", "--", "targets"] + brief, cwd=ROOT, env=env, check=True)
-        subprocess.run(["cargo", "bench", "--bench", "product", "--", "scaling"] + brief, cwd=ROOT, env=env, check=True)
+        env = dict(os.environ, RAYON_NUM_THREADS="1", PRODUCT_BENCH_SIZES=args.sizes, PRODUCT_BENCH_LATLONG=args.latlong)
+        # Short groups: the bench sets its own sample counts and measurement times.
+        filt = "scaling" if args.skip_targets else "targets|scaling"
+        subprocess.run(["cargo", "bench", "--bench", "product", "--", filt], cwd=ROOT, env=env, check=True)
     load_after = open("/proc/loadavg").read().split()[:3]
     OUT.mkdir(parents=True, exist_ok=True)
     note = (f"Criterion medians, f32, one core (RAYON_NUM_THREADS=1), on a 2-core machine shared with other jobs: "
@@ -99,10 +100,10 @@ def main():
     (OUT / "targets.md").write_text("# Product integral speed targets (6 x 64^2 cube map, real data)\n\n" + note + "\n"
                                     + targets_table() + "\n")
     (OUT / "scaling.md").write_text("# Tree product integral against the pixel domain and pairwise products\n\n" + note + "\n"
-                                    + scaling_table(sizes) + "\n")
+                                    + scaling_table(params) + "\n")
     print(targets_table())
     print()
-    print(scaling_table(sizes))
+    print(scaling_table(params))
 
 
 if __name__ == "__main__":

@@ -414,6 +414,42 @@ pub fn write_image<T: Sample>(
     out.commit()
 }
 
+/// Writes `array` (any shape, row-major) as a `.npy` array, atomically: float64 at depth
+/// [`SampleDepth::F64`], float32 otherwise. An existing `path` is replaced only with `force`.
+///
+/// ```
+/// use haarshift::{SampleDepth, io::write_npy};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("c.npy");
+/// let a = ndarray::Array4::<f64>::from_elem((6, 2, 2, 3), 0.5);
+/// write_npy(a.view(), SampleDepth::F32, &path, false).unwrap();
+/// let back: ndarray::Array4<f32> = ndarray_npy::read_npy(&path).unwrap();
+/// assert_eq!(back.dim(), (6, 2, 2, 3));
+/// assert!(write_npy(a.view(), SampleDepth::F32, &path, false).is_err());
+/// ```
+pub fn write_npy<T: Sample, D: ndarray::Dimension>(
+    array: ndarray::ArrayView<'_, T, D>,
+    depth: SampleDepth,
+    path: &Path,
+    force: bool,
+) -> Result<()> {
+    ensure_finite(&array).map_err(|e| e.in_file(path))?;
+    let mut out = atomic::PendingFile::create(path, force)?;
+    let shape = array.shape().to_vec();
+    match depth {
+        SampleDepth::F64 => {
+            npy::write_samples(array.iter().map(|v| v.as_f64()), &shape, path, out.writer())?
+        }
+        _ => npy::write_samples(
+            array.iter().map(|v| v.as_f64() as f32),
+            &shape,
+            path,
+            out.writer(),
+        )?,
+    }
+    out.commit()
+}
+
 /// The depth `format` stores for an image of `depth` when `requested` (or else `depth`) is
 /// asked for, or why it cannot.
 fn stored_depth(

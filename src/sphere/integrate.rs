@@ -9,10 +9,15 @@
 //! applied exactly once), builds each map's tree with its [`Selection`], and integrates by the
 //! chosen [`IntegralMethod`]. With lat-long at the maps' own height, every coefficient kept
 //! and no depth limit, the result is `sum over pixels of prod_k f_k(p) x solid_angle(p)`.
+//!
+//! It computes in the maps' sample type (`f32` or `f64`; the geometry and the sums in `f64`),
+//! converts and builds the maps' trees in parallel (rayon over maps, and over faces within a
+//! map), and integrates all channels in one traversal (an RGB coefficient is one tree node).
 
 use std::time::Instant;
 
 use ndarray::{Array3, Array4};
+use rayon::prelude::*;
 
 use super::LatLongMap;
 use super::convert::{Conversion, default_samples};
@@ -23,7 +28,7 @@ use crate::product::triple::triple_integral;
 use crate::product::{
     FaceLayout, HaarTree, IntegralOptions, Selection, Transport, WeightedPixels, product_integral,
 };
-use crate::{Error, Result};
+use crate::{Error, Result, Sample};
 
 named_enum! {
     /// How [`integrate`] computes the product integral.
@@ -96,9 +101,10 @@ pub struct SphereIntegral {
 /// assert_eq!(got.value.len(), 3);
 /// assert!((got.value[1] - want).abs() < 1e-12 * want);
 /// ```
-pub fn integrate(maps: &[LatLongMap<f64>], options: &IntegrateOptions) -> Result<SphereIntegral> {
-    let channels = check_maps(maps)?;
-    let selections = per_map_selections(maps.len(), &options.selections)?;
+pub fn integrate<T: Sample>(
+    maps: &[LatLongMap<T>],
+    options: &IntegrateOptions,
+) -> Result<SphereIntegral> {
     if options.method == IntegralMethod::Triple && maps.len() != 3 {
         return Err(Error::parameter(
             "method",
@@ -114,48 +120,63 @@ pub fn integrate(maps: &[LatLongMap<f64>], options: &IntegrateOptions) -> Result
             ),
         ));
     }
+    let work = working_faces(maps, options.param, options.resolution, &options.selections)?;
+    match work.channels {
+        1 => integrate_faces::<T, 1>(&work, options),
+        2 => integrate_faces::<T, 2>(&work, options),
+        3 => integrate_faces::<T, 3>(&work, options),
+        _ => integrate_faces::<T, 4>(&work, options),
+    }
+}
+
+/// The maps of a product on the sphere, ready for their trees: in the working
+/// parameterisation, broadcast to one channel count, each with its selection.
+pub(super) struct Working<T> {
+    /// The working parameterisation.
+    pub(super) param: Parameterization,
+    /// Channels of every face array (1 to 4).
+    pub(super) channels: usize,
+    /// Each map as a `(faces, S, S, channels)` array.
+    pub(super) faces: Vec<Array4<T>>,
+    /// Each map's selection.
+    pub(super) selections: Vec<Selection>,
+}
+
+/// Checks `maps` and brings them into the parameterisation `kind` at face side `resolution`
+/// (`None`: the maps' height `H` for lat-long, `H / 2` for the cube), maps in parallel; one
+/// selection per map from `selections` (one for all, one each, or none: everything kept).
+pub(super) fn working_faces<T: Sample>(
+    maps: &[LatLongMap<T>],
+    kind: ParamKind,
+    resolution: Option<usize>,
+    selections: &[Selection],
+) -> Result<Working<T>> {
+    let channels = check_maps(maps)?;
+    let selections = per_map_selections(maps.len(), selections)?;
     let h = maps[0].height();
-    let size = match (options.resolution, options.param) {
+    let size = match (resolution, kind) {
         (Some(n), _) => n,
         (None, ParamKind::LatLong) => h,
         (None, ParamKind::Cube) => (h / 2).max(1),
     };
-    let param = Parameterization::new(options.param, size)?;
+    let param = Parameterization::new(kind, size)?;
     let faces = face_arrays(maps, param, channels)?;
-    match channels {
-        1 => integrate_faces::<1>(&faces, param, &selections, options),
-        2 => integrate_faces::<2>(&faces, param, &selections, options),
-        3 => integrate_faces::<3>(&faces, param, &selections, options),
-        _ => integrate_faces::<4>(&faces, param, &selections, options),
-    }
+    Ok(Working {
+        param,
+        channels,
+        faces,
+        selections,
+    })
 }
 
-/// Checks the maps: at least two, one height (a power of two), 1 or `C` channels with `C` at
+/// Checks the maps: at least one, one height (a power of two), 1 or `C` channels with `C` at
 /// most 4; returns `C`.
-fn check_maps(maps: &[LatLongMap<f64>]) -> Result<usize> {
+fn check_maps<T: Sample>(maps: &[LatLongMap<T>]) -> Result<usize> {
     let Some(first) = maps.first() else {
-        return Err(Error::parameter("maps", "no map to integrate"));
+        return Err(Error::parameter("maps", "no map given"));
     };
-    let h = first.height();
-    if !h.is_power_of_two() {
-        return Err(Error::shape(
-            &[h, 2 * h],
-            format!("the map's height {h} is not a power of two"),
-        ));
-    }
-    for m in &maps[1..] {
-        if m.height() != h {
-            return Err(Error::shape(
-                &[m.height(), m.width()],
-                format!(
-                    "maps of different sizes: {} x {} and {} x {} (width x height)",
-                    first.width(),
-                    h,
-                    m.width(),
-                    m.height()
-                ),
-            ));
-        }
+    for m in maps {
+        check_size(first.height(), m)?;
     }
     let channels = maps.iter().map(|m| m.channels()).max().unwrap_or(1);
     if channels > 4
@@ -172,6 +193,40 @@ fn check_maps(maps: &[LatLongMap<f64>]) -> Result<usize> {
     Ok(channels)
 }
 
+/// Checks that `map` can join maps of height `height` (the first map's) in [`integrate`] or
+/// [`multiply`](super::product::multiply): its height is `height`, a power of two. A caller
+/// that reads maps one by one can name the file at fault.
+///
+/// ```
+/// use haarshift::sphere::LatLongMap;
+/// use haarshift::sphere::integrate::check_size;
+/// let m = LatLongMap::<f32>::from_fn(8, 1, |_, o| o[0] = 1.0).unwrap();
+/// assert!(check_size(8, &m).is_ok());
+/// assert!(check_size(16, &m).unwrap_err().to_string().contains("different sizes"));
+/// let odd = LatLongMap::<f32>::from_fn(6, 1, |_, o| o[0] = 1.0).unwrap();
+/// assert!(check_size(6, &odd).unwrap_err().to_string().contains("not a power of two"));
+/// ```
+pub fn check_size<T: Sample>(height: usize, map: &LatLongMap<T>) -> Result<()> {
+    let h = map.height();
+    if h != height {
+        return Err(Error::shape(
+            &[h, map.width()],
+            format!(
+                "maps of different sizes: {} x {height} and {} x {h} (width x height)",
+                2 * height,
+                map.width(),
+            ),
+        ));
+    }
+    if !h.is_power_of_two() {
+        return Err(Error::shape(
+            &[h, map.width()],
+            format!("the map's height {h} is not a power of two"),
+        ));
+    }
+    Ok(())
+}
+
 /// One selection per map: `given` repeated when it has one, all kept when it is empty.
 fn per_map_selections(maps: usize, given: &[Selection]) -> Result<Vec<Selection>> {
     match given.len() {
@@ -185,22 +240,21 @@ fn per_map_selections(maps: usize, given: &[Selection]) -> Result<Vec<Selection>
     }
 }
 
-/// Each map in `param`, broadcast to `channels` channels, as a `(faces, S, S, C)` array.
-fn face_arrays(
-    maps: &[LatLongMap<f64>],
+/// Each map in `param`, broadcast to `channels` channels, as a `(faces, S, S, C)` array; maps
+/// in parallel.
+fn face_arrays<T: Sample>(
+    maps: &[LatLongMap<T>],
     param: Parameterization,
     channels: usize,
-) -> Result<Vec<Array4<f64>>> {
-    let h = maps[0].height();
+) -> Result<Vec<Array4<T>>> {
     let own = SphereMap::from_lat_long(&maps[0])?.param();
     let conversion = if own == param {
         None
     } else {
         Some(Conversion::new(own, param, default_samples(own, param))?)
     };
-    maps.iter()
+    maps.par_iter()
         .map(|m| {
-            debug_assert_eq!(m.height(), h);
             let map = SphereMap::from_lat_long(m)?;
             let map = match &conversion {
                 Some(c) => c.apply(&map)?,
@@ -219,6 +273,19 @@ fn face_arrays(
         .collect()
 }
 
+/// The plain (unweighted) trees of `faces[k]` with `selections[k]`, in parallel.
+pub(super) fn plain_trees<T: Sample, const C: usize>(
+    faces: &[Array4<T>],
+    selections: &[Selection],
+    layout: FaceLayout,
+) -> Result<Vec<HaarTree<T, C>>> {
+    faces
+        .par_iter()
+        .zip(selections.par_iter())
+        .map(|(f, &s)| HaarTree::from_pixels(f.view(), layout, s))
+        .collect()
+}
+
 /// The layout whose Mallat index breaks selection ties: lat-long faces side by side.
 pub(crate) fn layout(param: Parameterization) -> FaceLayout {
     match param.kind() {
@@ -228,22 +295,19 @@ pub(crate) fn layout(param: Parameterization) -> FaceLayout {
 }
 
 /// Trees and the integral, for `C` channels.
-fn integrate_faces<const C: usize>(
-    faces: &[Array4<f64>],
-    param: Parameterization,
-    selections: &[Selection],
+fn integrate_faces<T: Sample, const C: usize>(
+    work: &Working<T>,
     options: &IntegrateOptions,
 ) -> Result<SphereIntegral> {
-    let layout = layout(param);
-    let weights: Array3<f64> = param.solid_angles();
-    let weighted = WeightedPixels::<f64, C>::new(faces[0].view(), weights.view())?;
-    let transport = Transport::new(&weighted, layout, selections[0])?;
-    let trees = faces[1..]
-        .iter()
-        .zip(&selections[1..])
-        .map(|(f, &s)| HaarTree::<f64, C>::from_pixels(f.view(), layout, s))
-        .collect::<Result<Vec<_>>>()?;
-    let refs: Vec<&HaarTree<f64, C>> = trees.iter().collect();
+    let layout = layout(work.param);
+    let weights: Array3<T> = work.param.solid_angles().mapv(T::from_f64);
+    let weighted = WeightedPixels::<T, C>::new(work.faces[0].view(), weights.view())?;
+    let (transport, trees) = rayon::join(
+        || Transport::new(&weighted, layout, work.selections[0]),
+        || plain_trees::<T, C>(&work.faces[1..], &work.selections[1..], layout),
+    );
+    let (transport, trees) = (transport?, trees?);
+    let refs: Vec<&HaarTree<T, C>> = trees.iter().collect();
     let start = Instant::now();
     let integral = match options.method {
         IntegralMethod::Tree => product_integral(
@@ -324,6 +388,31 @@ mod tests {
                 assert!((g - w).abs() < 1e-12 * w, "{method}: {g} vs {w}");
             }
             assert_eq!(got.kept, vec![16 * 32 - 2; 3]);
+        }
+    }
+
+    #[test]
+    fn f32_maps_integrate_within_single_precision() {
+        let maps = [map(16, 3, 11), map(16, 1, 12), map(16, 3, 13)];
+        let want = pixel_sum(&maps);
+        let single: Vec<LatLongMap<f32>> = maps
+            .iter()
+            .map(|m| LatLongMap::new(m.as_array().mapv(|v| v as f32)).unwrap())
+            .collect();
+        for &method in IntegralMethod::ALL {
+            let o = IntegrateOptions {
+                method,
+                ..Default::default()
+            };
+            let got = integrate(&single, &o).unwrap();
+            for (g, w) in got.value.iter().zip(&want) {
+                let err = ((g - w) / w).abs();
+                // f32 rounding of the maps and the weights (~1e-7 each), not f64's 1e-12.
+                assert!(
+                    err < 1e-5 && err > 1e-12,
+                    "{method}: {g} vs {w} ({err:.1e})"
+                );
+            }
         }
     }
 

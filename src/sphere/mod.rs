@@ -38,8 +38,9 @@
 //! six; texel directions, exact texel solid angles, [`SphereMap`]), [`cube`] (the cube map's
 //! faces, orientation and exact spherical-quadrilateral solid angles), [`convert`] (between
 //! parameterisations by solid-angle integration over each target texel), [`integrate`] (the
-//! integral over the sphere of a product of maps, on their Haar trees), [`harmonics`] (real
-//! spherical harmonics: evaluation, projection, reconstruction, the Lambertian convolution).
+//! integral over the sphere of a product of maps, on their Haar trees), [`product`] (the
+//! product of maps as a map, through their Haar trees), [`harmonics`] (real spherical
+//! harmonics: evaluation, projection, reconstruction, the Lambertian convolution).
 
 pub mod chain_rule;
 pub mod coefficients;
@@ -50,6 +51,7 @@ pub mod harmonics;
 pub mod integrate;
 pub mod latlong;
 pub mod param;
+pub mod product;
 pub mod reference;
 pub mod resample;
 pub mod rotation;

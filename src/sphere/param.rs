@@ -21,7 +21,7 @@ use super::LatLongMap;
 use super::cube;
 use super::latlong::{angles, direction, fill_grid, pixel_centre, pixel_solid_angle};
 use crate::named::named_enum;
-use crate::{Error, Result, Sample, ensure_finite};
+use crate::{Channels, Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
 named_enum! {
     /// Which parameterisation: the user-facing choice (`--param`).
@@ -320,6 +320,35 @@ impl<T: Sample> SphereMap<T> {
             .into_shape_with_order((s, 2 * s, c))
             .expect("standard layout");
         LatLongMap::new(data)
+    }
+
+    /// The map as one image with samples of `depth` (values not rescaled; 1 to 4 channels):
+    /// lat-long faces side by side (the `H x 2H` map itself), cube faces stacked from the top
+    /// in face order `+X, -X, +Y, -Y, +Z, -Z` (an `S` wide, `6 S` high strip).
+    ///
+    /// ```
+    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// use haarshift::SampleDepth;
+    /// let p = Parameterization::new(ParamKind::Cube, 4).unwrap();
+    /// let data = ndarray::Array4::from_shape_fn((6, 4, 4, 1), |(f, r, c, _)| (100 * f + 10 * r + c) as f32);
+    /// let m = SphereMap::new(p, data).unwrap();
+    /// let image = m.to_image(SampleDepth::F32).unwrap();
+    /// assert_eq!((image.width(), image.height()), (4, 24));
+    /// assert_eq!(image.planes()[[0, 4 * 5 + 2, 3]], 523.0); // face 5, row 2, column 3
+    /// ```
+    pub fn to_image(&self, depth: SampleDepth) -> Result<PlanarImage<T>> {
+        let (f, s, _, c) = self.data.dim();
+        let (planes, h, w) = match self.param.kind() {
+            // (C, row, face, col): each row runs through the faces side by side.
+            ParamKind::LatLong => (self.data.view().permuted_axes([3, 1, 0, 2]), s, f * s),
+            ParamKind::Cube => (self.data.view().permuted_axes([3, 0, 1, 2]), f * s, s),
+        };
+        let planes = planes
+            .as_standard_layout()
+            .into_owned()
+            .into_shape_with_order((c, h, w))
+            .expect("standard layout");
+        PlanarImage::new(planes, Channels::from_count(c)?, depth)
     }
 
     /// The parameterisation.

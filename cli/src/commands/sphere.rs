@@ -3,25 +3,33 @@
 use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
-use haarshift::io::{CoefficientFile, WriteOptions, read_image};
+use haarshift::io::{CoefficientFile, FileFormat, WriteOptions, read_image};
 use haarshift::product::Selection;
-use haarshift::sphere::integrate::{IntegralMethod, IntegrateOptions};
+use haarshift::sphere::integrate::{IntegralMethod, IntegrateOptions, check_size};
+use haarshift::sphere::product::{ProductOptions, multiply};
 use haarshift::sphere::{LatLongMap, Method, ParamKind, SphereOptions, SphereRotation, rotate_map};
 use haarshift::{Error, PlanarImage, Result, Sample, SampleDepth};
+use indicatif::ProgressBar;
 
-use super::{choice, names, print, refuse_existing, refuse_overwriting_input};
+use super::experiment::progress_bar;
+use super::{
+    Compute, ComputeFlag, ImageOutput, choice, names, print, refuse_existing,
+    refuse_overwriting_input,
+};
 
 /// Operations on lat-long environment maps.
 #[derive(Subcommand, Debug)]
 pub enum SphereCommand {
     Rotate(RotateArgs),
     Integrate(IntegrateArgs),
+    Product(ProductArgs),
 }
 
 pub fn run(command: SphereCommand) -> Result<()> {
     match command {
         SphereCommand::Rotate(args) => rotate(args),
         SphereCommand::Integrate(args) => integrate(args),
+        SphereCommand::Product(args) => product(args),
     }
 }
 
@@ -179,28 +187,11 @@ fn rotate_image<T: Sample>(
     }
 }
 
-const INTEGRATE_HELP: &str = "\
-The integral over the sphere of the product of the maps, computed on their Haar trees:
-  sum over texels of f_1(p) x f_2(p) x ... x solid_angle(p),
-the solid angle folded into the first map. Maps are lat-long (H x 2H, H a power of two; HDR,
-OpenEXR or .npy), all of one size; a 1-channel map multiplies every channel of the others.
-With --param latlong, no --keep and no --depth the result is exactly that pixel sum (to
-rounding); with --keep K each map keeps its K largest detail coefficients (orthonormal
-magnitudes, RGB by the root of the sum of squares, ties by index in the H x 2H Mallat array)
-plus its face scaling coefficients, and the result is the same sum over the pruned maps.
-
-Examples:
-  haarshift sphere integrate light.hdr visibility.npy brdf.exr
-  haarshift sphere integrate light.hdr visibility.npy --keep 200,70
-  haarshift sphere integrate light.hdr visibility.npy brdf.exr --param cube --resolution 64 --keep 1200 --per-face
-  haarshift sphere integrate a.npy b.npy --depth 4 --json result.json
-  haarshift sphere integrate a.npy b.npy c.npy --method triple --threshold 0.01";
-
-/// Integrate the product of lat-long maps over the sphere, on their Haar coefficients.
+/// The maps of `sphere integrate` and `sphere product` and how each is represented.
 #[derive(clap::Args, Debug)]
-#[command(after_help = INTEGRATE_HELP)]
-pub struct IntegrateArgs {
-    /// Two or more lat-long maps; the first carries the solid angle
+pub struct MapFlags {
+    /// Two or more lat-long maps (HDR, OpenEXR or .npy; H x 2H, H a power of two, all of one
+    /// size; a 1-channel map multiplies every channel of the others)
     #[arg(required = true, num_args = 2..)]
     pub maps: Vec<PathBuf>,
 
@@ -221,11 +212,6 @@ pub struct IntegrateArgs {
     #[arg(long, requires = "keep")]
     pub per_face: bool,
 
-    /// Visit detail levels 0..=D only (0 the coarsest; faces of side S have levels
-    /// 0..=log2(S)-1), as the sphere commands' --level [default: all]
-    #[arg(long, value_name = "D")]
-    pub depth: Option<usize>,
-
     /// `latlong`: two H x H faces, the halves of the map. `cube`: six faces, each map
     /// converted by solid-angle integration over each cube texel
     #[arg(long, default_value = "latlong", value_parser = choice::<ParamKind>(names!(ParamKind)))]
@@ -235,6 +221,89 @@ pub struct IntegrateArgs {
     /// maps' height H for latlong, H / 2 for cube]
     #[arg(long, value_name = "N")]
     pub resolution: Option<usize>,
+
+    #[command(flatten)]
+    pub compute: ComputeFlag,
+}
+
+impl MapFlags {
+    /// The selection of each map (one for all when one is given).
+    fn selections(&self) -> Vec<Selection> {
+        match (self.threshold, self.per_face) {
+            (Some(t), _) => vec![Selection::Threshold(t)],
+            (None, true) => self
+                .keep
+                .iter()
+                .map(|&k| Selection::LargestPerFace(k))
+                .collect(),
+            (None, false) => self.keep.iter().map(|&k| Selection::Largest(k)).collect(),
+        }
+    }
+
+    /// The float type given, or f64 when any map holds f64 samples and f32 otherwise.
+    fn compute(&self) -> Result<Compute> {
+        for path in &self.maps {
+            if self.compute.resolve(path)? == Compute::F64 {
+                return Ok(Compute::F64);
+            }
+        }
+        Ok(Compute::F32)
+    }
+
+    /// Reads the maps as lat-long maps of `T`, checking each one's size against the first's
+    /// so that an error names its file; one bar step each.
+    fn read<T: Sample>(&self, bar: &ProgressBar) -> Result<Vec<LatLongMap<T>>> {
+        let mut maps: Vec<LatLongMap<T>> = Vec::with_capacity(self.maps.len());
+        for path in &self.maps {
+            bar.set_message(format!("reading {}", path.display()));
+            let image = read_image::<T>(path)?;
+            let map = LatLongMap::from_image(&image).map_err(|e| e.in_file(path))?;
+            let height = maps.first().unwrap_or(&map).height();
+            check_size(height, &map).map_err(|e| e.in_file(path))?;
+            maps.push(map);
+            bar.inc(1);
+        }
+        Ok(maps)
+    }
+}
+
+/// A bar over reading `maps` maps and one computation, its elapsed time kept ticking (hidden
+/// when stderr is not a terminal).
+fn map_progress(maps: usize) -> ProgressBar {
+    let bar = progress_bar(maps + 1);
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
+const INTEGRATE_HELP: &str = "\
+The integral over the sphere of the product of the maps, computed on their Haar trees:
+  sum over texels of f_1(p) x f_2(p) x ... x solid_angle(p),
+the solid angle folded into the first map. Maps are lat-long (H x 2H, H a power of two; HDR,
+OpenEXR or .npy), all of one size; a 1-channel map multiplies every channel of the others.
+With --param latlong, no --keep and no --depth the result is exactly that pixel sum (to
+rounding); with --keep K each map keeps its K largest detail coefficients (orthonormal
+magnitudes, RGB by the root of the sum of squares, ties by index in the H x 2H Mallat array)
+plus its face scaling coefficients, and the result is the same sum over the pruned maps.
+The sums are accumulated in f64 whatever --compute says.
+
+Examples:
+  haarshift sphere integrate light.hdr visibility.npy brdf.exr
+  haarshift sphere integrate light.hdr visibility.npy --keep 200,70
+  haarshift sphere integrate light.hdr visibility.npy brdf.exr --param cube --resolution 64 --keep 1200 --per-face
+  haarshift sphere integrate a.npy b.npy --depth 4 --json result.json --compute f64
+  haarshift sphere integrate a.npy b.npy c.npy --method triple --threshold 0.01";
+
+/// Integrate the product of lat-long maps over the sphere, on their Haar coefficients.
+#[derive(clap::Args, Debug)]
+#[command(after_help = INTEGRATE_HELP)]
+pub struct IntegrateArgs {
+    #[command(flatten)]
+    pub maps: MapFlags,
+
+    /// Visit detail levels 0..=D only (0 the coarsest; faces of side S have levels
+    /// 0..=log2(S)-1), as the sphere commands' --level [default: all]
+    #[arg(long, value_name = "D")]
+    pub depth: Option<usize>,
 
     /// `tree`: the N-function tree traversal. `triple`: the three-function fast path (3 maps).
     /// `pixel`: inverse transforms, then the pixel sum. `pairwise`: products of two
@@ -262,54 +331,50 @@ struct IntegralRecord {
     seconds: f64,
     method: IntegralMethod,
     param: ParamKind,
+    compute: &'static str,
 }
 
 fn integrate(args: IntegrateArgs) -> Result<()> {
     if let Some(json) = &args.json {
-        for m in &args.maps {
+        for m in &args.maps.maps {
             refuse_overwriting_input(m, &[json])?;
         }
-        if json.exists() && !args.force {
-            return Err(Error::OutputExists { path: json.clone() });
-        }
+        refuse_existing(&[json], args.force)?;
     }
-    let selections: Vec<Selection> = match (args.threshold, args.per_face) {
-        (Some(t), _) => vec![Selection::Threshold(t)],
-        (None, true) => args
-            .keep
-            .iter()
-            .map(|&k| Selection::LargestPerFace(k))
-            .collect(),
-        (None, false) => args.keep.iter().map(|&k| Selection::Largest(k)).collect(),
-    };
-    let maps = args
-        .maps
-        .iter()
-        .map(|path| {
-            let image = read_image::<f64>(path)?;
-            LatLongMap::from_image(&image).map_err(|e| e.in_file(path))
-        })
-        .collect::<Result<Vec<_>>>()?;
+    match args.maps.compute()? {
+        Compute::F32 => integrate_as::<f32>(&args),
+        Compute::F64 => integrate_as::<f64>(&args),
+    }
+}
+
+fn integrate_as<T: Sample>(args: &IntegrateArgs) -> Result<()> {
+    let flags = &args.maps;
+    let bar = map_progress(flags.maps.len());
+    let maps = flags.read::<T>(&bar)?;
     let options = IntegrateOptions {
-        param: args.param,
-        resolution: args.resolution,
-        selections,
+        param: flags.param,
+        resolution: flags.resolution,
+        selections: flags.selections(),
         depth: args.depth,
         method: args.method,
     };
-    let result = haarshift::sphere::integrate::integrate(&maps, &options)?;
+    bar.set_message("integrating");
+    let result = haarshift::sphere::integrate::integrate(&maps, &options);
+    bar.finish_and_clear();
+    let result = result?;
     let kept: Vec<String> = result.kept.iter().map(|k| k.to_string()).collect();
     let mut text = String::new();
     for (channel, value) in result.value.iter().enumerate() {
         text += &format!("channel {channel}: integral {value:.17e}\n");
     }
     text += &format!(
-        "kept {} detail coefficients per map, visited {}, {:.6} s ({} method, {} param)\n",
+        "kept {} detail coefficients per map, visited {}, {:.6} s ({} method, {} param, {})\n",
         kept.join(","),
         result.visited,
         result.seconds,
         args.method,
-        args.param
+        flags.param,
+        T::NAME
     );
     if let Some(json) = &args.json {
         let records: Vec<IntegralRecord> = result
@@ -323,10 +388,126 @@ fn integrate(args: IntegrateArgs) -> Result<()> {
                 visited: result.visited,
                 seconds: result.seconds,
                 method: args.method,
-                param: args.param,
+                param: flags.param,
+                compute: T::NAME,
             })
             .collect();
         haarshift::experiments::output::write_json(json, &records, args.force)?;
     }
     print(&text)
+}
+
+const PRODUCT_HELP: &str = "\
+The product of the maps, f_1(p) x f_2(p) x ..., computed on their Haar trees (the tree
+product, not pixel by pixel): with everything kept it equals the pixelwise product to
+rounding; with --keep K each map keeps its K largest detail coefficients (the rule of
+`sphere integrate`, no solid angle: a product is a map, not an integral) and the result is
+the product of the pruned maps. Maps are lat-long (H x 2H, H a power of two; HDR, OpenEXR or
+.npy), all of one size; a 1-channel map multiplies every channel of the others.
+
+Output: with --param latlong the H x 2H product map; with --param cube its six S x S faces
+stacked from the top in the order +X, -X, +Y, -Y, +Z, -Z (S wide, 6 S high), as .exr, .hdr or
+.npy. With --coefficients, a .npy array (faces, S, S, C) of the product's Haar coefficients:
+per face the full-depth orthonormal Mallat pyramid ([f, 0, 0, c] the pixel sum over S; the
+H, V, D details of level l at (r, 2^l + c), (2^l + r, c), (2^l + r, 2^l + c)); faces are the
+map's halves (phi in [0, pi), then [pi, 2 pi)) or the cube's faces in the order above.
+
+Examples:
+  haarshift sphere product light.hdr visibility.npy -o lit.exr
+  haarshift sphere product light.hdr brdf.exr --keep 200 -o approx.npy
+  haarshift sphere product light.hdr visibility.npy --param cube --resolution 64 -o cube.exr
+  haarshift sphere product light.hdr visibility.npy --coefficients -o product-coeffs.npy";
+
+/// Multiply lat-long maps through their Haar trees; write the product map or its coefficients.
+#[derive(clap::Args, Debug)]
+#[command(after_help = PRODUCT_HELP)]
+pub struct ProductArgs {
+    #[command(flatten)]
+    pub maps: MapFlags,
+
+    /// Where to write the product (.exr, .hdr or .npy), or with --coefficients its Haar
+    /// coefficients (.npy)
+    #[arg(short, long, value_name = "OUTPUT")]
+    pub output: PathBuf,
+
+    /// Write the product's Haar coefficients (.npy, (faces, S, S, C), orthonormal) instead of
+    /// its pixels
+    #[arg(long)]
+    pub coefficients: bool,
+
+    /// Replace the output if it exists
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn product(args: ProductArgs) -> Result<()> {
+    let output = ImageOutput {
+        output: args.output.clone(),
+        force: args.force,
+    };
+    let inputs: Vec<&Path> = args.maps.maps.iter().map(|p| p.as_path()).collect();
+    output.refuse_overwriting(&inputs)?;
+    let format = FileFormat::from_extension(&args.output);
+    let allowed: &[FileFormat] = if args.coefficients {
+        &[FileFormat::Npy]
+    } else {
+        &[FileFormat::Exr, FileFormat::Hdr, FileFormat::Npy]
+    };
+    if !format.is_some_and(|f| allowed.contains(&f)) {
+        return Err(Error::Format {
+            path: args.output.clone(),
+            reason: if args.coefficients {
+                "coefficients are written as .npy".into()
+            } else {
+                "a product map is written as .exr, .hdr or .npy".into()
+            },
+        });
+    }
+    match args.maps.compute()? {
+        Compute::F32 => product_as::<f32>(&args, &output, SampleDepth::F32),
+        Compute::F64 => product_as::<f64>(&args, &output, SampleDepth::F64),
+    }
+}
+
+/// The product in `T`, written at `depth`.
+fn product_as<T: Sample>(
+    args: &ProductArgs,
+    output: &ImageOutput,
+    depth: SampleDepth,
+) -> Result<()> {
+    let flags = &args.maps;
+    let bar = map_progress(flags.maps.len());
+    let maps = flags.read::<T>(&bar)?;
+    let options = ProductOptions {
+        param: flags.param,
+        resolution: flags.resolution,
+        selections: flags.selections(),
+    };
+    bar.set_message("multiplying");
+    let result = multiply(&maps, &options);
+    bar.finish_and_clear();
+    let result = result?;
+    let kept: Vec<String> = result.kept.iter().map(|k| k.to_string()).collect();
+    let what = format!(
+        ", the product of {} maps ({} param, kept {} detail coefficients per map, {} tree nodes, \
+         {:.6} s, {})",
+        flags.maps.len(),
+        flags.param,
+        kept.join(","),
+        result.nodes,
+        result.seconds,
+        T::NAME
+    );
+    if args.coefficients {
+        let c = &result.coefficients;
+        haarshift::io::write_npy(c.view(), depth, &args.output, args.force)?;
+        let (f, s, _, ch) = c.dim();
+        print(&format!(
+            "{}: ({f}, {s}, {s}, {ch}) {} Haar coefficients{what}\n",
+            args.output.display(),
+            T::NAME
+        ))
+    } else {
+        output.write(&result.map.to_image(depth)?, Some(depth), &what)
+    }
 }

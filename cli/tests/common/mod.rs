@@ -3,6 +3,8 @@
 // Each test crate compiles this module and uses only some of it.
 #![allow(dead_code)]
 
+pub mod maps;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -61,6 +61,40 @@ fn dense_triple_of_one_channel_uses_the_vector_path() {
     assert_close(&dense, &want, &scale, 1e-12, "dense f64");
 }
 
+/// The dense path in f32 on full 6 x 64^2 maps (its benchmark size; with a partial last
+/// chunk of 16 nodes and several accumulation blocks), one channel and RGB.
+fn dense_f32_within_single_precision<const C: usize>() {
+    let maps: Vec<_> = (0..3)
+        .map(|k| random_faces(500 + k, 6, 64, C, -1.0, 1.0))
+        .collect();
+    let weights = random_weights(10, 6, 64);
+    let single = |a: &Array4<f64>| a.mapv(|v| v as f32);
+    let w =
+        WeightedPixels::<f32, C>::new(single(&maps[0]).view(), weights.mapv(|v| v as f32).view())
+            .unwrap();
+    let t = Transport::new(&w, FaceLayout::Stacked, Selection::All).unwrap();
+    let tree = |m: &Array4<f64>| {
+        HaarTree::<f32, C>::from_pixels(single(m).view(), FaceLayout::Stacked, Selection::All)
+            .unwrap()
+    };
+    let dense = dense_triple_integral(
+        &DenseTransport::from_transport(&t),
+        &DenseFaces::from_tree(&tree(&maps[1])),
+        &DenseFaces::from_tree(&tree(&maps[2])),
+    )
+    .unwrap();
+    let views: Vec<_> = maps.iter().map(|m| m.view()).collect();
+    let (want, scale) = pixel_oracle(&weights, &views);
+    // f32 rounding of the maps, the transforms and the sums of 1,024 nodes (f64 beyond).
+    assert_close(&dense, &want, &scale, 1e-5, "dense f32");
+}
+
+#[test]
+fn dense_triple_in_f32_equals_the_pixel_sum_to_single_precision() {
+    dense_f32_within_single_precision::<1>();
+    dense_f32_within_single_precision::<3>();
+}
+
 #[test]
 fn baselines_equal_the_tree_integral() {
     for n in 2..=5 {
