@@ -6,36 +6,11 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
+use common::maps::{planes, pruned, write_map};
 use common::{fails_cleanly, p, succeeds_with_stdout};
 
-use haarshift::io::{WriteOptions, write_image};
-use haarshift::transform::{Normalization, pyramid};
-use haarshift::{Channels, PlanarImage, SampleDepth};
-use ndarray::{Array2, Array3};
-
-/// A deterministic pseudo-random positive `(channels, h, 2h)` map.
-fn planes(h: usize, channels: usize, seed: u64) -> Array3<f64> {
-    let mut x = seed;
-    Array3::from_shape_fn((channels, h, 2 * h), |_| {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        0.1 + (x >> 11) as f64 / (1u64 << 53) as f64
-    })
-}
-
-/// Writes `planes` as an f64 `.npy` map in `dir`.
-fn write_map(dir: &Path, name: &str, planes: &Array3<f64>) -> PathBuf {
-    let channels = if planes.dim().0 == 1 {
-        Channels::Gray
-    } else {
-        Channels::Rgb
-    };
-    let image = PlanarImage::new(planes.clone(), channels, SampleDepth::F64).unwrap();
-    let path = dir.join(name);
-    write_image(&image, &path, WriteOptions::default()).unwrap();
-    path
-}
+use haarshift::SampleDepth;
+use ndarray::Array3;
 
 /// The solid angle of a pixel of row `i` of an `h x 2h` map: `(pi / h)(cos theta_i -
 /// cos theta_i+1)`.
@@ -61,25 +36,6 @@ fn pixel_sum(maps: &[Array3<f64>], c: usize) -> f64 {
     sum
 }
 
-/// A one-channel `h x 2h` plane reconstructed from its `k` largest orthonormal detail
-/// coefficients and its two scaling coefficients: sort by `|c|` descending, ties by row-major
-/// index in the `h x 2h` Mallat array ascending.
-fn pruned(plane: &Array2<f64>, k: usize) -> Array2<f64> {
-    let levels = plane.dim().0.trailing_zeros() as usize;
-    let c = pyramid::forward(plane.view(), levels, Normalization::Orthonormal).unwrap();
-    let w = c.dim().1;
-    let mut order: Vec<usize> = (0..c.len()).filter(|&i| i != 0 && i != 1).collect();
-    order.sort_by(|&a, &b| {
-        let (va, vb) = (c[[a / w, a % w]].abs(), c[[b / w, b % w]].abs());
-        vb.total_cmp(&va).then(a.cmp(&b))
-    });
-    let mut kept = Array2::zeros(c.dim());
-    for &i in order.iter().take(k).chain([0, 1].iter()) {
-        kept[[i / w, i % w]] = c[[i / w, i % w]];
-    }
-    pyramid::inverse(kept.view(), levels, Normalization::Orthonormal).unwrap()
-}
-
 /// The integrals printed for each channel.
 fn integrals(stdout: &str) -> Vec<f64> {
     stdout
@@ -100,7 +56,7 @@ fn the_printed_integral_is_the_pixel_sum_with_solid_angles() {
     let paths: Vec<PathBuf> = maps
         .iter()
         .enumerate()
-        .map(|(k, m)| write_map(dir.path(), &format!("m{k}.npy"), m))
+        .map(|(k, m)| write_map(dir.path(), &format!("m{k}.npy"), m, SampleDepth::F64))
         .collect();
     for method in ["tree", "triple", "pixel", "pairwise"] {
         let mut args = vec!["sphere", "integrate"];
@@ -121,8 +77,8 @@ fn keep_is_the_pixel_sum_of_the_pruned_maps() {
     let (h, k) = (16, 40);
     let (f, g) = (planes(h, 1, 4), planes(h, 1, 5));
     let (fp, gp) = (
-        write_map(dir.path(), "f.npy", &f),
-        write_map(dir.path(), "g.npy", &g),
+        write_map(dir.path(), "f.npy", &f, SampleDepth::F64),
+        write_map(dir.path(), "g.npy", &g, SampleDepth::F64),
     );
     // The first map is weighted by the solid angle before its coefficients are selected.
     let mut weighted = f.index_axis(ndarray::Axis(0), 0).to_owned();
@@ -172,9 +128,9 @@ fn keep_is_the_pixel_sum_of_the_pruned_maps() {
 #[test]
 fn bad_requests_fail_in_one_line() {
     let dir = tempfile::tempdir().unwrap();
-    let a = write_map(dir.path(), "a.npy", &planes(16, 1, 6));
-    let b = write_map(dir.path(), "b.npy", &planes(8, 1, 7));
-    let odd = write_map(dir.path(), "odd.npy", &planes(6, 1, 8));
+    let a = write_map(dir.path(), "a.npy", &planes(16, 1, 6), SampleDepth::F64);
+    let b = write_map(dir.path(), "b.npy", &planes(8, 1, 7), SampleDepth::F64);
+    let odd = write_map(dir.path(), "odd.npy", &planes(6, 1, 8), SampleDepth::F64);
     let mut nan_planes = planes(16, 1, 9);
     nan_planes[[0, 3, 4]] = f64::NAN;
     let nan = dir.path().join("nan.npy");
