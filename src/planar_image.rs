@@ -146,6 +146,30 @@ impl<T: Sample> PlanarImage<T> {
         self.depth
     }
 
+    /// The image relabelled as stored at `depth`, with samples rescaled as a file written at
+    /// that depth would hold them: between the integer depths by 257 (8 -> 16) or 1/257
+    /// (16 -> 8); nothing else is rescaled (float samples are code values). No rounding: an
+    /// operation that ends at an integer depth (such as [`rotate_image`](crate::rotate::rotate_image))
+    /// rounds once, at the new depth, so converting before it keeps the finer codes.
+    ///
+    /// ```
+    /// use haarshift::{PlanarImage, SampleDepth};
+    /// use ndarray::Array2;
+    /// let eight = PlanarImage::from_gray(Array2::from_elem((1, 2), 2.0f32), SampleDepth::U8).unwrap();
+    /// let wide = eight.with_depth(SampleDepth::U16);
+    /// assert_eq!((wide.depth(), wide.plane(0)[[0, 0]]), (SampleDepth::U16, 514.0));
+    /// assert_eq!(wide.with_depth(SampleDepth::F32).plane(0)[[0, 1]], 514.0);
+    /// ```
+    pub fn with_depth(mut self, depth: SampleDepth) -> Self {
+        let scale = depth_scale(self.depth, depth);
+        if scale != 1.0 {
+            let scale = T::from_f64(scale);
+            self.planes.par_mapv_inplace(|v| v * scale);
+        }
+        self.depth = depth;
+        self
+    }
+
     /// All planes, alpha last when present.
     pub fn planes(&self) -> ArrayView3<'_, T> {
         self.planes.view()
@@ -201,5 +225,14 @@ impl<T: Sample> PlanarImage<T> {
         let stacked = ndarray::stack(Axis(0), &views)
             .map_err(|e| Error::shape(&[planes.len()], e.to_string()))?;
         Self::new(stacked, self.channels, self.depth)
+    }
+}
+
+/// The factor a sample of depth `from` is multiplied by when stored at depth `to`: integer
+/// depths are rescaled into each other, nothing else is.
+pub(crate) fn depth_scale(from: SampleDepth, to: SampleDepth) -> f64 {
+    match (from.integer_max(), to.integer_max()) {
+        (Some(a), Some(b)) => b / a,
+        _ => 1.0,
     }
 }

@@ -238,6 +238,42 @@ fn depth_u16_writes_sixteen_bit_codes() {
     assert!(want.iter().all(|&v| v > 255.0 && v % 257.0 != 0.0));
 }
 
+/// `rotate --depth u16` from an 8-bit image: the rotation is rounded once, to 16-bit codes,
+/// not to 8-bit codes then multiplied by 257. It equals 257 x the unrounded rotation (written
+/// as f32) rounded, within one code for f32 arithmetic; rounding to 8 bits first would give
+/// only multiples of 257.
+#[test]
+fn depth_u16_from_eight_bits_keeps_the_finer_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    let planes = irregular().insert_axis(ndarray::Axis(0));
+    let input = write(dir.path(), "i.png", planes, Channels::Gray, SampleDepth::U8);
+    let flags = ["--angle", "30", "--method", "linear"];
+    let wide = run(
+        "rotate",
+        &input,
+        &dir.path().join("w.png"),
+        &[&flags[..], &["--depth", "u16"]].concat(),
+    );
+    let exact = run(
+        "rotate",
+        &input,
+        &dir.path().join("e.npy"),
+        &[&flags[..], &["--depth", "f32"]].concat(),
+    );
+    assert_eq!(wide.depth(), SampleDepth::U16);
+    assert_eq!(wide.plane(0).dim(), exact.plane(0).dim());
+    let mut finer = 0;
+    for (&w, &e) in wide.plane(0).iter().zip(exact.plane(0).iter()) {
+        assert!(
+            (w - (e * 257.0).round()).abs() <= 1.0,
+            "{w} against {}",
+            e * 257.0
+        );
+        finer += usize::from(w % 257.0 != 0.0);
+    }
+    assert!(finer > 20, "only {finer} pixels off the 8-bit codes");
+}
+
 /// The nearest half float of `v` (round to nearest even), from the format: 11 significant
 /// bits for normal values.
 fn to_f16(v: f64) -> f64 {

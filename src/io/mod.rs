@@ -70,6 +70,7 @@ use std::path::Path;
 use ndarray::Array3;
 
 use crate::named::named_enum;
+use crate::planar_image::depth_scale;
 use crate::sample::round_to_code;
 use crate::{Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
@@ -478,15 +479,6 @@ fn stored_depth(
         FileFormat::Exr => Ok(if wanted == F16 { F16 } else { F32 }),
         FileFormat::Npy => Ok(if wanted == F64 { F64 } else { F32 }),
         FileFormat::Hdr => Ok(F32),
-    }
-}
-
-/// The value a sample of an image of depth `from` is stored as at depth `to`, before any
-/// integer rounding: integer depths are rescaled into each other, nothing else is.
-fn depth_scale(from: SampleDepth, to: SampleDepth) -> f64 {
-    match (from.integer_max(), to.integer_max()) {
-        (Some(a), Some(b)) => b / a,
-        _ => 1.0,
     }
 }
 

@@ -110,7 +110,12 @@ fn rotate<T: Sample>(args: &Args) -> Result<()> {
         supersample: args.supersample,
         ..Default::default()
     };
-    let image = read_image::<T>(&args.input)?;
+    let mut image = read_image::<T>(&args.input)?;
+    if let Some(depth) = args.depth {
+        // Rotation rounds integer depths to their codes: round once, at the output's depth
+        // (an 8-bit input written as 16 bits keeps the rotation's finer values).
+        image = image.with_depth(depth);
+    }
     let rotated = rotate_image(&image, args.angle, kernel.as_ref(), &options)?;
     drop(image);
     let what = format!(
