@@ -496,3 +496,56 @@ fn sixteen_bit_images_round_trip() {
     // Measured 4 code values; bound 2x.
     assert!(err <= 8.0, "{err} code values of 65535");
 }
+
+/// Alpha at a float depth under every boundary mode: colour is premultiplied by alpha, the
+/// planes rotated alone, and divided by the rotated alpha (the definition in `rotate_image`'s
+/// docs), with no rounding to codes. Skipping the premultiplication moves colour by far more
+/// than the bound (the alpha here varies from 0.2 to 1), and rounding would show on the
+/// non-integer values.
+#[test]
+fn float_alpha_is_premultiplied_under_every_boundary_mode() {
+    use crate::boundary::BoundaryMode;
+    use ndarray::Axis;
+    let (h, w) = (14, 17);
+    let mut rng = StdRng::seed_from_u64(41);
+    let mut planes = Array3::<f64>::zeros((4, h, w));
+    for r in 0..h {
+        for c in 0..w {
+            for ch in 0..3 {
+                planes[[ch, r, c]] = rng.random::<f64>();
+            }
+            planes[[3, r, c]] = 0.2 + 0.8 * ((r * w + c) % 7) as f64 / 6.0;
+        }
+    }
+    let img = PlanarImage::new(planes.clone(), Channels::Rgba, SampleDepth::F32).unwrap();
+    let k = ShiftMethod::Keys.kernel::<f64>();
+    for &mode in BoundaryMode::ALL {
+        let opts = RotateOptions {
+            outside: Outside::Boundary(mode),
+            ..Default::default()
+        };
+        let got = rotate_image(&img, 23.0, k.as_ref(), &opts).unwrap();
+        assert_eq!(got.depth(), SampleDepth::F32);
+        let alpha = rotate_plane(planes.index_axis(Axis(0), 3), 23.0, k.as_ref(), &opts).unwrap();
+        assert_eq!(got.plane(3), alpha, "{mode}: alpha is rotated as a plane");
+        let mut fractional = 0;
+        for ch in 0..3 {
+            let premultiplied = &planes.index_axis(Axis(0), ch) * &planes.index_axis(Axis(0), 3);
+            let rotated = rotate_plane(premultiplied.view(), 23.0, k.as_ref(), &opts).unwrap();
+            for ((rc, &v), (&p, &a)) in got
+                .plane(ch)
+                .indexed_iter()
+                .zip(rotated.iter().zip(alpha.iter()))
+            {
+                let want = if a > 1e-6 { p / a } else { 0.0 };
+                // Same operations in the same order: equal to rounding.
+                assert!(
+                    (v - want).abs() <= 1e-12 * want.abs().max(1.0),
+                    "{mode} {ch} {rc:?}: {v} vs {want}"
+                );
+                fractional += usize::from(v.fract() != 0.0);
+            }
+        }
+        assert!(fractional > h * w, "{mode}: float samples are not rounded");
+    }
+}
