@@ -213,17 +213,7 @@ impl SphericalHarmonics {
         coefficients: ArrayView2<'_, f64>,
         param: Parameterization,
     ) -> Result<SphereMap<f64>> {
-        let (n, ch) = coefficients.dim();
-        if n != self.len() {
-            return Err(Error::shape(
-                &[n, ch],
-                format!(
-                    "{} bands need {} coefficients per channel",
-                    self.bands,
-                    self.len()
-                ),
-            ));
-        }
+        let (n, ch) = self.check_coefficients(coefficients)?;
         SphereMap::from_texels(param, ch, |(face, row, col), out| {
             let mut y = vec![0.0; n];
             self.evaluate(param.texel_direction(face, row, col), &mut y);
@@ -236,6 +226,22 @@ impl SphericalHarmonics {
                     .sum();
             }
         })
+    }
+
+    /// `(B^2, C)` of a coefficient array, or a shape error when it has not `B^2` rows.
+    fn check_coefficients(&self, coefficients: ArrayView2<'_, f64>) -> Result<(usize, usize)> {
+        let (n, ch) = coefficients.dim();
+        if n != self.len() {
+            return Err(Error::shape(
+                &[n, ch],
+                format!(
+                    "{} bands need {} coefficients per channel",
+                    self.bands,
+                    self.len()
+                ),
+            ));
+        }
+        Ok((n, ch))
     }
 
     /// The irradiance coefficients `E_lm = A_l L_lm` of lighting coefficients `L` (`(B^2, C)`):
@@ -253,17 +259,7 @@ impl SphericalHarmonics {
     /// assert!((e[[0, 0]] * y[0] - pi).abs() < 1e-14); // E = pi
     /// ```
     pub fn lambert_irradiance(&self, lighting: ArrayView2<'_, f64>) -> Result<Array2<f64>> {
-        let (n, ch) = lighting.dim();
-        if n != self.len() {
-            return Err(Error::shape(
-                &[n, ch],
-                format!(
-                    "{} bands need {} coefficients per channel",
-                    self.bands,
-                    self.len()
-                ),
-            ));
-        }
+        self.check_coefficients(lighting)?;
         let mut out = lighting.to_owned();
         for l in 0..self.bands {
             let a = lambert_factor(l);
