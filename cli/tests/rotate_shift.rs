@@ -284,7 +284,8 @@ fn fractional_haar_shift_is_bilinear_at_the_rounded_shift_and_retained_box_avera
     let err = (&got - &expected)
         .mapv(f64::abs)
         .fold(0.0f64, |m, &v| m.max(v));
-    assert!(err < 1e-9, "max difference {err}");
+    // Measured 0: the quarter-pixel weights are dyadic; 1e-14 allows a reordered sum.
+    assert!(err < 1e-14, "max difference {err}");
 
     let retained = dir.path().join("retained.npy");
     let mut args = vec!["shift", p(&input), "-o", p(&retained), "--retain"];
@@ -300,7 +301,8 @@ fn fractional_haar_shift_is_bilinear_at_the_rounded_shift_and_retained_box_avera
     let err = (&boxed - &got)
         .mapv(f64::abs)
         .fold(0.0f64, |m, &v| m.max(v));
-    assert!(err < 1e-9, "max difference {err}");
+    // Measured 0: the quarter-pixel weights are dyadic; 1e-14 allows a reordered sum.
+    assert!(err < 1e-14, "max difference {err}");
     // The fine image is the input's pixels as 4x4 blocks moved by (1, -3) fine samples.
     assert_eq!(fine[[3, 1]], x[[1, 0]]);
 }

@@ -388,7 +388,9 @@ mod rotation_tests {
                 .zip(b.iter())
                 .map(|(x, y)| (x - y).abs())
                 .fold(0.0, f64::max);
-            assert!(err < 1e-9, "h={h}: {err}");
+            // Measured 0 for h = 1, 2, 3 (integer values, dyadic weights); 1e-12 allows a
+            // reordered sum.
+            assert!(err < 1e-12, "h={h}: {err}");
         }
     }
 }

@@ -687,7 +687,8 @@ fn sparse_queries_agree_with_the_dense_shift() {
     ];
     let got = query.coefficients(dx, dy, &which).unwrap();
     let want = [dense[[0, 1]], dense[[32 + 31, 64 + 63]], dense[[4 + 3, 7]]];
-    assert!(max_diff(&got, &want) < 1e-10);
+    // Measured 9.8e-15; bound 10x.
+    assert!(max_diff(&got, &want) < 1e-13);
     // The coarse-resolution query needs only the top-left 1/4^t of the coefficients.
     let mut coarse_only = c.clone();
     coarse_only.slice_mut(s![8.., ..]).fill(f64::NAN);
@@ -839,6 +840,11 @@ fn rejects_bad_inputs_with_typed_errors() {
     );
 }
 
+/// The bound of the two proptests below: over their 48 cases each the largest difference
+/// measured was 1.4e-14 (values of magnitude up to 10, up to 128 x 128 or 1,024 samples at
+/// `h <= 8`); the bound is 70x that, for the sizes and shifts a run did not draw.
+const RANDOM_SIZE_BOUND: f64 = 1e-12;
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
@@ -858,20 +864,20 @@ proptest! {
         let (gx, gy) = (GridShift::new(dx, h).unwrap(), GridShift::new(dy, h).unwrap());
         let got = dense::shift_pyramid(c.view(), levels, norm, gx, gy).unwrap();
         let pixel = pyramid::forward(interpolate_2d(x.view(), dx, dy, h).view(), levels, norm).unwrap();
-        prop_assert!(max_diff(&got, &pixel) < 1e-10);
+        prop_assert!(max_diff(&got, &pixel) < RANDOM_SIZE_BOUND);
         let query = ShiftQuery2d::new(c.view(), levels, norm).unwrap();
         let (h0, w0) = (rows >> levels, cols >> levels);
         for n in 0..16usize {
             let (r, q) = ((n * 7919 + seed as usize) % rows, (n * 104_729 + seed as usize) % cols);
             let idx = random_access::pyramid_index(h0, w0, r, q);
             let v = query.coefficients(gx, gy, &[idx]).unwrap()[0];
-            prop_assert!((v - got[[r, q]]).abs() < 1e-10);
+            prop_assert!((v - got[[r, q]]).abs() < RANDOM_SIZE_BOUND);
         }
         let (ga, gb) = (GridShift::whole(a), GridShift::whole(b));
         let first = dense::shift_pyramid(c.view(), levels, norm, ga, gb).unwrap();
         let twice = dense::shift_pyramid(first.view(), levels, norm, gb, ga).unwrap();
         let once = dense::shift_pyramid(c.view(), levels, norm, ga + gb, gb + ga).unwrap();
-        prop_assert!(max_diff(&twice, &once) < 1e-10);
+        prop_assert!(max_diff(&twice, &once) < RANDOM_SIZE_BOUND);
     }
 
     /// Larger 1D sizes, precisions up to 8, against the oracle itself; composition on the
@@ -889,19 +895,19 @@ proptest! {
         let shift = GridShift::new(s, h).unwrap();
         let got = dense::shift_signal(c.view(), levels, norm, shift).unwrap();
         let pixel = haar1d::forward(interpolate_1d(x.view(), s, h).view(), levels, norm).unwrap();
-        prop_assert!(max_diff(&got, &pixel) < 1e-10);
+        prop_assert!(max_diff(&got, &pixel) < RANDOM_SIZE_BOUND);
         if n << h <= 1 << 14 {
             let want = oracle::shift_signal(c.view(), levels, norm, shift).unwrap();
-            prop_assert!(max_diff(&got, &want) < 1e-10);
+            prop_assert!(max_diff(&got, &want) < RANDOM_SIZE_BOUND);
         }
         let query = ShiftQuery1d::new(c.view(), levels, norm).unwrap();
-        prop_assert!(max_diff(&query.coarse(shift, levels).unwrap(), &got) < 1e-10);
+        prop_assert!(max_diff(&query.coarse(shift, levels).unwrap(), &got) < RANDOM_SIZE_BOUND);
         let mut chain = RetainedSignal::new(c.view(), levels, norm, h).unwrap();
         chain.shift(s).unwrap();
         chain.shift(t).unwrap();
         let mut once = RetainedSignal::new(c.view(), levels, norm, h).unwrap();
         let total = GridShift::new(s, h).unwrap() + GridShift::new(t, h).unwrap();
         once.shift(total.amount()).unwrap();
-        prop_assert!(max_diff(chain.fine(), once.fine()) < 1e-10);
+        prop_assert!(max_diff(chain.fine(), once.fine()) < RANDOM_SIZE_BOUND);
     }
 }

@@ -319,14 +319,16 @@ proptest! {
         let k = pyramid::max_levels(h, w);
         let c = pyramid::forward(x.view(), k, Normalization::Average).unwrap();
         // The scaling block is the block means.
+        // Measured over 64 cases (values of magnitude up to 84, up to 256 x 256): at most
+        // 7.1e-15 for the means and 2.8e-14 for the round trip; bound 1e-12 (35x and more).
         let side = 1 << k;
         for i in 0..h >> k {
             for j in 0..w >> k {
                 let mean = x.slice(ndarray::s![i * side..(i + 1) * side, j * side..(j + 1) * side]).mean().unwrap();
-                prop_assert!((c[[i, j]] - mean).abs() < 1e-10);
+                prop_assert!((c[[i, j]] - mean).abs() < 1e-12);
             }
         }
         let back = pyramid::inverse(c.view(), k, Normalization::Average).unwrap();
-        prop_assert!(back.iter().zip(x.iter()).all(|(a, b)| (a - b).abs() < 1e-10));
+        prop_assert!(back.iter().zip(x.iter()).all(|(a, b)| (a - b).abs() < 1e-12));
     }
 }
