@@ -1,5 +1,5 @@
 //! Product integrals on real data: the rooitou park envmap, the visibility of bunny vertices
-//! (brute-force ray-triangle tests against `testdata/meshes/bunny.obj` in the setup) and a
+//! (rays through the relighting module's BVH against `testdata/meshes/bunny.obj`) and a
 //! Phong-50 lobe, sampled at the texel centres of a cube map (6 x S^2) or a lat-long map
 //! (H x 2H) of the library's parameterisations (bilinear lookups in the lat-long envmap: data
 //! preparation for timing only); weights are the texels' exact solid angles.
@@ -21,6 +21,7 @@ use haarshift::product::triple::{
 use haarshift::product::{
     FaceLayout, HaarTree, IntegralOptions, Selection, Transport, WeightedPixels, product_integral,
 };
+use haarshift::relight::{Mesh, Occlusion, SceneBvh, ray_offset};
 use haarshift::sphere::latlong::angles;
 use haarshift::sphere::{LatLongMap, ParamKind, Parameterization, SphereMap};
 use ndarray::{Array3, Array4, Axis};
@@ -31,105 +32,38 @@ fn sample(p: Parameterization, c: usize, f: impl Fn([f64; 3], &mut [f64]) + Sync
     SphereMap::from_fn(p, c, f).expect("finite").into_array()
 }
 
-struct Mesh {
-    vertices: Vec<[f64; 3]>,
-    triangles: Vec<[usize; 3]>,
+/// The bunny, its BVH, and the ray offset of the relighting precomputation.
+struct Bunny {
+    mesh: Mesh,
+    bvh: SceneBvh,
+    offset: f64,
 }
 
-fn bunny() -> Mesh {
-    let text = std::fs::read_to_string(concat!(
+fn bunny() -> Bunny {
+    let mesh = Mesh::load(std::path::Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/testdata/meshes/bunny.obj"
-    ))
+    )))
     .expect("bunny.obj");
-    let mut mesh = Mesh {
-        vertices: Vec::new(),
-        triangles: Vec::new(),
-    };
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let v: Vec<f64> = it.take(3).map(|x| x.parse().expect("number")).collect();
-                mesh.vertices.push([v[0], v[1], v[2]]);
-            }
-            Some("f") => {
-                let f: Vec<usize> = it
-                    .take(3)
-                    .map(|x| {
-                        x.split('/')
-                            .next()
-                            .unwrap()
-                            .parse::<usize>()
-                            .expect("index")
-                            - 1
-                    })
-                    .collect();
-                mesh.triangles.push([f[0], f[1], f[2]]);
-            }
-            _ => {}
-        }
+    Bunny {
+        bvh: SceneBvh::new(&mesh),
+        offset: ray_offset(&mesh),
+        mesh,
     }
-    mesh
 }
 
-/// Whether the ray `o + t d` (t > 1e-6) hits a triangle (Moller-Trumbore).
-fn occluded(mesh: &Mesh, o: [f64; 3], d: [f64; 3]) -> bool {
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    mesh.triangles.iter().any(|t| {
-        let (a, b, c) = (
-            mesh.vertices[t[0]],
-            mesh.vertices[t[1]],
-            mesh.vertices[t[2]],
-        );
-        let (e1, e2) = (sub(b, a), sub(c, a));
-        let p = cross(d, e2);
-        let det = dot(e1, p);
-        if det.abs() < 1e-12 {
-            return false;
-        }
-        let tv = sub(o, a);
-        let u = dot(tv, p) / det;
-        if !(0.0..=1.0).contains(&u) {
-            return false;
-        }
-        let q = cross(tv, e1);
-        let v = dot(d, q) / det;
-        if v < 0.0 || u + v > 1.0 {
-            return false;
-        }
-        dot(e2, q) / det > 1e-6
-    })
-}
-
-/// Visibility of bunny vertex `k` (1 where the ray escapes), nudged off the surface.
-fn visibility(mesh: &Mesh, k: usize, param: Parameterization) -> Array4<f64> {
-    let centre = mesh.vertices.iter().fold([0.0; 3], |acc, v| {
-        [acc[0] + v[0], acc[1] + v[1], acc[2] + v[2]]
-    });
-    let n = mesh.vertices.len() as f64;
-    let p = mesh.vertices[k];
-    let out = [
-        p[0] - centre[0] / n,
-        p[1] - centre[1] / n,
-        p[2] - centre[2] / n,
-    ];
-    let len = (out[0] * out[0] + out[1] * out[1] + out[2] * out[2]).sqrt();
-    let o = [
-        p[0] + 1e-3 * out[0] / len,
-        p[1] + 1e-3 * out[1] / len,
-        p[2] + 1e-3 * out[2] / len,
-    ];
+/// Visibility of bunny vertex `k` (1 where the ray escapes), from the origin offset along its
+/// normal as the relighting precomputation does.
+fn visibility(bunny: &Bunny, k: usize, param: Parameterization) -> Array4<f64> {
+    let (p, n) = (bunny.mesh.positions(), bunny.mesh.normals());
+    let o: [f32; 3] = std::array::from_fn(|i| (p[[k, i]] + bunny.offset * n[[k, i]]) as f32);
     sample(param, 1, |d, px| {
-        px[0] = if occluded(mesh, o, d) { 0.0 } else { 1.0 }
+        let d = d.map(|x| x as f32);
+        px[0] = if bunny.bvh.occluded(o, d, f32::INFINITY) {
+            0.0
+        } else {
+            1.0
+        }
     })
 }
 
@@ -178,9 +112,9 @@ struct Scene<const C: usize> {
     layout: FaceLayout,
 }
 
-fn scene<const C: usize>(mesh: &Mesh, p: Parameterization, extra: usize) -> Scene<C> {
+fn scene<const C: usize>(bunny: &Bunny, p: Parameterization, extra: usize) -> Scene<C> {
     let widen = |a: &Array4<f64>| if C == 1 { to32(a) } else { rgb(a) };
-    let vis = widen(&visibility(mesh, 100, p));
+    let vis = widen(&visibility(bunny, 100, p));
     let weights = p.solid_angles().mapv(|v| v as f32);
     let env = if C == 1 {
         to32(&envmap(p, 1))
@@ -189,7 +123,7 @@ fn scene<const C: usize>(mesh: &Mesh, p: Parameterization, extra: usize) -> Scen
     };
     let mut factors = vec![env, widen(&phong(p))];
     for k in 0..extra {
-        factors.push(widen(&visibility(mesh, 400 + 300 * k, p)));
+        factors.push(widen(&visibility(bunny, 400 + 300 * k, p)));
     }
     Scene {
         weighted: WeightedPixels::new(vis.view(), weights.view()).expect("shapes"),
@@ -219,8 +153,8 @@ fn trees<const C: usize>(
     (t, f)
 }
 
-fn targets_for<const C: usize>(c: &mut Criterion, mesh: &Mesh, label: &str) {
-    let sc = scene::<C>(mesh, param(ParamKind::Cube, 64), 0);
+fn targets_for<const C: usize>(c: &mut Criterion, bunny: &Bunny, label: &str) {
+    let sc = scene::<C>(bunny, param(ParamKind::Cube, 64), 0);
     let mut group = c.benchmark_group(format!("targets_{label}"));
     group.sample_size(30);
     group.warm_up_time(Duration::from_millis(300));
@@ -270,9 +204,9 @@ fn targets_for<const C: usize>(c: &mut Criterion, mesh: &Mesh, label: &str) {
 }
 
 fn targets(c: &mut Criterion) {
-    let mesh = bunny();
-    targets_for::<1>(c, &mesh, "mono");
-    targets_for::<3>(c, &mesh, "rgb");
+    let bunny = bunny();
+    targets_for::<1>(c, &bunny, "mono");
+    targets_for::<3>(c, &bunny, "rgb");
 }
 
 fn param(kind: ParamKind, size: usize) -> Parameterization {
@@ -292,7 +226,7 @@ fn sizes(name: &str, default: &[usize]) -> Vec<usize> {
 }
 
 fn scaling(c: &mut Criterion) {
-    let mesh = bunny();
+    let bunny = bunny();
     let cube = sizes("PRODUCT_BENCH_SIZES", &[32, 64, 128, 256]);
     let latlong = sizes("PRODUCT_BENCH_LATLONG", &[64, 128, 256]);
     let params = cube
@@ -301,7 +235,7 @@ fn scaling(c: &mut Criterion) {
         .chain(latlong.into_iter().map(|h| param(ParamKind::LatLong, h)));
     for p in params {
         let (s, faces) = (p.face_size(), p.faces());
-        let sc = scene::<1>(&mesh, p, 3);
+        let sc = scene::<1>(&bunny, p, 3);
         let details = faces * (s * s - 1);
         let mut group = c.benchmark_group(format!("scaling_{}{s}", p.kind()));
         group.sample_size(10);

@@ -45,7 +45,7 @@
 //! `sqrt(4 pi / (2l + 1))` (the Funk-Hecke theorem). A Lambertian vertex of albedo `a` and
 //! normal `n` then reflects `a / pi x E(n)`.
 
-use ndarray::{Array2, ArrayView2, Axis};
+use ndarray::{Array2, Array3, ArrayView2, Axis};
 use rayon::prelude::*;
 
 use super::param::{Parameterization, SphereMap};
@@ -214,18 +214,28 @@ impl SphericalHarmonics {
         param: Parameterization,
     ) -> Result<SphereMap<f64>> {
         let (n, ch) = self.check_coefficients(coefficients)?;
-        SphereMap::from_texels(param, ch, |(face, row, col), out| {
-            let mut y = vec![0.0; n];
-            self.evaluate(param.texel_direction(face, row, col), &mut y);
-            for (c, o) in out.iter_mut().enumerate() {
-                *o = coefficients
-                    .index_axis(Axis(1), c)
-                    .iter()
-                    .zip(&y)
-                    .map(|(a, b)| a * b)
-                    .sum();
-            }
-        })
+        let s = param.face_size();
+        let mut data = Array3::<f64>::zeros((param.faces() * s, s, ch));
+        // One harmonics buffer per worker, not per texel.
+        data.outer_iter_mut()
+            .into_par_iter()
+            .enumerate()
+            .for_each_init(
+                || vec![0.0; n],
+                |y, (fr, mut texels)| {
+                    let (face, row) = (fr / s, fr % s);
+                    for (col, mut out) in texels.outer_iter_mut().enumerate() {
+                        self.evaluate(param.texel_direction(face, row, col), y);
+                        for (o, c) in out.iter_mut().zip(coefficients.axis_iter(Axis(1))) {
+                            *o = c.iter().zip(y.iter()).map(|(a, b)| a * b).sum();
+                        }
+                    }
+                },
+            );
+        let data = data
+            .into_shape_with_order((param.faces(), s, s, ch))
+            .expect("faces x rows is the outer axis");
+        SphereMap::new(param, data)
     }
 
     /// `(B^2, C)` of a coefficient array, or a shape error when it has not `B^2` rows.
