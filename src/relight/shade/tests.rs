@@ -12,6 +12,7 @@ use crate::relight::{
 use crate::sphere::integrate::layout;
 use crate::sphere::param::{ParamKind, SphereMap};
 use crate::sphere::{LatLongMap, SphereRotation};
+use crate::test_support::corner_form_factor;
 
 fn latlong(n: usize) -> Parameterization {
     Parameterization::new(ParamKind::LatLong, n).unwrap()
@@ -136,16 +137,6 @@ fn an_unoccluded_sphere_returns_its_albedo() {
         }
         eprintln!("sphere N = {n}: worst error {worst:.3e}, at most {worst_ratio:.3} of its bound");
     }
-}
-
-/// Howell's catalogue, B-3: the form factor from a differential area to a parallel rectangle
-/// `x x y` at distance `c`, the area's normal through one corner:
-/// `F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))]`,
-/// `X = x/c`, `Y = y/c`.
-fn corner_form_factor(x: f64, y: f64, c: f64) -> f64 {
-    let (x, y) = (x / c, y / c);
-    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
-    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
 }
 
 #[test]
