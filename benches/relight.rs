@@ -7,7 +7,8 @@
 //! at cube `6 x 64^2`, each vertex's transport keeping its 420 largest coefficients, a
 //! lighting keeping its 200 largest, Lambertian: the lighting's encoding (the 512 x 1024 map
 //! downsampled by solid-angle means, turned, converted to the cube, transformed, selected) and
-//! the shading (one sparse dot per vertex, f32) timed separately and together. The turn is a
+//! the shading (one sparse dot per vertex, f32) timed separately and together; the mapping
+//! into the cube (its overlap table) is made once, as an animation makes it. The turn is a
 //! yaw by whole columns of the working map (the animation's step: a column permutation) or a
 //! general rotation (applied at the source's resolution). The transport is precomputed once
 //! per run with the real ray caster ([`vertex_major`], a few minutes on two cores, with a
@@ -18,7 +19,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::sync::OnceLock;
 
 use haarshift::product::Selection;
-use haarshift::relight::environment::{Environment, downsample_solid_angle};
+use haarshift::relight::environment::{Environment, SphereMapping, downsample_solid_angle};
 use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV, Mesh, render};
 use haarshift::relight::{
     Generator, Lighting, PreparedTransport, SceneBvh, ShadeOptions, VisibilityOptions, vertex_major,
@@ -139,19 +140,21 @@ fn bench_relighting(c: &mut Criterion) {
     // 37 columns of the 256 of the 128 x 256 working map; and a tilted turn.
     let whole = SphereRotation::from_degrees(37.0 * 360.0 / 256.0, 0.0, 0.0).expect("yaw");
     let general = SphereRotation::from_degrees(30.0, 20.0, 0.0).expect("rotation");
+    // Made once, as the animation does: the lat-long-to-cube overlap table.
+    let mapping = SphereMapping::new(env.map().height(), param).expect("mapping");
     let transport = OnceLock::new();
     let prepared = || transport.get_or_init(|| cubes_transport(param));
     let mut group = c.benchmark_group("relight_cubes_85860");
     group.sample_size(10);
     group.bench_function("encode_lighting_cube64_keep200/whole_column_yaw", |b| {
-        b.iter(|| Lighting::new(&env, param, &whole, keep).expect("encodes"))
+        b.iter(|| Lighting::encode(&env, &mapping, &whole, keep).expect("encodes"))
     });
     group.bench_function("encode_lighting_cube64_keep200/general_rotation", |b| {
-        b.iter(|| Lighting::new(&env, param, &general, keep).expect("encodes"))
+        b.iter(|| Lighting::encode(&env, &mapping, &general, keep).expect("encodes"))
     });
     group.bench_function("shade_keep420_f32", |b| {
         let t = prepared();
-        let light = Lighting::new(&env, param, &whole, keep).expect("encodes");
+        let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
         b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
     });
@@ -159,7 +162,7 @@ fn bench_relighting(c: &mut Criterion) {
         let t = prepared();
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
         b.iter(|| {
-            let light = Lighting::new(&env, param, &whole, keep).expect("encodes");
+            let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
             t.shade_into(&light, &mut out).expect("shades")
         })
     });
@@ -167,7 +170,7 @@ fn bench_relighting(c: &mut Criterion) {
         let t = prepared();
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
         b.iter(|| {
-            let light = Lighting::new(&env, param, &general, keep).expect("encodes");
+            let light = Lighting::encode(&env, &mapping, &general, keep).expect("encodes");
             t.shade_into(&light, &mut out).expect("shades")
         })
     });
