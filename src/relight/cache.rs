@@ -9,7 +9,7 @@
 //! | 4 | format version ([`CACHE_VERSION`]) |
 //! | 4 | CRC-32 of everything after this field |
 //! | 8 | length `H` of the header |
-//! | `H` | header, JSON: [`CacheHeader`] (the parameters, the counts, the scene hash) |
+//! | `H` | header, JSON: [`CacheHeader`] (the parameters, the counts, the scene hash, the scene file's environment and camera) |
 //! | | positions `V x 3` f64, normals `V x 3` f64, triangles `T x 3` u32, albedo `V x 3` f32 |
 //! | | transport: offsets `V + 1` u64, indices `N` u32, values `N` f32 ([`TransportSet`]) |
 //!
@@ -24,6 +24,7 @@ use std::path::Path;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
+use super::scene::{CameraSpec, EnvironmentSpec};
 use super::transport::TransportSet;
 use super::{Mesh, SceneError};
 use crate::product::Selection;
@@ -31,7 +32,7 @@ use crate::sphere::{ParamKind, Parameterization};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
-pub const CACHE_VERSION: u32 = 1;
+pub const CACHE_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"HSRCACHE";
 
@@ -107,6 +108,10 @@ pub struct CacheHeader {
     pub coefficients: usize,
     /// [`scene_hash`] of the mesh.
     pub scene_hash: u32,
+    /// The scene file's lighting (path resolved when the scene was read), if it had one.
+    pub environment: Option<EnvironmentSpec>,
+    /// The scene file's camera, if it had one.
+    pub camera: Option<CameraSpec>,
 }
 
 /// A precomputed scene: the mesh, its albedo and every vertex's sparse transport.
@@ -137,6 +142,11 @@ pub struct SceneCache {
     pub albedo: Array2<f32>,
     /// Every vertex's transport.
     pub transport: TransportSet,
+    /// The scene file's lighting, used when a render names none ([`SceneCache::new`] leaves
+    /// it `None`).
+    pub environment: Option<EnvironmentSpec>,
+    /// The scene file's camera, likewise.
+    pub camera: Option<CameraSpec>,
 }
 
 /// A CRC-32 of the mesh's positions, normals and triangles: what "the same scene" means.
@@ -196,6 +206,8 @@ impl SceneCache {
             mesh,
             albedo,
             transport,
+            environment: None,
+            camera: None,
         })
     }
 
@@ -209,6 +221,8 @@ impl SceneCache {
             triangles: self.mesh.triangles().len(),
             coefficients: indices.len(),
             scene_hash: scene_hash(&self.mesh),
+            environment: self.environment.clone(),
+            camera: self.camera.clone(),
         };
         let json = serde_json::to_vec(&header).expect("the header serialises");
         let mut body = Vec::with_capacity(8 + json.len() + self.transport.stored_bytes());
@@ -314,7 +328,10 @@ impl SceneCache {
         let param = Parameterization::new(kind, header.params.resolution)?;
         let transport =
             TransportSet::from_parts(param, header.params.keep.into(), offsets, indices, values)?;
-        SceneCache::new(header.params, mesh, albedo, transport)
+        let mut cache = SceneCache::new(header.params, mesh, albedo, transport)?;
+        cache.environment = header.environment;
+        cache.camera = header.camera;
+        Ok(cache)
     }
 }
 

@@ -14,6 +14,8 @@
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
 //! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
 //! | [`animation`] | frames into an animated GIF |
+//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
+//! | [`memory`] | the process's peak resident memory, for reports |
 //!
 //! Conventions are the sphere module's: world Y up, right-handed, directions as in
 //! [`sphere::latlong`](crate::sphere::latlong), rotations `g(p) = f(R p)` with
@@ -24,7 +26,9 @@ pub mod animation;
 pub mod cache;
 pub mod environment;
 pub mod error;
+pub mod memory;
 pub mod mesh;
+pub mod precompute;
 pub mod raster;
 pub mod raycast;
 pub mod scene;

@@ -128,6 +128,11 @@ impl TransportSet {
         (&self.offsets, &self.indices, &self.values)
     }
 
+    /// Coefficients stored, all vertices.
+    pub fn coefficient_count(&self) -> usize {
+        self.values.len()
+    }
+
     /// Bytes held by the coefficient arrays.
     pub fn stored_bytes(&self) -> usize {
         self.offsets.len() * 8 + self.indices.len() * 4 + self.values.len() * 4
