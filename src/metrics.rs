@@ -1,6 +1,7 @@
 //! Error measures between a result and its reference: RMS, PSNR and maximum absolute error,
 //! optionally over a mask (the rotation experiments measure inside a centred disk so that the
-//! corners, which a rotation fills from outside, do not count).
+//! corners, which a rotation fills from outside, do not count), and the relighting error
+//! relative to the scene's RMS radiance ([`relative_rms_error`]).
 
 use ndarray::{Array2, ArrayView2, Zip};
 use serde::{Deserialize, Serialize};
@@ -76,6 +77,40 @@ impl ErrorStats {
             count,
         })
     }
+}
+
+/// The RMS of `result - reference` over all samples divided by the RMS of `reference`: the
+/// relighting error measure (per-vertex radiance `(V, 3)`, all vertices and channels
+/// together), relative to the scene's RMS radiance and never per vertex, since a shadowed
+/// vertex's radiance is near 0. An error when the shapes differ or the reference is 0
+/// everywhere (no scale to be relative to).
+///
+/// ```
+/// use haarshift::metrics::relative_rms_error;
+/// use ndarray::array;
+/// let reference = array![[3.0, 0.0], [0.0, 4.0]]; // RMS 2.5
+/// let result = array![[3.0, 0.5], [0.0, 4.0]]; // RMS difference 0.25
+/// assert!((relative_rms_error(result.view(), reference.view()).unwrap() - 0.1).abs() < 1e-15);
+/// assert!(relative_rms_error(result.view(), reference.mapv(|_| 0.0).view()).is_err());
+/// ```
+pub fn relative_rms_error<T: Sample>(
+    result: ArrayView2<'_, T>,
+    reference: ArrayView2<'_, T>,
+) -> Result<f64> {
+    let difference = ErrorStats::between(result, reference, None, 1.0)?;
+    let scale = (reference
+        .iter()
+        .map(|v| v.as_f64() * v.as_f64())
+        .sum::<f64>()
+        / difference.count as f64)
+        .sqrt();
+    if scale == 0.0 {
+        return Err(Error::parameter(
+            "reference",
+            "is 0 everywhere: an error relative to its RMS is undefined",
+        ));
+    }
+    Ok(difference.rms / scale)
 }
 
 /// The pixels whose centres lie within `radius` of the array's centre `((h-1)/2, (w-1)/2)`.

@@ -12,6 +12,9 @@
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
+//! | [`lighting`] | [`Lighting`]: the environment's kept Haar coefficients, RGB, in Mallat order |
+//! | [`brdf`] | [`Brdf`]: the material (Lambert), and where a glossy BRDF enters the integral |
+//! | [`shade`](mod@shade) | per-vertex outgoing radiance: [`PreparedTransport`], one sparse dot per vertex |
 //! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
 //! | [`animation`] | frames into an animated GIF |
 //! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
@@ -23,27 +26,33 @@
 //! The transport is the one factor of a product integral that carries the texel solid angle
 //! ([`crate::product::Transport`]).
 pub mod animation;
+pub mod brdf;
 pub mod cache;
 pub mod environment;
 pub mod error;
+pub mod lighting;
 pub mod memory;
 pub mod mesh;
 pub mod precompute;
 pub mod raster;
 pub mod raycast;
 pub mod scene;
+pub mod shade;
 pub mod shadowmap;
 pub mod transport;
 pub mod visibility;
 
+pub use brdf::Brdf;
 pub use cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
 pub use error::SceneError;
+pub use lighting::Lighting;
 pub use mesh::{Bounds, Mesh};
 pub use raycast::{Occlusion, SceneBvh};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,
 };
+pub use shade::{PreparedTransport, ShadeOptions, shade};
 pub use shadowmap::ShadowMap;
 pub use transport::TransportSet;
 pub use visibility::{

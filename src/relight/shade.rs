@@ -1,0 +1,376 @@
+//! Shading: every vertex's outgoing radiance `(V, 3)` from its sparse transport and the
+//! lighting's coefficients.
+//!
+//! **What is computed.** For a Lambertian vertex `v`,
+//! `B_v = albedo_v / pi x <T_v, L> = albedo_v / pi x sum_t L(t) T_v(t)`, `T_v(t) = V(v, t)
+//! max(0, n_v . w_t) dOmega_t` ([`TransportSet`]): issue 7's double product integral. For two
+//! functions in one orthonormal basis the integral of the product is the dot product of their
+//! coefficients (Parseval, face by face), so it is a sparse dot product of the vertex's stored
+//! `(index, value)` pairs with the lighting's dense `(texels, 3)` rows ([`Lighting`]). This is
+//! seed 001's just-in-time radiance transfer (section 3.5, eq. 3.9): the fixed factors
+//! (visibility, cosine, solid angle, and the BRDF's constant) are formed once, at
+//! precomputation and in [`PreparedTransport::new`]; a change of lighting costs one sparse dot
+//! per vertex. The same number as [`product_integral`](crate::product::product_integral) of
+//! the two trees (tested), without building a tree per vertex.
+//!
+//! **Options** ([`ShadeOptions`]), applied once when the transport is prepared, not per frame:
+//! * `keep_visibility`: re-truncates each vertex's stored transport to the coefficients a
+//!   [`Selection`] picks among those stored (the rule of [`crate::product::selection`]: scaling
+//!   coefficients always kept, ties by the layout's index), exactly what
+//!   [`Transport::select`](crate::product::Transport::select) keeps. Asking for more than a
+//!   vertex stores keeps what it stores.
+//! * `depth = d`: the traversal depth of seed 001 Fig. 3.5: only the detail levels `0..d` take
+//!   part, i.e. the integral of the two functions averaged over blocks of side `S >> d` (faces
+//!   `2^d` texels wide, the thesis's "level `d`"). `d = 0` keeps only the scaling
+//!   coefficients (the product of face means); `d = log2 S` is the full integral.
+//!   [`product_integral`](crate::product::product_integral) with
+//!   `finest_level = Some(d - 1)` gives the same (tested). Applied after `keep_visibility`.
+//!
+//! **Precision.** [`PreparedTransport<T>`] computes in `T`: f32 (the fast path) or f64. Each
+//! vertex's dot product is accumulated in `T` over runs of [`RUN`] coefficients and the runs in
+//! f64, so an f32 sum of thousands of terms (full coefficients) loses no more than a run's
+//! rounding. The output is `T`.
+//!
+//! **Speed.** Vertices in parallel (rayon) in chunks of [`CHUNK`]; the hot loop allocates
+//! nothing and reads the lighting rows (`texels x 3 x size_of T`, 295 KB for a `6 x 64^2`
+//! cube in f32) at the vertex's indices, which are ascending.
+
+use ndarray::{Array2, ArrayView2};
+use rayon::prelude::*;
+
+use super::brdf::Brdf;
+use super::lighting::Lighting;
+use super::transport::TransportSet;
+use crate::product::Selection;
+use crate::product::selection::{Candidate, keep_largest};
+use crate::sphere::Parameterization;
+use crate::sphere::integrate::layout;
+use crate::{Error, Result, Sample};
+
+/// Coefficients summed in the working precision before the sum is added in f64.
+pub const RUN: usize = 64;
+
+/// Vertices per parallel task.
+pub const CHUNK: usize = 512;
+
+/// How to shade; see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::{Brdf, ShadeOptions};
+/// let o = ShadeOptions::default();
+/// assert_eq!((o.brdf, o.keep_visibility, o.depth), (Brdf::Lambert, None, None));
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShadeOptions {
+    /// The material.
+    pub brdf: Brdf,
+    /// Re-truncation of each vertex's stored transport (`None`: as stored).
+    pub keep_visibility: Option<Selection>,
+    /// Detail levels taking part, `0..=log2 S` (`None`: all).
+    pub depth: Option<usize>,
+}
+
+/// The transport of every vertex made ready to shade: re-truncated, depth-limited, converted
+/// to `T`, with each vertex's BRDF constant; reused for every lighting (an animation's
+/// frames). See the [module docs](self).
+///
+/// ```
+/// use haarshift::product::Selection;
+/// use haarshift::relight::{Lighting, PreparedTransport, ShadeOptions, TransportSet};
+/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use ndarray::{Array2, Array3};
+/// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
+/// // One vertex that sees the whole sphere with cosine 1: its transport is the solid angle.
+/// let mut set = TransportSet::new(param, Selection::All);
+/// set.push(Array3::ones((2, 8, 8)).view()).unwrap();
+/// let sky = SphereMap::<f64>::from_fn(param, 3, |d, out| out.fill(1.0 + d[1])).unwrap();
+/// let light = Lighting::from_map(&sky, Selection::All).unwrap();
+/// let albedo = Array2::from_elem((1, 3), std::f32::consts::PI);
+/// let prepared = PreparedTransport::<f64>::new(&set, albedo.view(), &ShadeOptions::default()).unwrap();
+/// let b = prepared.shade(&light).unwrap();
+/// // pi / pi x the integral of 1 + y over the sphere, 4 pi (y integrates to 0 by symmetry).
+/// assert!((b[[0, 1]] - 4.0 * std::f64::consts::PI).abs() < 1e-4);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct PreparedTransport<T> {
+    param: Parameterization,
+    offsets: Vec<usize>,
+    indices: Vec<u32>,
+    values: Vec<T>,
+    factors: Vec<[f64; 3]>,
+}
+
+impl<T: Sample> PreparedTransport<T> {
+    /// Prepares `set` for shading with per-vertex RGB `albedo` (`(V, 3)`) under `options`.
+    pub fn new(
+        set: &TransportSet,
+        albedo: ArrayView2<'_, f32>,
+        options: &ShadeOptions,
+    ) -> Result<Self> {
+        let param = set.param();
+        let vertices = set.vertex_count();
+        if albedo.dim() != (vertices, 3) {
+            return Err(Error::shape(
+                albedo.shape(),
+                format!(
+                    "the albedo must be ({vertices}, 3): one RGB triple per vertex of the transport"
+                ),
+            ));
+        }
+        let factors = options
+            .brdf
+            .vertex_factors(albedo)?
+            .rows()
+            .into_iter()
+            .map(|r| [r[0], r[1], r[2]].map(f64::from))
+            .collect();
+        let s = param.face_size();
+        let levels = s.trailing_zeros() as usize;
+        let depth = match options.depth {
+            Some(d) if d > levels => {
+                return Err(Error::parameter(
+                    "depth",
+                    format!("{d}: faces of side {s} have detail levels 0 to {levels}"),
+                ));
+            }
+            Some(d) => d,
+            None => levels,
+        };
+        let keep = options.keep_visibility.unwrap_or(Selection::All);
+        keep.limit(param.texels() - param.faces())?;
+        if let Selection::LargestPerFace(k) = keep
+            && k >= s * s
+        {
+            return Err(Error::parameter(
+                "keep",
+                format!(
+                    "{k} coefficients per face asked for but a face has {}",
+                    s * s - 1
+                ),
+            ));
+        }
+        let per_vertex: Vec<(Vec<u32>, Vec<T>)> = (0..vertices)
+            .into_par_iter()
+            .map_init(Vec::new, |pool, v| {
+                let (indices, values) = set.coefficients(v);
+                retruncate(param, keep, depth, indices, values, pool)
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(vertices + 1);
+        offsets.push(0);
+        let total = per_vertex.iter().map(|(i, _)| i.len()).sum();
+        let (mut indices, mut values) = (Vec::with_capacity(total), Vec::with_capacity(total));
+        for (i, c) in per_vertex {
+            indices.extend_from_slice(&i);
+            values.extend_from_slice(&c);
+            offsets.push(indices.len());
+        }
+        Ok(PreparedTransport {
+            param,
+            offsets,
+            indices,
+            values,
+            factors,
+        })
+    }
+
+    /// The parameterisation of the transport.
+    pub fn param(&self) -> Parameterization {
+        self.param
+    }
+
+    /// Vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.factors.len()
+    }
+
+    /// Coefficients kept over all vertices (scaling coefficients included).
+    pub fn coefficient_count(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// Vertex `v`'s coefficients as shaded: Mallat indices (ascending) and values.
+    pub fn coefficients(&self, v: usize) -> (&[u32], &[T]) {
+        let (a, b) = (self.offsets[v], self.offsets[v + 1]);
+        (&self.indices[a..b], &self.values[a..b])
+    }
+
+    /// Every vertex's outgoing radiance under `lighting`, `(V, 3)`.
+    pub fn shade(&self, lighting: &Lighting) -> Result<Array2<T>> {
+        let mut out = Array2::zeros((self.vertex_count(), 3));
+        self.shade_into(lighting, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`shade`](Self::shade) into `out` (`(V, 3)`), reused from frame to frame.
+    pub fn shade_into(&self, lighting: &Lighting, out: &mut Array2<T>) -> Result<()> {
+        if lighting.param() != self.param {
+            return Err(Error::parameter(
+                "lighting",
+                format!(
+                    "it is a {} {} map but the transport was precomputed at {} {}",
+                    lighting.param().kind(),
+                    lighting.param().face_size(),
+                    self.param.kind(),
+                    self.param.face_size()
+                ),
+            ));
+        }
+        if out.dim() != (self.vertex_count(), 3) {
+            return Err(Error::shape(
+                out.shape(),
+                format!("the output must be ({}, 3)", self.vertex_count()),
+            ));
+        }
+        let light = lighting.rows::<T>();
+        let out = out.as_slice_mut().ok_or_else(|| {
+            Error::shape(&[self.vertex_count(), 3], "the output must be contiguous")
+        })?;
+        out.par_chunks_mut(3 * CHUNK)
+            .enumerate()
+            .for_each(|(chunk, rows)| {
+                let first = chunk * CHUNK;
+                for (k, row) in rows.chunks_exact_mut(3).enumerate() {
+                    let v = first + k;
+                    let (a, b) = (self.offsets[v], self.offsets[v + 1]);
+                    let sum = dot(&self.indices[a..b], &self.values[a..b], &light);
+                    let f = self.factors[v];
+                    for c in 0..3 {
+                        row[c] = T::from_f64(sum[c] * f[c]);
+                    }
+                }
+            });
+        Ok(())
+    }
+}
+
+/// `sum_i values_i light[indices_i]` per channel: runs of [`RUN`] in `T`, runs added in f64.
+#[inline]
+fn dot<T: Sample>(indices: &[u32], values: &[T], light: &[[T; 3]]) -> [f64; 3] {
+    let mut total = [0.0f64; 3];
+    for (is, vs) in indices.chunks(RUN).zip(values.chunks(RUN)) {
+        let mut acc = [T::zero(); 3];
+        for (&i, &t) in is.iter().zip(vs) {
+            let l = light[i as usize];
+            acc[0] += t * l[0];
+            acc[1] += t * l[1];
+            acc[2] += t * l[2];
+        }
+        for c in 0..3 {
+            total[c] += acc[c].as_f64();
+        }
+    }
+    total
+}
+
+/// Every vertex's outgoing radiance: [`PreparedTransport::new`] then
+/// [`shade`](PreparedTransport::shade), for one lighting.
+///
+/// ```
+/// use haarshift::product::Selection;
+/// use haarshift::relight::{Lighting, ShadeOptions, TransportSet, shade};
+/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use ndarray::{Array2, Array3};
+/// let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
+/// let mut set = TransportSet::new(param, Selection::All);
+/// set.push(Array3::ones((6, 4, 4)).view()).unwrap();
+/// let one = SphereMap::<f64>::from_fn(param, 1, |_, out| out[0] = 1.0).unwrap();
+/// let light = Lighting::from_map(&one, Selection::All).unwrap();
+/// let albedo = Array2::from_elem((1, 3), 0.5f32);
+/// let b = shade::<f32>(&set, albedo.view(), &light, &ShadeOptions::default()).unwrap();
+/// assert!((b[[0, 2]] - 2.0).abs() < 1e-5); // 0.5 / pi x 4 pi
+/// // A lighting in another parameterisation is refused.
+/// let other = Parameterization::new(ParamKind::Cube, 8).unwrap();
+/// let wrong = Lighting::from_map(&SphereMap::from_fn(other, 1, |_, o| o[0] = 1.0).unwrap(),
+///                                Selection::All).unwrap();
+/// assert!(shade::<f32>(&set, albedo.view(), &wrong, &ShadeOptions::default()).is_err());
+/// ```
+pub fn shade<T: Sample>(
+    set: &TransportSet,
+    albedo: ArrayView2<'_, f32>,
+    lighting: &Lighting,
+    options: &ShadeOptions,
+) -> Result<Array2<T>> {
+    PreparedTransport::<T>::new(set, albedo, options)?.shade(lighting)
+}
+
+/// The detail level of the coefficient at `(r, c)` of a face's Mallat array (`None`: the
+/// scaling coefficient at `(0, 0)`), with its band (0 `H`, 1 `V`, 2 `D`) and node position.
+fn detail_of(r: usize, c: usize) -> Option<(usize, usize, usize, usize)> {
+    let m = r.max(c);
+    if m == 0 {
+        return None;
+    }
+    let level = (usize::BITS - 1 - m.leading_zeros()) as usize;
+    let side = 1 << level;
+    Some(if r < side {
+        (0, level, r, c - side)
+    } else if c < side {
+        (1, level, r - side, c)
+    } else {
+        (2, level, r - side, c - side)
+    })
+}
+
+/// One vertex's stored coefficients re-truncated by `keep` (among the stored details) and
+/// limited to detail levels `0..depth`, ascending by index, converted to `T`.
+fn retruncate<T: Sample>(
+    param: Parameterization,
+    keep: Selection,
+    depth: usize,
+    indices: &[u32],
+    values: &[f32],
+    pool: &mut Vec<Candidate>,
+) -> (Vec<u32>, Vec<T>) {
+    let (faces, s) = (param.faces(), param.face_size());
+    let face_layout = layout(param);
+    let mut kept = vec![false; indices.len()];
+    pool.clear();
+    for (slot, (&i, &c)) in indices.iter().zip(values).enumerate() {
+        let i = i as usize;
+        let face = i / (s * s);
+        match detail_of((i / s) % s, i % s) {
+            None => kept[slot] = true,
+            Some((band, level, row, col)) => pool.push(Candidate {
+                magnitude2: f64::from(c).powi(2),
+                index: face_layout.index(faces, s, face, band, level, row, col),
+                slot,
+            }),
+        }
+    }
+    let mut mark = |pool: &mut [Candidate], k: usize| {
+        let count = keep_largest(pool, k);
+        for cand in &pool[..count] {
+            kept[cand.slot] = true;
+        }
+    };
+    match keep {
+        Selection::All => mark(pool, usize::MAX),
+        Selection::Threshold(t) => {
+            pool.retain(|c| c.magnitude2 > t * t);
+            mark(pool, usize::MAX);
+        }
+        Selection::Largest(k) => mark(pool, k),
+        Selection::LargestPerFace(k) => {
+            // The stored indices need not be sorted: group the candidates by face first.
+            let face_of = |c: &Candidate| indices[c.slot] as usize / (s * s);
+            pool.sort_unstable_by_key(face_of);
+            for run in pool.chunk_by_mut(|a, b| face_of(a) == face_of(b)) {
+                mark(run, k);
+            }
+        }
+    }
+    let shallow = |i: u32| {
+        let i = i as usize;
+        (i / s) % s < (1 << depth) && i % s < (1 << depth)
+    };
+    let mut out: Vec<(u32, T)> = indices
+        .iter()
+        .zip(values)
+        .zip(&kept)
+        .filter(|&((&i, _), &k)| k && shallow(i))
+        .map(|((&i, &c), _)| (i, T::from_f64(f64::from(c))))
+        .collect();
+    out.sort_unstable_by_key(|&(i, _)| i);
+    out.into_iter().unzip()
+}
