@@ -250,6 +250,304 @@ fn absurd_resolutions_and_sample_counts_fail_cleanly() {
     );
 }
 
+/// A precomputed sphere on its plane in `dir` (lat-long 8 x 16): the cache's path.
+fn small_cache(dir: &Path) -> PathBuf {
+    let out = dir.join("sphere.hsr");
+    precompute(&sphere_on_plane(dir), &out, &["--resolution", "8"]);
+    out
+}
+
+fn env32() -> PathBuf {
+    testdata("envmaps/rooitou_park_32x16.hdr")
+}
+
+/// `relight render CACHE --env ENV -o OUT` with `extra` flags, small images.
+fn render_args<'a>(cache: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["relight", "render", p(cache), "-o", p(out)];
+    if !extra.contains(&"--width") {
+        args.extend(["--width", "40", "--height", "30"]);
+    }
+    args.extend(extra);
+    args
+}
+
+#[test]
+fn render_writes_the_image_and_vertices_and_times_each_stage() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = small_cache(dir.path());
+    let env = env32();
+    let (png, npy) = (dir.path().join("a.png"), dir.path().join("a.npy"));
+    let stdout = text(
+        &succeeds(&render_args(
+            &cache,
+            &png,
+            &[
+                "--env",
+                p(&env),
+                "--vertices",
+                p(&npy),
+                "--keep-light",
+                "20",
+            ],
+        ))
+        .stdout,
+    );
+    for needle in [
+        "lighting encoding ",
+        "shading ",
+        "rasterisation ",
+        "40 x 30",
+    ] {
+        assert!(stdout.contains(needle), "{needle:?} in {stdout}");
+    }
+    let image = haarshift::io::read_image::<f32>(&png).unwrap();
+    assert_eq!(
+        (image.width(), image.height(), image.channels().count()),
+        (40, 30, 3)
+    );
+    let radiance: ndarray::Array2<f32> = ndarray_npy::read_npy(&npy).unwrap();
+    // 6 x 4^2 sphere vertices, then the 33 x 33 ground plane.
+    assert_eq!(radiance.dim(), (6 * 16 + 1089, 3));
+    // The sphere's albedo is (0.9, 0.6, 0.3) and the park is nearly grey: red leads blue.
+    let top = radiance.row(0);
+    assert!(top[0] > top[2] && top[2] > 0.0, "{top}");
+    // EXR: linear f32, the same radiance behind the same pixels as the PNG's codes.
+    let exr = dir.path().join("a.exr");
+    succeeds(&render_args(
+        &cache,
+        &exr,
+        &["--env", p(&env), "--keep-light", "20"],
+    ));
+    let linear = haarshift::io::read_image::<f32>(&exr).unwrap();
+    let srgb = haarshift::relight::raster::to_srgb8(&linear, 0.0).unwrap();
+    assert_eq!(srgb.planes(), image.planes());
+}
+
+#[test]
+fn render_refuses_existing_outputs_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = small_cache(dir.path());
+    let env = env32();
+    let png = file(dir.path(), "a.png", b"old image");
+    let npy = dir.path().join("a.npy");
+    fails_cleanly(
+        &render_args(&cache, &png, &["--env", p(&env), "--vertices", p(&npy)]),
+        &["a.png", "already exists"],
+    );
+    assert!(!npy.exists());
+    let fresh = dir.path().join("b.png");
+    let npy = file(dir.path(), "b.npy", b"old array");
+    fails_cleanly(
+        &render_args(&cache, &fresh, &["--env", p(&env), "--vertices", p(&npy)]),
+        &["b.npy", "already exists"],
+    );
+    assert!(!fresh.exists());
+    // The image's format is checked before any work too, and the cache is never an output.
+    fails_cleanly(
+        &render_args(&cache, &dir.path().join("c.jpg"), &["--env", p(&env)]),
+        &["c.jpg", ".png", ".exr"],
+    );
+    fails_cleanly(
+        &render_args(
+            &cache,
+            &fresh,
+            &["--env", p(&env), "--vertices", p(&cache), "--force"],
+        ),
+        &["sphere.hsr"],
+    );
+    // With --force both are replaced.
+    succeeds(&render_args(
+        &cache,
+        &png,
+        &["--env", p(&env), "--vertices", p(&npy), "--force"],
+    ));
+    assert_ne!(std::fs::read(&png).unwrap(), b"old image");
+    assert_ne!(std::fs::read(&npy).unwrap(), b"old array");
+}
+
+#[test]
+fn bad_lighting_and_caches_fail_cleanly_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = small_cache(dir.path());
+    let env = env32();
+    let out = dir.path().join("x.png");
+    // An environment map that is not 2:1.
+    let square = testdata("camera.png");
+    fails_cleanly(
+        &render_args(&cache, &out, &["--env", p(&square)]),
+        &["camera.png", "twice as wide"],
+    );
+    // A cache with one byte flipped, cut short, or from another format version.
+    let good = std::fs::read(&cache).unwrap();
+    let mut flipped = good.clone();
+    let middle = flipped.len() / 2;
+    flipped[middle] ^= 0x10;
+    let damaged = file(dir.path(), "damaged.hsr", &flipped);
+    fails_cleanly(
+        &render_args(&damaged, &out, &["--env", p(&env)]),
+        &["damaged.hsr", "damaged", "checksum"],
+    );
+    let short = file(dir.path(), "short.hsr", &good[..good.len() - 100]);
+    fails_cleanly(
+        &render_args(&short, &out, &["--env", p(&env)]),
+        &["short.hsr", "damaged"],
+    );
+    let mut old = good.clone();
+    old[8..12].copy_from_slice(&1u32.to_le_bytes());
+    let old = file(dir.path(), "old.hsr", &old);
+    fails_cleanly(
+        &render_args(&old, &out, &["--env", p(&env)]),
+        &["old.hsr", "format version 1"],
+    );
+    let mesh = testdata("meshes/bunny.ply");
+    fails_cleanly(
+        &render_args(&mesh, &out, &["--env", p(&env)]),
+        &["bunny.ply", "not a haarshift scene cache"],
+    );
+    assert!(!out.exists());
+    // No lighting at all: the scene file named none.
+    fails_cleanly(&render_args(&cache, &out, &[]), &["--env"]);
+    // Truncations that keep nothing, or more than there is.
+    usage_error(
+        &render_args(&cache, &out, &["--env", p(&env), "--keep-light", "0"]),
+        &["--keep-light", "at least 1"],
+    );
+    usage_error(
+        &render_args(&cache, &out, &["--env", p(&env), "--keep-visibility", "0"]),
+        &["--keep-visibility"],
+    );
+    fails_cleanly(
+        &render_args(&cache, &out, &["--env", p(&env), "--keep-light", "1000000"]),
+        &["keep", "1000000"],
+    );
+    fails_cleanly(
+        &render_args(&cache, &out, &["--env", p(&env), "--width", "0"]),
+        &["32768"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_scene_files_lighting_and_camera_are_used_when_no_flag_names_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = env32();
+    std::fs::copy(&env, dir.path().join("sky.hdr")).unwrap();
+    let scene = file(
+        dir.path(),
+        "lit.json",
+        br#"{"objects": [{"generator": {"sphere": {"cells": 3}}}],
+            "environment": {"path": "sky.hdr", "yaw": 45},
+            "camera": {"position": [0, 0, 6], "look_at": [0, 0, 0], "fov": 30}}"#,
+    );
+    let cache = dir.path().join("lit.hsr");
+    precompute(&scene, &cache, &["--resolution", "8"]);
+    let from_file = dir.path().join("file.npy");
+    succeeds(&render_args(
+        &cache,
+        &dir.path().join("a.png"),
+        &["--vertices", p(&from_file)],
+    ));
+    let from_flags = dir.path().join("flags.npy");
+    succeeds(&render_args(
+        &cache,
+        &dir.path().join("b.png"),
+        &[
+            "--env",
+            p(&env),
+            "--yaw",
+            "45",
+            "--camera",
+            "0,0,6",
+            "--look-at",
+            "0,0,0",
+            "--fov",
+            "30",
+            "--vertices",
+            p(&from_flags),
+        ],
+    ));
+    let a: ndarray::Array2<f32> = ndarray_npy::read_npy(&from_file).unwrap();
+    let b: ndarray::Array2<f32> = ndarray_npy::read_npy(&from_flags).unwrap();
+    assert_eq!(a, b);
+    assert_eq!(
+        std::fs::read(dir.path().join("a.png")).unwrap(),
+        std::fs::read(dir.path().join("b.png")).unwrap()
+    );
+    // Another yaw gives another radiance.
+    let turned = dir.path().join("turned.npy");
+    succeeds(&render_args(
+        &cache,
+        &dir.path().join("c.png"),
+        &["--yaw", "135", "--vertices", p(&turned)],
+    ));
+    let c: ndarray::Array2<f32> = ndarray_npy::read_npy(&turned).unwrap();
+    assert_ne!(a, c);
+}
+
+#[test]
+fn animate_writes_a_gif_or_numbered_frames_and_times_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = small_cache(dir.path());
+    let env = env32();
+    let gif = dir.path().join("turn.gif");
+    let base = [
+        "relight",
+        "animate",
+        p(&cache),
+        "--env",
+        p(&env),
+        "--frames",
+        "4",
+        "--width",
+        "24",
+        "--height",
+        "16",
+    ];
+    let mut args = base.to_vec();
+    args.extend(["-o", p(&gif)]);
+    let stdout = succeeds_with_stdout(&args);
+    assert_eq!(stdout.matches("frame ").count(), 4, "{stdout}");
+    assert!(stdout.contains("frame 3: yaw 270.00"), "{stdout}");
+    let decoder = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(&gif).unwrap(),
+    ))
+    .unwrap();
+    use image::AnimationDecoder;
+    assert_eq!(decoder.into_frames().count(), 4);
+    fails_cleanly(&args, &["turn.gif", "already exists"]);
+    // Numbered PNGs: frame k is `relight render` at yaw 90 k.
+    let pattern = dir.path().join("f_%02d.png");
+    let mut args = base.to_vec();
+    args.extend(["-o", p(&pattern), "--background", "0,0,0"]);
+    succeeds(&args);
+    let single = dir.path().join("single.png");
+    succeeds(&render_args(
+        &cache,
+        &single,
+        &[
+            "--env",
+            p(&env),
+            "--yaw",
+            "180",
+            "--background",
+            "0,0,0",
+            "--width",
+            "24",
+            "--height",
+            "16",
+        ],
+    ));
+    assert_eq!(
+        std::fs::read(dir.path().join("f_02.png")).unwrap(),
+        std::fs::read(&single).unwrap()
+    );
+    assert!(dir.path().join("f_03.png").exists() && !dir.path().join("f_04.png").exists());
+    let mut args = base.to_vec();
+    let bad = dir.path().join("frame.png");
+    args.extend(["-o", p(&bad)]);
+    fails_cleanly(&args, &["frame.png", "%d"]);
+}
+
 #[test]
 fn every_subcommand_has_an_example_in_its_help() {
     for sub in ["precompute", "render", "reference", "animate"] {

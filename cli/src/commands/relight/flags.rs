@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use haarshift::product::Selection;
+use haarshift::relight::ShadeOptions;
 use haarshift::relight::environment::Environment;
 use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
@@ -69,8 +71,9 @@ pub struct LightFlags {
 }
 
 impl LightFlags {
-    /// The environment's file and rotation: the flags, else the scene file's `environment`.
-    pub fn resolve(&self, scene: Option<&EnvironmentSpec>) -> Result<(PathBuf, SphereRotation)> {
+    /// The environment's file and rotation angles `[yaw, pitch, roll]` in degrees: the flags,
+    /// else the scene file's `environment`.
+    fn resolve(&self, scene: Option<&EnvironmentSpec>) -> Result<(PathBuf, [f64; 3])> {
         let path = match (&self.env, scene) {
             (Some(path), _) => path.clone(),
             (None, Some(spec)) => spec.path.clone(),
@@ -84,19 +87,24 @@ impl LightFlags {
         let angle = |flag: Option<f64>, file: fn(&EnvironmentSpec) -> f64| {
             flag.or(scene.map(file)).unwrap_or(0.0)
         };
-        let rotation = SphereRotation::from_degrees(
+        let angles = [
             angle(self.yaw, |s| s.yaw),
             angle(self.pitch, |s| s.pitch),
             angle(self.roll, |s| s.roll),
-        )?;
-        Ok((path, rotation))
+        ];
+        Ok((path, angles))
     }
 
-    /// The environment (read) and its rotation.
-    pub fn load(&self, scene: Option<&EnvironmentSpec>) -> Result<(Environment, SphereRotation)> {
-        let (path, rotation) = self.resolve(scene)?;
-        Ok((Environment::load(&path)?, rotation))
+    /// The environment (read) and its rotation angles `[yaw, pitch, roll]`, degrees.
+    pub fn load(&self, scene: Option<&EnvironmentSpec>) -> Result<(Environment, [f64; 3])> {
+        let (path, angles) = self.resolve(scene)?;
+        Ok((Environment::load(&path)?, angles))
     }
+}
+
+/// The rotation `R = Rz(roll) Ry(yaw) Rx(pitch)` of `[yaw, pitch, roll]` in degrees.
+pub fn rotation([yaw, pitch, roll]: [f64; 3]) -> Result<SphereRotation> {
+    SphereRotation::from_degrees(yaw, pitch, roll)
 }
 
 /// The material: a Lambertian albedo.
@@ -241,4 +249,62 @@ pub fn refuse_inputs(inputs: &[&Path], outputs: &[&Path]) -> Result<()> {
         crate::commands::refuse_overwriting_input(input, outputs)?;
     }
     Ok(())
+}
+
+/// A whole number of at least 1.
+fn positive(s: &str) -> std::result::Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(k) => Ok(k),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// How the per-vertex radiance is computed: the basis and the truncations.
+#[derive(clap::Args, Debug)]
+pub struct ShadingFlags {
+    /// Detail coefficients of the lighting kept (the largest by RGB magnitude, orthonormal),
+    /// plus each face's scaling coefficient [default: all]
+    #[arg(long, value_name = "K", value_parser = positive)]
+    pub keep_light: Option<usize>,
+
+    /// Detail coefficients of each vertex's transport kept at render time (the largest of
+    /// those stored), plus each face's scaling coefficient [default: all stored]
+    #[arg(long, value_name = "K", value_parser = positive)]
+    pub keep_visibility: Option<usize>,
+
+    /// Detail levels 0..=D only (0 the coarsest) [default: all]
+    #[arg(long, value_name = "D")]
+    pub depth: Option<usize>,
+}
+
+impl ShadingFlags {
+    /// The lighting's truncation.
+    pub fn light_selection(&self) -> Selection {
+        self.keep_light.map_or(Selection::All, Selection::Largest)
+    }
+
+    /// The shading options (Lambertian).
+    pub fn options(&self) -> ShadeOptions {
+        ShadeOptions {
+            keep_visibility: self.keep_visibility.map(Selection::Largest),
+            depth: self.depth,
+            ..ShadeOptions::default()
+        }
+    }
+}
+
+/// The background's lat-long height: the environment's, at most this (a background is seen,
+/// not integrated).
+const BACKGROUND_HEIGHT: usize = 512;
+
+/// The environment as a background: rotated like the lighting, at most
+/// [`BACKGROUND_HEIGHT`] rows.
+pub fn background_map(env: &Environment, rotation: &SphereRotation) -> Result<LatLongMap<f64>> {
+    env.lat_long(env.map().height().min(BACKGROUND_HEIGHT), rotation)
+}
+
+/// Milliseconds since `start`.
+pub fn ms(start: std::time::Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
 }

@@ -6,17 +6,23 @@
 use clap::Subcommand;
 use haarshift::Result;
 
+pub mod animate;
 mod flags;
 pub mod precompute;
+pub mod render;
 
 /// Relight meshes under environment maps: precompute, render, reference, animate.
 #[derive(Subcommand, Debug)]
 pub enum RelightCommand {
-    Precompute(precompute::Args),
+    Precompute(Box<precompute::Args>),
+    Render(Box<render::Args>),
+    Animate(Box<animate::Args>),
 }
 
 pub fn run(command: RelightCommand) -> Result<()> {
     match command {
-        RelightCommand::Precompute(args) => precompute::run(args),
+        RelightCommand::Precompute(args) => precompute::run(*args),
+        RelightCommand::Render(args) => render::run(*args),
+        RelightCommand::Animate(args) => animate::run(*args),
     }
 }
