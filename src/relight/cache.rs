@@ -12,6 +12,10 @@
 //! | `H` | header, JSON: [`CacheHeader`] (the parameters, the counts, the scene hash, the scene file's environment and camera) |
 //! | | positions `V x 3` f64, normals `V x 3` f64, triangles `T x 3` u32, albedo `V x 3` f32 |
 //! | | transport: offsets `V + 1` u64, indices `N` u32, values `N` f32 ([`TransportSet`]) |
+//! | | with `sh_bands = B` in the parameters: the spherical-harmonic transfer `V x B^2` f32 ([`ShTransfer`](super::harmonics::ShTransfer)) |
+//!
+//! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
+//! environment and camera in the header; a version-1 file is refused like any other version.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
 //! cache"), the version (another version is refused, never guessed at), the checksum (a
@@ -24,6 +28,7 @@ use std::path::Path;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
+use super::harmonics::ShTransfer;
 use super::scene::{CameraSpec, EnvironmentSpec};
 use super::transport::TransportSet;
 use super::{Mesh, SceneError};
@@ -92,6 +97,8 @@ pub struct CacheParams {
     pub map_size: Option<usize>,
     /// Whether the ground plane was added.
     pub ground_plane: bool,
+    /// Bands of the spherical-harmonic transfer stored beside the Haar transport, if any.
+    pub sh_bands: Option<usize>,
 }
 
 /// The JSON header of a cache file.
@@ -124,7 +131,8 @@ pub struct CacheHeader {
 /// let options = VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
-///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false };
+///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
+///     sh_bands: None };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");
@@ -171,7 +179,7 @@ fn corrupt(reason: impl Into<String>) -> Error {
 
 impl SceneCache {
     /// Bundles the parts, checking that they describe the same vertices and that `params`
-    /// names the transport's parameterisation.
+    /// names the transport's parameterisation and spherical-harmonic bands.
     pub fn new(
         params: CacheParams,
         mesh: Mesh,
@@ -189,13 +197,18 @@ impl SceneCache {
             ));
         }
         let p = transport.param();
-        if params.param != p.kind().to_string() || params.resolution != p.face_size() {
+        let bands = transport.sh().map(|t| t.bands());
+        if params.param != p.kind().to_string()
+            || params.resolution != p.face_size()
+            || params.sh_bands != bands
+        {
             return Err(Error::parameter(
                 "cache parameters",
                 format!(
-                    "they say {} {} but the transport is {} {}",
+                    "they say {} {} with {:?} sh bands but the transport is {} {} with {bands:?}",
                     params.param,
                     params.resolution,
+                    params.sh_bands,
                     p.kind(),
                     p.face_size()
                 ),
@@ -249,6 +262,7 @@ impl SceneCache {
             .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
         values
             .iter()
+            .chain(self.transport.sh().map_or(&[][..], |t| t.as_slice()))
             .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
         let checksum = crc32fast::hash(&body);
         crate::io::write_file_atomically(path, force, |w| {
@@ -320,14 +334,31 @@ impl SceneCache {
         let offsets = r.u64s(v + 1)?;
         let indices = r.u32s(n)?;
         let values = r.f32s(n)?;
+        let sh = match header.params.sh_bands {
+            Some(b) => {
+                let per_vertex = b.checked_mul(b).ok_or_else(|| corrupt("size overflows"))?;
+                let flat = r.f32s(
+                    v.checked_mul(per_vertex)
+                        .ok_or_else(|| corrupt("size overflows"))?,
+                )?;
+                Some(ShTransfer::from_flat(b, flat)?)
+            }
+            None => None,
+        };
         if !r.bytes.is_empty() {
             return Err(corrupt("bytes after the transport"));
         }
         let mesh = Mesh::new(positions, triangles, Some(normals))?;
         let kind: ParamKind = header.params.param.parse()?;
         let param = Parameterization::new(kind, header.params.resolution)?;
-        let transport =
-            TransportSet::from_parts(param, header.params.keep.into(), offsets, indices, values)?;
+        let transport = TransportSet::from_parts(
+            param,
+            header.params.keep.into(),
+            offsets,
+            indices,
+            values,
+            sh,
+        )?;
         let mut cache = SceneCache::new(header.params, mesh, albedo, transport)?;
         cache.environment = header.environment;
         cache.camera = header.camera;

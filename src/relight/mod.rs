@@ -10,6 +10,8 @@
 //! | [`shadowmap`] | [`ShadowMap`], seed 003's orthographic depth buffer along one direction |
 //! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
+//! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, and its shading [`shade_sh`] |
+//! | [`reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
 //! | [`lighting`] | [`Lighting`]: the environment's kept Haar coefficients, RGB, in Mallat order |
@@ -30,12 +32,14 @@ pub mod brdf;
 pub mod cache;
 pub mod environment;
 pub mod error;
+pub mod harmonics;
 pub mod lighting;
 pub mod memory;
 pub mod mesh;
 pub mod precompute;
 pub mod raster;
 pub mod raycast;
+pub mod reference;
 pub mod scene;
 pub mod shade;
 pub mod shadowmap;
@@ -45,9 +49,11 @@ pub mod visibility;
 pub use brdf::Brdf;
 pub use cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
 pub use error::SceneError;
+pub use harmonics::{ShTransfer, shade_sh};
 pub use lighting::Lighting;
 pub use mesh::{Bounds, Mesh};
 pub use raycast::{Occlusion, SceneBvh};
+pub use reference::{ReferenceOptions, ReferenceReport, reference};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,

@@ -18,6 +18,7 @@ fn made(cells: usize) -> SceneCache {
         order: "vertex".into(),
         map_size: None,
         ground_plane: true,
+        sh_bands: None,
     };
     let mut cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
     // The scene file's lighting and camera travel in the header.
