@@ -115,19 +115,21 @@ fn an_existing_output_is_refused_before_any_work_and_replaced_with_force() {
 fn bad_meshes_fail_cleanly_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.hsr");
-    let cases: [(&str, String, &[&str]); 4] = [
+    let cases: [(&str, String, &[&str]); 5] = [
         (
             "nofaces.ply",
             ply(&TETRA, &[]),
             &["nofaces.ply", "no triangles"],
         ),
         (
+            "nan.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n".to_string(),
+            &["nan.obj", "non-finite position"],
+        ),
+        (
             "nan.ply",
-            ply(
-                &[[0.0, f64::NAN, 0.0], TETRA[1], TETRA[2], TETRA[3]],
-                &TETRA_FACES,
-            ),
-            &["nan.ply", "non-finite position"],
+            ply(&TETRA, &TETRA_FACES).replace("\n1 0 0\n", "\n1 NaN 0\n"),
+            &["nan.ply", "not a readable mesh", "NaN"],
         ),
         (
             "range.ply",
@@ -548,9 +550,180 @@ fn animate_writes_a_gif_or_numbered_frames_and_times_each() {
     fails_cleanly(&args, &["frame.png", "%d"]);
 }
 
+/// The relative RMS difference of two `(V, 3)` arrays, over all vertices and channels.
+fn relative_rms(a: &ndarray::Array2<f32>, b: &ndarray::Array2<f32>) -> f64 {
+    haarshift::metrics::relative_rms_error(a.mapv(f64::from).view(), b.mapv(f64::from).view())
+        .unwrap()
+}
+
+fn read_vertices(path: &Path) -> ndarray::Array2<f32> {
+    ndarray_npy::read_npy(path).unwrap()
+}
+
+#[test]
+fn the_haar_render_at_full_coefficients_equals_the_reference() {
+    // The contract for checking: lat-long N, nothing truncated, same rays, the same
+    // downsampled lighting; only the order of the sums and f32 rounding differ.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = sphere_on_plane(dir.path());
+    let cache = dir.path().join("s.hsr");
+    precompute(&scene, &cache, &["--resolution", "8", "--sh-bands", "3"]);
+    let env = env32();
+    let common = ["--env", p(&env), "--yaw", "-37", "--albedo", "0.7,0.5,0.2"];
+    let haar = dir.path().join("haar.npy");
+    let h_png = dir.path().join("h.png");
+    let mut args = render_args(&cache, &h_png, &common);
+    args.extend(["--vertices", p(&haar)]);
+    succeeds(&args);
+    let truth = dir.path().join("truth.npy");
+    let mut args = vec![
+        "relight",
+        "reference",
+        p(&scene),
+        "--resolution",
+        "8",
+        "--vertices",
+        p(&truth),
+    ];
+    args.extend(common);
+    let stdout = succeeds_with_stdout(&args);
+    assert!(stdout.contains("rays "), "{stdout}");
+    let (haar, truth) = (read_vertices(&haar), read_vertices(&truth));
+    assert_eq!(haar.dim(), (96 + 1089, 3));
+    let full = relative_rms(&haar, &truth);
+    assert!(full < 1e-6, "full coefficients: {full:.2e}");
+    // Truncating the lighting moves away from it (so the comparison can fail) ...
+    let kept = dir.path().join("kept.npy");
+    let k_png = dir.path().join("k.png");
+    let mut args = render_args(&cache, &k_png, &common);
+    args.extend(["--vertices", p(&kept), "--keep-light", "8"]);
+    succeeds(&args);
+    let kept = relative_rms(&read_vertices(&kept), &truth);
+    assert!(kept > 1e-3, "8 lighting coefficients: {kept:.2e}");
+    // ... and so does the low-frequency basis.
+    let sh = dir.path().join("sh.npy");
+    let sh_png = dir.path().join("sh.png");
+    let mut args = render_args(&cache, &sh_png, &common);
+    args.extend(["--vertices", p(&sh), "--basis", "sh"]);
+    let stdout = succeeds_with_stdout(&args);
+    assert!(stdout.contains("3 bands (9 coefficients)"), "{stdout}");
+    let sh = relative_rms(&read_vertices(&sh), &truth);
+    assert!(sh > 1e-3 && sh < 0.5, "SH, 3 bands: {sh:.2e}");
+    // SH needs its transfer in the cache, and takes no Haar truncation.
+    let plain = small_cache(dir.path());
+    let out = dir.path().join("x.png");
+    fails_cleanly(
+        &render_args(&plain, &out, &["--env", p(&env), "--basis", "sh"]),
+        &["sphere.hsr", "--sh-bands"],
+    );
+    fails_cleanly(
+        &render_args(
+            &cache,
+            &out,
+            &["--env", p(&env), "--basis", "sh", "--keep-light", "5"],
+        ),
+        &["--keep-light", "basis"],
+    );
+}
+
+#[test]
+fn reference_refuses_bad_inputs_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = sphere_on_plane(dir.path());
+    let env = env32();
+    let out = file(dir.path(), "truth.npy", b"old");
+    let base = [
+        "relight",
+        "reference",
+        p(&scene),
+        "--env",
+        p(&env),
+        "--vertices",
+    ];
+    let mut args = base.to_vec();
+    args.push(p(&out));
+    fails_cleanly(&args, &["truth.npy", "already exists"]);
+    let fresh = dir.path().join("fresh.npy");
+    for (flags, needles) in [
+        (&["--resolution", "1000"][..], &["resolution", "1000"][..]),
+        (&["--resolution", "0"], &["resolution"]),
+        (&["-o", "x.gif"], &["x.gif", ".png"]),
+    ] {
+        let mut args = base.to_vec();
+        args.push(p(&fresh));
+        args.extend(flags);
+        fails_cleanly(&args, needles);
+        assert!(!fresh.exists());
+    }
+    let square = testdata("camera.png");
+    fails_cleanly(
+        &[
+            "relight",
+            "reference",
+            p(&scene),
+            "--env",
+            p(&square),
+            "--vertices",
+            p(&fresh),
+        ],
+        &["camera.png", "twice as wide"],
+    );
+}
+
+#[test]
+fn the_gallery_writes_its_images_table_and_turntable() {
+    let dir = tempfile::tempdir().unwrap();
+    let maps = dir.path().join("maps");
+    std::fs::create_dir(&maps).unwrap();
+    std::fs::copy(env32(), maps.join("park.hdr")).unwrap();
+    std::fs::write(maps.join("SOURCES.md"), "not a map").unwrap();
+    let out = dir.path().join("out");
+    let bunny = testdata("meshes/bunny.ply");
+    let args = [
+        "relight",
+        "gallery",
+        p(&bunny),
+        "--env-dir",
+        p(&maps),
+        "--out-dir",
+        p(&out),
+        "--resolution",
+        "8",
+        "--keep-light",
+        "20",
+        "--sh-bands",
+        "3",
+        "--frames",
+        "2",
+    ];
+    let stdout = succeeds_with_stdout(&args);
+    assert!(stdout.contains("1 maps"), "{stdout}");
+    let table = std::fs::read_to_string(out.join("errors.md")).unwrap();
+    assert!(
+        table.contains("relight gallery") && table.contains("| park | [park.png](park.png) |"),
+        "{table}"
+    );
+    let image = haarshift::io::read_image::<f32>(out.join("park.png")).unwrap();
+    assert_eq!((image.width(), image.height()), (3 * 320, 240));
+    assert!(out.join("turntable.gif").exists());
+    // The Haar error at every coefficient is rounding; the other two are not.
+    let row = table.lines().find(|l| l.starts_with("| park")).unwrap();
+    let errors: Vec<f64> = row
+        .split('|')
+        .skip(3)
+        .take(3)
+        .map(|x| x.trim().parse().unwrap())
+        .collect();
+    assert!(
+        errors[0] < 1e-6 && errors[1] > errors[0] && errors[2] > errors[0],
+        "{row}"
+    );
+    fails_cleanly(&args, &["already exists"]);
+}
+
 #[test]
 fn every_subcommand_has_an_example_in_its_help() {
-    for sub in ["precompute", "render", "reference", "animate"] {
+    for sub in ["precompute", "render", "reference", "animate", "gallery"] {
         let help = succeeds_with_stdout(&["relight", sub, "--help"]);
         assert!(
             help.contains(&format!("haarshift relight {sub} ")),

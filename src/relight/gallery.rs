@@ -23,13 +23,12 @@ use std::path::{Path, PathBuf};
 
 use ndarray::{Array2, Array3, Axis, concatenate};
 
-
 use super::environment::Environment;
 use super::precompute::{PrecomputeOptions, precompute};
 use super::raster::{Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8};
 use super::{
-    Lighting, Mesh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, SceneCache,
-    ShadeOptions, VisibilityOptions, reference, shade_sh,
+    Lighting, Mesh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, SceneCache, ShadeOptions,
+    VisibilityOptions, reference, shade_sh,
 };
 use crate::io::{WriteOptions, write_image};
 use crate::metrics::relative_rms_error;
@@ -164,7 +163,11 @@ pub fn gallery(
         let b = cache.mesh.bounds();
         Camera::framing(b.min, b.max, DEFAULT_FOV)?
     };
-    let full = PreparedTransport::<f64>::new(&cache.transport, cache.albedo.view(), &ShadeOptions::default())?;
+    let full = PreparedTransport::<f64>::new(
+        &cache.transport,
+        cache.albedo.view(),
+        &ShadeOptions::default(),
+    )?;
     let identity = SphereRotation::identity();
     std::fs::create_dir_all(out_dir).map_err(|source| Error::Io {
         path: out_dir.to_path_buf(),
@@ -173,13 +176,24 @@ pub fn gallery(
     let mut rows = Vec::with_capacity(maps.len());
     for (path, env) in maps.iter().zip(&environments) {
         let haar_all = full.shade(&Lighting::new(env, param, &identity, Selection::All)?)?;
-        let kept = Lighting::new(env, param, &identity, Selection::Largest(options.keep_light))?;
+        let kept = Lighting::new(
+            env,
+            param,
+            &identity,
+            Selection::Largest(options.keep_light),
+        )?;
         let haar_kept = full.shade(&kept)?;
         let sh_light = harmonics.project(&env.sphere_map(param, &identity)?);
         let sh = shade_sh(transfer, cache.albedo.view(), sh_light.view())?.mapv(f64::from);
         let quadrature = ReferenceOptions { progress: true };
         let lighting = env.lat_long(options.resolution, &identity)?;
-        let (truth, _) = reference(&cache.mesh, &bvh, cache.albedo.view(), &lighting, &quadrature)?;
+        let (truth, _) = reference(
+            &cache.mesh,
+            &bvh,
+            cache.albedo.view(),
+            &lighting,
+            &quadrature,
+        )?;
         rows.push(GalleryRow {
             name: stem(path),
             haar_all: relative_rms_error(haar_all.view(), truth.view())?,
@@ -197,17 +211,36 @@ pub fn gallery(
                     triangles: cache.mesh.triangles(),
                     radiance: radiance.view(),
                 };
-                let image = render(&camera, options.width, options.height, &mesh, Background::Environment(&backdrop))?;
+                let image = render(
+                    &camera,
+                    options.width,
+                    options.height,
+                    &mesh,
+                    Background::Environment(&backdrop),
+                )?;
                 to_srgb8(&image, exposure)
             })
             .collect::<Result<Vec<_>>>()?;
         let views: Vec<_> = panels.iter().map(|p| p.planes()).collect();
         let side_by_side: Array3<f32> = concatenate(Axis(2), &views).expect("panels of one size");
         let image = PlanarImage::new(side_by_side, Channels::Rgb, SampleDepth::U8)?;
-        write_image(&image, &out_dir.join(format!("{}.png", stem(path))), WriteOptions { force: options.force, ..Default::default() })?;
+        write_image(
+            &image,
+            out_dir.join(format!("{}.png", stem(path))),
+            WriteOptions {
+                force: options.force,
+                ..Default::default()
+            },
+        )?;
     }
     write_errors(&out_dir.join("errors.md"), &rows, options)?;
-    turntable(&cache, &environments[0], &camera, &out_dir.join("turntable.gif"), options)?;
+    turntable(
+        &cache,
+        &environments[0],
+        &camera,
+        &out_dir.join("turntable.gif"),
+        options,
+    )?;
     Ok(rows)
 }
 
@@ -265,13 +298,24 @@ fn turntable(
     options: &GalleryOptions,
 ) -> Result<()> {
     let param = cache.transport.param();
-    let prepared = PreparedTransport::<f32>::new(&cache.transport, cache.albedo.view(), &ShadeOptions::default())?;
-    let first = prepared.shade(&Lighting::new(env, param, &SphereRotation::identity(), Selection::All)?)?;
+    let prepared = PreparedTransport::<f32>::new(
+        &cache.transport,
+        cache.albedo.view(),
+        &ShadeOptions::default(),
+    )?;
+    let first = prepared.shade(&Lighting::new(
+        env,
+        param,
+        &SphereRotation::identity(),
+        Selection::All,
+    )?)?;
     let exposure = exposure_for(&first.mapv(f64::from));
     let frames = (0..options.frames)
         .map(|k| {
-            let turn = SphereRotation::from_degrees(360.0 * k as f64 / options.frames as f64, 0.0, 0.0)?;
-            let lighting = Lighting::new(env, param, &turn, Selection::Largest(options.keep_light))?;
+            let turn =
+                SphereRotation::from_degrees(360.0 * k as f64 / options.frames as f64, 0.0, 0.0)?;
+            let lighting =
+                Lighting::new(env, param, &turn, Selection::Largest(options.keep_light))?;
             let radiance = prepared.shade(&lighting)?;
             let backdrop = env.lat_long(env.map().height().min(512), &turn)?;
             let mesh = RasterMesh {
@@ -279,7 +323,16 @@ fn turntable(
                 triangles: cache.mesh.triangles(),
                 radiance: radiance.view(),
             };
-            to_srgb8(&render(camera, options.width, options.height, &mesh, Background::Environment(&backdrop))?, exposure)
+            to_srgb8(
+                &render(
+                    camera,
+                    options.width,
+                    options.height,
+                    &mesh,
+                    Background::Environment(&backdrop),
+                )?,
+                exposure,
+            )
         })
         .collect::<Result<Vec<_>>>()?;
     super::animation::write_gif(&frames, path, 100, options.force)

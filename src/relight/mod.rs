@@ -21,6 +21,7 @@
 //! | [`animation`] | frames into an animated GIF |
 //! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
 //! | [`memory`] | the process's peak resident memory, for reports |
+//! | [`gallery`] | the committed diffuse renders: Haar, SH and the reference under several maps |
 //!
 //! Conventions are the sphere module's: world Y up, right-handed, directions as in
 //! [`sphere::latlong`](crate::sphere::latlong), rotations `g(p) = f(R p)` with
@@ -32,6 +33,7 @@ pub mod brdf;
 pub mod cache;
 pub mod environment;
 pub mod error;
+pub mod gallery;
 pub mod harmonics;
 pub mod lighting;
 pub mod memory;

@@ -74,6 +74,7 @@ impl PrecomputeOptions {
             order: self.order.to_string(),
             map_size: (self.order == Order::Direction).then_some(self.map_size),
             ground_plane,
+            sh_bands: v.sh_bands,
         }
     }
 }

@@ -284,6 +284,11 @@ impl ShadingFlags {
         self.keep_light.map_or(Selection::All, Selection::Largest)
     }
 
+    /// Whether any truncation was asked for.
+    pub fn is_set(&self) -> bool {
+        self.keep_light.is_some() || self.keep_visibility.is_some() || self.depth.is_some()
+    }
+
     /// The shading options (Lambertian).
     pub fn options(&self) -> ShadeOptions {
         ShadeOptions {

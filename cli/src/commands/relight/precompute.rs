@@ -27,6 +27,7 @@ work) or a scene file (.json, see the library's relight::scene docs).
 Examples:
   haarshift relight precompute testdata/meshes/bunny.ply --ground-plane -o bunny.hsr
   haarshift relight precompute bunny.ply --ground-plane --param cube --resolution 32 -o bunny.hsr
+  haarshift relight precompute bunny.ply --ground-plane --resolution 64 --sh-bands 9 -o bunny.hsr
   haarshift relight precompute testdata/scenes/cubes.json --param cube --resolution 64 -o cubes.hsr
   haarshift relight precompute scene.json --order direction --map-size 2048 -o scene.hsr";
 
@@ -70,6 +71,11 @@ pub struct Args {
     #[arg(long, value_name = "M", default_value_t = DEFAULT_MAP_SIZE)]
     pub map_size: usize,
 
+    /// Also store each vertex's transport projected onto B bands of real spherical harmonics
+    /// (degrees 0 to B - 1, B^2 coefficients), for `relight render --basis sh`
+    #[arg(long, value_name = "B")]
+    pub sh_bands: Option<usize>,
+
     /// Replace the output if it exists
     #[arg(long)]
     pub force: bool,
@@ -83,6 +89,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut visibility = VisibilityOptions::new(param);
     visibility.samples = args.visibility_samples;
     visibility.seed = args.seed;
+    visibility.sh_bands = args.sh_bands;
     visibility.progress = true;
     visibility.keep = args
         .keep_visibility

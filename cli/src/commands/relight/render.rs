@@ -5,8 +5,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use haarshift::relight::raster::{Mesh as RasterMesh, render, render_format, write_render};
-use haarshift::relight::{Lighting, PreparedTransport, SceneCache};
-use haarshift::{Result, SampleDepth};
+use haarshift::relight::{Lighting, PreparedTransport, SceneCache, shade_sh};
+use haarshift::sphere::harmonics::SphericalHarmonics;
+use haarshift::{Error, Result, SampleDepth};
+use ndarray::Array2;
 
 use super::flags::{
     CameraFlags, LightFlags, MaterialFlags, ShadingFlags, background_map, ms, refuse_inputs,
@@ -31,7 +33,17 @@ Examples:
   haarshift relight render bunny.hsr --env park.hdr --yaw 120 --keep-light 200 -o bunny.exr
   haarshift relight render cubes.hsr --env park.hdr --keep-light 194 --keep-visibility 414 -o cubes.png
   haarshift relight render bunny.hsr --env park.hdr --camera 0,1,4 --look-at 0,0.5,0 --fov 35 -o near.png
-  haarshift relight render bunny.hsr --env park.hdr --vertices radiance.npy --background 0,0,0 -o b.png";
+  haarshift relight render bunny.hsr --env park.hdr --vertices radiance.npy --background 0,0,0 -o b.png
+  haarshift relight render bunny.hsr --env park.hdr --basis sh -o bunny-sh.png   (after --sh-bands)";
+
+/// The basis the radiance is computed in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Basis {
+    /// Haar wavelets: all-frequency.
+    Haar,
+    /// Spherical harmonics: low-frequency PRT.
+    Sh,
+}
 
 /// Render a precomputed scene under an environment map.
 #[derive(clap::Args, Debug)]
@@ -58,6 +70,11 @@ pub struct Args {
     #[command(flatten)]
     pub shading: ShadingFlags,
 
+    /// `haar`: the sparse Haar transport and lighting. `sh`: the spherical-harmonic transfer
+    /// stored by `precompute --sh-bands B` and the lighting projected onto the same bands
+    #[arg(long, value_enum, default_value = "haar")]
+    pub basis: Basis,
+
     #[command(flatten)]
     pub camera: CameraFlags,
 
@@ -81,24 +98,72 @@ pub fn run(args: Args) -> Result<()> {
     let rotation = rotation(angles)?;
     let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
 
-    let start = Instant::now();
-    let prepared = PreparedTransport::<f32>::new(
-        &cache.transport,
-        cache.albedo.view(),
-        &args.shading.options(),
-    )?;
-    let prepare_ms = ms(start);
-    let start = Instant::now();
-    let lighting = Lighting::new(
-        &env,
-        cache.transport.param(),
-        &rotation,
-        args.shading.light_selection(),
-    )?;
-    let encode_ms = ms(start);
-    let start = Instant::now();
-    let radiance = prepared.shade(&lighting)?;
-    let shade_ms = ms(start);
+    let param = cache.transport.param();
+    let shaded = match args.basis {
+        Basis::Haar => {
+            let start = Instant::now();
+            let prepared = PreparedTransport::<f32>::new(
+                &cache.transport,
+                cache.albedo.view(),
+                &args.shading.options(),
+            )?;
+            let prepare_ms = ms(start);
+            let start = Instant::now();
+            let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
+            let encode_ms = ms(start);
+            let start = Instant::now();
+            let radiance = prepared.shade(&lighting)?;
+            Shaded {
+                radiance,
+                encode_ms,
+                shade_ms: ms(start),
+                what: format!(
+                    "Haar, lighting kept {} detail coefficients, transport {} coefficients; \
+                     transport prepared once in {prepare_ms:.1} ms",
+                    lighting.kept(),
+                    prepared.coefficient_count()
+                ),
+            }
+        }
+        Basis::Sh => {
+            if args.shading.is_set() {
+                return Err(Error::InvalidParameter {
+                    name: "basis",
+                    reason: "--keep-light, --keep-visibility and --depth truncate the Haar \
+                             basis; --basis sh uses every band stored"
+                        .into(),
+                });
+            }
+            let transfer = cache.transport.sh().ok_or_else(|| Error::Format {
+                path: args.cache.clone(),
+                reason: "the cache holds no spherical-harmonic transfer: precompute it with \
+                         --sh-bands B"
+                    .into(),
+            })?;
+            let start = Instant::now();
+            let map = env.sphere_map(param, &rotation)?;
+            let lighting = SphericalHarmonics::new(transfer.bands())?.project(&map);
+            let encode_ms = ms(start);
+            let start = Instant::now();
+            let radiance = shade_sh(transfer, cache.albedo.view(), lighting.view())?;
+            Shaded {
+                radiance,
+                encode_ms,
+                shade_ms: ms(start),
+                what: format!(
+                    "spherical harmonics, {} bands ({} coefficients)",
+                    transfer.bands(),
+                    transfer.bands() * transfer.bands()
+                ),
+            }
+        }
+    };
+    let Shaded {
+        radiance,
+        encode_ms,
+        shade_ms,
+        what,
+    } = shaded;
 
     let start = Instant::now();
     let backdrop = background_map(&env, &rotation)?;
@@ -120,18 +185,23 @@ pub fn run(args: Args) -> Result<()> {
         haarshift::io::write_npy(radiance.view(), SampleDepth::F32, path, args.force)?;
     }
     print(&format!(
-        "{}: {} x {} image of {} vertices ({} {}, lighting kept {} detail coefficients, \
-         transport {} coefficients)\n\
+        "{}: {} x {} image of {} vertices ({} {}, {what})\n\
          lighting encoding {encode_ms:.1} ms, shading {shade_ms:.1} ms, together {:.1} ms; \
-         rasterisation {raster_ms:.1} ms; transport prepared once in {prepare_ms:.1} ms\n",
+         rasterisation {raster_ms:.1} ms\n",
         args.output.display(),
         args.camera.width,
         args.camera.height,
         cache.mesh.vertex_count(),
-        cache.transport.param().kind(),
-        cache.transport.param().face_size(),
-        lighting.kept(),
-        prepared.coefficient_count(),
+        param.kind(),
+        param.face_size(),
         encode_ms + shade_ms,
     ))
+}
+
+/// The per-vertex radiance of one basis, with its timings.
+struct Shaded {
+    radiance: Array2<f32>,
+    encode_ms: f64,
+    shade_ms: f64,
+    what: String,
 }
