@@ -52,7 +52,7 @@ echo
 echo "| step | wall (m:ss) | CPU s (user + sys) | peak resident MiB | what the command reports |"
 echo "|---|---|---|---|---|"
 for step in precompute render; do
-    report=$(tr '\n' ' ' <"$work/$step.out" | sed 's/|/\\|/g; s/  */ /g')
+    report=$(tr '\n' ' ' <"$work/$step.out" | sed "s|$work/||g; s/|/\\\\|/g; s/  */ /g")
     echo "| $step | $(field "$step" 'Elapsed (wall clock)') | $(cpu "$step") | $(peak_mib "$step") | $report |"
 done
 echo
