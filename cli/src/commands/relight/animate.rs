@@ -4,13 +4,12 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use haarshift::relight::animation::{numbered_path, write_gif};
-use haarshift::relight::raster::{Mesh as RasterMesh, render, to_srgb8, write_render};
-use haarshift::relight::{Lighting, PreparedTransport, SceneCache};
+use haarshift::relight::raster::{to_srgb8, write_render};
+use haarshift::relight::{Lighting, SceneCache};
 use haarshift::{Error, Result};
 
 use super::flags::{
-    CameraFlags, LightFlags, MaterialFlags, ShadingFlags, background_map, ms, refuse_inputs,
-    rotation,
+    CameraFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -104,11 +103,7 @@ pub fn run(args: Args) -> Result<()> {
     let (env, [yaw, pitch, roll]) = args.light.load(cache.environment.as_ref())?;
     let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
     let start = Instant::now();
-    let prepared = PreparedTransport::<f32>::new(
-        &cache.transport,
-        cache.albedo.view(),
-        &args.shading.options(),
-    )?;
+    let prepared = args.shading.prepare(&cache)?;
     let mut text = format!("transport prepared once in {:.1} ms\n", ms(start));
     let mut radiance = ndarray::Array2::<f32>::zeros((cache.mesh.vertex_count(), 3));
     let mut frames = Vec::with_capacity(if gif { args.frames } else { 0 });
@@ -125,18 +120,13 @@ pub fn run(args: Args) -> Result<()> {
         prepared.shade_into(&lighting, &mut radiance)?;
         let shade_ms = ms(start);
         let start = Instant::now();
-        let backdrop = background_map(&env, &turn)?;
-        let mesh = RasterMesh {
-            positions: cache.mesh.positions(),
-            triangles: cache.mesh.triangles(),
-            radiance: radiance.view(),
-        };
-        let image = render(
+        let image = args.camera.draw(
             &camera,
-            args.camera.width,
-            args.camera.height,
-            &mesh,
-            background.with(&backdrop),
+            &cache.mesh,
+            radiance.view(),
+            &background,
+            &env,
+            &turn,
         )?;
         let raster_ms = ms(start);
         match frame_paths.get(k) {

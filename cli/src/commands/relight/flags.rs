@@ -3,13 +3,16 @@
 
 use std::path::{Path, PathBuf};
 
+use haarshift::PlanarImage;
 use haarshift::product::Selection;
-use haarshift::relight::ShadeOptions;
 use haarshift::relight::environment::Environment;
 use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
+use haarshift::relight::raster::{Mesh as RasterMesh, render};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
+use haarshift::relight::{PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift::{Error, Result};
+use ndarray::ArrayView2;
 
 /// A mesh or a scene file, and the ground plane.
 #[derive(clap::Args, Debug)]
@@ -198,6 +201,33 @@ impl CameraFlags {
         }
     }
 
+    /// `mesh` with per-vertex `radiance` as `camera` sees it, `--width x --height`, in front
+    /// of `background`: the lighting `env` rotated by `rotation`, or a colour.
+    pub fn draw(
+        &self,
+        camera: &Camera,
+        mesh: &Mesh,
+        radiance: ArrayView2<'_, f32>,
+        background: &BackgroundChoice,
+        env: &Environment,
+        rotation: &SphereRotation,
+    ) -> Result<PlanarImage<f32>> {
+        let backdrop;
+        let background = match *background {
+            BackgroundChoice::Environment => {
+                backdrop = background_map(env, rotation)?;
+                Background::Environment(&backdrop)
+            }
+            BackgroundChoice::Colour(c) => Background::Colour(c),
+        };
+        let drawn = RasterMesh {
+            positions: mesh.positions(),
+            triangles: mesh.triangles(),
+            radiance,
+        };
+        render(camera, self.width, self.height, &drawn, background)
+    }
+
     /// `--background`, parsed.
     pub fn background(&self) -> Result<BackgroundChoice> {
         if self.background == "env" {
@@ -214,16 +244,6 @@ impl CameraFlags {
                     self.background
                 ),
             })
-    }
-}
-
-impl BackgroundChoice {
-    /// The rasteriser's background, `env` being the lighting's map.
-    pub fn with<'a>(&self, env: &'a LatLongMap<f64>) -> Background<'a> {
-        match *self {
-            BackgroundChoice::Environment => Background::Environment(env),
-            BackgroundChoice::Colour(c) => Background::Colour(c),
-        }
     }
 }
 
@@ -289,8 +309,13 @@ impl ShadingFlags {
         self.keep_light.is_some() || self.keep_visibility.is_some() || self.depth.is_some()
     }
 
+    /// `cache`'s transport prepared for shading with its albedo under these options.
+    pub fn prepare(&self, cache: &SceneCache) -> Result<PreparedTransport<f32>> {
+        PreparedTransport::new(&cache.transport, cache.albedo.view(), &self.options())
+    }
+
     /// The shading options (Lambertian).
-    pub fn options(&self) -> ShadeOptions {
+    fn options(&self) -> ShadeOptions {
         ShadeOptions {
             keep_visibility: self.keep_visibility.map(Selection::Largest),
             depth: self.depth,
@@ -305,7 +330,7 @@ const BACKGROUND_HEIGHT: usize = 512;
 
 /// The environment as a background: rotated like the lighting, at most
 /// [`BACKGROUND_HEIGHT`] rows.
-pub fn background_map(env: &Environment, rotation: &SphereRotation) -> Result<LatLongMap<f64>> {
+fn background_map(env: &Environment, rotation: &SphereRotation) -> Result<LatLongMap<f64>> {
     env.lat_long(env.map().height().min(BACKGROUND_HEIGHT), rotation)
 }
 

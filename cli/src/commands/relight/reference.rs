@@ -4,12 +4,12 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::relight::raster::{Mesh as RasterMesh, render, render_format, write_render};
+use haarshift::relight::raster::{render_format, write_render};
 use haarshift::relight::{ReferenceOptions, SceneBvh, reference};
 use haarshift::{Result, SampleDepth};
 
 use super::flags::{
-    CameraFlags, LightFlags, MaterialFlags, SceneFlags, background_map, ms, refuse_inputs, rotation,
+    CameraFlags, LightFlags, MaterialFlags, SceneFlags, ms, refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -105,18 +105,13 @@ pub fn run(args: Args) -> Result<()> {
     );
     if let Some(path) = &args.output {
         let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh)?;
-        let backdrop = background_map(&env, &rotation)?;
-        let mesh = RasterMesh {
-            positions: scene.mesh.positions(),
-            triangles: scene.mesh.triangles(),
-            radiance: radiance.view(),
-        };
-        let image = render(
+        let image = args.camera.draw(
             &camera,
-            args.camera.width,
-            args.camera.height,
-            &mesh,
-            background.with(&backdrop),
+            &scene.mesh,
+            radiance.view(),
+            &background,
+            &env,
+            &rotation,
         )?;
         write_render(&image, path, args.camera.exposure, args.force)?;
         text += &format!(

@@ -4,15 +4,14 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::relight::raster::{Mesh as RasterMesh, render, render_format, write_render};
-use haarshift::relight::{Lighting, PreparedTransport, SceneCache, shade_sh};
+use haarshift::relight::raster::{render_format, write_render};
+use haarshift::relight::{Lighting, SceneCache, shade_sh};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::Array2;
 
 use super::flags::{
-    CameraFlags, LightFlags, MaterialFlags, ShadingFlags, background_map, ms, refuse_inputs,
-    rotation,
+    CameraFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -102,11 +101,7 @@ pub fn run(args: Args) -> Result<()> {
     let shaded = match args.basis {
         Basis::Haar => {
             let start = Instant::now();
-            let prepared = PreparedTransport::<f32>::new(
-                &cache.transport,
-                cache.albedo.view(),
-                &args.shading.options(),
-            )?;
+            let prepared = args.shading.prepare(&cache)?;
             let prepare_ms = ms(start);
             let start = Instant::now();
             let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
@@ -166,18 +161,13 @@ pub fn run(args: Args) -> Result<()> {
     } = shaded;
 
     let start = Instant::now();
-    let backdrop = background_map(&env, &rotation)?;
-    let mesh = RasterMesh {
-        positions: cache.mesh.positions(),
-        triangles: cache.mesh.triangles(),
-        radiance: radiance.view(),
-    };
-    let image = render(
+    let image = args.camera.draw(
         &camera,
-        args.camera.width,
-        args.camera.height,
-        &mesh,
-        background.with(&backdrop),
+        &cache.mesh,
+        radiance.view(),
+        &background,
+        &env,
+        &rotation,
     )?;
     let raster_ms = ms(start);
     write_render(&image, &args.output, args.camera.exposure, args.force)?;
