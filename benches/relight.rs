@@ -2,15 +2,33 @@
 //! (all threads, and one thread for the ratio), the solid-angle-weighted downsample of a
 //! 512 x 1024 map to 128 x 256 beside the plain block mean, and the projection of a
 //! 128 x 256 RGB map onto 9 bands (81) of spherical harmonics.
+//!
+//! And the relighting itself (`relight_cubes_85860`): seed 002's Cubes scene (85,860 vertices)
+//! at cube `6 x 64^2`, each vertex's transport keeping its 420 largest coefficients, a
+//! lighting keeping its 200 largest, Lambertian: the lighting's encoding (the 512 x 1024 map
+//! downsampled by solid-angle means, turned, converted to the cube, transformed, selected) and
+//! the shading (one sparse dot per vertex, f32) timed separately and together; the mapping
+//! into the cube (its overlap table) is made once, as an animation makes it. The turn is a
+//! yaw by whole columns of the working map (the animation's step: a column permutation) or a
+//! general rotation (applied at the source's resolution). The transport is precomputed once
+//! per run with the real ray caster ([`vertex_major`], a few minutes on two cores, with a
+//! progress bar) and only when one of these benchmarks is selected; nothing is synthetic.
 //! Run: `cargo bench --bench relight -- --warm-up-time 1 --measurement-time 5`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use haarshift::relight::environment::downsample_solid_angle;
+use std::sync::OnceLock;
+
+use haarshift::product::Selection;
+use haarshift::relight::environment::{Environment, SphereMapping, downsample_solid_angle};
 use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV, Mesh, render};
-use haarshift::sphere::LatLongMap;
+use haarshift::relight::{
+    Generator, Lighting, PreparedTransport, SceneBvh, ShadeOptions, VisibilityOptions, vertex_major,
+};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::sphere::latlong::direction;
 use haarshift::sphere::param::SphereMap;
+use haarshift::sphere::param::{ParamKind, Parameterization};
+use haarshift::sphere::{LatLongMap, SphereRotation};
 use ndarray::{Array2, Array3};
 
 /// A UV sphere of radius 1 with `n x 2n` quads (`4 n^2` triangles) and a smooth radiance.
@@ -92,5 +110,72 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// The Cubes scene's transport at cube 64, 420 coefficients a vertex, ready to shade.
+fn cubes_transport(param: Parameterization) -> PreparedTransport<f32> {
+    let mesh = Generator::Cubes {
+        count: 10,
+        cells: 10,
+        distance: 1.5,
+    }
+    .mesh()
+    .expect("the cubes scene");
+    let mut options = VisibilityOptions::new(param);
+    options.keep = Selection::Largest(420);
+    options.progress = true;
+    let (set, report) = vertex_major(&mesh, &SceneBvh::new(&mesh), &options).expect("precomputes");
+    eprintln!(
+        "precomputed {} vertices in {:.1} s ({:.1} M rays/s)",
+        set.vertex_count(),
+        report.seconds,
+        report.rays as f64 / report.seconds / 1e6
+    );
+    let albedo = ndarray::Array2::from_elem((set.vertex_count(), 3), 0.8f32);
+    PreparedTransport::new(&set, albedo.view(), &ShadeOptions::default()).expect("prepares")
+}
+
+fn bench_relighting(c: &mut Criterion) {
+    let param = Parameterization::new(ParamKind::Cube, 64).expect("cube 64");
+    let env = Environment::new(map_512());
+    let keep = Selection::Largest(200);
+    // 37 columns of the 256 of the 128 x 256 working map; and a tilted turn.
+    let whole = SphereRotation::from_degrees(37.0 * 360.0 / 256.0, 0.0, 0.0).expect("yaw");
+    let general = SphereRotation::from_degrees(30.0, 20.0, 0.0).expect("rotation");
+    // Made once, as the animation does: the lat-long-to-cube overlap table.
+    let mapping = SphereMapping::new(env.map().height(), param).expect("mapping");
+    let transport = OnceLock::new();
+    let prepared = || transport.get_or_init(|| cubes_transport(param));
+    let mut group = c.benchmark_group("relight_cubes_85860");
+    group.sample_size(10);
+    group.bench_function("encode_lighting_cube64_keep200/whole_column_yaw", |b| {
+        b.iter(|| Lighting::encode(&env, &mapping, &whole, keep).expect("encodes"))
+    });
+    group.bench_function("encode_lighting_cube64_keep200/general_rotation", |b| {
+        b.iter(|| Lighting::encode(&env, &mapping, &general, keep).expect("encodes"))
+    });
+    group.bench_function("shade_keep420_f32", |b| {
+        let t = prepared();
+        let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
+        let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
+        b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
+    });
+    group.bench_function("encode_and_shade/whole_column_yaw", |b| {
+        let t = prepared();
+        let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
+        b.iter(|| {
+            let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
+            t.shade_into(&light, &mut out).expect("shades")
+        })
+    });
+    group.bench_function("encode_and_shade/general_rotation", |b| {
+        let t = prepared();
+        let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
+        b.iter(|| {
+            let light = Lighting::encode(&env, &mapping, &general, keep).expect("encodes");
+            t.shade_into(&light, &mut out).expect("shades")
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_relighting);
 criterion_main!(benches);

@@ -31,3 +31,13 @@ macro_rules! assert_err {
         }
     };
 }
+
+/// The form factor from a differential area to a parallel `a x b` rectangle at distance `h`,
+/// one corner of the rectangle straight above the area (Howell's catalogue of configuration
+/// factors, B-3): `F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2)
+/// atan(X/sqrt(1+Y^2))]`, `X = a/h`, `Y = b/h`.
+pub(crate) fn corner_form_factor(a: f64, b: f64, h: f64) -> f64 {
+    let (x, y) = (a / h, b / h);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+}

@@ -159,18 +159,83 @@ impl Environment {
         param: Parameterization,
         rotation: &SphereRotation,
     ) -> Result<SphereMap<f64>> {
-        match param.kind() {
-            ParamKind::LatLong => {
-                SphereMap::from_lat_long(&self.lat_long(param.face_size(), rotation)?)
-            }
+        SphereMapping::new(self.map.height(), param)?.apply(self, rotation)
+    }
+}
+
+/// What [`Environment::sphere_map`] prepares before it sees a map, kept to be applied to many
+/// (an animation's frames, the lighting of a benchmark): the working lat-long height and, for
+/// a cube map, the [`Conversion`] (its overlap table costs more to build than to apply).
+///
+/// ```
+/// use haarshift::relight::environment::{Environment, SphereMapping};
+/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// use haarshift::sphere::{LatLongMap, SphereRotation};
+/// let env = Environment::new(LatLongMap::<f64>::from_fn(64, 1, |d, o| o[0] = 1.0 + d[0]).unwrap());
+/// let cube = Parameterization::new(ParamKind::Cube, 8).unwrap();
+/// let mapping = SphereMapping::new(64, cube).unwrap();
+/// let turn = SphereRotation::from_degrees(45.0, 0.0, 0.0).unwrap();
+/// assert_eq!(mapping.apply(&env, &turn).unwrap(), env.sphere_map(cube, &turn).unwrap());
+/// ```
+#[derive(Clone, Debug)]
+pub struct SphereMapping {
+    param: Parameterization,
+    source_height: usize,
+    /// The lat-long height the environment is brought to first.
+    height: usize,
+    conversion: Option<Conversion>,
+}
+
+impl SphereMapping {
+    /// The mapping of environments `source_height` high into `param`.
+    pub fn new(source_height: usize, param: Parameterization) -> Result<Self> {
+        if source_height == 0 {
+            return Err(Error::parameter("environment", "a map 0 texels high"));
+        }
+        Ok(match param.kind() {
+            ParamKind::LatLong => SphereMapping {
+                param,
+                source_height,
+                height: param.face_size(),
+                conversion: None,
+            },
             ParamKind::Cube => {
-                let h = self.map.height();
-                let largest = 1usize << (usize::BITS - 1 - h.leading_zeros());
+                let largest = 1usize << (usize::BITS - 1 - source_height.leading_zeros());
                 let height = (2 * param.face_size()).min(largest);
-                let ll = SphereMap::from_lat_long(&self.lat_long(height, rotation)?)?;
-                let samples = default_samples(ll.param(), param);
-                Conversion::new(ll.param(), param, samples)?.apply(&ll)
+                let ll = Parameterization::new(ParamKind::LatLong, height)?;
+                let conversion = Conversion::new(ll, param, default_samples(ll, param))?;
+                SphereMapping {
+                    param,
+                    source_height,
+                    height,
+                    conversion: Some(conversion),
+                }
             }
+        })
+    }
+
+    /// The parameterisation mapped to.
+    pub fn param(&self) -> Parameterization {
+        self.param
+    }
+
+    /// `env` rotated by `rotation` in this mapping's parameterisation; `env` must be as high as
+    /// the mapping was made for.
+    pub fn apply(&self, env: &Environment, rotation: &SphereRotation) -> Result<SphereMap<f64>> {
+        let h = env.map().height();
+        if h != self.source_height {
+            return Err(Error::parameter(
+                "environment",
+                format!(
+                    "{h} texels high, but the mapping was made for maps {} high",
+                    self.source_height
+                ),
+            ));
+        }
+        let ll = SphereMap::from_lat_long(&env.lat_long(self.height, rotation)?)?;
+        match &self.conversion {
+            None => Ok(ll),
+            Some(conversion) => conversion.apply(&ll),
         }
     }
 }

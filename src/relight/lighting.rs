@@ -4,7 +4,9 @@
 //! **Pipeline.** [`Lighting::new`] takes the environment to the parameterisation, rotated by
 //! `g(p) = f(R p)` ([`Environment::sphere_map`]: lat-long `N x 2N` by solid-angle-weighted
 //! means, or a cube map `6 x N^2`), transforms each face to its orthonormal Haar pyramid and
-//! keeps the coefficients a [`Selection`] picks (`--keep-light K`). [`Lighting::from_map`]
+//! keeps the coefficients a [`Selection`] picks (`--keep-light K`). [`Lighting::encode`] does
+//! the same with the mapping into the parameterisation made once ([`SphereMapping`]: for a
+//! cube map, the conversion's overlap table), for many lightings. [`Lighting::from_map`]
 //! starts from a map already at the working resolution.
 //!
 //! **Selection on the RGB magnitude.** A coefficient is kept or dropped for all three channels
@@ -25,7 +27,7 @@
 
 use ndarray::{Array2, Array4, ArrayView2};
 
-use super::environment::Environment;
+use super::environment::{Environment, SphereMapping};
 use crate::product::{HaarTree, Selection};
 use crate::sphere::SphereRotation;
 use crate::sphere::integrate::layout;
@@ -67,7 +69,39 @@ impl Lighting {
         rotation: &SphereRotation,
         keep: Selection,
     ) -> Result<Lighting> {
-        Lighting::from_map(&env.sphere_map(param, rotation)?, keep)
+        Lighting::encode(
+            env,
+            &SphereMapping::new(env.map().height(), param)?,
+            rotation,
+            keep,
+        )
+    }
+
+    /// [`new`](Self::new) with the mapping into the parameterisation made once
+    /// ([`SphereMapping`]) and reused: what an animation or a benchmark calls per frame.
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::Lighting;
+    /// use haarshift::relight::environment::{Environment, SphereMapping};
+    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::sphere::{LatLongMap, SphereRotation};
+    /// let env = Environment::new(LatLongMap::<f64>::from_fn(32, 3, |d, o| o.fill(1.0 + d[2])).unwrap());
+    /// let cube = Parameterization::new(ParamKind::Cube, 8).unwrap();
+    /// let mapping = SphereMapping::new(32, cube).unwrap();
+    /// for step in 0..4 {
+    ///     let turn = SphereRotation::from_degrees(90.0 * step as f64, 0.0, 0.0).unwrap();
+    ///     let light = Lighting::encode(&env, &mapping, &turn, Selection::Largest(30)).unwrap();
+    ///     assert_eq!(light, Lighting::new(&env, cube, &turn, Selection::Largest(30)).unwrap());
+    /// }
+    /// ```
+    pub fn encode(
+        env: &Environment,
+        mapping: &SphereMapping,
+        rotation: &SphereRotation,
+        keep: Selection,
+    ) -> Result<Lighting> {
+        Lighting::from_map(&mapping.apply(env, rotation)?, keep)
     }
 
     /// The lighting of a map already at the working resolution (1 or 3 channels), truncated

@@ -374,3 +374,6 @@ fn retruncate<T: Sample>(
     out.sort_unstable_by_key(|&(i, _)| i);
     out.into_iter().unzip()
 }
+
+#[cfg(test)]
+mod tests;

@@ -3,6 +3,7 @@ use std::f64::consts::PI;
 use super::*;
 use crate::relight::{Generator, SceneBvh, add_ground_plane};
 use crate::sphere::ParamKind;
+use crate::test_support::corner_form_factor;
 
 fn latlong(n: usize) -> Parameterization {
     Parameterization::new(ParamKind::LatLong, n).unwrap()
@@ -79,14 +80,6 @@ fn a_convex_sphere_is_unoccluded_above_its_horizon() {
         "{near_horizon_blocked}"
     );
     assert!(report.rays > 0);
-}
-
-/// The form factor from a point to a parallel `a x b` rectangle with one corner straight above
-/// it at height `h`.
-fn corner_form_factor(a: f64, b: f64, h: f64) -> f64 {
-    let (x, y) = (a / h, b / h);
-    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
-    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
 }
 
 #[test]
