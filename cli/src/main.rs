@@ -36,6 +36,11 @@ enum Command {
         #[command(subcommand)]
         command: commands::sphere::SphereCommand,
     },
+    /// Relight meshes under environment maps: precompute, render, reference, animate
+    Relight {
+        #[command(subcommand)]
+        command: commands::relight::RelightCommand,
+    },
     /// Measure methods against ground truth: rotation cycle, shift chain, sphere, stability
     Experiment {
         #[command(subcommand)]
@@ -56,6 +61,7 @@ fn main() -> ExitCode {
         Command::Rotate(args) => commands::rotate::run(args),
         Command::Shift(args) => commands::shift::run(args),
         Command::Sphere { command } => commands::sphere::run(command),
+        Command::Relight { command } => commands::relight::run(command),
         Command::Experiment { command } => commands::experiment::run(command),
     };
     match result {

@@ -5,9 +5,9 @@
 //! encoder) at sampling speed [`QUANTIZER_SPEED`] (1 is the slowest and best, 30 the fastest),
 //! and every pixel takes its nearest palette colour, without dithering. The animation loops
 //! forever; frame delays are stored in hundredths of a second, so `delay_ms` is rounded to
-//! 10 ms.
+//! 10 ms. [`numbered_path`] names the files of an animation written as numbered images.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
@@ -99,6 +99,48 @@ fn rgba(frame: &PlanarImage<f32>) -> RgbaImage {
         };
         image::Rgba([at(0), at(1), at(2), 255])
     })
+}
+
+/// Frame `index`'s file for a numbered-image pattern: the one `%d` or `%0Nd` (`N` from 1 to 9)
+/// in `pattern`'s file name replaced by `index`, zero-padded to `N` digits. A pattern without
+/// exactly one such field is refused.
+///
+/// ```
+/// use haarshift::relight::animation::numbered_path;
+/// use std::path::Path;
+/// assert_eq!(numbered_path(Path::new("out/frame_%03d.png"), 7).unwrap(), Path::new("out/frame_007.png"));
+/// assert_eq!(numbered_path(Path::new("f%d.png"), 12).unwrap(), Path::new("f12.png"));
+/// assert!(numbered_path(Path::new("frame.png"), 0).is_err());
+/// assert!(numbered_path(Path::new("%d_%d.png"), 0).is_err());
+/// ```
+pub fn numbered_path(pattern: &Path, index: usize) -> Result<PathBuf> {
+    let refuse = || Error::Format {
+        path: pattern.to_path_buf(),
+        reason: "numbered frames need one %d or %0Nd (N from 1 to 9) in the file name".into(),
+    };
+    let name = pattern
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(refuse)?;
+    let start = name.find('%').ok_or_else(refuse)?;
+    let rest = &name[start + 1..];
+    let (width, after) = match rest.strip_prefix('0') {
+        Some(r) => {
+            let digit = r
+                .chars()
+                .next()
+                .and_then(|c| c.to_digit(10))
+                .filter(|&d| d >= 1);
+            (digit.ok_or_else(refuse)? as usize, &r[1..])
+        }
+        None => (0, rest),
+    };
+    let tail = after.strip_prefix('d').ok_or_else(refuse)?;
+    if tail.contains('%') {
+        return Err(refuse());
+    }
+    let file = format!("{}{index:0width$}{tail}", &name[..start]);
+    Ok(pattern.with_file_name(file))
 }
 
 #[cfg(test)]

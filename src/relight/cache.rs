@@ -9,9 +9,13 @@
 //! | 4 | format version ([`CACHE_VERSION`]) |
 //! | 4 | CRC-32 of everything after this field |
 //! | 8 | length `H` of the header |
-//! | `H` | header, JSON: [`CacheHeader`] (the parameters, the counts, the scene hash) |
+//! | `H` | header, JSON: [`CacheHeader`] (the parameters, the counts, the scene hash, the scene file's environment and camera) |
 //! | | positions `V x 3` f64, normals `V x 3` f64, triangles `T x 3` u32, albedo `V x 3` f32 |
 //! | | transport: offsets `V + 1` u64, indices `N` u32, values `N` f32 ([`TransportSet`]) |
+//! | | with `sh_bands = B` in the parameters: the spherical-harmonic transfer `V x B^2` f32 ([`ShTransfer`](super::harmonics::ShTransfer)) |
+//!
+//! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
+//! environment and camera in the header; a version-1 file is refused like any other version.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
 //! cache"), the version (another version is refused, never guessed at), the checksum (a
@@ -24,6 +28,8 @@ use std::path::Path;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
+use super::harmonics::ShTransfer;
+use super::scene::{CameraSpec, EnvironmentSpec};
 use super::transport::TransportSet;
 use super::{Mesh, SceneError};
 use crate::product::Selection;
@@ -31,7 +37,7 @@ use crate::sphere::{ParamKind, Parameterization};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
-pub const CACHE_VERSION: u32 = 1;
+pub const CACHE_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"HSRCACHE";
 
@@ -91,6 +97,8 @@ pub struct CacheParams {
     pub map_size: Option<usize>,
     /// Whether the ground plane was added.
     pub ground_plane: bool,
+    /// Bands of the spherical-harmonic transfer stored beside the Haar transport, if any.
+    pub sh_bands: Option<usize>,
 }
 
 /// The JSON header of a cache file.
@@ -107,6 +115,10 @@ pub struct CacheHeader {
     pub coefficients: usize,
     /// [`scene_hash`] of the mesh.
     pub scene_hash: u32,
+    /// The scene file's lighting (path resolved when the scene was read), if it had one.
+    pub environment: Option<EnvironmentSpec>,
+    /// The scene file's camera, if it had one.
+    pub camera: Option<CameraSpec>,
 }
 
 /// A precomputed scene: the mesh, its albedo and every vertex's sparse transport.
@@ -119,7 +131,8 @@ pub struct CacheHeader {
 /// let options = VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
-///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false };
+///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
+///     sh_bands: None };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");
@@ -137,6 +150,11 @@ pub struct SceneCache {
     pub albedo: Array2<f32>,
     /// Every vertex's transport.
     pub transport: TransportSet,
+    /// The scene file's lighting, used when a render names none ([`SceneCache::new`] leaves
+    /// it `None`).
+    pub environment: Option<EnvironmentSpec>,
+    /// The scene file's camera, likewise.
+    pub camera: Option<CameraSpec>,
 }
 
 /// A CRC-32 of the mesh's positions, normals and triangles: what "the same scene" means.
@@ -161,7 +179,7 @@ fn corrupt(reason: impl Into<String>) -> Error {
 
 impl SceneCache {
     /// Bundles the parts, checking that they describe the same vertices and that `params`
-    /// names the transport's parameterisation.
+    /// names the transport's parameterisation and spherical-harmonic bands.
     pub fn new(
         params: CacheParams,
         mesh: Mesh,
@@ -179,13 +197,18 @@ impl SceneCache {
             ));
         }
         let p = transport.param();
-        if params.param != p.kind().to_string() || params.resolution != p.face_size() {
+        let bands = transport.sh().map(|t| t.bands());
+        if params.param != p.kind().to_string()
+            || params.resolution != p.face_size()
+            || params.sh_bands != bands
+        {
             return Err(Error::parameter(
                 "cache parameters",
                 format!(
-                    "they say {} {} but the transport is {} {}",
+                    "they say {} {} with {:?} sh bands but the transport is {} {} with {bands:?}",
                     params.param,
                     params.resolution,
+                    params.sh_bands,
                     p.kind(),
                     p.face_size()
                 ),
@@ -196,6 +219,8 @@ impl SceneCache {
             mesh,
             albedo,
             transport,
+            environment: None,
+            camera: None,
         })
     }
 
@@ -209,6 +234,8 @@ impl SceneCache {
             triangles: self.mesh.triangles().len(),
             coefficients: indices.len(),
             scene_hash: scene_hash(&self.mesh),
+            environment: self.environment.clone(),
+            camera: self.camera.clone(),
         };
         let json = serde_json::to_vec(&header).expect("the header serialises");
         let mut body = Vec::with_capacity(8 + json.len() + self.transport.stored_bytes());
@@ -235,6 +262,7 @@ impl SceneCache {
             .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
         values
             .iter()
+            .chain(self.transport.sh().map_or(&[][..], |t| t.as_slice()))
             .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
         let checksum = crc32fast::hash(&body);
         crate::io::write_file_atomically(path, force, |w| {
@@ -306,15 +334,35 @@ impl SceneCache {
         let offsets = r.u64s(v + 1)?;
         let indices = r.u32s(n)?;
         let values = r.f32s(n)?;
+        let sh = match header.params.sh_bands {
+            Some(b) => {
+                let per_vertex = b.checked_mul(b).ok_or_else(|| corrupt("size overflows"))?;
+                let flat = r.f32s(
+                    v.checked_mul(per_vertex)
+                        .ok_or_else(|| corrupt("size overflows"))?,
+                )?;
+                Some(ShTransfer::from_flat(b, flat)?)
+            }
+            None => None,
+        };
         if !r.bytes.is_empty() {
             return Err(corrupt("bytes after the transport"));
         }
         let mesh = Mesh::new(positions, triangles, Some(normals))?;
         let kind: ParamKind = header.params.param.parse()?;
         let param = Parameterization::new(kind, header.params.resolution)?;
-        let transport =
-            TransportSet::from_parts(param, header.params.keep.into(), offsets, indices, values)?;
-        SceneCache::new(header.params, mesh, albedo, transport)
+        let transport = TransportSet::from_parts(
+            param,
+            header.params.keep.into(),
+            offsets,
+            indices,
+            values,
+            sh,
+        )?;
+        let mut cache = SceneCache::new(header.params, mesh, albedo, transport)?;
+        cache.environment = header.environment;
+        cache.camera = header.camera;
+        Ok(cache)
     }
 }
 

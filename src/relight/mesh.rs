@@ -311,8 +311,11 @@ fn fan(polygon: &[u32], triangles: &mut Vec<[u32; 3]>) {
     }
 }
 
+/// A parse failure as one line: the PLY reader's messages span several lines (the line, the
+/// string, the nested error), and an error is printed on one.
 fn corrupt(reason: impl std::fmt::Display) -> Error {
-    SceneError::Corrupt(reason.to_string()).into()
+    let reason = reason.to_string();
+    SceneError::Corrupt(reason.split_whitespace().collect::<Vec<_>>().join(" ")).into()
 }
 
 fn read_obj(path: &Path) -> Result<Mesh> {

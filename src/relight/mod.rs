@@ -10,6 +10,8 @@
 //! | [`shadowmap`] | [`ShadowMap`], seed 003's orthographic depth buffer along one direction |
 //! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
+//! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, and its shading [`shade_sh`] |
+//! | [`reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
 //! | [`lighting`] | [`Lighting`]: the environment's kept Haar coefficients, RGB, in Mallat order |
@@ -17,6 +19,9 @@
 //! | [`shade`](mod@shade) | per-vertex outgoing radiance: [`PreparedTransport`], one sparse dot per vertex |
 //! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
 //! | [`animation`] | frames into an animated GIF |
+//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
+//! | [`memory`] | the process's peak resident memory, for reports |
+//! | [`gallery`] | the committed diffuse renders: Haar, SH and the reference under several maps |
 //!
 //! Conventions are the sphere module's: world Y up, right-handed, directions as in
 //! [`sphere::latlong`](crate::sphere::latlong), rotations `g(p) = f(R p)` with
@@ -28,10 +33,15 @@ pub mod brdf;
 pub mod cache;
 pub mod environment;
 pub mod error;
+pub mod gallery;
+pub mod harmonics;
 pub mod lighting;
+pub mod memory;
 pub mod mesh;
+pub mod precompute;
 pub mod raster;
 pub mod raycast;
+pub mod reference;
 pub mod scene;
 pub mod shade;
 pub mod shadowmap;
@@ -41,9 +51,11 @@ pub mod visibility;
 pub use brdf::Brdf;
 pub use cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
 pub use error::SceneError;
+pub use harmonics::{ShTransfer, shade_sh};
 pub use lighting::Lighting;
 pub use mesh::{Bounds, Mesh};
 pub use raycast::{Occlusion, SceneBvh};
+pub use reference::{ReferenceOptions, ReferenceReport, reference};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,

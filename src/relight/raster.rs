@@ -629,8 +629,8 @@ pub fn write_render(
         force,
         ..Default::default()
     };
-    match FileFormat::from_extension(path) {
-        Some(FileFormat::Exr) => {
+    match render_format(path)? {
+        FileFormat::Exr => {
             let linear = PlanarImage::new(
                 image.planes().to_owned(),
                 image.channels(),
@@ -638,7 +638,22 @@ pub fn write_render(
             )?;
             write_image(&linear, path, options)
         }
-        Some(FileFormat::Png) => write_image(&to_srgb8(image, exposure)?, path, options),
+        _ => write_image(&to_srgb8(image, exposure)?, path, options),
+    }
+}
+
+/// The format [`write_render`] writes to `path`: PNG or OpenEXR by the extension, anything else
+/// refused (so a caller can check an output before rendering).
+///
+/// ```
+/// use haarshift::io::FileFormat;
+/// use haarshift::relight::raster::render_format;
+/// assert_eq!(render_format("a.PNG".as_ref()).unwrap(), FileFormat::Png);
+/// assert!(render_format("a.tif".as_ref()).unwrap_err().to_string().contains("a.tif"));
+/// ```
+pub fn render_format(path: &Path) -> Result<FileFormat> {
+    match FileFormat::from_extension(path) {
+        Some(format @ (FileFormat::Exr | FileFormat::Png)) => Ok(format),
         _ => Err(Error::Format {
             path: path.to_path_buf(),
             reason: "a render is written as .png (8-bit sRGB) or .exr (linear f32)".into(),

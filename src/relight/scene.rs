@@ -561,6 +561,8 @@ pub struct Scene {
     pub environment: Option<EnvironmentSpec>,
     /// The camera.
     pub camera: Option<CameraSpec>,
+    /// Whether the ground plane has been added (its vertices are the last ones).
+    pub ground_plane: bool,
 }
 
 impl Scene {
@@ -571,6 +573,7 @@ impl Scene {
             mesh,
             environment: None,
             camera: None,
+            ground_plane: false,
         };
         let Material::Lambert { albedo } = Material::default();
         scene.albedo = Array2::from_shape_fn((scene.mesh.vertex_count(), 3), |(_, c)| albedo[c]);
@@ -580,8 +583,21 @@ impl Scene {
         scene
     }
 
-    /// Appends the ground plane ([`add_ground_plane`]) with albedo [`GROUND_ALBEDO`].
+    /// Appends the ground plane ([`add_ground_plane`]) with albedo [`GROUND_ALBEDO`], unless the
+    /// scene has it already.
+    ///
+    /// ```
+    /// use haarshift::relight::{Generator, Scene};
+    /// let mut scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true);
+    /// let v = scene.mesh.vertex_count();
+    /// scene.add_ground_plane();
+    /// assert_eq!((scene.mesh.vertex_count(), scene.ground_plane), (v, true));
+    /// ```
     pub fn add_ground_plane(&mut self) {
+        if self.ground_plane {
+            return;
+        }
+        self.ground_plane = true;
         let before = self.mesh.vertex_count();
         add_ground_plane(&mut self.mesh);
         let added = Array2::from_shape_fn((self.mesh.vertex_count() - before, 3), |(_, c)| {
@@ -650,6 +666,7 @@ impl SceneFile {
                 e
             }),
             camera: self.camera.clone(),
+            ground_plane: false,
         };
         if self.ground_plane {
             scene.add_ground_plane();

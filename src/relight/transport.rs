@@ -10,9 +10,14 @@
 //! after face, each face a full-depth pyramid of
 //! [`transform::pyramid`](crate::transform::pyramid)); the face's scaling coefficient is at
 //! `(face, 0, 0)`.
+//!
+//! A set may also carry the same transport projected onto spherical harmonics
+//! ([`ShTransfer`], seed 003's low-frequency transfer), made from the same values by the same
+//! precomputation, for the comparison method.
 
 use ndarray::{Array3, Array4, ArrayView3, Axis};
 
+use super::harmonics::{ShProjector, ShTransfer};
 use crate::product::{HaarTree, Selection, Transport, WeightedPixels};
 use crate::sphere::Parameterization;
 use crate::sphere::integrate::layout;
@@ -37,10 +42,10 @@ use crate::{Error, Result};
 pub struct TransportSet {
     param: Parameterization,
     keep: Selection,
-    weights: Array3<f32>,
     offsets: Vec<u64>,
     indices: Vec<u32>,
     values: Vec<f32>,
+    sh: Option<ShTransfer>,
 }
 
 impl TransportSet {
@@ -49,11 +54,33 @@ impl TransportSet {
         TransportSet {
             param,
             keep,
-            weights: param.solid_angles().mapv(|w| w as f32),
             offsets: vec![0],
             indices: Vec::new(),
             values: Vec::new(),
+            sh: None,
         }
+    }
+
+    /// An empty set that also projects every vertex onto `bands` bands of spherical harmonics
+    /// ([`ShTransfer`]; 1 to [`MAX_SH_BANDS`](super::harmonics::MAX_SH_BANDS)).
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::TransportSet;
+    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use ndarray::Array3;
+    /// let param = Parameterization::new(ParamKind::LatLong, 32).unwrap();
+    /// let mut set = TransportSet::with_sh(param, Selection::All, 2).unwrap();
+    /// set.push(Array3::ones((2, 32, 32)).view()).unwrap(); // sees everything, cosine 1
+    /// let t = set.sh().unwrap().coefficients();
+    /// // Only Y_00 survives: int 1 x Y_00 = 4 pi / (2 sqrt pi) = 2 sqrt pi.
+    /// assert!((t[[0, 0]] - 2.0 * std::f32::consts::PI.sqrt()).abs() < 1e-5);
+    /// assert!(t[[0, 2]].abs() < 1e-5);
+    /// ```
+    pub fn with_sh(param: Parameterization, keep: Selection, bands: usize) -> Result<Self> {
+        let mut set = Self::new(param, keep);
+        set.sh = Some(ShTransfer::empty(bands)?);
+        Ok(set)
     }
 
     /// The set from stored parts (the cache): checked for consistency.
@@ -63,6 +90,7 @@ impl TransportSet {
         offsets: Vec<u64>,
         indices: Vec<u32>,
         values: Vec<f32>,
+        sh: Option<ShTransfer>,
     ) -> Result<Self> {
         let texels = param.texels() as u32;
         let consistent = offsets.first() == Some(&0)
@@ -70,36 +98,51 @@ impl TransportSet {
             && offsets.last().copied() == Some(indices.len() as u64)
             && indices.len() == values.len()
             && indices.iter().all(|&i| i < texels)
-            && values.iter().all(|v| v.is_finite());
+            && values.iter().all(|v| v.is_finite())
+            && sh
+                .as_ref()
+                .is_none_or(|t| t.vertex_count() + 1 == offsets.len());
         if !consistent {
             return Err(Error::parameter(
                 "transport",
-                "offsets, indices and values do not describe sparse trees of this resolution",
+                "offsets, indices, values and transfer do not describe sparse trees of this \
+                 resolution, one per vertex",
             ));
         }
         Ok(TransportSet {
-            weights: param.solid_angles().mapv(|w| w as f32),
             param,
             keep,
             offsets,
             indices,
             values,
+            sh,
         })
     }
 
     /// Encodes one more vertex from its unweighted values `V x max(0, n . w)`, `(faces, S, S)`:
-    /// weighted by the solid angles, transformed, truncated, stored.
+    /// weighted by the solid angles, transformed, truncated, stored (and projected onto the
+    /// spherical harmonics when the set carries them). It makes its tables on every call; the
+    /// precomputation makes them once.
     pub fn push(&mut self, values: ArrayView3<'_, f32>) -> Result<()> {
-        let (indices, coefficients) = encode(values, self.weights.view(), self.param, self.keep)?;
-        self.extend(&indices, &coefficients);
+        let bands = self.sh.as_ref().map(ShTransfer::bands);
+        let vertex = Encoder::new(self.param, self.keep, bands)?.encode(values)?;
+        self.extend(&vertex);
         Ok(())
     }
 
     /// Appends one vertex's already encoded coefficients.
-    pub(crate) fn extend(&mut self, indices: &[u32], values: &[f32]) {
-        self.indices.extend_from_slice(indices);
-        self.values.extend_from_slice(values);
+    pub(crate) fn extend(&mut self, vertex: &Encoded) {
+        self.indices.extend_from_slice(&vertex.indices);
+        self.values.extend_from_slice(&vertex.coefficients);
         self.offsets.push(self.indices.len() as u64);
+        if let Some(t) = &mut self.sh {
+            t.push(&vertex.sh);
+        }
+    }
+
+    /// The spherical-harmonic transfer, when the set was made with it.
+    pub fn sh(&self) -> Option<&ShTransfer> {
+        self.sh.as_ref()
     }
 
     /// The parameterisation the transport is sampled in.
@@ -128,9 +171,15 @@ impl TransportSet {
         (&self.offsets, &self.indices, &self.values)
     }
 
-    /// Bytes held by the coefficient arrays.
+    /// Haar coefficients stored, all vertices.
+    pub fn coefficient_count(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Bytes held by the coefficient arrays (the spherical-harmonic transfer included).
     pub fn stored_bytes(&self) -> usize {
-        self.offsets.len() * 8 + self.indices.len() * 4 + self.values.len() * 4
+        let sh = self.sh.as_ref().map_or(0, ShTransfer::stored_bytes);
+        self.offsets.len() * 8 + self.indices.len() * 4 + self.values.len() * 4 + sh
     }
 
     /// Vertex `v`'s transport as a tree for [`product_integral`](crate::product::product_integral).
@@ -158,9 +207,76 @@ impl TransportSet {
     }
 }
 
+/// One vertex as a [`TransportSet`] stores it.
+pub(crate) struct Encoded {
+    /// Mallat indices of the kept non-zero coefficients.
+    pub(crate) indices: Vec<u32>,
+    /// Their values.
+    pub(crate) coefficients: Vec<f32>,
+    /// The spherical-harmonic transfer vector (empty without it).
+    pub(crate) sh: Vec<f32>,
+}
+
+/// Encodes vertices for the precomputation: the solid angles and (when asked) the table of
+/// spherical harmonics at the texels, made once and shared by all vertices and threads.
+pub(crate) struct Encoder {
+    param: Parameterization,
+    keep: Selection,
+    weights: Array3<f32>,
+    sh: Option<ShProjector>,
+}
+
+impl Encoder {
+    /// The encoder of `param`'s texels, keeping `keep`, projecting onto `sh_bands` bands.
+    pub(crate) fn new(
+        param: Parameterization,
+        keep: Selection,
+        sh_bands: Option<usize>,
+    ) -> Result<Self> {
+        Ok(Encoder {
+            param,
+            keep,
+            weights: param.solid_angles().mapv(|w| w as f32),
+            sh: sh_bands.map(|b| ShProjector::new(param, b)).transpose()?,
+        })
+    }
+
+    /// An empty set that [`Encoded`] vertices of this encoder extend.
+    pub(crate) fn empty_set(&self) -> Result<TransportSet> {
+        match &self.sh {
+            Some(p) => TransportSet::with_sh(self.param, self.keep, p.bands()),
+            None => Ok(TransportSet::new(self.param, self.keep)),
+        }
+    }
+
+    /// One vertex from its unweighted values `(faces, S, S)`.
+    pub(crate) fn encode(&self, values: ArrayView3<'_, f32>) -> Result<Encoded> {
+        let (indices, coefficients) = encode(values, self.weights.view(), self.param, self.keep)?;
+        let sh = match &self.sh {
+            Some(p) => {
+                let mut row = vec![0.0; p.len()];
+                let flat = values.as_standard_layout();
+                p.project(flat.as_slice().expect("standard layout"), &mut row);
+                row
+            }
+            None => Vec::new(),
+        };
+        Ok(Encoded {
+            indices,
+            coefficients,
+            sh,
+        })
+    }
+
+    /// Bytes of the shared tables.
+    pub(crate) fn bytes(&self) -> usize {
+        self.weights.len() * 4 + self.sh.as_ref().map_or(0, ShProjector::bytes)
+    }
+}
+
 /// Weights `values` by `weights`, transforms, keeps what `keep` picks: the non-zero kept
 /// coefficients with their Mallat indices.
-pub(crate) fn encode(
+fn encode(
     values: ArrayView3<'_, f32>,
     weights: ArrayView3<'_, f32>,
     param: Parameterization,

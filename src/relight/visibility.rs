@@ -32,10 +32,11 @@ use ndarray::Array3;
 use rayon::prelude::*;
 
 use super::Mesh;
+use super::harmonics::check_bands;
 use super::mesh::dot;
 use super::raycast::Occlusion;
 use super::shadowmap::ShadowMap;
-use super::transport::{TransportSet, encode};
+use super::transport::{Encoded, Encoder, TransportSet};
 use crate::product::Selection;
 use crate::sphere::Parameterization;
 use crate::{Error, Result};
@@ -46,7 +47,7 @@ use crate::{Error, Result};
 /// use haarshift::relight::VisibilityOptions;
 /// use haarshift::sphere::{ParamKind, Parameterization};
 /// let o = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 16).unwrap());
-/// assert_eq!((o.samples, o.seed, o.progress), (1, 0, false));
+/// assert_eq!((o.samples, o.seed, o.sh_bands, o.progress), (1, 0, None, false));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VisibilityOptions {
@@ -58,6 +59,11 @@ pub struct VisibilityOptions {
     pub keep: Selection,
     /// Seed of the stratified jitter.
     pub seed: u64,
+    /// Also project every vertex's transport onto this many bands of spherical harmonics
+    /// (`--sh-bands B`: degrees `0..B`, `B^2` coefficients, 1 to
+    /// [`MAX_SH_BANDS`](super::harmonics::MAX_SH_BANDS)); the set then carries an
+    /// [`ShTransfer`](super::harmonics::ShTransfer).
+    pub sh_bands: Option<usize>,
     /// Show a progress bar on standard error (hidden when it is not a terminal).
     pub progress: bool,
 }
@@ -70,6 +76,7 @@ impl VisibilityOptions {
             samples: 1,
             keep: Selection::All,
             seed: 0,
+            sh_bands: None,
             progress: false,
         }
     }
@@ -80,6 +87,9 @@ impl VisibilityOptions {
                 "visibility samples",
                 format!("{}: must be 1 to 64 (S x S rays per texel)", self.samples),
             ));
+        }
+        if let Some(b) = self.sh_bands {
+            check_bands(b)?;
         }
         let p = self.param;
         self.keep.limit(p.texels() - p.faces())?;
@@ -120,7 +130,7 @@ fn texel_directions(param: Parameterization) -> Vec<[f64; 3]> {
         .collect()
 }
 
-fn progress_bar(show: bool, len: usize, what: &str) -> ProgressBar {
+pub(crate) fn progress_bar(show: bool, len: usize, what: &str) -> ProgressBar {
     if !show {
         return ProgressBar::hidden();
     }
@@ -149,18 +159,15 @@ fn jitter(seed: u64, vertex: usize, texel: usize, sample: usize) -> (f64, f64) {
 }
 
 /// The ray origin of vertex `v` and its normal.
-fn origin_and_normal(mesh: &Mesh, v: usize, eps: f64) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn origin_and_normal(mesh: &Mesh, v: usize, eps: f64) -> ([f64; 3], [f64; 3]) {
     let (p, n) = (mesh.positions(), mesh.normals());
     let n = [n[[v, 0]], n[[v, 1]], n[[v, 2]]];
     (std::array::from_fn(|k| p[[v, k]] + eps * n[k]), n)
 }
 
-fn f32x3(a: [f64; 3]) -> [f32; 3] {
+pub(crate) fn f32x3(a: [f64; 3]) -> [f32; 3] {
     a.map(|x| x as f32)
 }
-
-/// One vertex's kept coefficients (indices, values) and the rays it cast.
-type EncodedVertex = ((Vec<u32>, Vec<f32>), u64);
 
 /// Vertex-major precomputation by ray casting; see the [module docs](self).
 ///
@@ -189,10 +196,10 @@ pub fn vertex_major(
     let eps = ray_offset(mesh);
     let s = param.face_size();
     let samples = options.samples;
-    let mut set = TransportSet::new(param, options.keep);
-    let weights = param.solid_angles().mapv(|w| w as f32);
+    let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
+    let mut set = encoder.empty_set()?;
     let bar = progress_bar(options.progress, mesh.vertex_count(), "visibility (rays)");
-    let encoded: Vec<Result<EncodedVertex>> = (0..mesh.vertex_count())
+    let encoded: Vec<Result<(Encoded, u64)>> = (0..mesh.vertex_count())
         .into_par_iter()
         .map_init(
             || Array3::<f32>::zeros((param.faces(), s, s)),
@@ -228,24 +235,23 @@ pub fn vertex_major(
                     };
                     *value = (visible as f64 / (samples * samples) as f64 * cos) as f32;
                 }
-                let (indices, coefficients) =
-                    encode(values.view(), weights.view(), param, options.keep)?;
+                let vertex = encoder.encode(values.view())?;
                 bar.inc(1);
-                Ok(((indices, coefficients), rays))
+                Ok((vertex, rays))
             },
         )
         .collect();
     bar.finish_and_clear();
     let mut rays = 0;
     for vertex in encoded {
-        let ((indices, coefficients), r) = vertex?;
-        set.extend(&indices, &coefficients);
+        let (vertex, r) = vertex?;
+        set.extend(&vertex);
         rays += r;
     }
     let report = PrecomputeReport {
         rays,
         seconds: start.elapsed().as_secs_f64(),
-        working_bytes: rayon::current_num_threads() * param.texels() * 4,
+        working_bytes: rayon::current_num_threads() * param.texels() * 4 + encoder.bytes(),
     };
     Ok((set, report))
 }
@@ -312,9 +318,9 @@ pub fn direction_major(
     let bits_bytes = directions.len() * words * 8;
     let maps_bytes = rayon::current_num_threads() * map_size * map_size * 4;
     let s = param.face_size();
-    let weights = param.solid_angles().mapv(|w| w as f32);
+    let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
     let bar = progress_bar(options.progress, vertices, "transport (shadow maps)");
-    let encoded: Vec<Result<(Vec<u32>, Vec<f32>)>> = (0..vertices)
+    let encoded: Vec<Result<Encoded>> = (0..vertices)
         .into_par_iter()
         .map(|v| {
             let n = origins[v].1;
@@ -327,21 +333,20 @@ pub fn direction_major(
                     0.0
                 }
             });
-            let out = encode(values.view(), weights.view(), param, options.keep);
+            let out = encoder.encode(values.view());
             bar.inc(1);
             out
         })
         .collect();
     bar.finish_and_clear();
-    let mut set = TransportSet::new(param, options.keep);
+    let mut set = encoder.empty_set()?;
     for vertex in encoded {
-        let (indices, coefficients) = vertex?;
-        set.extend(&indices, &coefficients);
+        set.extend(&vertex?);
     }
     let report = PrecomputeReport {
         rays: 0,
         seconds: start.elapsed().as_secs_f64(),
-        working_bytes: bits_bytes + maps_bytes,
+        working_bytes: bits_bytes + maps_bytes + encoder.bytes(),
     };
     Ok((set, report))
 }

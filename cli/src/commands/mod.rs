@@ -12,6 +12,7 @@ pub mod experiment;
 pub mod info;
 pub mod inverse;
 mod method;
+pub mod relight;
 pub mod rotate;
 pub mod shift;
 pub mod sphere;

@@ -18,8 +18,22 @@ fn made(cells: usize) -> SceneCache {
         order: "vertex".into(),
         map_size: None,
         ground_plane: true,
+        sh_bands: None,
     };
-    SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap()
+    let mut cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
+    // The scene file's lighting and camera travel in the header.
+    cache.environment = Some(crate::relight::EnvironmentSpec {
+        path: PathBuf::from("maps/sky.hdr"),
+        yaw: 30.0,
+        pitch: -5.0,
+        roll: 0.0,
+    });
+    cache.camera = Some(crate::relight::CameraSpec {
+        position: [0.0, 2.0, 5.0],
+        look_at: [0.0, 0.5, 0.0],
+        fov: 35.0,
+    });
+    cache
 }
 
 fn written(cache: &SceneCache) -> (tempfile::TempDir, PathBuf) {

@@ -1,0 +1,152 @@
+//! `haarshift relight animate`: the lighting turning about the vertical axis, frame by frame.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use haarshift::relight::animation::{numbered_path, write_gif};
+use haarshift::relight::raster::{to_srgb8, write_render};
+use haarshift::relight::{Lighting, SceneCache};
+use haarshift::{Error, Result};
+
+use super::flags::{
+    CameraFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
+};
+use crate::commands::{print, refuse_existing};
+
+const HELP: &str = "\
+Frame k (0 to F - 1) is `relight render` with the lighting's yaw increased by k x 360 / F
+degrees (pitch and roll as given): the environment turns about +Y while the scene and the
+camera stay. The transport is prepared once; each frame encodes the lighting, shades and
+rasterises, and its time is printed. The output is one looping GIF (per-frame palette), or
+numbered PNG files when -o holds %d or %0Nd (frame_%03d.png: frame_000.png, frame_001.png ...).
+
+Examples:
+  haarshift relight animate bunny.hsr --env testdata/envmaps/rooitou_park_256x128.npy --frames 24 -o turn.gif
+  haarshift relight animate bunny.hsr --env park.hdr --frames 36 --keep-light 300 --delay 80 -o turn.gif
+  haarshift relight animate bunny.hsr --env park.hdr --frames 12 -o frames/frame_%03d.png";
+
+/// Animate a precomputed scene under a turning environment.
+#[derive(clap::Args, Debug)]
+#[command(after_help = HELP)]
+pub struct Args {
+    /// The scene cache (`relight precompute ... -o SCENE.hsr`)
+    #[arg(value_name = "SCENE.hsr")]
+    pub cache: PathBuf,
+
+    /// Frames in one turn (360 / F degrees a frame)
+    #[arg(long, value_name = "F", default_value_t = 24)]
+    pub frames: usize,
+
+    /// A looping .gif, or numbered .png frames (a pattern with %d or %0Nd)
+    #[arg(short, long, value_name = "turn.gif|frame_%03d.png")]
+    pub output: PathBuf,
+
+    /// Time each GIF frame is shown, milliseconds (stored in hundredths of a second)
+    #[arg(long, value_name = "MS", default_value_t = 100)]
+    pub delay: u32,
+
+    #[command(flatten)]
+    pub light: LightFlags,
+
+    #[command(flatten)]
+    pub material: MaterialFlags,
+
+    #[command(flatten)]
+    pub shading: ShadingFlags,
+
+    #[command(flatten)]
+    pub camera: CameraFlags,
+
+    /// Replace the outputs if they exist
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// The most frames in one animation.
+const MAX_FRAMES: usize = 3600;
+
+pub fn run(args: Args) -> Result<()> {
+    if !(1..=MAX_FRAMES).contains(&args.frames) {
+        return Err(Error::InvalidParameter {
+            name: "frames",
+            reason: format!("{}: must be 1 to {MAX_FRAMES}", args.frames),
+        });
+    }
+    let gif = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
+    // Numbered frames' files (none for a GIF).
+    let frame_paths: Vec<PathBuf> = if gif {
+        Vec::new()
+    } else {
+        (0..args.frames)
+            .map(|k| numbered_path(&args.output, k))
+            .collect::<Result<_>>()?
+    };
+    if let Some(first) = frame_paths.first() {
+        haarshift::relight::raster::render_format(first)?;
+    }
+    let outputs = if gif {
+        vec![args.output.clone()]
+    } else {
+        frame_paths.clone()
+    };
+    let output_refs: Vec<&std::path::Path> = outputs.iter().map(|p| p.as_path()).collect();
+    let mut inputs = vec![args.cache.as_path()];
+    inputs.extend(args.light.env.as_deref());
+    refuse_inputs(&inputs, &output_refs)?;
+    refuse_existing(&output_refs, args.force)?;
+    let background = args.camera.background()?;
+    let mut cache = SceneCache::read(&args.cache)?;
+    args.material.apply(&mut cache.albedo)?;
+    let (env, [yaw, pitch, roll]) = args.light.load(cache.environment.as_ref())?;
+    let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
+    let start = Instant::now();
+    let prepared = args.shading.prepare(&cache)?;
+    let mut text = format!("transport prepared once in {:.1} ms\n", ms(start));
+    let mut radiance = ndarray::Array2::<f32>::zeros((cache.mesh.vertex_count(), 3));
+    let mut frames = Vec::with_capacity(if gif { args.frames } else { 0 });
+    for k in 0..args.frames {
+        let start = Instant::now();
+        let frame_yaw = yaw + 360.0 * k as f64 / args.frames as f64;
+        let turn = rotation([frame_yaw, pitch, roll])?;
+        let lighting = Lighting::new(
+            &env,
+            cache.transport.param(),
+            &turn,
+            args.shading.light_selection(),
+        )?;
+        prepared.shade_into(&lighting, &mut radiance)?;
+        let shade_ms = ms(start);
+        let start = Instant::now();
+        let image = args.camera.draw(
+            &camera,
+            &cache.mesh,
+            radiance.view(),
+            &background,
+            &env,
+            &turn,
+        )?;
+        let raster_ms = ms(start);
+        match frame_paths.get(k) {
+            Some(path) => write_render(&image, path, args.camera.exposure, args.force)?,
+            None => frames.push(to_srgb8(&image, args.camera.exposure)?),
+        }
+        text += &format!(
+            "frame {k}: yaw {frame_yaw:.2}, lighting and shading {shade_ms:.1} ms, \
+             rasterisation {raster_ms:.1} ms\n"
+        );
+    }
+    if gif {
+        write_gif(&frames, &args.output, args.delay, args.force)?;
+    }
+    text += &format!(
+        "{}: {} frames of {} x {}\n",
+        args.output.display(),
+        args.frames,
+        args.camera.width,
+        args.camera.height
+    );
+    print(&text)
+}

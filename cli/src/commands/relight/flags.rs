@@ -1,0 +1,340 @@
+//! Flags shared by the `relight` subcommands: the scene, the lighting, the material, the camera
+//! and the image.
+
+use std::path::{Path, PathBuf};
+
+use haarshift::PlanarImage;
+use haarshift::product::Selection;
+use haarshift::relight::environment::Environment;
+use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
+use haarshift::relight::raster::{Mesh as RasterMesh, render};
+use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
+use haarshift::relight::{PreparedTransport, SceneCache, ShadeOptions};
+use haarshift::sphere::{LatLongMap, SphereRotation};
+use haarshift::{Error, Result};
+use ndarray::ArrayView2;
+
+/// A mesh or a scene file, and the ground plane.
+#[derive(clap::Args, Debug)]
+pub struct SceneFlags {
+    /// A mesh (.obj, .ply) or a scene file (.json)
+    #[arg(value_name = "MESH|SCENE.json")]
+    pub input: PathBuf,
+
+    /// Add a ground plane under the scene (a 32 x 32-cell square at its lowest y, 4 x its
+    /// horizontal extent), unless the scene file has one
+    #[arg(long)]
+    pub ground_plane: bool,
+}
+
+impl SceneFlags {
+    /// The scene, with the ground plane when asked.
+    pub fn load(&self) -> Result<Scene> {
+        let mut scene = Scene::load(&self.input)?;
+        if self.ground_plane {
+            scene.add_ground_plane();
+        }
+        Ok(scene)
+    }
+}
+
+/// Three numbers `x,y,z`.
+fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let values: Vec<f64> = parts
+        .iter()
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| format!("{s:?}: {e}"))?;
+    match values[..] {
+        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
+        _ => Err(format!("{s:?}: expected three finite numbers x,y,z")),
+    }
+}
+
+/// The lighting: the environment map and its rotation.
+#[derive(clap::Args, Debug)]
+pub struct LightFlags {
+    /// Environment map: lat-long (2:1) .hdr, .exr or .npy [default: the scene file's]
+    #[arg(long, value_name = "ENV")]
+    pub env: Option<PathBuf>,
+
+    /// Rotation of the lighting about +Y, degrees (g(p) = f(R p), R = Rz(roll) Ry(yaw) Rx(pitch))
+    /// [default: the scene file's]
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub yaw: Option<f64>,
+
+    /// Rotation of the lighting about +X, degrees [default: the scene file's]
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub pitch: Option<f64>,
+
+    /// Rotation of the lighting about +Z, degrees [default: the scene file's]
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub roll: Option<f64>,
+}
+
+impl LightFlags {
+    /// The environment's file and rotation angles `[yaw, pitch, roll]` in degrees: the flags,
+    /// else the scene file's `environment`.
+    fn resolve(&self, scene: Option<&EnvironmentSpec>) -> Result<(PathBuf, [f64; 3])> {
+        let path = match (&self.env, scene) {
+            (Some(path), _) => path.clone(),
+            (None, Some(spec)) => spec.path.clone(),
+            (None, None) => {
+                return Err(Error::InvalidParameter {
+                    name: "environment",
+                    reason: "give --env ENV (the scene names none)".into(),
+                });
+            }
+        };
+        let angle = |flag: Option<f64>, file: fn(&EnvironmentSpec) -> f64| {
+            flag.or(scene.map(file)).unwrap_or(0.0)
+        };
+        let angles = [
+            angle(self.yaw, |s| s.yaw),
+            angle(self.pitch, |s| s.pitch),
+            angle(self.roll, |s| s.roll),
+        ];
+        Ok((path, angles))
+    }
+
+    /// The environment (read) and its rotation angles `[yaw, pitch, roll]`, degrees.
+    pub fn load(&self, scene: Option<&EnvironmentSpec>) -> Result<(Environment, [f64; 3])> {
+        let (path, angles) = self.resolve(scene)?;
+        Ok((Environment::load(&path)?, angles))
+    }
+}
+
+/// The rotation `R = Rz(roll) Ry(yaw) Rx(pitch)` of `[yaw, pitch, roll]` in degrees.
+pub fn rotation([yaw, pitch, roll]: [f64; 3]) -> Result<SphereRotation> {
+    SphereRotation::from_degrees(yaw, pitch, roll)
+}
+
+/// The material: a Lambertian albedo.
+#[derive(clap::Args, Debug)]
+pub struct MaterialFlags {
+    /// Lambertian albedo r,g,b (each 0 to 1) for every vertex [default: the scene's, 0.8 for
+    /// a mesh and the ground plane]
+    #[arg(long, value_name = "R,G,B", value_parser = triple)]
+    pub albedo: Option<[f64; 3]>,
+}
+
+impl MaterialFlags {
+    /// `albedo` `(V, 3)` with every row replaced by `--albedo` when given (checked to be in
+    /// `[0, 1]`).
+    pub fn apply(&self, albedo: &mut ndarray::Array2<f32>) -> Result<()> {
+        if let Some(a) = self.albedo {
+            if a.iter().any(|x| !(0.0..=1.0).contains(x)) {
+                return Err(Error::InvalidParameter {
+                    name: "albedo",
+                    reason: format!("{a:?}: every channel must be from 0 to 1"),
+                });
+            }
+            for mut row in albedo.rows_mut() {
+                row.assign(&ndarray::arr1(&a.map(|x| x as f32)));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The camera and the image.
+#[derive(clap::Args, Debug)]
+pub struct CameraFlags {
+    /// Camera position x,y,z [default: the scene file's camera, else one that frames the
+    /// scene from 20 degrees above the horizon on the +Z side]
+    #[arg(long, value_name = "X,Y,Z", value_parser = triple, allow_hyphen_values = true, requires = "look_at")]
+    pub camera: Option<[f64; 3]>,
+
+    /// The point the camera looks at, x,y,z
+    #[arg(long, value_name = "X,Y,Z", value_parser = triple, allow_hyphen_values = true, requires = "camera")]
+    pub look_at: Option<[f64; 3]>,
+
+    /// Vertical field of view, degrees [default: the scene file's, else 40]
+    #[arg(long, value_name = "DEG")]
+    pub fov: Option<f64>,
+
+    /// Image width, pixels
+    #[arg(long, value_name = "W", default_value_t = 640)]
+    pub width: usize,
+
+    /// Image height, pixels
+    #[arg(long, value_name = "H", default_value_t = 480)]
+    pub height: usize,
+
+    /// Exposure for PNG output, stops (the linear radiance is multiplied by 2^E before sRGB)
+    #[arg(
+        long,
+        value_name = "E",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub exposure: f64,
+
+    /// What uncovered pixels show: `env` (the rotated environment) or a linear colour r,g,b
+    #[arg(long, value_name = "env|R,G,B", default_value = "env")]
+    pub background: String,
+}
+
+/// The background a render shows.
+pub enum BackgroundChoice {
+    /// The lighting, as the surfaces see it.
+    Environment,
+    /// A constant linear colour.
+    Colour([f32; 3]),
+}
+
+impl CameraFlags {
+    /// The camera: the flags, else the scene file's, else [`Camera::framing`] of `mesh`.
+    pub fn camera(&self, scene: Option<&CameraSpec>, mesh: &Mesh) -> Result<Camera> {
+        match (self.camera, self.look_at, scene) {
+            (Some(position), Some(look_at), _) => {
+                Camera::new(position, look_at, self.fov.unwrap_or(DEFAULT_FOV))
+            }
+            (_, _, Some(spec)) => {
+                Camera::new(spec.position, spec.look_at, self.fov.unwrap_or(spec.fov))
+            }
+            _ => {
+                let b = mesh.bounds();
+                Camera::framing(b.min, b.max, self.fov.unwrap_or(DEFAULT_FOV))
+            }
+        }
+    }
+
+    /// `mesh` with per-vertex `radiance` as `camera` sees it, `--width x --height`, in front
+    /// of `background`: the lighting `env` rotated by `rotation`, or a colour.
+    pub fn draw(
+        &self,
+        camera: &Camera,
+        mesh: &Mesh,
+        radiance: ArrayView2<'_, f32>,
+        background: &BackgroundChoice,
+        env: &Environment,
+        rotation: &SphereRotation,
+    ) -> Result<PlanarImage<f32>> {
+        let backdrop;
+        let background = match *background {
+            BackgroundChoice::Environment => {
+                backdrop = background_map(env, rotation)?;
+                Background::Environment(&backdrop)
+            }
+            BackgroundChoice::Colour(c) => Background::Colour(c),
+        };
+        let drawn = RasterMesh {
+            positions: mesh.positions(),
+            triangles: mesh.triangles(),
+            radiance,
+        };
+        render(camera, self.width, self.height, &drawn, background)
+    }
+
+    /// `--background`, parsed.
+    pub fn background(&self) -> Result<BackgroundChoice> {
+        if self.background == "env" {
+            return Ok(BackgroundChoice::Environment);
+        }
+        triple(&self.background)
+            .ok()
+            .filter(|c| c.iter().all(|&x| x >= 0.0))
+            .map(|c| BackgroundChoice::Colour(c.map(|x| x as f32)))
+            .ok_or_else(|| Error::InvalidParameter {
+                name: "background",
+                reason: format!(
+                    "{:?}: expected `env` or a linear colour r,g,b (non-negative)",
+                    self.background
+                ),
+            })
+    }
+}
+
+/// A byte count as people read it (`812 B`, `3.4 KiB`, `51.2 MiB`, `1.07 GiB`).
+pub fn bytes(n: u64) -> String {
+    const UNITS: [&str; 4] = ["B", "KiB", "MiB", "GiB"];
+    let mut value = n as f64;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{n} B")
+    } else {
+        format!("{value:.1} {}", UNITS[unit])
+    }
+}
+
+/// Refuses an output that is one of the inputs.
+pub fn refuse_inputs(inputs: &[&Path], outputs: &[&Path]) -> Result<()> {
+    for input in inputs {
+        crate::commands::refuse_overwriting_input(input, outputs)?;
+    }
+    Ok(())
+}
+
+/// A whole number of at least 1.
+fn positive(s: &str) -> std::result::Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(k) => Ok(k),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// How the per-vertex radiance is computed: the basis and the truncations.
+#[derive(clap::Args, Debug)]
+pub struct ShadingFlags {
+    /// Detail coefficients of the lighting kept (the largest by RGB magnitude, orthonormal),
+    /// plus each face's scaling coefficient [default: all]
+    #[arg(long, value_name = "K", value_parser = positive)]
+    pub keep_light: Option<usize>,
+
+    /// Detail coefficients of each vertex's transport kept at render time (the largest of
+    /// those stored), plus each face's scaling coefficient [default: all stored]
+    #[arg(long, value_name = "K", value_parser = positive)]
+    pub keep_visibility: Option<usize>,
+
+    /// Detail levels 0..=D only (0 the coarsest) [default: all]
+    #[arg(long, value_name = "D")]
+    pub depth: Option<usize>,
+}
+
+impl ShadingFlags {
+    /// The lighting's truncation.
+    pub fn light_selection(&self) -> Selection {
+        self.keep_light.map_or(Selection::All, Selection::Largest)
+    }
+
+    /// Whether any truncation was asked for.
+    pub fn is_set(&self) -> bool {
+        self.keep_light.is_some() || self.keep_visibility.is_some() || self.depth.is_some()
+    }
+
+    /// `cache`'s transport prepared for shading with its albedo under these options.
+    pub fn prepare(&self, cache: &SceneCache) -> Result<PreparedTransport<f32>> {
+        PreparedTransport::new(&cache.transport, cache.albedo.view(), &self.options())
+    }
+
+    /// The shading options (Lambertian).
+    fn options(&self) -> ShadeOptions {
+        ShadeOptions {
+            keep_visibility: self.keep_visibility.map(Selection::Largest),
+            depth: self.depth,
+            ..ShadeOptions::default()
+        }
+    }
+}
+
+/// The background's lat-long height: the environment's, at most this (a background is seen,
+/// not integrated).
+const BACKGROUND_HEIGHT: usize = 512;
+
+/// The environment as a background: rotated like the lighting, at most
+/// [`BACKGROUND_HEIGHT`] rows.
+fn background_map(env: &Environment, rotation: &SphereRotation) -> Result<LatLongMap<f64>> {
+    env.lat_long(env.map().height().min(BACKGROUND_HEIGHT), rotation)
+}
+
+/// Milliseconds since `start`.
+pub fn ms(start: std::time::Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}

@@ -1,0 +1,34 @@
+//! `haarshift relight ...`: all-frequency relighting of meshes under environment maps.
+//!
+//! One file per subcommand; the flags they share (scene, lighting, material, camera, image)
+//! are in [`flags`].
+
+use clap::Subcommand;
+use haarshift::Result;
+
+pub mod animate;
+mod flags;
+pub mod gallery;
+pub mod precompute;
+pub mod reference;
+pub mod render;
+
+/// Relight meshes under environment maps: precompute, render, reference, animate, gallery.
+#[derive(Subcommand, Debug)]
+pub enum RelightCommand {
+    Precompute(Box<precompute::Args>),
+    Render(Box<render::Args>),
+    Reference(Box<reference::Args>),
+    Animate(Box<animate::Args>),
+    Gallery(Box<gallery::Args>),
+}
+
+pub fn run(command: RelightCommand) -> Result<()> {
+    match command {
+        RelightCommand::Precompute(args) => precompute::run(*args),
+        RelightCommand::Render(args) => render::run(*args),
+        RelightCommand::Reference(args) => reference::run(*args),
+        RelightCommand::Animate(args) => animate::run(*args),
+        RelightCommand::Gallery(args) => gallery::run(*args),
+    }
+}

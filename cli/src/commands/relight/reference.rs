@@ -1,0 +1,125 @@
+//! `haarshift relight reference`: the ground truth, by direct quadrature over the lighting's
+//! texels with ray casting, independent of every Haar path.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use haarshift::relight::raster::{render_format, write_render};
+use haarshift::relight::{ReferenceOptions, SceneBvh, reference};
+use haarshift::{Result, SampleDepth};
+
+use super::flags::{
+    CameraFlags, LightFlags, MaterialFlags, SceneFlags, ms, refuse_inputs, rotation,
+};
+use crate::commands::{print, refuse_existing};
+
+const HELP: &str = "\
+The radiance leaving each vertex (Lambertian), by direct quadrature:
+  albedo / pi x sum over texels t of L(t) V(v, t) max(0, n . w_t) dOmega_t,
+L the environment rotated by g(p) = f(R p) and downsampled to N x 2N by solid-angle-weighted
+means, w_t the texel centre's direction, V one ray per texel centre from the vertex offset
+along its normal by 1e-4 x the scene's bounding-box diagonal (blocked when it hits any
+triangle). No Haar transform, no cache: the ground truth that `relight render` is checked
+against (with --param latlong --resolution N and every coefficient kept, they agree to
+rounding). Same output formats as `relight render`.
+
+Examples:
+  haarshift relight reference testdata/meshes/bunny.ply --ground-plane --env park.hdr --vertices truth.npy
+  haarshift relight reference bunny.ply --ground-plane --env park.hdr --resolution 64 --vertices truth.npy -o truth.png
+  haarshift relight reference scene.json --yaw 90 --albedo 0.5,0.5,0.5 --vertices truth.npy";
+
+/// Per-vertex radiance by direct quadrature (the ground truth), optionally rendered.
+#[derive(clap::Args, Debug)]
+#[command(after_help = HELP)]
+pub struct Args {
+    #[command(flatten)]
+    pub scene: SceneFlags,
+
+    /// Where to write the per-vertex radiance, (V, 3) f32 .npy
+    #[arg(long, value_name = "OUT.npy")]
+    pub vertices: PathBuf,
+
+    /// Also render an image: .png (8-bit sRGB) or .exr (linear f32)
+    #[arg(short, long, value_name = "IMAGE")]
+    pub output: Option<PathBuf>,
+
+    /// The lighting's lat-long height N (N x 2N texels, a power of two)
+    #[arg(long, value_name = "N", default_value_t = 32)]
+    pub resolution: usize,
+
+    #[command(flatten)]
+    pub light: LightFlags,
+
+    #[command(flatten)]
+    pub material: MaterialFlags,
+
+    #[command(flatten)]
+    pub camera: CameraFlags,
+
+    /// Replace the outputs if they exist
+    #[arg(long)]
+    pub force: bool,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let mut outputs = vec![args.vertices.as_path()];
+    outputs.extend(args.output.as_deref());
+    let mut inputs = vec![args.scene.input.as_path()];
+    inputs.extend(args.light.env.as_deref());
+    refuse_inputs(&inputs, &outputs)?;
+    refuse_existing(&outputs, args.force)?;
+    if let Some(image) = &args.output {
+        render_format(image)?;
+    }
+    let background = args.camera.background()?;
+    let mut scene = args.scene.load()?;
+    args.material.apply(&mut scene.albedo)?;
+    let (env, angles) = args.light.load(scene.environment.as_ref())?;
+    let rotation = rotation(angles)?;
+    let start = Instant::now();
+    let lighting = env.lat_long(args.resolution, &rotation)?;
+    let lighting_ms = ms(start);
+    let (radiance, report) = reference(
+        &scene.mesh,
+        &SceneBvh::new(&scene.mesh),
+        scene.albedo.view(),
+        &lighting,
+        &ReferenceOptions { progress: true },
+    )?;
+    let radiance = radiance.mapv(|v| v as f32);
+    haarshift::io::write_npy(
+        radiance.view(),
+        SampleDepth::F32,
+        &args.vertices,
+        args.force,
+    )?;
+    let mut text = format!(
+        "{}: ({}, 3) radiance by quadrature over {} x {} texels: rays {}, {:.3} s \
+         (lighting downsampled in {lighting_ms:.1} ms)\n",
+        args.vertices.display(),
+        scene.mesh.vertex_count(),
+        args.resolution,
+        2 * args.resolution,
+        report.rays,
+        report.seconds,
+    );
+    if let Some(path) = &args.output {
+        let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh)?;
+        let image = args.camera.draw(
+            &camera,
+            &scene.mesh,
+            radiance.view(),
+            &background,
+            &env,
+            &rotation,
+        )?;
+        write_render(&image, path, args.camera.exposure, args.force)?;
+        text += &format!(
+            "{}: {} x {} image\n",
+            path.display(),
+            args.camera.width,
+            args.camera.height
+        );
+    }
+    print(&text)
+}

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The relighting speed figures on this machine: the 85,860-vertex "cubes" scene of seed 002
+# (testdata/scenes/cubes.json) precomputed at cube 6 x 64^2, then one render (new lighting,
+# fixed view, Lambertian) keeping 200 lighting and 420 visibility coefficients in all (194 and
+# 414 detail coefficients, plus the 6 faces' scaling coefficients: seed 001's 70 per cube face),
+# each run under /usr/bin/time -v for its peak resident memory and CPU time. Prints a Markdown
+# report on standard output:
+#   scripts/relight_speed.sh > results/relight/speed.md
+# ENV (first argument) is the lighting; the default is the committed 256 x 128 Rooitou Park.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+env_map=${1:-testdata/envmaps/rooitou_park_256x128.npy}
+cargo build --release -p haarshift-cli >&2
+hs=target/release/haarshift
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# Runs `haarshift ARGS` under /usr/bin/time -v; its stdout in $work/NAME.out, time's in .time.
+timed() {
+    local name=$1
+    shift
+    echo "+ haarshift $*" >&2
+    /usr/bin/time -v "$hs" "$@" >"$work/$name.out" 2>"$work/$name.time"
+    cat "$work/$name.out" >&2
+}
+# A field of /usr/bin/time -v's report.
+field() { grep -F "$2" "$work/$1.time" | sed 's/.*: //'; }
+cpu() { echo "$(field "$1" 'User time') + $(field "$1" 'System time')" | bc; }
+peak_mib() { echo "scale=1; $(field "$1" 'Maximum resident set size') / 1024" | bc; }
+
+precompute=(relight precompute testdata/scenes/cubes.json --param cube --resolution 64 --keep-visibility 414
+    -o "$work/cubes.hsr")
+render=(relight render "$work/cubes.hsr" --env "$env_map" --yaw 30 --keep-light 194
+    --keep-visibility 414 -o "$work/cubes.png" --width 640 --height 480)
+start_load=$(uptime)
+timed precompute "${precompute[@]}"
+timed render "${render[@]}"
+
+echo "# Relighting speed: the 85,860-vertex cubes scene"
+echo
+echo "Made by \`scripts/relight_speed.sh > results/relight/speed.md\` on $(nproc) cores;"
+echo "load when it started (\`uptime\`): \`$start_load\`"
+
+echo
+echo "Commands (the cache in a temporary directory):"
+echo
+echo '```'
+echo "haarshift ${precompute[*]}" | sed "s|$work/||g"
+echo "haarshift ${render[*]}" | sed "s|$work/||g"
+echo '```'
+echo
+echo "| step | wall (m:ss) | CPU s (user + sys) | peak resident MiB | what the command reports |"
+echo "|---|---|---|---|---|"
+for step in precompute render; do
+    report=$(tr '\n' ' ' <"$work/$step.out" | sed "s|$work/||g; s/|/\\\\|/g; s/  */ /g")
+    echo "| $step | $(field "$step" 'Elapsed (wall clock)') | $(cpu "$step") | $(peak_mib "$step") | $report |"
+done
+echo
+echo "Load when it ended: \`$(uptime)\`"
+echo
+echo "Seeds, for scale: 002 (Matlab) 5.8 min for 85,860 vertices at 64^2; 001 under 10 s a frame for"
+echo "180,000 vertices; Ng et al. 2004: 3-5 s for 300,000 vertices at 6 x 64^2."
+

@@ -1,0 +1,171 @@
+//! The ground truth of relighting, independent of every Haar path: direct quadrature over the
+//! lighting's texels with one ray per texel.
+//!
+//! For a Lambertian vertex `v` (albedo `a_v`, unit normal `n_v`) under a lat-long lighting map
+//! `L` of `N x 2N` texels, the outgoing radiance is
+//!
+//! `R_v = a_v / pi x sum_t L(t) V(v, t) max(0, n_v . w_t) dOmega_t`,
+//!
+//! the sum over every texel `t` with centre direction `w_t` and exact solid angle `dOmega_t`
+//! ([`sphere::latlong`](crate::sphere::latlong)), `V(v, t)` one ray through the texel centre
+//! from the offset origin `p_v + eps n_v` ([`ray_offset`](super::ray_offset)), through the
+//! [`Occlusion`] trait. This is issue 11's contract for checking: `L` is the environment brought
+//! to `N x 2N` by solid-angle-weighted means and rotated
+//! ([`Environment::lat_long`](super::environment::Environment::lat_long)); `N` need not be a
+//! power of two. Nothing here touches the transport, the Haar transform or a product integral,
+//! so the Haar path at full coefficients can be checked against it (the two cast the same rays
+//! in the same `f32` arithmetic, so their visibility agrees bit for bit).
+//!
+//! Texels below the horizon (`n_v . w_t <= 0`) and texels where the lighting is 0 in every
+//! channel cast no ray. Sums are `f64`; vertices run in parallel (rayon).
+
+use std::time::Instant;
+
+use ndarray::{Array2, ArrayView2, Axis};
+use rayon::prelude::*;
+
+use super::Mesh;
+use super::mesh::dot;
+use super::raycast::Occlusion;
+use super::visibility::{f32x3, origin_and_normal, progress_bar, ray_offset};
+use crate::sphere::LatLongMap;
+use crate::sphere::latlong::{direction, pixel_centre, pixel_solid_angle};
+use crate::{Error, Result};
+
+/// How to compute the reference.
+///
+/// ```
+/// use haarshift::relight::ReferenceOptions;
+/// assert!(!ReferenceOptions::default().progress);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReferenceOptions {
+    /// Show a progress bar on standard error (hidden when it is not a terminal).
+    pub progress: bool,
+}
+
+/// What the reference computation did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceReport {
+    /// Rays cast.
+    pub rays: u64,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// A texel of the lighting that can contribute: its centre direction, solid angle and
+/// radiance (RGB).
+struct LitTexel {
+    direction: [f64; 3],
+    ray: [f32; 3],
+    solid_angle: f64,
+    radiance: [f64; 3],
+}
+
+/// The texels of `lighting` with radiance in some channel; gray maps are spread to RGB.
+fn lit_texels(lighting: &LatLongMap<f64>) -> Result<Vec<LitTexel>> {
+    let (h, w, ch) = lighting.as_array().dim();
+    if !(ch == 1 || ch == 3) {
+        return Err(Error::parameter(
+            "lighting",
+            format!("{ch} channels: the reference takes gray or RGB lighting"),
+        ));
+    }
+    let map = lighting.as_array();
+    let mut out = Vec::new();
+    for i in 0..h {
+        let solid_angle = pixel_solid_angle(h, i);
+        for j in 0..w {
+            let radiance = std::array::from_fn(|c| map[[i, j, c.min(ch - 1)]]);
+            if radiance == [0.0; 3] {
+                continue;
+            }
+            let (theta, phi) = pixel_centre(h, i, j);
+            let d = direction(theta, phi);
+            out.push(LitTexel {
+                direction: d,
+                ray: f32x3(d),
+                solid_angle,
+                radiance,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Every vertex's outgoing radiance `(V, 3)` by direct quadrature over `lighting`'s texels
+/// (see the [module docs](self)); `albedo` is `(V, 3)`, `lighting` a lat-long map of any height
+/// `N`, gray or RGB, already rotated.
+///
+/// ```
+/// use haarshift::relight::{Mesh, ReferenceOptions, SceneBvh, reference};
+/// use haarshift::sphere::LatLongMap;
+/// use ndarray::{Array2, array};
+/// // One upward triangle under a sky of radiance 1: irradiance pi, so R = albedo.
+/// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+///                   vec![[0, 1, 2]], None).unwrap();
+/// let sky = LatLongMap::<f64>::from_fn(24, 1, |_, o| o[0] = 1.0).unwrap();
+/// let albedo = Array2::from_elem((3, 3), 0.5f32);
+/// let (r, report) = reference(&m, &SceneBvh::new(&m), albedo.view(), &sky,
+///                             &ReferenceOptions::default()).unwrap();
+/// assert!((r[[0, 0]] - 0.5).abs() < 2e-3); // the quadrature: 0.5 x 1.0021
+/// assert_eq!(report.rays, 3 * 12 * 48); // the upper half of 24 x 48 texels, per vertex
+/// ```
+pub fn reference(
+    mesh: &Mesh,
+    occlusion: &impl Occlusion,
+    albedo: ArrayView2<'_, f32>,
+    lighting: &LatLongMap<f64>,
+    options: &ReferenceOptions,
+) -> Result<(Array2<f64>, ReferenceReport)> {
+    let vertices = mesh.vertex_count();
+    if albedo.dim() != (vertices, 3) {
+        return Err(Error::shape(
+            albedo.shape(),
+            format!("the albedo must be ({vertices}, 3), one RGB row per vertex"),
+        ));
+    }
+    let start = Instant::now();
+    let texels = lit_texels(lighting)?;
+    let eps = ray_offset(mesh);
+    let bar = progress_bar(options.progress, vertices, "reference (rays)");
+    let mut out = Array2::<f64>::zeros((vertices, 3));
+    let rays: u64 = out
+        .axis_iter_mut(Axis(0))
+        .into_par_iter()
+        .enumerate()
+        .map(|(v, mut radiance)| {
+            let (origin, n) = origin_and_normal(mesh, v, eps);
+            let o = f32x3(origin);
+            let mut sum = [0.0f64; 3];
+            let mut rays = 0u64;
+            for t in &texels {
+                let cos = dot(n, t.direction);
+                if cos <= 0.0 {
+                    continue;
+                }
+                rays += 1;
+                if !occlusion.occluded(o, t.ray, f32::INFINITY) {
+                    let w = cos * t.solid_angle;
+                    sum.iter_mut()
+                        .zip(t.radiance)
+                        .for_each(|(s, l)| *s += l * w);
+                }
+            }
+            for c in 0..3 {
+                radiance[c] = f64::from(albedo[[v, c]]) / std::f64::consts::PI * sum[c];
+            }
+            bar.inc(1);
+            rays
+        })
+        .sum();
+    bar.finish_and_clear();
+    let report = ReferenceReport {
+        rays,
+        seconds: start.elapsed().as_secs_f64(),
+    };
+    Ok((out, report))
+}
+
+#[cfg(test)]
+mod tests;
