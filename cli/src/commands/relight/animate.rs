@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use haarshift::relight::animation::{numbered_path, write_gif};
+use haarshift::relight::environment::SphereMapping;
 use haarshift::relight::raster::{to_srgb8, write_render};
 use haarshift::relight::{Lighting, SceneCache};
 use haarshift::{Error, Result};
@@ -104,6 +105,8 @@ pub fn run(args: Args) -> Result<()> {
     let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
     let start = Instant::now();
     let prepared = args.shading.prepare(&cache)?;
+    // The lat-long-to-working mapping (a cube's conversion table) is built once, not per frame.
+    let mapping = SphereMapping::new(env.map().height(), cache.transport.param())?;
     let mut text = format!("transport prepared once in {:.1} ms\n", ms(start));
     let mut radiance = ndarray::Array2::<f32>::zeros((cache.mesh.vertex_count(), 3));
     let mut frames = Vec::with_capacity(if gif { args.frames } else { 0 });
@@ -111,12 +114,7 @@ pub fn run(args: Args) -> Result<()> {
         let start = Instant::now();
         let frame_yaw = yaw + 360.0 * k as f64 / args.frames as f64;
         let turn = rotation([frame_yaw, pitch, roll])?;
-        let lighting = Lighting::new(
-            &env,
-            cache.transport.param(),
-            &turn,
-            args.shading.light_selection(),
-        )?;
+        let lighting = Lighting::encode(&env, &mapping, &turn, args.shading.light_selection())?;
         prepared.shade_into(&lighting, &mut radiance)?;
         let shade_ms = ms(start);
         let start = Instant::now();
