@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The relighting speed figures on this machine: the 85,860-vertex "cubes" scene of seed 002
 # (testdata/scenes/cubes.json) precomputed at cube 6 x 64^2, then one render (new lighting,
-# fixed view, Lambertian) keeping 200 lighting and 420 visibility coefficients in all (194 and
+# fixed view, Lambertian) and eight animation frames, keeping 200 lighting and 420 visibility
+# coefficients in all (194 and
 # 414 detail coefficients, plus the 6 faces' scaling coefficients: seed 001's 70 per cube face),
 # each run under /usr/bin/time -v for its peak resident memory and CPU time. Prints a Markdown
 # report on standard output:
@@ -32,9 +33,15 @@ precompute=(relight precompute testdata/scenes/cubes.json --param cube --resolut
     -o "$work/cubes.hsr")
 render=(relight render "$work/cubes.hsr" --env "$env_map" --yaw 30 --keep-light 194
     --keep-visibility 414 -o "$work/cubes.png" --width 640 --height 480)
+# Eight frames of the lighting turning about Y by 45 degrees (whole columns of the working
+# map): the per-frame cost of a new lighting once the transport and the cube's conversion
+# table are prepared.
+animate=(relight animate "$work/cubes.hsr" --env "$env_map" --frames 8 --keep-light 194
+    --keep-visibility 414 -o "$work/frame_%03d.png" --width 640 --height 480)
 start_load=$(uptime)
 timed precompute "${precompute[@]}"
 timed render "${render[@]}"
+timed animate "${animate[@]}"
 
 echo "# Relighting speed: the 85,860-vertex cubes scene"
 echo
@@ -47,11 +54,12 @@ echo
 echo '```'
 echo "haarshift ${precompute[*]}" | sed "s|$work/||g"
 echo "haarshift ${render[*]}" | sed "s|$work/||g"
+echo "haarshift ${animate[*]}" | sed "s|$work/||g"
 echo '```'
 echo
 echo "| step | wall (m:ss) | CPU s (user + sys) | peak resident MiB | what the command reports |"
 echo "|---|---|---|---|---|"
-for step in precompute render; do
+for step in precompute render animate; do
     report=$(tr '\n' ' ' <"$work/$step.out" | sed "s|$work/||g; s/|/\\\\|/g; s/  */ /g")
     echo "| $step | $(field "$step" 'Elapsed (wall clock)') | $(cpu "$step") | $(peak_mib "$step") | $report |"
 done
