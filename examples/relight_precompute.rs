@@ -3,13 +3,14 @@
 //! of the whole process.
 //!
 //! ```text
-//! cargo run --release --example relight_precompute -- SCENE PARAM RESOLUTION KEEP ORDER
+//! cargo run --release --example relight_precompute -- SCENE PARAM RESOLUTION KEEP ORDER [SH]
 //!   SCENE       bunny (the bunny on its ground plane) | cubes (seed 002, 85,860 vertices)
 //!               | cylinder-and-bump | plane-with-sphere
 //!   PARAM       latlong | cube
 //!   RESOLUTION  face side: lat-long N x 2N, cube 6 x N x N
 //!   KEEP        visibility coefficients kept per vertex, or all
 //!   ORDER       vertex (rays through the BVH) | direction (seed 003's shadow maps, 2048^2)
+//!   SH          optional: also project onto this many bands of spherical harmonics
 //! ```
 //!
 //! The README's figure: `cargo run --release --example relight_precompute -- cubes latlong 128 420 vertex`.
@@ -25,8 +26,8 @@ use haarshift::sphere::{ParamKind, Parameterization};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.len() != 5 {
-        eprintln!("usage: relight_precompute SCENE PARAM RESOLUTION KEEP ORDER");
+    if !(5..=6).contains(&args.len()) {
+        eprintln!("usage: relight_precompute SCENE PARAM RESOLUTION KEEP ORDER [SH]");
         std::process::exit(2);
     }
     let mesh = match args[0].as_str() {
@@ -52,8 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if args[3] != "all" {
         options.keep = Selection::Largest(args[3].parse()?);
     }
+    options.sh_bands = args.get(5).map(|b| b.parse()).transpose()?;
     println!(
-        "scene {} ({} vertices, {} triangles), {} {} ({} directions), keep {}, order {}, {} threads",
+        "scene {} ({} vertices, {} triangles), {} {} ({} directions), keep {}, order {}, sh bands {:?}, {} threads",
         args[0],
         mesh.vertex_count(),
         mesh.triangles().len(),
@@ -62,6 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         param.texels(),
         args[3],
         args[4],
+        options.sh_bands,
         rayon::current_num_threads()
     );
     let start = Instant::now();

@@ -22,6 +22,11 @@
 //!   85,860 vertices x 32,768 directions, against 11 GB as f32), then each vertex is encoded.
 //!   Texel centres only (`samples = 1`).
 //!
+//! With [`VisibilityOptions::sh_bands`], both also project every vertex's values onto spherical
+//! harmonics ([`harmonics`](super::harmonics): `t_i = sum_t V cos Y_i(w_t) dOmega_t`, the
+//! basis tabulated once per texel and shared by all threads); the returned set carries the
+//! transfer ([`TransportSet::sh`]).
+//!
 //! Both report what they did in a [`PrecomputeReport`]: rays cast, wall time, the working
 //! memory the method holds beyond its inputs and outputs.
 
@@ -105,7 +110,8 @@ pub struct PrecomputeReport {
     /// Wall-clock seconds, encoding included.
     pub seconds: f64,
     /// Bytes of working memory the method held at its peak beyond the mesh and the output
-    /// (visibility bits and depth buffers, or per-thread texel arrays).
+    /// (visibility bits and depth buffers, or per-thread texel arrays, and the shared tables:
+    /// solid angles and spherical harmonics).
     pub working_bytes: usize,
 }
 

@@ -4,10 +4,15 @@ use super::*;
 use crate::relight::{Generator, Scene, SceneBvh, VisibilityOptions, vertex_major};
 
 fn made(cells: usize) -> SceneCache {
+    made_with(cells, None)
+}
+
+fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
     let scene = Scene::from_mesh(Generator::Sphere { cells }.mesh().unwrap(), true);
     let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
     let mut options = VisibilityOptions::new(param);
     options.keep = Selection::Largest(10);
+    options.sh_bands = sh_bands;
     let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
     let params = CacheParams {
         param: "cube".into(),
@@ -18,7 +23,7 @@ fn made(cells: usize) -> SceneCache {
         order: "vertex".into(),
         map_size: None,
         ground_plane: true,
-        sh_bands: None,
+        sh_bands,
     };
     let mut cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
     // The scene file's lighting and camera travel in the header.
@@ -159,4 +164,59 @@ fn inconsistent_parts_are_refused() {
     );
     let short = cache.albedo.slice(ndarray::s![1.., ..]).to_owned();
     assert!(SceneCache::new(cache.params.clone(), cache.mesh, short, cache.transport).is_err());
+}
+
+#[test]
+fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
+    let cache = made_with(2, Some(3));
+    let transfer = cache.transport.sh().unwrap();
+    assert_eq!(
+        transfer.coefficients().dim(),
+        (cache.mesh.vertex_count(), 9)
+    );
+    let (_dir, path) = written(&cache);
+    assert_eq!(SceneCache::read(&path).unwrap(), cache);
+    // The transfer is the file's last V x 9 f32: a flipped byte there fails the checksum.
+    let good = std::fs::read(&path).unwrap();
+    let block = cache.mesh.vertex_count() * 9 * 4;
+    for k in [good.len() - block, good.len() - block / 2, good.len() - 1] {
+        let mut bad = good.clone();
+        bad[k] ^= 0x04;
+        std::fs::write(&path, &bad).unwrap();
+        assert_eq!(
+            refusal(&path),
+            SceneError::CacheCorrupt("checksum mismatch".into()),
+            "byte {k}"
+        );
+    }
+    // Parameters that do not name the transfer's bands are refused.
+    let mut params = cache.params.clone();
+    params.sh_bands = Some(4);
+    let parts = (cache.mesh.clone(), cache.albedo.clone());
+    assert!(SceneCache::new(params, parts.0.clone(), parts.1.clone(), cache.transport).is_err());
+    let plain = made(2);
+    let mut params = plain.params.clone();
+    params.sh_bands = Some(3);
+    assert!(SceneCache::new(params, parts.0, parts.1, plain.transport).is_err());
+}
+
+#[test]
+fn a_version_1_file_is_refused() {
+    // Version 1 had no spherical-harmonic transfer; its files must be remade, not misread.
+    let (_dir, path) = written(&made(2));
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let e = refusal(&path);
+    assert_eq!(
+        e,
+        SceneError::CacheVersion {
+            found: 1,
+            expected: 2
+        }
+    );
+    assert_eq!(
+        e.to_string(),
+        "scene cache has format version 1, this build reads version 2; compute it again"
+    );
 }

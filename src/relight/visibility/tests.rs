@@ -160,6 +160,52 @@ fn bad_options_are_refused() {
     assert!(vertex_major(&mesh, &bvh, &options).is_err());
     options.keep = Selection::All;
     assert!(direction_major(&mesh, &options, 0).is_err());
+    for bands in [0, 17] {
+        options.sh_bands = Some(bands);
+        assert!(vertex_major(&mesh, &bvh, &options).is_err());
+        assert!(direction_major(&mesh, &options, 64).is_err());
+    }
+}
+
+#[test]
+fn both_orders_make_the_same_spherical_harmonic_transfer() {
+    // An open triangle: nothing occludes it, so both orders see the same cosine lobe.
+    let mesh = Mesh::new(
+        ndarray::array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+        vec![[0, 1, 2]],
+        None,
+    )
+    .unwrap();
+    let mut options = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap());
+    options.sh_bands = Some(3);
+    let (by_maps, _) = direction_major(&mesh, &options, 256).unwrap();
+    let (by_rays, _) = vertex_major(&mesh, &SceneBvh::new(&mesh), &options).unwrap();
+    assert!(by_maps == by_rays && by_rays.sh().is_some());
+    options.param = latlong(32);
+    let (by_rays, _) = vertex_major(&mesh, &SceneBvh::new(&mesh), &options).unwrap();
+    // The clamped cosine about +Y: t_00 = pi / (2 sqrt pi) and t_10 = 2 pi / 3 sqrt(3 / 4 pi)
+    // (Lambert's A_l / sqrt(4 pi / (2l + 1))), to the quadrature; odd orders m vanish.
+    let t = by_rays.sh().unwrap().coefficients();
+    let want = [
+        PI / (2.0 * PI.sqrt()),
+        2.0 * PI / 3.0 * (3.0 / (4.0 * PI)).sqrt(),
+    ];
+    for (got, want) in [t[[0, 0]], t[[0, 2]]].into_iter().zip(want) {
+        assert!(
+            (f64::from(got) - want).abs() < 2e-3 * want,
+            "{got} vs {want}"
+        );
+    }
+    assert!(t[[0, 1]].abs() < 1e-5 && t[[0, 3]].abs() < 1e-5);
+    // Without the option there is no transfer.
+    options.sh_bands = None;
+    assert!(
+        vertex_major(&mesh, &SceneBvh::new(&mesh), &options)
+            .unwrap()
+            .0
+            .sh()
+            .is_none()
+    );
 }
 
 #[test]
