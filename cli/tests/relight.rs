@@ -418,6 +418,11 @@ fn bad_lighting_and_caches_fail_cleanly_naming_the_file() {
         &render_args(&cache, &out, &["--env", p(&env), "--keep-visibility", "0"]),
         &["--keep-visibility"],
     );
+    // Glossy materials are not shaded by this version: refused, not rendered as Lambertian.
+    usage_error(
+        &render_args(&cache, &out, &["--env", p(&env), "--brdf", "phong:50"]),
+        &["--brdf", "phong:50", "lambert"],
+    );
     fails_cleanly(
         &render_args(&cache, &out, &["--env", p(&env), "--keep-light", "1000000"]),
         &["keep", "1000000"],

@@ -8,11 +8,13 @@ use haarshift::product::Selection;
 use haarshift::relight::environment::Environment;
 use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
 use haarshift::relight::raster::{Mesh as RasterMesh, render};
+use haarshift::relight::{Brdf, PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
-use haarshift::relight::{PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift::{Error, Result};
 use ndarray::ArrayView2;
+
+use crate::commands::{choice, names};
 
 /// A mesh or a scene file, and the ground plane.
 #[derive(clap::Args, Debug)]
@@ -110,9 +112,14 @@ pub fn rotation([yaw, pitch, roll]: [f64; 3]) -> Result<SphereRotation> {
     SphereRotation::from_degrees(yaw, pitch, roll)
 }
 
-/// The material: a Lambertian albedo.
+/// The material: the BRDF and its albedo.
 #[derive(clap::Args, Debug)]
 pub struct MaterialFlags {
+    /// The BRDF (this version shades Lambertian surfaces; glossy ones come with the Haar-domain
+    /// BRDF rotation)
+    #[arg(long, default_value = "lambert", value_parser = choice::<Brdf>(names!(Brdf)))]
+    pub brdf: Brdf,
+
     /// Lambertian albedo r,g,b (each 0 to 1) for every vertex [default: the scene's, 0.8 for
     /// a mesh and the ground plane]
     #[arg(long, value_name = "R,G,B", value_parser = triple)]
@@ -293,7 +300,8 @@ pub struct ShadingFlags {
     #[arg(long, value_name = "K", value_parser = positive)]
     pub keep_visibility: Option<usize>,
 
-    /// Detail levels 0..=D only (0 the coarsest) [default: all]
+    /// Traversal depth: detail levels 0..D-1 only (0: each face's mean alone; the thesis's
+    /// level D, faces 2^D texels wide) [default: all]
     #[arg(long, value_name = "D")]
     pub depth: Option<usize>,
 }
@@ -309,18 +317,14 @@ impl ShadingFlags {
         self.keep_light.is_some() || self.keep_visibility.is_some() || self.depth.is_some()
     }
 
-    /// `cache`'s transport prepared for shading with its albedo under these options.
-    pub fn prepare(&self, cache: &SceneCache) -> Result<PreparedTransport<f32>> {
-        PreparedTransport::new(&cache.transport, cache.albedo.view(), &self.options())
-    }
-
-    /// The shading options (Lambertian).
-    fn options(&self) -> ShadeOptions {
-        ShadeOptions {
+    /// `cache`'s transport prepared for shading with its albedo and `brdf` under these options.
+    pub fn prepare(&self, cache: &SceneCache, brdf: Brdf) -> Result<PreparedTransport<f32>> {
+        let options = ShadeOptions {
+            brdf,
             keep_visibility: self.keep_visibility.map(Selection::Largest),
             depth: self.depth,
-            ..ShadeOptions::default()
-        }
+        };
+        PreparedTransport::new(&cache.transport, cache.albedo.view(), &options)
     }
 }
 
