@@ -13,7 +13,8 @@
 //!   SH          optional: also project onto this many bands of spherical harmonics
 //! ```
 //!
-//! The README's figure: `cargo run --release --example relight_precompute -- cubes latlong 128 420 vertex`.
+//! For example `cargo run --release --example relight_precompute -- cubes cube 64 414 vertex`; the
+//! committed figures come from the CLI (`scripts/relight_speed.sh`).
 
 use std::path::Path;
 use std::time::Instant;
