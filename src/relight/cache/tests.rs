@@ -153,17 +153,25 @@ fn inconsistent_parts_are_refused() {
     let cache = made(2);
     let mut params = cache.params.clone();
     params.resolution = 8;
-    assert!(
+    assert_err!(
         SceneCache::new(
             params,
             cache.mesh.clone(),
             cache.albedo.clone(),
             cache.transport.clone()
-        )
-        .is_err()
+        ),
+        InvalidParameter {
+            name: "cache parameters",
+            ..
+        },
+        "cube 8"
     );
     let short = cache.albedo.slice(ndarray::s![1.., ..]).to_owned();
-    assert!(SceneCache::new(cache.params.clone(), cache.mesh, short, cache.transport).is_err());
+    assert_err!(
+        SceneCache::new(cache.params.clone(), cache.mesh, short, cache.transport),
+        InvalidShape { .. },
+        "albedo must be (1143, 3)"
+    );
 }
 
 #[test]
@@ -193,11 +201,25 @@ fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
     let mut params = cache.params.clone();
     params.sh_bands = Some(4);
     let parts = (cache.mesh.clone(), cache.albedo.clone());
-    assert!(SceneCache::new(params, parts.0.clone(), parts.1.clone(), cache.transport).is_err());
+    assert_err!(
+        SceneCache::new(params, parts.0.clone(), parts.1.clone(), cache.transport),
+        InvalidParameter {
+            name: "cache parameters",
+            ..
+        },
+        "Some(4) sh bands"
+    );
     let plain = made(2);
     let mut params = plain.params.clone();
     params.sh_bands = Some(3);
-    assert!(SceneCache::new(params, parts.0, parts.1, plain.transport).is_err());
+    assert_err!(
+        SceneCache::new(params, parts.0, parts.1, plain.transport),
+        InvalidParameter {
+            name: "cache parameters",
+            ..
+        },
+        "Some(3) sh bands but the transport is cube 4 with None"
+    );
 }
 
 #[test]

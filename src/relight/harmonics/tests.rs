@@ -48,12 +48,45 @@ fn shading_is_albedo_over_pi_times_the_dot_product() {
             .all(|row| row[0] == row[1] && row[1] == row[2])
     );
     // Shapes that do not fit are errors.
-    assert!(shade_sh(&t, albedo.slice(ndarray::s![1.., ..]), rgb.view()).is_err());
-    assert!(shade_sh(&t, albedo.view(), rgb.slice(ndarray::s![1.., ..])).is_err());
-    assert!(shade_sh(&t, albedo.view(), Array2::zeros((4, 2)).view()).is_err());
-    assert!(ShTransfer::new(0, Array2::zeros((1, 0))).is_err());
-    assert!(ShTransfer::new(17, Array2::zeros((1, 289))).is_err());
-    assert!(ShTransfer::new(1, Array2::from_elem((1, 1), f32::NAN)).is_err());
+    assert_err!(
+        shade_sh(&t, albedo.slice(ndarray::s![1.., ..]), rgb.view()),
+        InvalidShape { .. },
+        "the albedo must be (3, 3)"
+    );
+    assert_err!(
+        shade_sh(&t, albedo.view(), rgb.slice(ndarray::s![1.., ..])),
+        InvalidShape { .. },
+        "(4, 1) or (4, 3) for 2 bands"
+    );
+    assert_err!(
+        shade_sh(&t, albedo.view(), Array2::zeros((4, 2)).view()),
+        InvalidShape { .. },
+        "(4, 1) or (4, 3) for 2 bands"
+    );
+    assert_err!(
+        ShTransfer::new(0, Array2::zeros((1, 0))),
+        InvalidParameter {
+            name: "sh-bands",
+            ..
+        },
+        "0: transfer takes 1 to 16 bands"
+    );
+    assert_err!(
+        ShTransfer::new(17, Array2::zeros((1, 289))),
+        InvalidParameter {
+            name: "sh-bands",
+            ..
+        },
+        "17: transfer takes 1 to 16 bands"
+    );
+    assert_err!(
+        ShTransfer::new(1, Array2::from_elem((1, 1), f32::NAN)),
+        InvalidParameter {
+            name: "sh transfer",
+            ..
+        },
+        "not finite"
+    );
 }
 
 /// Never occluded: visibility 1 everywhere above the horizon.

@@ -180,7 +180,18 @@ fn unlit_texels_cast_no_rays_and_bad_input_is_refused() {
     let (r, report) = reference(&mesh, &bvh, albedo.view(), &dark, &options).unwrap();
     assert_eq!((report.rays, r.sum()), (0, 0.0));
     let short = albedo.slice(ndarray::s![1.., ..]);
-    assert!(reference(&mesh, &bvh, short, &constant(8, 1.0), &options).is_err());
+    assert_err!(
+        reference(&mesh, &bvh, short, &constant(8, 1.0), &options),
+        InvalidShape { .. },
+        "the albedo must be (54, 3)"
+    );
     let two = LatLongMap::<f64>::from_fn(8, 2, |_, o| o.fill(1.0)).unwrap();
-    assert!(reference(&mesh, &bvh, albedo.view(), &two, &options).is_err());
+    assert_err!(
+        reference(&mesh, &bvh, albedo.view(), &two, &options),
+        InvalidParameter {
+            name: "lighting",
+            ..
+        },
+        "2 channels"
+    );
 }

@@ -38,17 +38,32 @@ fn generators_have_their_documented_sizes() {
     assert_eq!(count(Generator::PlaneWithSphere {}), 5_959);
     assert_eq!(count(Generator::Sphere { cells: 16 }), 1_734);
     assert_eq!(count(Generator::PlaneUnderBox { height: 1.0 }), 159);
-    assert!(Generator::Sphere { cells: 0 }.mesh().is_err());
-    assert!(
+    assert_err!(
+        Generator::Sphere { cells: 0 }.mesh(),
+        InvalidParameter {
+            name: "generator",
+            ..
+        },
+        "0 cells"
+    );
+    assert_err!(
         Generator::Cubes {
             count: 0,
             cells: 10,
             distance: 1.5
         }
-        .mesh()
-        .is_err()
+        .mesh(),
+        InvalidParameter {
+            name: "generator",
+            ..
+        },
+        "0 cells"
     );
-    assert!(Generator::PlaneUnderBox { height: -1.0 }.mesh().is_err());
+    assert_err!(
+        Generator::PlaneUnderBox { height: -1.0 }.mesh(),
+        InvalidParameter { name: "height", .. },
+        "-1: must be positive"
+    );
 }
 
 #[test]
@@ -131,13 +146,17 @@ fn transforms_scale_rotate_then_translate() {
     // The box's +X face normal turns to -Z.
     let n = moved.normals().row(9).to_vec();
     assert!((n[2] + 1.0).abs() < 1e-12, "{n:?}");
-    assert!(
+    assert_err!(
         Transform {
             scale: 0.0,
             ..Transform::default()
         }
-        .apply(&mesh)
-        .is_err()
+        .apply(&mesh),
+        InvalidParameter {
+            name: "transform",
+            ..
+        },
+        "scale must be positive"
     );
 }
 

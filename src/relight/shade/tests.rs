@@ -554,11 +554,12 @@ fn mismatches_are_one_line_errors() {
     let e = Lighting::from_map(&two, Selection::All).unwrap_err();
     assert!(message(e).contains("2 channels"));
     // Every detail of the 2 x 16 texels may be kept, no more.
-    assert!(
+    assert_err!(
         Lighting::from_map(
             &SphereMap::from_fn(param, 1, |_, o| o[0] = 1.0).unwrap(),
             Selection::Largest(31)
-        )
-        .is_err()
+        ),
+        InvalidParameter { name: "keep", .. },
+        "only 30 details"
     );
 }

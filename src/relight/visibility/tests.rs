@@ -152,18 +152,57 @@ fn bad_options_are_refused() {
     let bvh = SceneBvh::new(&mesh);
     let mut options = VisibilityOptions::new(latlong(4));
     options.samples = 0;
-    assert!(vertex_major(&mesh, &bvh, &options).is_err());
+    assert_err!(
+        vertex_major(&mesh, &bvh, &options),
+        InvalidParameter {
+            name: "visibility samples",
+            ..
+        },
+        "0: must be 1 to 64"
+    );
     options.samples = 2;
-    assert!(direction_major(&mesh, &options, 64).is_err());
+    assert_err!(
+        direction_major(&mesh, &options, 64),
+        InvalidParameter {
+            name: "visibility samples",
+            ..
+        },
+        "texel centres only"
+    );
     options.samples = 1;
     options.keep = Selection::Largest(31); // 2 x 16 texels have 30 details
-    assert!(vertex_major(&mesh, &bvh, &options).is_err());
+    assert_err!(
+        vertex_major(&mesh, &bvh, &options),
+        InvalidParameter { name: "keep", .. },
+        "only 30 details"
+    );
     options.keep = Selection::All;
-    assert!(direction_major(&mesh, &options, 0).is_err());
+    assert_err!(
+        direction_major(&mesh, &options, 0),
+        InvalidParameter {
+            name: "shadow map size",
+            ..
+        },
+        "0: must be 1 to 16384"
+    );
     for bands in [0, 17] {
         options.sh_bands = Some(bands);
-        assert!(vertex_major(&mesh, &bvh, &options).is_err());
-        assert!(direction_major(&mesh, &options, 64).is_err());
+        assert_err!(
+            vertex_major(&mesh, &bvh, &options),
+            InvalidParameter {
+                name: "sh-bands",
+                ..
+            },
+            "transfer takes 1 to 16 bands"
+        );
+        assert_err!(
+            direction_major(&mesh, &options, 64),
+            InvalidParameter {
+                name: "sh-bands",
+                ..
+            },
+            "transfer takes 1 to 16 bands"
+        );
     }
 }
 
