@@ -195,15 +195,27 @@ mod tests {
     fn bad_sequences_are_errors() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("bad.gif");
-        assert!(write_gif(&[], &path, 100, false).is_err());
+        assert_err!(
+            write_gif(&[], &path, 100, false),
+            InvalidParameter { name: "frames", .. },
+            "at least one frame"
+        );
         let linear = PlanarImage::new(
             Array3::<f32>::zeros((3, 2, 2)),
             Channels::Rgb,
             SampleDepth::F32,
         )
         .unwrap();
-        assert!(write_gif(&[frame(0), linear], &path, 100, false).is_err());
-        assert!(write_gif(&[frame(0)], &path, 5, false).is_err());
+        assert_err!(
+            write_gif(&[frame(0), linear], &path, 100, false),
+            InvalidParameter { name: "frames", .. },
+            "every frame must be 20 x 12"
+        );
+        assert_err!(
+            write_gif(&[frame(0)], &path, 5, false),
+            InvalidParameter { name: "delay", .. },
+            "5 ms"
+        );
         assert!(!path.exists());
     }
 }

@@ -417,8 +417,22 @@ mod tests {
     #[test]
     fn bad_resolutions_and_shapes_are_errors() {
         let f = bright_pole(8, 1);
-        assert!(downsample_solid_angle(&f, 0).is_err());
-        assert!(downsample_solid_angle(&f, 9).is_err());
+        assert_err!(
+            downsample_solid_angle(&f, 0),
+            InvalidParameter {
+                name: "resolution",
+                ..
+            },
+            "0: the working height"
+        );
+        assert_err!(
+            downsample_solid_angle(&f, 9),
+            InvalidParameter {
+                name: "resolution",
+                ..
+            },
+            "9: the working height"
+        );
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("square.npy");
         let planes = Array3::<f32>::ones((3, 4, 4));
@@ -427,7 +441,11 @@ mod tests {
         let err = Environment::load(&path).unwrap_err().to_string();
         assert!(err.starts_with(&path.display().to_string()), "{err}");
         assert!(err.contains("4 x 4"), "{err}");
-        assert!(Environment::load(&dir.path().join("missing.hdr")).is_err());
+        assert_err!(
+            Environment::load(&dir.path().join("missing.hdr")),
+            Io { .. },
+            "missing.hdr"
+        );
     }
 
     #[test]

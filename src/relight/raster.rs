@@ -988,7 +988,11 @@ mod tests {
         for (&v, &b) in planes.iter().zip(back.planes().iter()) {
             assert_eq!(b, (srgb_encode(v as f64) * 255.0).round() as f32);
         }
-        assert!(write_render(&image, &png, 0.0, false).is_err()); // exists
+        assert_err!(
+            write_render(&image, &png, 0.0, false),
+            OutputExists { .. },
+            "already exists"
+        );
         write_render(&image, &png, 1.0, true).unwrap();
         let exr = dir.path().join("r.exr");
         write_render(&image, &exr, 5.0, false).unwrap(); // the exposure does not touch EXR
@@ -1008,7 +1012,11 @@ mod tests {
             triangles: &[[0, 1, 2]],
             radiance: radiance.view(),
         };
-        assert!(render(&camera, 8, 8, &mesh, Background::Colour([0.0; 3])).is_err());
+        assert_err!(
+            render(&camera, 8, 8, &mesh, Background::Colour([0.0; 3])),
+            NonFinite { .. },
+            "NaN"
+        );
         let positions = Array2::<f64>::zeros((3, 3));
         let mesh = Mesh {
             positions: positions.view(),
@@ -1023,17 +1031,40 @@ mod tests {
             triangles: &[],
             radiance: short.view(),
         };
-        assert!(render(&camera, 8, 8, &mesh, Background::Colour([0.0; 3])).is_err());
+        assert_err!(
+            render(&camera, 8, 8, &mesh, Background::Colour([0.0; 3])),
+            InvalidShape { .. },
+            "positions (V, 3) and radiance (V, 3)"
+        );
         let mesh = Mesh {
             positions: positions.view(),
             triangles: &[],
             radiance: radiance.view(),
         };
-        assert!(render(&camera, 0, 8, &mesh, Background::Colour([0.0; 3])).is_err());
+        assert_err!(
+            render(&camera, 0, 8, &mesh, Background::Colour([0.0; 3])),
+            InvalidShape { .. },
+            "1 to 32768 pixels"
+        );
         let two = LatLongMap::<f64>::from_fn(4, 2, |_, o| o.fill(1.0)).unwrap();
-        assert!(render(&camera, 8, 8, &mesh, Background::Environment(&two)).is_err());
-        assert!(Camera::new([0.0; 3], [0.0, 0.0, -1.0], 180.0).is_err());
-        assert!(Camera::new([0.0, f64::INFINITY, 0.0], [0.0; 3], 40.0).is_err());
+        assert_err!(
+            render(&camera, 8, 8, &mesh, Background::Environment(&two)),
+            InvalidParameter {
+                name: "background",
+                ..
+            },
+            "2 channels"
+        );
+        assert_err!(
+            Camera::new([0.0; 3], [0.0, 0.0, -1.0], 180.0),
+            InvalidParameter { name: "fov", .. },
+            "180 degrees"
+        );
+        assert_err!(
+            Camera::new([0.0, f64::INFINITY, 0.0], [0.0; 3], 40.0),
+            InvalidParameter { name: "camera", .. },
+            "must be finite"
+        );
         // Looking straight down is allowed: the image's up is -Z.
         let down = Camera::new([0.0, 5.0, 0.0], [0.0; 3], 40.0).unwrap();
         let [_, y, _] = down.project([0.0, 0.0, -1.0], 10, 10).unwrap();

@@ -487,14 +487,33 @@ mod tests {
 
     #[test]
     fn bad_band_counts_and_shapes_are_errors() {
-        assert!(SphericalHarmonics::new(0).is_err());
-        assert!(SphericalHarmonics::new(65).is_err());
+        assert_err!(
+            SphericalHarmonics::new(0),
+            InvalidParameter {
+                name: "sh-bands",
+                ..
+            },
+            "0 (expected 1 to 64 bands)"
+        );
+        assert_err!(
+            SphericalHarmonics::new(65),
+            InvalidParameter {
+                name: "sh-bands",
+                ..
+            },
+            "65 (expected"
+        );
         let sh = SphericalHarmonics::new(2).unwrap();
         let wrong = Array2::<f64>::zeros((3, 1));
-        assert!(
-            sh.reconstruct(wrong.view(), param(ParamKind::Cube, 2))
-                .is_err()
+        assert_err!(
+            sh.reconstruct(wrong.view(), param(ParamKind::Cube, 2)),
+            InvalidShape { .. },
+            "need 4 coefficients"
         );
-        assert!(sh.lambert_irradiance(wrong.view()).is_err());
+        assert_err!(
+            sh.lambert_irradiance(wrong.view()),
+            InvalidShape { .. },
+            "need 4 coefficients"
+        );
     }
 }

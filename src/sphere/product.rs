@@ -267,14 +267,30 @@ mod tests {
     fn bad_requests_are_errors() {
         let (a, b) = (map::<f64>(16, 1, 10), map::<f64>(8, 1, 11));
         let d = ProductOptions::default();
-        assert!(multiply(&[a.clone(), b], &d).is_err());
-        assert!(multiply::<f64>(&[], &d).is_err());
+        assert_err!(
+            multiply(&[a.clone(), b], &d),
+            InvalidShape { .. },
+            "maps of different sizes"
+        );
+        assert_err!(
+            multiply::<f64>(&[], &d),
+            InvalidParameter { name: "maps", .. },
+            "no map given"
+        );
         let many = ProductOptions {
             selections: vec![Selection::Largest(16 * 32)],
             ..Default::default()
         };
-        assert!(multiply(&[a.clone(), a.clone()], &many).is_err());
+        assert_err!(
+            multiply(&[a.clone(), a.clone()], &many),
+            InvalidParameter { name: "keep", .. },
+            "only 510 details"
+        );
         let odd = LatLongMap::<f64>::from_fn(6, 1, |_, o| o[0] = 1.0).unwrap();
-        assert!(multiply(&[odd.clone(), odd], &d).is_err());
+        assert_err!(
+            multiply(&[odd.clone(), odd], &d),
+            InvalidShape { .. },
+            "not a power of two"
+        );
     }
 }
