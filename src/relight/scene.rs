@@ -297,12 +297,12 @@ impl Generator {
                 ))
             }
         };
-        let cells_ok = |n: usize, vertices: usize| {
+        let cells_ok = |what: &str, n: usize, vertices: usize| {
             if n == 0 || vertices > MAX_GENERATED_VERTICES {
                 Err(Error::parameter(
                     "generator",
                     format!(
-                        "{n} cells: must be at least 1 and make at most {MAX_GENERATED_VERTICES} vertices"
+                        "{n} {what}: must be at least 1 and make at most {MAX_GENERATED_VERTICES} vertices"
                     ),
                 ))
             } else {
@@ -329,12 +329,11 @@ impl Generator {
                 distance,
             } => {
                 positive("distance", distance)?;
-                cells_ok(
-                    cells.min(count),
-                    6usize
-                        .saturating_mul(count.saturating_mul(count))
-                        .saturating_mul((cells + 1).saturating_mul(cells + 1)),
-                )?;
+                let vertices = 6usize
+                    .saturating_mul(count.saturating_mul(count))
+                    .saturating_mul((cells + 1).saturating_mul(cells + 1));
+                cells_ok("cubes per row", count, vertices)?;
+                cells_ok("cells", cells, vertices)?;
                 let wall = grid(
                     [-6.45, 0.0, 0.0],
                     [12.9, 0.0, 0.0],
@@ -360,6 +359,7 @@ impl Generator {
             ]),
             Generator::Sphere { cells } => {
                 cells_ok(
+                    "cells",
                     cells,
                     6usize.saturating_mul((cells + 1).saturating_mul(cells + 1)),
                 )?;

@@ -57,7 +57,7 @@ fn generators_have_their_documented_sizes() {
             name: "generator",
             ..
         },
-        "0 cells"
+        "0 cubes per row"
     );
     assert_err!(
         Generator::PlaneUnderBox { height: -1.0 }.mesh(),
