@@ -418,10 +418,14 @@ fn bad_lighting_and_caches_fail_cleanly_naming_the_file() {
         &render_args(&cache, &out, &["--env", p(&env), "--keep-visibility", "0"]),
         &["--keep-visibility"],
     );
-    // Glossy materials are not shaded by this version: refused, not rendered as Lambertian.
+    // A material the library cannot parse is a usage error naming the flag and the reason.
     usage_error(
-        &render_args(&cache, &out, &["--env", p(&env), "--brdf", "phong:50"]),
-        &["--brdf", "phong:50", "lambert"],
+        &render_args(&cache, &out, &["--env", p(&env), "--brdf", "phong:x"]),
+        &["--brdf", "phong:x", "not a number"],
+    );
+    usage_error(
+        &render_args(&cache, &out, &["--env", p(&env), "--brdf", "ward:2"]),
+        &["--brdf", "lambert, phong:EXP, blinn:EXP"],
     );
     fails_cleanly(
         &render_args(&cache, &out, &["--env", p(&env), "--keep-light", "1000000"]),

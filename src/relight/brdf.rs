@@ -1,79 +1,378 @@
 //! Materials: how a surface turns the light arriving at a vertex into the light leaving it.
 //!
-//! **Lambert** (this module's one material). A Lambertian surface reflects the constant BRDF
-//! `rho = albedo / pi` (per channel), so the outgoing radiance at vertex `v` is
-//! `B_v = albedo_v / pi x integral of L(w) V(v, w) max(0, n_v . w) dw`. The BRDF does not
-//! depend on the direction, so it leaves the integral as a per-vertex constant
-//! ([`Brdf::vertex_factors`]) and what is left is the double product integral `<T_v, L>` of the
-//! transport and the lighting ([`super::shade`]).
+//! | [`Brdf`] | `--brdf` | value `rho(w_i, w_o)` (per unit albedo) |
+//! |---|---|---|
+//! | [`Brdf::Lambert`] | `lambert` | `1 / pi` |
+//! | [`Brdf::Phong`] | `phong:EXP` | `(EXP + 2) / (2 pi) max(0, r . w_i)^EXP`, `r = 2 (n . w_o) n - w_o` the mirror direction |
+//! | [`Brdf::BlinnPhong`] | `blinn:EXP` | `(EXP + 8) / (8 pi) max(0, n . h)^EXP`, `h = (w_i + w_o) / |w_i + w_o|` |
 //!
-//! **Where a glossy BRDF enters.** A glossy BRDF depends on the incoming direction (and on
-//! the outgoing one, fixed per vertex by the view): in the vertex's frame it is a function on
-//! the sphere, brought into the global frame by a rotation (seed 004 chapter 4; seed 001's
-//! one shared copy rotated per vertex), then a Haar tree `rho_v` in the same parameterisation
-//! as `T_v` and `L`. It is then the third factor of the triple product
-//! `B_v = integral of T_v L rho_v` ([`triple_integral`](crate::product::triple::triple_integral)
-//! with `T_v` the [`Transport`](crate::product::Transport), `L` and `rho_v` plain
-//! [`HaarTree`](crate::product::HaarTree)s; or [`product_integral`](crate::product::product_integral)
-//! with more factors, for occluders). The Lambertian case is that same triple product with
-//! `rho_v` the constant `albedo_v / pi`, whose tree has only scaling coefficients: the triple
-//! integral then equals `albedo_v / pi x <T_v, L>` exactly (tested), which is why the shading
-//! can multiply a double product by a constant here. For just-in-time radiance transfer with a
-//! glossy BRDF and fixed view, `T_v x rho_v` is one fixed factor
-//! ([`multiply::product`](crate::product::multiply::product)), formed once, and a change of
-//! lighting is again one sparse dot product per vertex.
+//! `w_i` points toward the light, `w_o` toward the viewer, both unit; `0^0 = 1`, so Phong
+//! with exponent 0 is `1 / pi` everywhere: Lambert with albedo 1. The cosine
+//! `max(0, n . w_i)` and the visibility are not part of the BRDF: they are the transport's
+//! ([`super::TransportSet`]). A vertex's outgoing radiance is `albedo x` the integral of
+//! lighting x transport x `rho` (per channel), so `albedo` is the diffuse colour of a
+//! Lambertian surface and the specular colour of a glossy one.
+//!
+//! **Lambert** leaves the integral as a per-vertex constant ([`Brdf::vertex_factors`]) and
+//! what is left is the double product integral `<T_v, L>` of the transport and the lighting
+//! ([`super::shade`]): the triple product with `rho` constant, whose tree has only scaling
+//! coefficients.
+//!
+//! **Glossy BRDFs** depend on `w_i` and on `w_o` (fixed per vertex by the camera). In the
+//! vertex's global frame `rho_v(w) = rho(w, w_o)` is a spherical map, the third factor of the
+//! triple product `B_v = integral of T_v L rho_v` ([`triple_integral`](crate::product::triple::triple_integral)).
+//! haarshift keeps one copy in a local frame ([`Brdf::local_map`]) and brings it to each vertex
+//! ([`super::orient`]), seed 004 chapter 4:
+//! * **the reflection-vector parameterisation** (seed 001): a Phong lobe depends only on the
+//!   angle between `w_i` and `r`, so its local copy is the lobe about +Y (the lat-long north
+//!   pole) and one rotation taking `r` to +Y brings it to any vertex, whatever its normal and
+//!   view;
+//! * **view-dependent BRDFs** (Blinn-Phong): local copies with the normal at +Y and the
+//!   viewer at azimuth 0 (in the Y-Z plane, on the +Z side), one per outgoing elevation
+//!   ([`LocalTable`]); the viewer's azimuth about the normal is a yaw of that map and the
+//!   normal's tilt a rotation.
 
-use ndarray::{Array2, ArrayView2};
+use std::fmt;
+use std::str::FromStr;
 
-use crate::named::named_enum;
+use ndarray::ArrayView2;
+
+use crate::sphere::LatLongMap;
+use crate::sphere::latlong::direction;
 use crate::{Error, Result};
 
-named_enum! {
-    /// A surface's BRDF (`--brdf`); see the [module docs](self).
-    ///
-    /// ```
-    /// use haarshift::relight::Brdf;
-    /// assert_eq!("lambert".parse::<Brdf>().unwrap(), Brdf::Lambert);
-    /// assert!("phong".parse::<Brdf>().is_err());
-    /// ```
-    #[derive(Default)]
-    pub enum Brdf ("brdf") {
-        #[default]
-        /// Lambertian: `albedo / pi` in every direction.
-        Lambert = "lambert",
+/// The largest exponent accepted for Phong and Blinn-Phong: a Phong lobe of `1e4` is 1.3
+/// degrees wide at half maximum, finer than any map haarshift shades with.
+pub const MAX_EXPONENT: f64 = 1e4;
+
+/// A surface's BRDF (`--brdf`); see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::Brdf;
+/// assert_eq!("lambert".parse::<Brdf>().unwrap(), Brdf::Lambert);
+/// assert_eq!("phong:50".parse::<Brdf>().unwrap(), Brdf::Phong { exponent: 50.0 });
+/// assert_eq!("blinn:20".parse::<Brdf>().unwrap().to_string(), "blinn:20");
+/// assert!("phong".parse::<Brdf>().is_err());
+/// assert!("phong:-1".parse::<Brdf>().is_err());
+/// ```
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Brdf {
+    /// Lambertian: `1 / pi` in every direction.
+    #[default]
+    Lambert,
+    /// Energy-normalised Phong: a lobe about the mirror direction.
+    Phong {
+        /// Shininess, `0..=MAX_EXPONENT`.
+        exponent: f64,
+    },
+    /// Energy-normalised Blinn-Phong: a lobe of the half vector about the normal.
+    BlinnPhong {
+        /// Shininess, `0..=MAX_EXPONENT`.
+        exponent: f64,
+    },
+}
+
+/// The choices `--brdf` accepts, for help texts and errors.
+pub const BRDF_SYNTAX: &str = "lambert, phong:EXP, blinn:EXP";
+
+impl FromStr for Brdf {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Self> {
+        let bad = |why: String| Error::parameter("brdf", format!("{s:?}: {why}"));
+        let (name, arg) = match s.split_once(':') {
+            Some((name, arg)) => (name, Some(arg)),
+            None => (s, None),
+        };
+        let exponent = || -> Result<f64> {
+            let text = arg.ok_or_else(|| bad(format!("{name} needs an exponent: {name}:EXP")))?;
+            let e: f64 = text
+                .trim()
+                .parse()
+                .map_err(|_| bad(format!("the exponent {text:?} is not a number")))?;
+            if !(0.0..=MAX_EXPONENT).contains(&e) {
+                return Err(bad(format!(
+                    "the exponent must be from 0 to {MAX_EXPONENT}"
+                )));
+            }
+            Ok(e)
+        };
+        match name {
+            "lambert" if arg.is_none() => Ok(Brdf::Lambert),
+            "phong" => Ok(Brdf::Phong {
+                exponent: exponent()?,
+            }),
+            "blinn" => Ok(Brdf::BlinnPhong {
+                exponent: exponent()?,
+            }),
+            _ => Err(bad(format!("expected one of {BRDF_SYNTAX}"))),
+        }
     }
 }
 
+impl fmt::Display for Brdf {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Brdf::Lambert => f.write_str("lambert"),
+            Brdf::Phong { exponent } => write!(f, "phong:{exponent}"),
+            Brdf::BlinnPhong { exponent } => write!(f, "blinn:{exponent}"),
+        }
+    }
+}
+
+/// `a . b`.
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The mirror direction of `w_o` about the normal `n`: `2 (n . w_o) n - w_o`.
+///
+/// ```
+/// use haarshift::relight::brdf::mirror;
+/// let r = mirror([0.0, 1.0, 0.0], [0.6, 0.8, 0.0]);
+/// assert!((r[0] + 0.6).abs() < 1e-15 && (r[1] - 0.8).abs() < 1e-15 && r[2] == 0.0);
+/// ```
+pub fn mirror(n: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
+    let k = 2.0 * dot(n, wo);
+    std::array::from_fn(|i| k * n[i] - wo[i])
+}
+
+/// `max(0, c)^e` with `0^0 = 1`.
+fn lobe(c: f64, e: f64) -> f64 {
+    if e == 0.0 { 1.0 } else { c.max(0.0).powf(e) }
+}
+
 impl Brdf {
-    /// The per-vertex constant that multiplies `<T_v, L>`, `(V, 3)`, from the per-vertex RGB
-    /// albedo `(V, 3)` (finite, non-negative): for [`Brdf::Lambert`], `albedo / pi`.
+    /// Whether the BRDF is Lambertian, so that it leaves the integral as a constant.
+    pub fn is_lambert(&self) -> bool {
+        matches!(self, Brdf::Lambert)
+    }
+
+    /// Whether the BRDF depends on the incoming direction only through its angle to the
+    /// mirror direction (the reflection-vector parameterisation: one local lobe about +Y).
+    pub fn is_mirror_symmetric(&self) -> bool {
+        matches!(self, Brdf::Phong { .. })
+    }
+
+    /// `rho(w_i, w_o)` per RGB channel (per unit albedo) at a vertex of unit normal `n`;
+    /// every vector unit. See the [module docs](self) for the formulas.
     ///
     /// ```
     /// use haarshift::relight::Brdf;
-    /// use ndarray::array;
-    /// let f = Brdf::Lambert.vertex_factors(array![[0.5f32, 0.25, 1.0]].view()).unwrap();
-    /// assert!((f[[0, 0]] - 0.5 / std::f32::consts::PI).abs() < 1e-8);
-    /// assert!(Brdf::Lambert.vertex_factors(array![[0.5f32, -0.25, 1.0]].view()).is_err());
-    /// assert!(Brdf::Lambert.vertex_factors(array![[0.5f32, 0.25]].view()).is_err());
+    /// let n = [0.0, 1.0, 0.0];
+    /// let up = Brdf::Phong { exponent: 10.0 }.evaluate(n, n, n); // w_i on the mirror direction
+    /// assert!((up[0] - 12.0 / (2.0 * std::f64::consts::PI)).abs() < 1e-12);
+    /// let flat = Brdf::Phong { exponent: 0.0 }.evaluate(n, [1.0, 0.0, 0.0], n);
+    /// assert_eq!(flat, Brdf::Lambert.evaluate(n, [1.0, 0.0, 0.0], n));
     /// ```
-    pub fn vertex_factors(self, albedo: ArrayView2<'_, f32>) -> Result<Array2<f32>> {
-        if albedo.ncols() != 3 {
-            return Err(Error::shape(
-                albedo.shape(),
-                "the albedo must be (vertices, 3), one RGB triple per vertex",
-            ));
-        }
-        if let Some((at, v)) = albedo
-            .indexed_iter()
-            .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
-        {
+    pub fn evaluate(&self, n: [f64; 3], wi: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
+        let value = match *self {
+            Brdf::Lambert => std::f64::consts::FRAC_1_PI,
+            Brdf::Phong { exponent } => {
+                (exponent + 2.0) / std::f64::consts::TAU * lobe(dot(mirror(n, wo), wi), exponent)
+            }
+            Brdf::BlinnPhong { exponent } => {
+                let h: [f64; 3] = std::array::from_fn(|i| wi[i] + wo[i]);
+                let len = dot(h, h).sqrt();
+                let c = if len > 0.0 { dot(n, h) / len } else { 0.0 };
+                (exponent + 8.0) / (8.0 * std::f64::consts::PI) * lobe(c, exponent)
+            }
+        };
+        [value; 3]
+    }
+
+    /// The BRDF's copy in its local frame, an `height x 2 height` lat-long map of one channel
+    /// (RGB-independent materials) sampled at texel centres: for a mirror-symmetric BRDF
+    /// ([`is_mirror_symmetric`](Self::is_mirror_symmetric)) the lobe about +Y as a function of
+    /// the angle to the mirror direction (`theta_o` does not matter); otherwise
+    /// `rho(w, w_o)` for the normal +Y and the viewer `w_o = direction(theta_o, 0)` (elevation
+    /// `theta_o` from the normal, on the +Z side).
+    ///
+    /// ```
+    /// use haarshift::relight::Brdf;
+    /// let map = Brdf::Phong { exponent: 20.0 }.local_map(16, 0.0).unwrap();
+    /// assert_eq!(map.as_array().dim(), (16, 32, 1));
+    /// // Brightest in the top row (about +Y), and every column alike.
+    /// let a = map.as_array();
+    /// assert!(a[[0, 0, 0]] > a[[1, 0, 0]] && a[[0, 0, 0]] == a[[0, 17, 0]]);
+    /// ```
+    pub fn local_map(&self, height: usize, theta_o: f64) -> Result<LatLongMap<f64>> {
+        if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&theta_o) {
             return Err(Error::parameter(
-                "albedo",
-                format!("{v} at vertex {}: must be finite and non-negative", at.0),
+                "outgoing elevation",
+                format!("{theta_o} radians: must be from 0 to pi/2"),
             ));
         }
-        Ok(match self {
-            Brdf::Lambert => albedo.mapv(|a| a / std::f32::consts::PI),
-        })
+        let up = [0.0, 1.0, 0.0];
+        let (wo, n) = if self.is_mirror_symmetric() {
+            // The mirror direction of w_o = n about n is n itself: the lobe about +Y.
+            (up, up)
+        } else {
+            (direction(theta_o, 0.0), up)
+        };
+        LatLongMap::from_fn(height, 1, |w, out| out[0] = self.evaluate(n, w, wo)[0])
+    }
+}
+
+/// Checks a per-vertex RGB albedo `(V, 3)`: finite and non-negative.
+///
+/// ```
+/// use haarshift::relight::brdf::check_albedo;
+/// use ndarray::array;
+/// assert!(check_albedo(array![[0.5f32, 0.25, 1.0]].view()).is_ok());
+/// assert!(check_albedo(array![[0.5f32, -0.25, 1.0]].view()).is_err());
+/// assert!(check_albedo(array![[0.5f32, 0.25]].view()).is_err());
+/// ```
+pub fn check_albedo(albedo: ArrayView2<'_, f32>) -> Result<()> {
+    if albedo.ncols() != 3 {
+        return Err(Error::shape(
+            albedo.shape(),
+            "the albedo must be (vertices, 3), one RGB triple per vertex",
+        ));
+    }
+    if let Some((at, v)) = albedo
+        .indexed_iter()
+        .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+    {
+        return Err(Error::parameter(
+            "albedo",
+            format!("{v} at vertex {}: must be finite and non-negative", at.0),
+        ));
+    }
+    Ok(())
+}
+
+/// A view-dependent BRDF's local copies: one map per outgoing elevation
+/// `theta_k = (k + 1/2) (pi / 2) / E`, `k = 0..E` ([`Brdf::local_map`]); a viewer at
+/// elevation `theta_o` uses the nearest, the thesis's "BRDF transformed map corresponding to
+/// that direction". A mirror-symmetric BRDF needs one map, whatever `E`.
+///
+/// ```
+/// use haarshift::relight::brdf::{Brdf, LocalTable};
+/// let t = LocalTable::new(&Brdf::BlinnPhong { exponent: 10.0 }, 16, 8).unwrap();
+/// assert_eq!(t.len(), 8);
+/// assert_eq!(t.nearest(0.0), 0);
+/// assert_eq!(t.nearest(std::f64::consts::FRAC_PI_2), 7);
+/// assert_eq!(LocalTable::new(&Brdf::Phong { exponent: 10.0 }, 16, 8).unwrap().len(), 1);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct LocalTable {
+    maps: Vec<LatLongMap<f64>>,
+}
+
+/// Outgoing elevations of a view-dependent BRDF's [`LocalTable`] unless asked otherwise: 5.6
+/// degrees apart.
+pub const DEFAULT_ELEVATIONS: usize = 16;
+
+impl LocalTable {
+    /// `brdf`'s local maps of `height` rows at `elevations` (1 to 1024) outgoing elevations.
+    pub fn new(brdf: &Brdf, height: usize, elevations: usize) -> Result<Self> {
+        if !(1..=1024).contains(&elevations) {
+            return Err(Error::parameter(
+                "elevations",
+                format!("{elevations}: expected 1 to 1024"),
+            ));
+        }
+        let count = if brdf.is_mirror_symmetric() {
+            1
+        } else {
+            elevations
+        };
+        let step = std::f64::consts::FRAC_PI_2 / count as f64;
+        let maps = (0..count)
+            .map(|k| brdf.local_map(height, (k as f64 + 0.5) * step))
+            .collect::<Result<_>>()?;
+        Ok(LocalTable { maps })
+    }
+
+    /// The number of maps.
+    pub fn len(&self) -> usize {
+        self.maps.len()
+    }
+
+    /// Whether the table is empty (never: it holds at least one map).
+    pub fn is_empty(&self) -> bool {
+        self.maps.is_empty()
+    }
+
+    /// The map of the elevation nearest `theta_o` (radians from the normal, clamped to
+    /// `[0, pi/2]`).
+    pub fn nearest(&self, theta_o: f64) -> usize {
+        let e = self.maps.len();
+        let k = (theta_o.clamp(0.0, std::f64::consts::FRAC_PI_2) / std::f64::consts::FRAC_PI_2
+            * e as f64)
+            .floor() as usize;
+        k.min(e - 1)
+    }
+
+    /// Map `k`.
+    pub fn map(&self, k: usize) -> &LatLongMap<f64> {
+        &self.maps[k]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn phong_lobe_integrates_to_one_about_its_axis() {
+        // (e + 2) / (2 pi) x the integral of cos^e over the hemisphere, 2 pi / (e + 1): the
+        // normalisation is the cosine-weighted one, so the plain integral is (e + 2) / (e + 1).
+        for e in [1.0, 10.0, 50.0] {
+            let got = Brdf::Phong { exponent: e }
+                .local_map(256, 0.0)
+                .unwrap()
+                .energy()[0];
+            let want = (e + 2.0) / (e + 1.0);
+            assert!((got - want).abs() < 2e-3 * want, "e = {e}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn phong_zero_is_lambert() {
+        let n = [0.0, 0.6, 0.8];
+        for wi in [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.6, 0.8]] {
+            let p = Brdf::Phong { exponent: 0.0 }.evaluate(n, wi, [0.0, 1.0, 0.0]);
+            let l = Brdf::Lambert.evaluate(n, wi, [0.0, 1.0, 0.0]);
+            assert!((p[0] - l[0]).abs() < 1e-12 * l[0]);
+        }
+    }
+
+    #[test]
+    fn blinn_peaks_where_the_half_vector_is_the_normal() {
+        let n = [0.0, 1.0, 0.0];
+        let wo = direction(0.7, 0.0);
+        let b = Brdf::BlinnPhong { exponent: 30.0 };
+        let peak = b.evaluate(n, mirror(n, wo), wo)[0];
+        assert!((peak - 38.0 / (8.0 * std::f64::consts::PI)).abs() < 1e-12);
+        assert!(b.evaluate(n, direction(0.6, std::f64::consts::PI), wo)[0] < peak);
+    }
+
+    #[test]
+    fn parse_refuses_what_it_cannot_shade() {
+        assert_err!(
+            "phong:nan".parse::<Brdf>(),
+            InvalidParameter { name: "brdf", .. },
+            "must be from 0"
+        );
+        assert_err!(
+            "phong:x".parse::<Brdf>(),
+            InvalidParameter { name: "brdf", .. },
+            "not a number"
+        );
+        assert_err!(
+            "lambert:2".parse::<Brdf>(),
+            InvalidParameter { name: "brdf", .. },
+            "expected one of"
+        );
+        assert_err!(
+            "blinn:1e5".parse::<Brdf>(),
+            InvalidParameter { name: "brdf", .. },
+            "must be from 0"
+        );
+        for s in ["lambert", "phong:0", "phong:200", "blinn:12.5"] {
+            assert_eq!(s.parse::<Brdf>().unwrap().to_string(), s);
+        }
     }
 }

@@ -38,7 +38,7 @@
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use super::brdf::Brdf;
+use super::brdf::check_albedo;
 use super::lighting::Lighting;
 use super::transport::TransportSet;
 use crate::product::Selection;
@@ -56,14 +56,12 @@ pub const CHUNK: usize = 512;
 /// How to shade; see the [module docs](self).
 ///
 /// ```
-/// use haarshift::relight::{Brdf, ShadeOptions};
+/// use haarshift::relight::ShadeOptions;
 /// let o = ShadeOptions::default();
-/// assert_eq!((o.brdf, o.keep_visibility, o.depth), (Brdf::Lambert, None, None));
+/// assert_eq!((o.keep_visibility, o.depth), (None, None));
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ShadeOptions {
-    /// The material.
-    pub brdf: Brdf,
     /// Re-truncation of each vertex's stored transport (`None`: as stored).
     pub keep_visibility: Option<Selection>,
     /// Detail levels taking part, `0..=log2 S` (`None`: all).
@@ -97,7 +95,7 @@ pub struct PreparedTransport<T> {
     offsets: Vec<usize>,
     indices: Vec<u32>,
     values: Vec<T>,
-    factors: Vec<[f64; 3]>,
+    albedo: Vec<[f64; 3]>,
 }
 
 impl<T: Sample> PreparedTransport<T> {
@@ -117,9 +115,8 @@ impl<T: Sample> PreparedTransport<T> {
                 ),
             ));
         }
-        let factors = options
-            .brdf
-            .vertex_factors(albedo)?
+        check_albedo(albedo)?;
+        let albedo = albedo
             .rows()
             .into_iter()
             .map(|r| [r[0], r[1], r[2]].map(f64::from))
@@ -170,7 +167,7 @@ impl<T: Sample> PreparedTransport<T> {
             offsets,
             indices,
             values,
-            factors,
+            albedo,
         })
     }
 
@@ -181,7 +178,7 @@ impl<T: Sample> PreparedTransport<T> {
 
     /// Vertices.
     pub fn vertex_count(&self) -> usize {
-        self.factors.len()
+        self.albedo.len()
     }
 
     /// Coefficients kept over all vertices (scaling coefficients included).
@@ -234,9 +231,9 @@ impl<T: Sample> PreparedTransport<T> {
                     let v = first + k;
                     let (a, b) = (self.offsets[v], self.offsets[v + 1]);
                     let sum = dot(&self.indices[a..b], &self.values[a..b], &light);
-                    let f = self.factors[v];
+                    let a = self.albedo[v];
                     for c in 0..3 {
-                        row[c] = T::from_f64(sum[c] * f[c]);
+                        row[c] = T::from_f64(sum[c] * a[c] * std::f64::consts::FRAC_1_PI);
                     }
                 }
             });

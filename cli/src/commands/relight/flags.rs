@@ -14,8 +14,6 @@ use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift::{Error, Result};
 use ndarray::ArrayView2;
 
-use crate::commands::{choice, names};
-
 /// A mesh or a scene file, and the ground plane.
 #[derive(clap::Args, Debug)]
 pub struct SceneFlags {
@@ -52,6 +50,11 @@ fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
         [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
         _ => Err(format!("{s:?}: expected three finite numbers x,y,z")),
     }
+}
+
+/// `--brdf`, parsed by the library.
+fn brdf(s: &str) -> std::result::Result<Brdf, String> {
+    s.parse::<Brdf>().map_err(|e| e.to_string())
 }
 
 /// The lighting: the environment map and its rotation.
@@ -115,9 +118,10 @@ pub fn rotation([yaw, pitch, roll]: [f64; 3]) -> Result<SphereRotation> {
 /// The material: the BRDF and its albedo.
 #[derive(clap::Args, Debug)]
 pub struct MaterialFlags {
-    /// The BRDF (this version shades Lambertian surfaces; glossy ones come with the Haar-domain
-    /// BRDF rotation)
-    #[arg(long, default_value = "lambert", value_parser = choice::<Brdf>(names!(Brdf)))]
+    /// The BRDF: lambert, phong:EXP (a lobe about the mirror direction), blinn:EXP (Blinn-Phong,
+    /// of the half vector); glossy ones apply to the scene's objects, the ground plane stays
+    /// Lambertian
+    #[arg(long, value_name = "BRDF", default_value = "lambert", value_parser = brdf)]
     pub brdf: Brdf,
 
     /// Lambertian albedo r,g,b (each 0 to 1) for every vertex [default: the scene's, 0.8 for
@@ -318,9 +322,14 @@ impl ShadingFlags {
     }
 
     /// `cache`'s transport prepared for shading with its albedo and `brdf` under these options.
-    pub fn prepare(&self, cache: &SceneCache, brdf: Brdf) -> Result<PreparedTransport<f32>> {
+    pub fn prepare(&self, cache: &SceneCache, brdf: &Brdf) -> Result<PreparedTransport<f32>> {
+        if !brdf.is_lambert() {
+            return Err(Error::InvalidParameter {
+                name: "brdf",
+                reason: format!("{brdf}: this command shades lambert only"),
+            });
+        }
         let options = ShadeOptions {
-            brdf,
             keep_visibility: self.keep_visibility.map(Selection::Largest),
             depth: self.depth,
         };
