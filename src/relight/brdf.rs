@@ -242,6 +242,11 @@ pub fn check_albedo(albedo: ArrayView2<'_, f32>) -> Result<()> {
     Ok(())
 }
 
+/// The centre of elevation bin `k` of `count` over `[0, pi/2]`.
+fn elevation_of(k: usize, count: usize) -> f64 {
+    (k as f64 + 0.5) * std::f64::consts::FRAC_PI_2 / count as f64
+}
+
 /// A view-dependent BRDF's local copies: one map per outgoing elevation
 /// `theta_k = (k + 1/2) (pi / 2) / E`, `k = 0..E` ([`Brdf::local_map`]); a viewer at
 /// elevation `theta_o` uses the nearest, the thesis's "BRDF transformed map corresponding to
@@ -278,11 +283,15 @@ impl LocalTable {
         } else {
             elevations
         };
-        let step = std::f64::consts::FRAC_PI_2 / count as f64;
-        let maps = (0..count)
-            .map(|k| brdf.local_map(height, (k as f64 + 0.5) * step))
-            .collect::<Result<_>>()?;
-        Ok(LocalTable { maps })
+        let mut table = LocalTable {
+            maps: Vec::with_capacity(count),
+        };
+        for k in 0..count {
+            table
+                .maps
+                .push(brdf.local_map(height, elevation_of(k, count))?);
+        }
+        Ok(table)
     }
 
     /// The number of maps.
@@ -303,6 +312,11 @@ impl LocalTable {
             * e as f64)
             .floor() as usize;
         k.min(e - 1)
+    }
+
+    /// The outgoing elevation of map `k`, radians from the normal.
+    pub fn elevation(&self, k: usize) -> f64 {
+        elevation_of(k, self.maps.len())
     }
 
     /// Map `k`.

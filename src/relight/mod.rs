@@ -15,8 +15,10 @@
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
 //! | [`lighting`] | [`Lighting`]: the environment's kept Haar coefficients, RGB, in Mallat order |
-//! | [`brdf`] | [`Brdf`]: the material (Lambert), and where a glossy BRDF enters the integral |
+//! | [`brdf`] | [`Brdf`]: Lambert, Phong, Blinn-Phong; local copies of a BRDF |
 //! | [`shade`](mod@shade) | per-vertex outgoing radiance: [`PreparedTransport`], one sparse dot per vertex |
+//! | [`orient`] | bringing a BRDF into a vertex's frame: Haar, spatial, reference or direct |
+//! | [`glossy`] | glossy shading: the triple product with the rotated BRDF, the rotation cache |
 //! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
 //! | [`animation`] | frames into an animated GIF |
 //! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
@@ -34,10 +36,12 @@ pub mod cache;
 pub mod environment;
 pub mod error;
 pub mod gallery;
+pub mod glossy;
 pub mod harmonics;
 pub mod lighting;
 pub mod memory;
 pub mod mesh;
+pub mod orient;
 pub mod precompute;
 pub mod raster;
 pub mod raycast;

@@ -96,6 +96,7 @@ pub struct PreparedTransport<T> {
     indices: Vec<u32>,
     values: Vec<T>,
     albedo: Vec<[f64; 3]>,
+    depth: usize,
 }
 
 impl<T: Sample> PreparedTransport<T> {
@@ -168,6 +169,7 @@ impl<T: Sample> PreparedTransport<T> {
             indices,
             values,
             albedo,
+            depth,
         })
     }
 
@@ -190,6 +192,23 @@ impl<T: Sample> PreparedTransport<T> {
     pub fn coefficients(&self, v: usize) -> (&[u32], &[T]) {
         let (a, b) = (self.offsets[v], self.offsets[v + 1]);
         (&self.indices[a..b], &self.values[a..b])
+    }
+
+    /// The detail levels taking part, `0..depth`.
+    pub fn depth(&self) -> usize {
+        self.depth
+    }
+
+    /// Vertex `v`'s albedo, RGB.
+    pub(crate) fn albedo(&self, v: usize) -> [f64; 3] {
+        self.albedo[v]
+    }
+
+    /// `<T_v, f>` per channel for a function `f` given as dense RGB rows in Mallat order (the
+    /// layout of [`Lighting`]'s coefficients).
+    pub(crate) fn dot_rows(&self, v: usize, rows: &[[T; 3]]) -> [f64; 3] {
+        let (a, b) = (self.offsets[v], self.offsets[v + 1]);
+        dot(&self.indices[a..b], &self.values[a..b], rows)
     }
 
     /// Every vertex's outgoing radiance under `lighting`, `(V, 3)`.
@@ -229,8 +248,7 @@ impl<T: Sample> PreparedTransport<T> {
                 let first = chunk * CHUNK;
                 for (k, row) in rows.chunks_exact_mut(3).enumerate() {
                     let v = first + k;
-                    let (a, b) = (self.offsets[v], self.offsets[v + 1]);
-                    let sum = dot(&self.indices[a..b], &self.values[a..b], &light);
+                    let sum = self.dot_rows(v, &light);
                     let a = self.albedo[v];
                     for c in 0..3 {
                         row[c] = T::from_f64(sum[c] * a[c] * std::f64::consts::FRAC_1_PI);
@@ -309,27 +327,27 @@ fn detail_of(r: usize, c: usize) -> Option<(usize, usize, usize, usize)> {
     })
 }
 
-/// One vertex's stored coefficients re-truncated by `keep` (among the stored details) and
-/// limited to detail levels `0..depth`, ascending by index, converted to `T`.
-fn retruncate<T: Sample>(
+/// Which of the coefficients at face-Mallat `indices` (`face x S^2 + row x S + col`, any
+/// order) `keep` retains: every scaling coefficient, and the details the rule of
+/// [`crate::product::selection`] picks by `magnitude2(slot)`, their squared (RGB) magnitudes.
+pub(crate) fn select_kept(
     param: Parameterization,
     keep: Selection,
-    depth: usize,
     indices: &[u32],
-    values: &[f32],
+    magnitude2: impl Fn(usize) -> f64,
     pool: &mut Vec<Candidate>,
-) -> (Vec<u32>, Vec<T>) {
+) -> Vec<bool> {
     let (faces, s) = (param.faces(), param.face_size());
     let face_layout = layout(param);
     let mut kept = vec![false; indices.len()];
     pool.clear();
-    for (slot, (&i, &c)) in indices.iter().zip(values).enumerate() {
+    for (slot, &i) in indices.iter().enumerate() {
         let i = i as usize;
         let face = i / (s * s);
         match detail_of((i / s) % s, i % s) {
             None => kept[slot] = true,
             Some((band, level, row, col)) => pool.push(Candidate {
-                magnitude2: f64::from(c).powi(2),
+                magnitude2: magnitude2(slot),
                 index: face_layout.index(faces, s, face, band, level, row, col),
                 slot,
             }),
@@ -349,7 +367,7 @@ fn retruncate<T: Sample>(
         }
         Selection::Largest(k) => mark(pool, k),
         Selection::LargestPerFace(k) => {
-            // The stored indices need not be sorted: group the candidates by face first.
+            // The indices need not be sorted: group the candidates by face first.
             let face_of = |c: &Candidate| indices[c.slot] as usize / (s * s);
             pool.sort_unstable_by_key(face_of);
             for run in pool.chunk_by_mut(|a, b| face_of(a) == face_of(b)) {
@@ -357,15 +375,38 @@ fn retruncate<T: Sample>(
             }
         }
     }
-    let shallow = |i: u32| {
-        let i = i as usize;
-        (i / s) % s < (1 << depth) && i % s < (1 << depth)
-    };
+    kept
+}
+
+/// Whether the coefficient at face-Mallat index `i` (faces of side `s`) belongs to a detail
+/// level below `depth` (or is a scaling coefficient).
+pub(crate) fn within_depth(s: usize, depth: usize, i: usize) -> bool {
+    (i / s) % s < (1 << depth) && i % s < (1 << depth)
+}
+
+/// One vertex's stored coefficients re-truncated by `keep` (among the stored details) and
+/// limited to detail levels `0..depth`, ascending by index, converted to `T`.
+fn retruncate<T: Sample>(
+    param: Parameterization,
+    keep: Selection,
+    depth: usize,
+    indices: &[u32],
+    values: &[f32],
+    pool: &mut Vec<Candidate>,
+) -> (Vec<u32>, Vec<T>) {
+    let s = param.face_size();
+    let kept = select_kept(
+        param,
+        keep,
+        indices,
+        |slot| f64::from(values[slot]).powi(2),
+        pool,
+    );
     let mut out: Vec<(u32, T)> = indices
         .iter()
         .zip(values)
         .zip(&kept)
-        .filter(|&((&i, _), &k)| k && shallow(i))
+        .filter(|&((&i, _), &k)| k && within_depth(s, depth, i as usize))
         .map(|((&i, &c), _)| (i, T::from_f64(f64::from(c))))
         .collect();
     out.sort_unstable_by_key(|&(i, _)| i);

@@ -1,0 +1,565 @@
+//! Glossy shading: per vertex, the triple product of lighting, transport and the BRDF rotated
+//! into the vertex's frame.
+//!
+//! **What is computed.** For a vertex `v` of albedo `a_v` (the specular colour), seen from the
+//! camera at `e` (`w_o = (e - p_v) / |e - p_v|`),
+//! `B_v = a_v x integral of T_v(w) L(w) rho_v(w) dw`, with `T_v` the transport (visibility x
+//! cosine x solid angle), `L` the lighting and `rho_v` the BRDF in the vertex's global frame
+//! ([`orient`](super::orient)). Each factor is truncated as the options say: the transport to
+//! `--keep-visibility`, the lighting to `--keep-light`, the BRDF to `--keep-brdf` (the `K`
+//! largest orthonormal details by RGB magnitude plus each face's scaling coefficient, the rule
+//! of [`crate::product::selection`]), and all three to the detail levels `0..depth`. Vertices
+//! from `object_vertices` on (the ground plane) stay Lambertian ([`super::shade`]).
+//!
+//! **How.** The triple product of the three truncated functions is the integral of the
+//! product of their reconstructions, so `B_v = a_v <T_v, Q>` with `Q` the orthonormal Haar
+//! coefficients of the pixel-wise product `L~ x rho~_v`: one dense `O(N)` product and forward
+//! transform per distinct BRDF map, then one sparse dot product per vertex. This is seed 001's
+//! just-in-time radiance transfer (section 3.5) with the lighting and the BRDF as the fixed
+//! pair: the same number as [`triple_integral`](crate::product::triple::triple_integral) on the
+//! three trees (tested to 1e-12), and with a depth limit the same as the traversal stopped at
+//! that depth (all three functions are then constant on blocks of side `S >> depth`, and so is
+//! their product).
+//!
+//! **Rotation cache** (`--rotation-cache N`, as Wang et al. 2006 precompute one rotation per
+//! sampled normal). Without it every vertex rotates its own BRDF map (exact frame). With it the
+//! key direction is quantised to the centres of an `N x 2N` lat-long grid of bins and each
+//! bin's map is rotated once and kept for every later view and lighting:
+//! * Phong: the key is the mirror direction; a vertex takes the bilinear blend of its four
+//!   nearest bins (four dot products; the triple product is linear in the BRDF), so the
+//!   quantisation error is second order in the bin size;
+//! * view-dependent BRDFs: the nearest normal bin, with the viewer's elevation and azimuth
+//!   quantised as [`orient`](super::orient) does anyway (the key is the triple).
+//!
+//! **Precision.** The product and the dot products run in `T` (f32 for speed, f64 for checks);
+//! the BRDF maps are computed in f64 and stored in `T`.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use ndarray::{Array2, ArrayView2};
+use rayon::prelude::*;
+
+use super::Mesh;
+use super::brdf::Brdf;
+use super::lighting::Lighting;
+use super::orient::{BrdfRotation, Frame, Orientation, to_pole, unit};
+use super::shade::{PreparedTransport, ShadeOptions, select_kept, within_depth};
+use super::transport::TransportSet;
+use crate::product::Selection;
+use crate::sphere::latlong::{angles, direction};
+use crate::sphere::param::Parameterization;
+use crate::transform::{Normalization, pyramid};
+use crate::{Error, Result, Sample};
+
+/// The most bins per axis of the rotation cache (`N x 2N` bins).
+pub const MAX_CACHE_BINS: usize = 1024;
+
+/// How glossy vertices are shaded; see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::glossy::GlossyOptions;
+/// use haarshift::relight::orient::BrdfRotation;
+/// let o = GlossyOptions::default();
+/// assert_eq!((o.rotation, o.level, o.keep_brdf, o.cache_bins), (BrdfRotation::Haar, None, None, None));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct GlossyOptions {
+    /// The material of the objects (the ground plane stays Lambertian).
+    pub brdf: Brdf,
+    /// How the BRDF is brought into each frame.
+    pub rotation: BrdfRotation,
+    /// The sphere module's detail level the rotation starts from (`None`: the finest).
+    pub level: Option<usize>,
+    /// Detail coefficients of each rotated BRDF map kept (`None`: all).
+    pub keep_brdf: Option<usize>,
+    /// Bins per axis of the rotation cache (`None`: no cache, one rotation per vertex).
+    pub cache_bins: Option<usize>,
+    /// Outgoing elevations of a view-dependent BRDF's local table.
+    pub elevations: usize,
+}
+
+impl Default for GlossyOptions {
+    fn default() -> Self {
+        GlossyOptions {
+            brdf: Brdf::default(),
+            rotation: BrdfRotation::default(),
+            level: None,
+            keep_brdf: None,
+            cache_bins: None,
+            elevations: super::brdf::DEFAULT_ELEVATIONS,
+        }
+    }
+}
+
+/// Which BRDF map a vertex uses: its own, or a bin of the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum MapKey {
+    /// Vertex `v`'s exact frame (no cache).
+    Vertex(u32),
+    /// A Phong bin: the mirror direction at bin `(row, col)`.
+    Mirror(u32, u32),
+    /// A view-dependent bin: the normal bin `(row, col)`, the table entry and the column turn.
+    View(u32, u32, u32, u32),
+}
+
+/// What one call of [`GlossyShader::shade`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GlossyReport {
+    /// Distinct BRDF maps the vertices used.
+    pub maps: usize,
+    /// Of those, maps rotated by this call (the rest came from the cache).
+    pub rotated: usize,
+    /// BRDF maps held by the cache after the call.
+    pub cached: usize,
+    /// Seconds spent filling the rotation cache (0 without a cache).
+    pub rotate_seconds: f64,
+    /// Seconds spent on the products and dot products (without a cache, the per-vertex
+    /// rotations too).
+    pub shade_seconds: f64,
+}
+
+/// A scene's transport made ready for glossy shading, with its BRDF and rotation cache;
+/// see the [module docs](self).
+///
+/// ```
+/// use haarshift::product::Selection;
+/// use haarshift::relight::{Brdf, Lighting, Mesh, ShadeOptions, TransportSet};
+/// use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
+/// use haarshift::relight::orient::BrdfRotation;
+/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use ndarray::{Array2, Axis, array};
+/// // An upward triangle whose vertices see the whole sky: transport = cosine x solid angle.
+/// let mesh = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+///                      vec![[0, 1, 2]], None).unwrap();
+/// let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
+/// let cosine = SphereMap::<f64>::from_fn(param, 1, |d, o| o[0] = d[1].max(0.0)).unwrap();
+/// let unweighted = cosine.as_array().index_axis(Axis(3), 0).mapv(|v| v as f32);
+/// let mut set = TransportSet::new(param, Selection::All);
+/// for _ in 0..3 {
+///     set.push(unweighted.view()).unwrap();
+/// }
+/// let sky = SphereMap::from_fn(param, 1, |_, o| o[0] = 1.0).unwrap();
+/// let light = Lighting::from_map(&sky, Selection::All).unwrap();
+/// let albedo = Array2::from_elem((3, 3), 1.0f32);
+/// let options = GlossyOptions { brdf: Brdf::Phong { exponent: 0.0 }, rotation: BrdfRotation::Direct,
+///                               ..Default::default() };
+/// let shader = GlossyShader::<f64>::new(&set, &mesh, albedo.view(), &ShadeOptions::default(),
+///                                       &options, 3).unwrap();
+/// let (b, report) = shader.shade(&light, [0.0, 5.0, 0.0]).unwrap();
+/// // Phong 0 is 1/pi everywhere: the irradiance of a unit sky, pi, times 1/pi.
+/// assert!((b[[0, 0]] - 1.0).abs() < 1e-2);
+/// assert_eq!(report.maps, 3); // no cache: one map per vertex
+/// ```
+#[derive(Debug)]
+pub struct GlossyShader<T> {
+    transport: PreparedTransport<T>,
+    orientation: Orientation,
+    keep_brdf: Option<usize>,
+    bins: Option<usize>,
+    positions: Vec<[f64; 3]>,
+    normals: Vec<[f64; 3]>,
+    object_vertices: usize,
+    cache: Mutex<HashMap<MapKey, Arc<Vec<T>>>>,
+}
+
+/// A BRDF map as the product needs it: `channels x texels`, channel-planar, face-major.
+type Planes<T> = Vec<T>;
+
+impl<T: Sample> GlossyShader<T> {
+    /// Prepares `set` (the transport of `mesh`'s vertices) with per-vertex RGB `albedo`
+    /// (`(V, 3)`): vertices `0..object_vertices` carry `options.brdf`, the rest are Lambertian.
+    pub fn new(
+        set: &TransportSet,
+        mesh: &Mesh,
+        albedo: ArrayView2<'_, f32>,
+        shade: &ShadeOptions,
+        options: &GlossyOptions,
+        object_vertices: usize,
+    ) -> Result<Self> {
+        let transport = PreparedTransport::new(set, albedo, shade)?;
+        let vertices = transport.vertex_count();
+        if mesh.vertex_count() != vertices || object_vertices > vertices {
+            return Err(Error::parameter(
+                "vertices",
+                format!(
+                    "the mesh has {} vertices, the transport {vertices}, {object_vertices} glossy",
+                    mesh.vertex_count()
+                ),
+            ));
+        }
+        let param = set.param();
+        let orientation = Orientation::new(
+            &options.brdf,
+            param,
+            options.rotation,
+            options.level,
+            options.elevations,
+        )?;
+        if let Some(k) = options.keep_brdf {
+            Selection::Largest(k).limit(param.texels() - param.faces())?;
+        }
+        if let Some(n) = options.cache_bins
+            && !(1..=MAX_CACHE_BINS).contains(&n)
+        {
+            return Err(Error::parameter(
+                "rotation cache",
+                format!("{n} bins per axis: expected 1 to {MAX_CACHE_BINS}"),
+            ));
+        }
+        let rows = |a: ArrayView2<'_, f64>| -> Vec<[f64; 3]> {
+            a.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect()
+        };
+        Ok(GlossyShader {
+            transport,
+            orientation,
+            keep_brdf: options.keep_brdf,
+            bins: options.cache_bins,
+            positions: rows(mesh.positions()),
+            normals: rows(mesh.normals()),
+            object_vertices,
+            cache: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// The prepared transport.
+    pub fn transport(&self) -> &PreparedTransport<T> {
+        &self.transport
+    }
+
+    /// The BRDF maps the rotation cache holds.
+    pub fn cached(&self) -> usize {
+        self.cache
+            .lock()
+            .expect("the cache lock is never poisoned")
+            .len()
+    }
+
+    /// Every vertex's outgoing radiance `(V, 3)` under `lighting`, seen from `eye`.
+    pub fn shade(&self, lighting: &Lighting, eye: [f64; 3]) -> Result<(Array2<T>, GlossyReport)> {
+        let param = self.transport.param();
+        if !eye.iter().all(|v| v.is_finite()) {
+            return Err(Error::parameter(
+                "camera",
+                format!("{eye:?} is not a finite position"),
+            ));
+        }
+        let mut out = self.transport.shade(lighting)?;
+        let light = light_pixels::<T>(lighting, self.transport.depth())?;
+        let uses = self.map_uses(eye)?;
+        let mut report = GlossyReport {
+            maps: uses.len(),
+            ..GlossyReport::default()
+        };
+        let start = Instant::now();
+        if self.bins.is_some() {
+            let missing: Vec<MapKey> = {
+                let cache = self.cache.lock().expect("the cache lock is never poisoned");
+                uses.keys()
+                    .filter(|k| !cache.contains_key(k))
+                    .copied()
+                    .collect()
+            };
+            let filled: Vec<(MapKey, Arc<Vec<T>>)> = missing
+                .par_iter()
+                .map(|&key| Ok((key, Arc::new(self.brdf_planes(&self.frame_of(key, eye)?)?))))
+                .collect::<Result<_>>()?;
+            report.rotated = filled.len();
+            let mut cache = self.cache.lock().expect("the cache lock is never poisoned");
+            cache.extend(filled);
+            report.cached = cache.len();
+            report.rotate_seconds = start.elapsed().as_secs_f64();
+        } else {
+            report.rotated = uses.len();
+        }
+        let start = Instant::now();
+        let jobs: Vec<(MapKey, Vec<(u32, f64)>)> = uses.into_iter().collect();
+        let contributions: Vec<Vec<(u32, [f64; 3])>> = jobs
+            .par_iter()
+            .map_init(
+                || (Vec::new(), Vec::new(), Vec::new()),
+                |(product, rows, work), (key, users)| {
+                    let planes = match self.bins {
+                        Some(_) => self
+                            .cache
+                            .lock()
+                            .expect("the cache lock is never poisoned")
+                            .get(key)
+                            .cloned()
+                            .expect("every used map was filled above"),
+                        None => Arc::new(self.brdf_planes(&self.frame_of(*key, eye)?)?),
+                    };
+                    product_rows(param, &light, &planes, product, rows, work)?;
+                    Ok(users
+                        .iter()
+                        .map(|&(v, w)| {
+                            let s = self.transport.dot_rows(v as usize, rows);
+                            (v, s.map(|x| w * x))
+                        })
+                        .collect())
+                },
+            )
+            .collect::<Result<_>>()?;
+        let mut sums = vec![[0.0f64; 3]; self.object_vertices];
+        for (v, s) in contributions.into_iter().flatten() {
+            for c in 0..3 {
+                sums[v as usize][c] += s[c];
+            }
+        }
+        for (v, s) in sums.iter().enumerate() {
+            let a = self.transport.albedo(v);
+            for c in 0..3 {
+                out[[v, c]] = T::from_f64(a[c] * s[c]);
+            }
+        }
+        report.shade_seconds = start.elapsed().as_secs_f64();
+        Ok((out, report))
+    }
+
+    /// Vertex `v`'s frame as seen from `eye`.
+    fn vertex_frame(&self, v: usize, eye: [f64; 3]) -> Result<Frame> {
+        let p = self.positions[v];
+        let view = std::array::from_fn(|k| eye[k] - p[k]);
+        Frame::new(self.normals[v], view).map_err(|_| {
+            Error::parameter(
+                "camera",
+                format!("the camera {eye:?} sits on vertex {v}: it has no view direction"),
+            )
+        })
+    }
+
+    /// The BRDF maps every glossy vertex uses, with the vertices and their weights.
+    fn map_uses(&self, eye: [f64; 3]) -> Result<HashMap<MapKey, Vec<(u32, f64)>>> {
+        let keyed: Vec<Vec<(MapKey, f64)>> = (0..self.object_vertices)
+            .into_par_iter()
+            .map(|v| {
+                let frame = self.vertex_frame(v, eye)?;
+                Ok(match self.bins {
+                    None => vec![(MapKey::Vertex(v as u32), 1.0)],
+                    Some(n) => self.bin_keys(&frame, n),
+                })
+            })
+            .collect::<Result<_>>()?;
+        let mut uses: HashMap<MapKey, Vec<(u32, f64)>> = HashMap::new();
+        for (v, keys) in keyed.into_iter().enumerate() {
+            for (key, w) in keys {
+                uses.entry(key).or_default().push((v as u32, w));
+            }
+        }
+        Ok(uses)
+    }
+
+    /// The cache bins of `frame` with their weights (see the [module docs](self)).
+    fn bin_keys(&self, frame: &Frame, n: usize) -> Vec<(MapKey, f64)> {
+        let step = std::f64::consts::PI / n as f64;
+        if self.orientation.brdf().is_mirror_symmetric() {
+            let (theta, phi) = angles(unit(frame.mirror()).unwrap_or(frame.normal));
+            let (fi, fj) = (theta / step - 0.5, phi / step - 0.5);
+            let (i0, j0) = (fi.floor(), fj.floor());
+            let (ti, tj) = (fi - i0, fj - j0);
+            let mut keys: Vec<(MapKey, f64)> = Vec::with_capacity(4);
+            for (di, wi) in [(0, 1.0 - ti), (1, ti)] {
+                for (dj, wj) in [(0, 1.0 - tj), (1, tj)] {
+                    let w = wi * wj;
+                    if w == 0.0 {
+                        continue;
+                    }
+                    // Rows clamp at the poles, columns wrap at the seam.
+                    let i = (i0 as i64 + di).clamp(0, n as i64 - 1) as u32;
+                    let j = (j0 as i64 + dj).rem_euclid(2 * n as i64) as u32;
+                    match keys.iter_mut().find(|(k, _)| *k == MapKey::Mirror(i, j)) {
+                        Some((_, acc)) => *acc += w,
+                        None => keys.push((MapKey::Mirror(i, j), w)),
+                    }
+                }
+            }
+            return keys;
+        }
+        let (theta, phi) = angles(frame.normal);
+        let i = ((theta / step) as usize).min(n - 1);
+        let j = ((phi / step) as usize).min(2 * n - 1);
+        let centre = bin_centre(n, i as u32, j as u32);
+        let (entry, turn) = self
+            .orientation
+            .quantise(&Frame {
+                normal: centre,
+                outgoing: frame.outgoing,
+            })
+            .unwrap_or((0, 0));
+        vec![(
+            MapKey::View(i as u32, j as u32, entry as u32, turn as u32),
+            1.0,
+        )]
+    }
+
+    /// The frame a map key stands for.
+    fn frame_of(&self, key: MapKey, eye: [f64; 3]) -> Result<Frame> {
+        let n = self.bins.unwrap_or(1);
+        match key {
+            MapKey::Vertex(v) => self.vertex_frame(v as usize, eye),
+            MapKey::Mirror(i, j) => {
+                let r = bin_centre(n, i, j);
+                Ok(Frame {
+                    normal: r,
+                    outgoing: r,
+                })
+            }
+            MapKey::View(i, j, entry, turn) => {
+                let normal = bin_centre(n, i, j);
+                let local = self.orientation.outgoing_of(entry as usize, turn as usize);
+                let outgoing = to_pole(normal).inverse().apply(local);
+                Ok(Frame { normal, outgoing })
+            }
+        }
+    }
+
+    /// The BRDF in `frame`, truncated to `--keep-brdf` and the depth, as channel planes in `T`.
+    fn brdf_planes(&self, frame: &Frame) -> Result<Planes<T>> {
+        let map = self.orientation.lobe(frame)?;
+        let param = map.param();
+        let (faces, s, _, channels) = map.as_array().dim();
+        let texels = faces * s * s;
+        let mut planes = vec![0.0f64; channels * texels];
+        for ((f, i, j, c), v) in map.as_array().indexed_iter() {
+            planes[c * texels + (f * s + i) * s + j] = *v;
+        }
+        let depth = self.transport.depth();
+        let levels = s.trailing_zeros() as usize;
+        if self.keep_brdf.is_some() || depth < levels {
+            truncate_planes(param, &mut planes, channels, self.keep_brdf, depth)?;
+        }
+        Ok(planes.into_iter().map(T::from_f64).collect())
+    }
+}
+
+/// The centre direction of bin `(i, j)` of an `n x 2n` lat-long grid.
+fn bin_centre(n: usize, i: u32, j: u32) -> [f64; 3] {
+    let step = std::f64::consts::PI / n as f64;
+    direction((i as f64 + 0.5) * step, (j as f64 + 0.5) * step)
+}
+
+/// Each face's `s x s` block of every plane of `planes` (`channels x texels`), in order.
+fn face_blocks(planes: &mut [f64], s: usize) -> std::slice::ChunksExactMut<'_, f64> {
+    planes.chunks_exact_mut(s * s)
+}
+
+/// Truncates a function given as pixel planes (`channels x texels`) in place: forward
+/// (orthonormal, per face), keep the `keep` largest details by RGB magnitude and the scaling
+/// coefficients, zero the levels from `depth` on, inverse.
+fn truncate_planes(
+    param: Parameterization,
+    planes: &mut [f64],
+    channels: usize,
+    keep: Option<usize>,
+    depth: usize,
+) -> Result<()> {
+    let s = param.face_size();
+    let levels = s.trailing_zeros() as usize;
+    let texels = param.texels();
+    let mut work = Vec::new();
+    let mut coefficients = vec![0.0f64; planes.len()];
+    for (src, dst) in face_blocks(planes, s).zip(coefficients.chunks_exact_mut(s * s)) {
+        let image = ArrayView2::from_shape((s, s), &*src).expect("a face is s x s");
+        let out = ndarray::ArrayViewMut2::from_shape((s, s), dst).expect("a face is s x s");
+        pyramid::forward_into(image, levels, Normalization::Orthonormal, out, &mut work)?;
+    }
+    let indices: Vec<u32> = (0..texels as u32).collect();
+    let kept = match keep {
+        Some(k) => select_kept(
+            param,
+            Selection::Largest(k),
+            &indices,
+            |t| {
+                (0..channels)
+                    .map(|c| coefficients[c * texels + t].powi(2))
+                    .sum()
+            },
+            &mut Vec::new(),
+        ),
+        None => vec![true; texels],
+    };
+    for c in 0..channels {
+        for t in 0..texels {
+            if !(kept[t] && within_depth(s, depth, t)) {
+                coefficients[c * texels + t] = 0.0;
+            }
+        }
+    }
+    for (src, dst) in coefficients.chunks_exact(s * s).zip(face_blocks(planes, s)) {
+        let coeffs = ArrayView2::from_shape((s, s), src).expect("a face is s x s");
+        let out = ndarray::ArrayViewMut2::from_shape((s, s), dst).expect("a face is s x s");
+        pyramid::inverse_into(coeffs, levels, Normalization::Orthonormal, out, &mut work)?;
+    }
+    Ok(())
+}
+
+/// The lighting's pixels (`3 x texels`, channel planes) as the product sees them: its kept
+/// coefficients, limited to the detail levels `0..depth`, inverted face by face.
+fn light_pixels<T: Sample>(lighting: &Lighting, depth: usize) -> Result<Vec<T>> {
+    let param = lighting.param();
+    let s = param.face_size();
+    let levels = s.trailing_zeros() as usize;
+    let texels = param.texels();
+    let c = lighting.coefficients_f64();
+    let mut coefficients = vec![0.0f64; 3 * texels];
+    for t in 0..texels {
+        if within_depth(s, depth, t) {
+            for ch in 0..3 {
+                coefficients[ch * texels + t] = c[[t, ch]];
+            }
+        }
+    }
+    let mut pixels = vec![0.0f64; 3 * texels];
+    let mut work = Vec::new();
+    for (src, dst) in coefficients
+        .chunks_exact(s * s)
+        .zip(pixels.chunks_exact_mut(s * s))
+    {
+        let coeffs = ArrayView2::from_shape((s, s), src).expect("a face is s x s");
+        let out = ndarray::ArrayViewMut2::from_shape((s, s), dst).expect("a face is s x s");
+        pyramid::inverse_into(coeffs, levels, Normalization::Orthonormal, out, &mut work)?;
+    }
+    Ok(pixels.into_iter().map(T::from_f64).collect())
+}
+
+/// `Q`, the orthonormal coefficients of `light x brdf` pixel by pixel, as RGB rows in Mallat
+/// order (the layout [`PreparedTransport::dot_rows`] reads). `brdf` has 1 or 3 planes; the
+/// buffers (`product`: a face's pixels and coefficients) are reused from call to call.
+fn product_rows<T: Sample>(
+    param: Parameterization,
+    light: &[T],
+    brdf: &[T],
+    product: &mut Vec<T>,
+    rows: &mut Vec<[T; 3]>,
+    work: &mut Vec<T>,
+) -> Result<()> {
+    let s = param.face_size();
+    let levels = s.trailing_zeros() as usize;
+    let texels = param.texels();
+    let channels = brdf.len() / texels;
+    product.resize(2 * s * s, T::zero());
+    rows.resize(texels, [T::zero(); 3]);
+    let (pixels, coefficients) = product.split_at_mut(s * s);
+    for c in 0..3 {
+        let b = &brdf[(c.min(channels - 1)) * texels..][..texels];
+        let l = &light[c * texels..][..texels];
+        for face in 0..param.faces() {
+            let at = face * s * s;
+            for (t, p) in pixels.iter_mut().enumerate() {
+                *p = l[at + t] * b[at + t];
+            }
+            let image = ArrayView2::from_shape((s, s), &*pixels).expect("a face is s x s");
+            let out = ndarray::ArrayViewMut2::from_shape((s, s), &mut *coefficients)
+                .expect("a face is s x s");
+            pyramid::forward_into(image, levels, Normalization::Orthonormal, out, work)?;
+            for (t, &q) in coefficients.iter().enumerate() {
+                rows[at + t][c] = q;
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;
