@@ -94,7 +94,7 @@ impl Default for GlossyOptions {
 }
 
 /// Which BRDF map a vertex uses: its own, or a bin of the cache.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 enum MapKey {
     /// Vertex `v`'s exact frame (no cache).
     Vertex(u32),
@@ -274,7 +274,9 @@ impl<T: Sample> GlossyShader<T> {
             report.rotated = uses.len();
         }
         let start = Instant::now();
-        let jobs: Vec<(MapKey, Vec<(u32, f64)>)> = uses.into_iter().collect();
+        // In key order, so that every vertex's sum is added up in the same order each time.
+        let mut jobs: Vec<(MapKey, Vec<(u32, f64)>)> = uses.into_iter().collect();
+        jobs.sort_unstable_by_key(|(key, _)| *key);
         let contributions: Vec<Vec<(u32, [f64; 3])>> = jobs
             .par_iter()
             .map_init(
