@@ -76,6 +76,15 @@ pub enum Error {
         #[source]
         source: crate::relight::SceneError,
     },
+    /// A measured-BRDF (MERL) file is not usable.
+    #[error("{}: {source}", path.display())]
+    Merl {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        #[source]
+        source: crate::relight::brdf::merl::MerlError,
+    },
     /// The output file exists and the caller did not ask to replace it.
     #[error("{}: already exists (use --force to replace it)", path.display())]
     OutputExists {
@@ -118,6 +127,7 @@ impl Error {
             Error::Io { .. }
             | Error::Format { .. }
             | Error::OutputExists { .. }
+            | Error::Merl { .. }
             | Error::Scene { .. } => self,
             other => Error::Format {
                 path: path.to_path_buf(),

@@ -425,7 +425,7 @@ fn bad_lighting_and_caches_fail_cleanly_naming_the_file() {
     );
     usage_error(
         &render_args(&cache, &out, &["--env", p(&env), "--brdf", "ward:2"]),
-        &["--brdf", "lambert, phong:EXP, blinn:EXP"],
+        &["--brdf", "lambert, phong:EXP, blinn:EXP, merl:FILE"],
     );
     fails_cleanly(
         &render_args(&cache, &out, &["--env", p(&env), "--keep-light", "1000000"]),
@@ -677,6 +677,92 @@ fn reference_refuses_bad_inputs_before_any_work() {
         ],
         &["camera.png", "twice as wide"],
     );
+}
+
+#[test]
+fn reference_takes_glossy_and_measured_brdfs() {
+    use haarshift::relight::brdf::merl::MerlBrdf;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = sphere_on_plane(dir.path());
+    let env = env32();
+    let run = |brdf: &str, out: &Path| {
+        succeeds_with_stdout(&[
+            "relight",
+            "reference",
+            p(&scene),
+            "--env",
+            p(&env),
+            "--resolution",
+            "8",
+            "--brdf",
+            brdf,
+            "--vertices",
+            p(out),
+        ])
+    };
+    let (lambert, phong) = (dir.path().join("l.npy"), dir.path().join("p.npy"));
+    run("lambert", &lambert);
+    let stdout = run("phong:20", &phong);
+    assert!(stdout.contains("(phong:20)"), "{stdout}");
+    let (lambert, phong) = (read_vertices(&lambert), read_vertices(&phong));
+    // The sphere's 96 vertices are glossy; the ground plane after them stays Lambertian.
+    let ground = ndarray::s![96.., ..];
+    assert_eq!(phong.slice(ground), lambert.slice(ground));
+    let sphere = ndarray::s![..96, ..];
+    let gap = relative_rms(
+        &phong.slice(sphere).to_owned(),
+        &lambert.slice(sphere).to_owned(),
+    );
+    assert!(gap > 0.05, "phong:20 against lambert: {gap:.2e}");
+    // A measured BRDF: a constant table of 1 / pi is Lambert wherever the camera sees the
+    // surface (a measured BRDF is 0 seen from below its horizon).
+    let table = dir.path().join("flat.binary");
+    MerlBrdf::from_fn(|_, _, _| [std::f64::consts::FRAC_1_PI; 3])
+        .unwrap()
+        .write(&table, false)
+        .unwrap();
+    let merl = dir.path().join("m.npy");
+    let stdout = run(&format!("merl:{}", p(&table)), &merl);
+    assert!(stdout.contains("flat.binary"), "{stdout}");
+    let merl = read_vertices(&merl);
+    assert_eq!(merl.slice(ground), lambert.slice(ground));
+    let same = (0..96)
+        .filter(|&v| (merl[[v, 0]] - lambert[[v, 0]]).abs() <= 1e-5 * lambert[[v, 0]])
+        .count();
+    let dark = (0..96).filter(|&v| merl[[v, 0]] == 0.0).count();
+    assert!(
+        same + dark == 96 && same > 30,
+        "{same} as lambert, {dark} dark"
+    );
+    // Bad files: one line naming the file and the problem.
+    let out = dir.path().join("x.npy");
+    let missing = dir.path().join("missing.binary");
+    let args = |brdf: &str| {
+        vec![
+            "relight".to_owned(),
+            "reference".to_owned(),
+            p(&scene).to_owned(),
+            "--env".to_owned(),
+            p(&env).to_owned(),
+            "--brdf".to_owned(),
+            brdf.to_owned(),
+            "--vertices".to_owned(),
+            p(&out).to_owned(),
+        ]
+    };
+    let missing_args = args(&format!("merl:{}", p(&missing)));
+    let missing_args: Vec<&str> = missing_args.iter().map(String::as_str).collect();
+    fails_cleanly(&missing_args, &["missing.binary"]);
+    let mut short: Vec<u8> = [90i32, 90, 180]
+        .iter()
+        .flat_map(|d| d.to_le_bytes())
+        .collect();
+    short.extend([0u8; 800]);
+    let truncated = file(dir.path(), "short.binary", &short);
+    let truncated_args = args(&format!("merl:{}", p(&truncated)));
+    let truncated_args: Vec<&str> = truncated_args.iter().map(String::as_str).collect();
+    fails_cleanly(&truncated_args, &["short.binary", "truncated"]);
+    assert!(!out.exists());
 }
 
 #[test]

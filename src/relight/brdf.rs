@@ -5,13 +5,15 @@
 //! | [`Brdf::Lambert`] | `lambert` | `1 / pi` |
 //! | [`Brdf::Phong`] | `phong:EXP` | `(EXP + 2) / (2 pi) max(0, r . w_i)^EXP`, `r = 2 (n . w_o) n - w_o` the mirror direction |
 //! | [`Brdf::BlinnPhong`] | `blinn:EXP` | `(EXP + 8) / (8 pi) max(0, n . h)^EXP`, `h = (w_i + w_o) / |w_i + w_o|` |
+//! | [`Brdf::Measured`] | `merl:FILE` | a MERL table's RGB value at the directions' half/difference angles ([`merl`]) |
 //!
 //! `w_i` points toward the light, `w_o` toward the viewer, both unit; `0^0 = 1`, so Phong
 //! with exponent 0 is `1 / pi` everywhere: Lambert with albedo 1. The cosine
 //! `max(0, n . w_i)` and the visibility are not part of the BRDF: they are the transport's
 //! ([`super::TransportSet`]). A vertex's outgoing radiance is `albedo x` the integral of
 //! lighting x transport x `rho` (per channel), so `albedo` is the diffuse colour of a
-//! Lambertian surface and the specular colour of a glossy one.
+//! Lambertian surface and the specular colour of a glossy one. A measured BRDF has its own
+//! colour ([`Brdf::channels`] is 3), which the albedo scales.
 //!
 //! **Lambert** leaves the integral as a per-vertex constant ([`Brdf::vertex_factors`]) and
 //! what is left is the double product integral `<T_v, L>` of the transport and the lighting
@@ -30,16 +32,26 @@
 //! * **view-dependent BRDFs** (Blinn-Phong): local copies with the normal at +Y and the
 //!   viewer at azimuth 0 (in the Y-Z plane, on the +Z side), one per outgoing elevation
 //!   ([`LocalTable`]); the viewer's azimuth about the normal is a yaw of that map and the
-//!   normal's tilt a rotation.
+//!   normal's tilt a rotation. A measured BRDF (MERL) is isotropic and view-dependent: it
+//!   takes the same table of local copies, of three channels.
+//!
+//! A measured BRDF is evaluated in the local frame of the normal and any tangent: it is
+//! isotropic, so only the angles between `n`, `w_i` and `w_o` matter.
+
+pub mod merl;
 
 use std::fmt;
+use std::path::Path;
 use std::str::FromStr;
+use std::sync::Arc;
 
 use ndarray::ArrayView2;
 
+use super::mesh::cross;
 use crate::sphere::LatLongMap;
 use crate::sphere::latlong::direction;
 use crate::{Error, Result};
+use merl::MerlBrdf;
 
 /// The largest exponent accepted for Phong and Blinn-Phong: a Phong lobe of `1e4` is 1.3
 /// degrees wide at half maximum, finer than any map haarshift shades with.
@@ -70,10 +82,12 @@ pub enum Brdf {
         /// Shininess, `0..=MAX_EXPONENT`.
         exponent: f64,
     },
+    /// A measured isotropic BRDF, RGB: a MERL table (`merl:FILE` reads it).
+    Measured(Arc<MerlBrdf>),
 }
 
 /// The choices `--brdf` accepts, for help texts and errors.
-pub const BRDF_SYNTAX: &str = "lambert, phong:EXP, blinn:EXP";
+pub const BRDF_SYNTAX: &str = "lambert, phong:EXP, blinn:EXP, merl:FILE";
 
 impl FromStr for Brdf {
     type Err = Error;
@@ -105,6 +119,12 @@ impl FromStr for Brdf {
             "blinn" => Ok(Brdf::BlinnPhong {
                 exponent: exponent()?,
             }),
+            "merl" => match arg {
+                Some(path) if !path.is_empty() => {
+                    Ok(Brdf::Measured(Arc::new(MerlBrdf::read(Path::new(path))?)))
+                }
+                _ => Err(bad("merl needs a file: merl:FILE".into())),
+            },
             _ => Err(bad(format!("expected one of {BRDF_SYNTAX}"))),
         }
     }
@@ -116,6 +136,10 @@ impl fmt::Display for Brdf {
             Brdf::Lambert => f.write_str("lambert"),
             Brdf::Phong { exponent } => write!(f, "phong:{exponent}"),
             Brdf::BlinnPhong { exponent } => write!(f, "blinn:{exponent}"),
+            Brdf::Measured(m) => match m.path() {
+                Some(path) => write!(f, "merl:{}", path.display()),
+                None => f.write_str("merl:(a computed table)"),
+            },
         }
     }
 }
@@ -135,6 +159,20 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 pub fn mirror(n: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
     let k = 2.0 * dot(n, wo);
     std::array::from_fn(|i| k * n[i] - wo[i])
+}
+
+/// Two unit vectors completing the unit `n` to a right-handed orthonormal frame `(t, b, n)`.
+fn tangents(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    // Crossed with the axis least aligned with n, so the tangent never degenerates.
+    let axis = if n[0].abs() < 0.6 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let b = cross(n, axis);
+    let len = dot(b, b).sqrt();
+    let b = b.map(|x| x / len);
+    (cross(b, n), b)
 }
 
 /// `max(0, c)^e` with `0^0 = 1`.
@@ -167,6 +205,11 @@ impl Brdf {
     /// ```
     pub fn evaluate(&self, n: [f64; 3], wi: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
         let value = match *self {
+            Brdf::Measured(ref m) => {
+                let (t, b) = tangents(n);
+                let local = |w: [f64; 3]| [dot(t, w), dot(b, w), dot(n, w)];
+                return m.evaluate(local(wi), local(wo));
+            }
             Brdf::Lambert => std::f64::consts::FRAC_1_PI,
             Brdf::Phong { exponent } => {
                 (exponent + 2.0) / std::f64::consts::TAU * lobe(dot(mirror(n, wo), wi), exponent)
@@ -181,8 +224,22 @@ impl Brdf {
         [value; 3]
     }
 
-    /// The BRDF's copy in its local frame, an `height x 2 height` lat-long map of one channel
-    /// (RGB-independent materials) sampled at texel centres: for a mirror-symmetric BRDF
+    /// Channels of [`evaluate`](Self::evaluate) that differ and of [`local_map`](Self::local_map):
+    /// 1 for the analytic BRDFs (the same in R, G and B), 3 for a measured one.
+    ///
+    /// ```
+    /// use haarshift::relight::Brdf;
+    /// assert_eq!(Brdf::BlinnPhong { exponent: 8.0 }.channels(), 1);
+    /// ```
+    pub fn channels(&self) -> usize {
+        match self {
+            Brdf::Measured(_) => 3,
+            _ => 1,
+        }
+    }
+
+    /// The BRDF's copy in its local frame, an `height x 2 height` lat-long map of
+    /// [`channels`](Self::channels) channels sampled at texel centres: for a mirror-symmetric BRDF
     /// ([`is_mirror_symmetric`](Self::is_mirror_symmetric)) the lobe about +Y as a function of
     /// the angle to the mirror direction (`theta_o` does not matter); otherwise
     /// `rho(w, w_o)` for the normal +Y and the viewer `w_o = direction(theta_o, 0)` (elevation
@@ -210,7 +267,10 @@ impl Brdf {
         } else {
             (direction(theta_o, 0.0), up)
         };
-        LatLongMap::from_fn(height, 1, |w, out| out[0] = self.evaluate(n, w, wo)[0])
+        let channels = self.channels();
+        LatLongMap::from_fn(height, channels, |w, out| {
+            out.copy_from_slice(&self.evaluate(n, w, wo)[..channels])
+        })
     }
 }
 
@@ -388,5 +448,62 @@ mod tests {
         for s in ["lambert", "phong:0", "phong:200", "blinn:12.5"] {
             assert_eq!(s.parse::<Brdf>().unwrap().to_string(), s);
         }
+        assert_err!(
+            "merl:".parse::<Brdf>(),
+            InvalidParameter { name: "brdf", .. },
+            "merl:FILE"
+        );
+        assert_err!(
+            "merl:no/such.binary".parse::<Brdf>(),
+            Io { .. },
+            "no/such.binary"
+        );
+    }
+
+    #[test]
+    fn a_measured_brdf_parses_and_depends_only_on_the_angles_between_n_wi_and_wo() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("phong.binary");
+        let table = merl::tests::phong_table(20.0);
+        table.write(&path, false).unwrap();
+        let spec = format!("merl:{}", path.display());
+        let brdf: Brdf = spec.parse().unwrap();
+        assert_eq!(brdf.to_string(), spec);
+        assert_eq!((brdf.channels(), brdf.is_mirror_symmetric()), (3, false));
+        let Brdf::Measured(read) = &brdf else {
+            panic!("{brdf:?}")
+        };
+        assert_eq!((read.path(), read.unmeasured()), (Some(path.as_path()), 0));
+        // The same configuration about the normal z (the table's own frame) and about two
+        // other normals, reached by rotations: the same value.
+        let (wi, wo) = (direction(0.5, 0.3), direction(0.7, 2.0));
+        let z = [0.0, 0.0, 1.0];
+        // A quarter turn about x takes direction()'s pole +Y to z.
+        let in_frame = |w: [f64; 3]| [w[0], -w[2], w[1]];
+        let want = table.evaluate(in_frame(wi), in_frame(wo));
+        assert!(want[0] > 0.0);
+        assert_eq!(brdf.evaluate(z, in_frame(wi), in_frame(wo)), want);
+        for (yaw, pitch) in [(0.3, 1.1), (2.0, -0.4)] {
+            let rotate = |w: [f64; 3]| {
+                let (s, c) = f64::sin_cos(pitch);
+                let w = [w[0], c * w[1] - s * w[2], s * w[1] + c * w[2]];
+                let (s, c) = f64::sin_cos(yaw);
+                [c * w[0] + s * w[2], w[1], -s * w[0] + c * w[2]]
+            };
+            let n = rotate([0.0, 1.0, 0.0]);
+            let got = brdf.evaluate(n, rotate(wi), rotate(wo));
+            for c in 0..3 {
+                assert!(
+                    (got[c] - want[c]).abs() < 1e-12 * want[c],
+                    "{got:?} {want:?}"
+                );
+            }
+        }
+        // Its local maps carry the three channels (the scales of the MERL channels).
+        let map = brdf.local_map(8, 0.5).unwrap();
+        let a = map.as_array();
+        assert_eq!(a.dim(), (8, 16, 3));
+        let (r, b) = (a[[1, 0, 0]], a[[1, 0, 2]]);
+        assert!(r > 0.0 && (b / r - 1.0).abs() < 1e-9, "{r} {b}");
     }
 }

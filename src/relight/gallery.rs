@@ -185,7 +185,10 @@ pub fn gallery(
         let haar_kept = full.shade(&kept)?;
         let sh_light = harmonics.project(&env.sphere_map(param, &identity)?);
         let sh = shade_sh(transfer, cache.albedo.view(), sh_light.view())?.mapv(f64::from);
-        let quadrature = ReferenceOptions { progress: true };
+        let quadrature = ReferenceOptions {
+            progress: true,
+            ..Default::default()
+        };
         let lighting = env.lat_long(options.resolution, &identity)?;
         let (truth, _) = reference(
             &cache.mesh,

@@ -1,15 +1,23 @@
 //! The ground truth of relighting, independent of every Haar path: direct quadrature over the
 //! lighting's texels with one ray per texel.
 //!
-//! For a Lambertian vertex `v` (albedo `a_v`, unit normal `n_v`) under a lat-long lighting map
-//! `L` of `N x 2N` texels, the outgoing radiance is
+//! For a vertex `v` (albedo `a_v`, unit normal `n_v`, position `p_v`) of BRDF `rho` under a
+//! lat-long lighting map `L` of `N x 2N` texels, the outgoing radiance toward the eye `e` is
 //!
-//! `R_v = a_v / pi x sum_t L(t) V(v, t) max(0, n_v . w_t) dOmega_t`,
+//! `R_v = a_v x sum_t L(t) V(v, t) max(0, n_v . w_t) rho(w_t, w_o,v) dOmega_t`,
+//! `w_o,v = (e - p_v) / |e - p_v|`,
 //!
 //! the sum over every texel `t` with centre direction `w_t` and exact solid angle `dOmega_t`
 //! ([`sphere::latlong`](crate::sphere::latlong)), `V(v, t)` one ray through the texel centre
 //! from the offset origin `p_v + eps n_v` ([`ray_offset`](super::ray_offset)), through the
-//! [`Occlusion`] trait. This is issue 11's contract for checking: `L` is the environment brought
+//! [`Occlusion`] trait, and `rho` evaluated analytically at `(w_t, w_o,v)` in the vertex's own
+//! frame ([`Brdf::evaluate`]): no local copy, no rotation. For a Lambertian vertex `rho = 1/pi`
+//! leaves the sum as `a_v / pi x sum_t L(t) V(v, t) max(0, n_v . w_t) dOmega_t`, which is
+//! what is computed (the eye is not needed). [`ReferenceOptions::object_vertices`] gives the
+//! BRDF to the scene's objects only, the ground plane after them staying Lambertian
+//! ([`Scene::object_vertices`](super::Scene::object_vertices)).
+//!
+//! This is issue 11's contract for checking: `L` is the environment brought
 //! to `N x 2N` by solid-angle-weighted means and rotated
 //! ([`Environment::lat_long`](super::environment::Environment::lat_long)); `N` need not be a
 //! power of two. Nothing here touches the transport, the Haar transform or a product integral,
@@ -24,10 +32,10 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2, Axis};
 use rayon::prelude::*;
 
-use super::Mesh;
 use super::mesh::dot;
 use super::raycast::Occlusion;
 use super::visibility::{f32x3, origin_and_normal, progress_bar, ray_offset};
+use super::{Brdf, Mesh};
 use crate::sphere::LatLongMap;
 use crate::sphere::latlong::{direction, pixel_centre, pixel_solid_angle};
 use crate::{Error, Result};
@@ -35,13 +43,52 @@ use crate::{Error, Result};
 /// How to compute the reference.
 ///
 /// ```
-/// use haarshift::relight::ReferenceOptions;
-/// assert!(!ReferenceOptions::default().progress);
+/// use haarshift::relight::{Brdf, ReferenceOptions};
+/// let o = ReferenceOptions::default();
+/// assert!(!o.progress && o.brdf == Brdf::Lambert && o.eye.is_none());
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReferenceOptions {
     /// Show a progress bar on standard error (hidden when it is not a terminal).
     pub progress: bool,
+    /// The objects' BRDF.
+    pub brdf: Brdf,
+    /// The camera's position, which fixes every vertex's outgoing direction: required unless
+    /// `brdf` is Lambertian.
+    pub eye: Option<[f64; 3]>,
+    /// Vertices `0..object_vertices` have `brdf`, the rest (the ground plane) are Lambertian;
+    /// `None`: every vertex has `brdf`.
+    pub object_vertices: Option<usize>,
+}
+
+impl ReferenceOptions {
+    /// The eye when the BRDF needs one, checked against `vertices`' count.
+    fn checked_eye(&self, vertices: usize) -> Result<Option<[f64; 3]>> {
+        if let Some(objects) = self.object_vertices
+            && objects > vertices
+        {
+            return Err(Error::parameter(
+                "object vertices",
+                format!("{objects}, but the mesh has {vertices} vertices"),
+            ));
+        }
+        if self.brdf.is_lambert() || self.object_vertices == Some(0) {
+            return Ok(None);
+        }
+        match self.eye {
+            None => Err(Error::parameter(
+                "eye",
+                format!(
+                    "the BRDF {} depends on the outgoing direction: give the camera position",
+                    self.brdf
+                ),
+            )),
+            Some(e) if e.iter().any(|x| !x.is_finite()) => {
+                Err(Error::parameter("eye", format!("{e:?}: must be finite")))
+            }
+            Some(e) => Ok(Some(e)),
+        }
+    }
 }
 
 /// What the reference computation did.
@@ -95,7 +142,7 @@ fn lit_texels(lighting: &LatLongMap<f64>) -> Result<Vec<LitTexel>> {
 
 /// Every vertex's outgoing radiance `(V, 3)` by direct quadrature over `lighting`'s texels
 /// (see the [module docs](self)); `albedo` is `(V, 3)`, `lighting` a lat-long map of any height
-/// `N`, gray or RGB, already rotated.
+/// `N`, gray or RGB, already rotated. A BRDF other than Lambert needs `options.eye`.
 ///
 /// ```
 /// use haarshift::relight::{Mesh, ReferenceOptions, SceneBvh, reference};
@@ -110,6 +157,11 @@ fn lit_texels(lighting: &LatLongMap<f64>) -> Result<Vec<LitTexel>> {
 ///                             &ReferenceOptions::default()).unwrap();
 /// assert!((r[[0, 0]] - 0.5).abs() < 2e-3); // the quadrature: 0.5 x 1.0021
 /// assert_eq!(report.rays, 3 * 12 * 48); // the upper half of 24 x 48 texels, per vertex
+/// // Phong 1 seen from straight above vertex 0: at normal incidence it also reflects albedo.
+/// let phong = ReferenceOptions { brdf: "phong:1".parse().unwrap(), eye: Some([0.0, 5.0, 0.0]),
+///                                ..Default::default() };
+/// let (r, _) = reference(&m, &SceneBvh::new(&m), albedo.view(), &sky, &phong).unwrap();
+/// assert!((r[[0, 0]] - 0.5).abs() < 2e-3);
 /// ```
 pub fn reference(
     mesh: &Mesh,
@@ -125,6 +177,8 @@ pub fn reference(
             format!("the albedo must be ({vertices}, 3), one RGB row per vertex"),
         ));
     }
+    let eye = options.checked_eye(vertices)?;
+    let objects = options.object_vertices.unwrap_or(vertices);
     let start = Instant::now();
     let texels = lit_texels(lighting)?;
     let eps = ray_offset(mesh);
@@ -136,6 +190,11 @@ pub fn reference(
         .enumerate()
         .map(|(v, mut radiance)| {
             let (origin, n) = origin_and_normal(mesh, v, eps);
+            // The glossy vertex's view, or None for a Lambertian one.
+            let view = match eye {
+                Some(e) if v < objects => Some(outgoing(mesh, v, n, e)),
+                _ => None,
+            };
             let o = f32x3(origin);
             let mut sum = [0.0f64; 3];
             let mut rays = 0u64;
@@ -147,13 +206,23 @@ pub fn reference(
                 rays += 1;
                 if !occlusion.occluded(o, t.ray, f32::INFINITY) {
                     let w = cos * t.solid_angle;
+                    let rho = match view {
+                        Some(wo) => options.brdf.evaluate(n, t.direction, wo),
+                        None => [1.0; 3],
+                    };
                     sum.iter_mut()
                         .zip(t.radiance)
-                        .for_each(|(s, l)| *s += l * w);
+                        .zip(rho)
+                        .for_each(|((s, l), r)| *s += l * w * r);
                 }
             }
             for c in 0..3 {
-                radiance[c] = f64::from(albedo[[v, c]]) / std::f64::consts::PI * sum[c];
+                let a = f64::from(albedo[[v, c]]);
+                // A Lambertian sum still lacks its 1 / pi.
+                radiance[c] = match view {
+                    Some(_) => a * sum[c],
+                    None => a / std::f64::consts::PI * sum[c],
+                };
             }
             bar.inc(1);
             rays
@@ -165,6 +234,13 @@ pub fn reference(
         seconds: start.elapsed().as_secs_f64(),
     };
     Ok((out, report))
+}
+
+/// The unit direction from vertex `v` to the eye `e` (the normal `n` if the eye is on it).
+fn outgoing(mesh: &Mesh, v: usize, n: [f64; 3], e: [f64; 3]) -> [f64; 3] {
+    let d: [f64; 3] = std::array::from_fn(|k| e[k] - mesh.positions()[[v, k]]);
+    let len = dot(d, d).sqrt();
+    if len > 0.0 { d.map(|x| x / len) } else { n }
 }
 
 #[cfg(test)]

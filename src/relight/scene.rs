@@ -4,7 +4,8 @@
 //! [`add_ground_plane`]: a square at the scene's lowest `y`, centred under the bounding box's
 //! centre, of side `4 x` the box's largest horizontal extent (`max(dx, dz)`), normal `+Y`,
 //! subdivided into a grid of [`GROUND_CELLS`]` x `[`GROUND_CELLS`] cells (so it can receive
-//! shadows): `(GROUND_CELLS + 1)^2 = 1089` vertices appended after the mesh's, row by row from
+//! shadows): `(GROUND_CELLS + 1)^2 = 1089` ([`GROUND_VERTICES`]) vertices appended after the
+//! mesh's, row by row from
 //! the corner at `(-x, +z)`, `x` fastest.
 //!
 //! # Generators
@@ -58,6 +59,9 @@ use crate::{Error, Result};
 
 /// Cells per side of the ground plane's grid.
 pub const GROUND_CELLS: usize = 32;
+
+/// Vertices the ground plane adds: `(GROUND_CELLS + 1)^2`.
+pub const GROUND_VERTICES: usize = (GROUND_CELLS + 1) * (GROUND_CELLS + 1);
 
 /// The ground plane's albedo in a scene file.
 pub const GROUND_ALBEDO: [f32; 3] = [0.8, 0.8, 0.8];
@@ -606,6 +610,25 @@ impl Scene {
         self.albedo
             .append(ndarray::Axis(0), added.view())
             .expect("both are (V, 3)");
+    }
+
+    /// The vertices of the scene's objects, `0..object_vertices()`: all but the ground plane's
+    /// (the last [`GROUND_VERTICES`] when the scene has it), which stays Lambertian under a
+    /// glossy BRDF.
+    ///
+    /// ```
+    /// use haarshift::relight::{Generator, Scene};
+    /// let sphere = Generator::Sphere { cells: 2 }.mesh().unwrap();
+    /// assert_eq!(Scene::from_mesh(sphere.clone(), true).object_vertices(), 54);
+    /// assert_eq!(Scene::from_mesh(sphere, false).object_vertices(), 54);
+    /// ```
+    pub fn object_vertices(&self) -> usize {
+        let ground = if self.ground_plane {
+            GROUND_VERTICES
+        } else {
+            0
+        };
+        self.mesh.vertex_count().saturating_sub(ground)
     }
 
     /// Reads a scene: a JSON scene file (`.json`), or a mesh file (OBJ or PLY) as a scene of

@@ -104,7 +104,7 @@ pub fn run(args: Args) -> Result<()> {
     let (env, [yaw, pitch, roll]) = args.light.load(cache.environment.as_ref())?;
     let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
     let start = Instant::now();
-    let prepared = args.shading.prepare(&cache, &args.material.brdf)?;
+    let prepared = args.shading.prepare(&cache, &args.material.brdf()?)?;
     // The lat-long-to-working mapping (a cube's conversion table) is built once, not per frame.
     let mapping = SphereMapping::new(env.map().height(), cache.transport.param())?;
     let mut text = format!("transport prepared once in {:.1} ms\n", ms(start));

@@ -52,9 +52,16 @@ fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
     }
 }
 
-/// `--brdf`, parsed by the library.
-fn brdf(s: &str) -> std::result::Result<Brdf, String> {
-    s.parse::<Brdf>().map_err(|e| e.to_string())
+/// `--brdf`, its syntax checked by the library; a `merl:FILE` is read later
+/// ([`MaterialFlags::brdf`]), so that a bad file is one line naming it, not a usage error.
+fn brdf(s: &str) -> std::result::Result<String, String> {
+    match s.strip_prefix("merl:") {
+        Some(path) if !path.is_empty() => Ok(s.to_owned()),
+        _ => s
+            .parse::<Brdf>()
+            .map(|_| s.to_owned())
+            .map_err(|e| e.to_string()),
+    }
 }
 
 /// The lighting: the environment map and its rotation.
@@ -119,10 +126,10 @@ pub fn rotation([yaw, pitch, roll]: [f64; 3]) -> Result<SphereRotation> {
 #[derive(clap::Args, Debug)]
 pub struct MaterialFlags {
     /// The BRDF: lambert, phong:EXP (a lobe about the mirror direction), blinn:EXP (Blinn-Phong,
-    /// of the half vector); glossy ones apply to the scene's objects, the ground plane stays
-    /// Lambertian
+    /// of the half vector), merl:FILE (a measured BRDF, MERL binary format); glossy and measured
+    /// ones apply to the scene's objects, the ground plane stays Lambertian
     #[arg(long, value_name = "BRDF", default_value = "lambert", value_parser = brdf)]
-    pub brdf: Brdf,
+    pub brdf: String,
 
     /// Lambertian albedo r,g,b (each 0 to 1) for every vertex [default: the scene's, 0.8 for
     /// a mesh and the ground plane]
@@ -131,6 +138,16 @@ pub struct MaterialFlags {
 }
 
 impl MaterialFlags {
+    /// The BRDF of `--brdf`, a measured one read from its file.
+    pub fn brdf(&self) -> Result<Brdf> {
+        self.brdf.parse()
+    }
+
+    /// The file `--brdf merl:FILE` names, an input.
+    pub fn brdf_file(&self) -> Option<&Path> {
+        self.brdf.strip_prefix("merl:").map(Path::new)
+    }
+
     /// `albedo` `(V, 3)` with every row replaced by `--albedo` when given (checked to be in
     /// `[0, 1]`).
     pub fn apply(&self, albedo: &mut ndarray::Array2<f32>) -> Result<()> {

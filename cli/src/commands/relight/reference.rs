@@ -14,9 +14,11 @@ use super::flags::{
 use crate::commands::{print, refuse_existing};
 
 const HELP: &str = "\
-The radiance leaving each vertex (Lambertian), by direct quadrature:
-  albedo / pi x sum over texels t of L(t) V(v, t) max(0, n . w_t) dOmega_t,
-L the environment rotated by g(p) = f(R p) and downsampled to N x 2N by solid-angle-weighted
+The radiance leaving each vertex toward the camera, by direct quadrature:
+  albedo x sum over texels t of L(t) V(v, t) max(0, n . w_t) rho(w_t, w_o) dOmega_t,
+rho the BRDF (--brdf; lambert is 1 / pi) evaluated analytically at each texel's direction,
+w_o the direction from the vertex to the camera (the one --camera, the scene or the framing
+gives); with a glossy or measured BRDF the ground plane stays Lambertian. L the environment rotated by g(p) = f(R p) and downsampled to N x 2N by solid-angle-weighted
 means, w_t the texel centre's direction, V one ray per texel centre from the vertex offset
 along its normal by 1e-4 x the scene's bounding-box diagonal (blocked when it hits any
 triangle). No Haar transform, no cache: the ground truth that `relight render` is checked
@@ -26,6 +28,8 @@ rounding). Same output formats as `relight render`.
 Examples:
   haarshift relight reference testdata/meshes/bunny.ply --ground-plane --env park.hdr --vertices truth.npy
   haarshift relight reference bunny.ply --ground-plane --env park.hdr --resolution 64 --vertices truth.npy -o truth.png
+  haarshift relight reference bunny.ply --ground-plane --env park.hdr --brdf phong:50 --resolution 128 --vertices glossy.npy
+  haarshift relight reference bunny.ply --env park.hdr --brdf merl:gold-metallic-paint.binary --vertices gold.npy
   haarshift relight reference scene.json --yaw 90 --albedo 0.5,0.5,0.5 --vertices truth.npy";
 
 /// Per-vertex radiance by direct quadrature (the ground truth), optionally rendered.
@@ -66,12 +70,14 @@ pub fn run(args: Args) -> Result<()> {
     outputs.extend(args.output.as_deref());
     let mut inputs = vec![args.scene.input.as_path()];
     inputs.extend(args.light.env.as_deref());
+    inputs.extend(args.material.brdf_file());
     refuse_inputs(&inputs, &outputs)?;
     refuse_existing(&outputs, args.force)?;
     if let Some(image) = &args.output {
         render_format(image)?;
     }
     let background = args.camera.background()?;
+    let brdf = args.material.brdf()?;
     let mut scene = args.scene.load()?;
     args.material.apply(&mut scene.albedo)?;
     let (env, angles) = args.light.load(scene.environment.as_ref())?;
@@ -79,12 +85,18 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     let lighting = env.lat_long(args.resolution, &rotation)?;
     let lighting_ms = ms(start);
+    let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh)?;
     let (radiance, report) = reference(
         &scene.mesh,
         &SceneBvh::new(&scene.mesh),
         scene.albedo.view(),
         &lighting,
-        &ReferenceOptions { progress: true },
+        &ReferenceOptions {
+            progress: true,
+            brdf: brdf.clone(),
+            eye: Some(camera.position()),
+            object_vertices: Some(scene.object_vertices()),
+        },
     )?;
     let radiance = radiance.mapv(|v| v as f32);
     haarshift::io::write_npy(
@@ -94,17 +106,17 @@ pub fn run(args: Args) -> Result<()> {
         args.force,
     )?;
     let mut text = format!(
-        "{}: ({}, 3) radiance by quadrature over {} x {} texels: rays {}, {:.3} s \
+        "{}: ({}, 3) radiance ({}) by quadrature over {} x {} texels: rays {}, {:.3} s \
          (lighting downsampled in {lighting_ms:.1} ms)\n",
         args.vertices.display(),
         scene.mesh.vertex_count(),
+        brdf,
         args.resolution,
         2 * args.resolution,
         report.rays,
         report.seconds,
     );
     if let Some(path) = &args.output {
-        let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh)?;
         let image = args.camera.draw(
             &camera,
             &scene.mesh,

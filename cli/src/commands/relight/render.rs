@@ -101,7 +101,7 @@ pub fn run(args: Args) -> Result<()> {
     let shaded = match args.basis {
         Basis::Haar => {
             let start = Instant::now();
-            let prepared = args.shading.prepare(&cache, &args.material.brdf)?;
+            let prepared = args.shading.prepare(&cache, &args.material.brdf()?)?;
             let prepare_ms = ms(start);
             let start = Instant::now();
             let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
