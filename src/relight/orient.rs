@@ -283,8 +283,9 @@ impl Orientation {
     pub fn lobe(&self, frame: &Frame) -> Result<SphereMap<f64>> {
         if self.rotation == BrdfRotation::Direct {
             let (n, wo) = (frame.normal, frame.outgoing);
-            return SphereMap::from_fn(self.param, 1, |w, out| {
-                out[0] = self.brdf.evaluate(n, w, wo)[0];
+            let channels = self.brdf.channels();
+            return SphereMap::from_fn(self.param, channels, |w, out| {
+                out.copy_from_slice(&self.brdf.evaluate(n, w, wo)[..channels]);
             });
         }
         let (entry, turn, tilt) = self.plan(frame)?;

@@ -9,8 +9,12 @@ use haarshift::relight::raster::{to_srgb8, write_render};
 use haarshift::relight::{Lighting, SceneCache};
 use haarshift::{Error, Result};
 
+use haarshift::relight::PreparedTransport;
+use haarshift::relight::glossy::GlossyShader;
+
 use super::flags::{
-    CameraFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs,
+    rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -56,11 +60,22 @@ pub struct Args {
     pub shading: ShadingFlags,
 
     #[command(flatten)]
+    pub glossy: GlossyFlags,
+
+    #[command(flatten)]
     pub camera: CameraFlags,
 
     /// Replace the outputs if they exist
     #[arg(long)]
     pub force: bool,
+}
+
+/// How the frames are shaded.
+enum Shader {
+    /// One sparse dot per vertex.
+    Lambert(PreparedTransport<f32>),
+    /// The triple product with the rotated BRDF.
+    Glossy(GlossyShader<f32>),
 }
 
 /// The most frames in one animation.
@@ -96,6 +111,7 @@ pub fn run(args: Args) -> Result<()> {
     let output_refs: Vec<&std::path::Path> = outputs.iter().map(|p| p.as_path()).collect();
     let mut inputs = vec![args.cache.as_path()];
     inputs.extend(args.light.env.as_deref());
+    inputs.extend(args.material.brdf_file());
     refuse_inputs(&inputs, &output_refs)?;
     refuse_existing(&output_refs, args.force)?;
     let background = args.camera.background()?;
@@ -103,8 +119,16 @@ pub fn run(args: Args) -> Result<()> {
     args.material.apply(&mut cache.albedo)?;
     let (env, [yaw, pitch, roll]) = args.light.load(cache.environment.as_ref())?;
     let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
+    let brdf = args.material.brdf()?;
+    args.glossy.check(&brdf)?;
     let start = Instant::now();
-    let prepared = args.shading.prepare(&cache, &args.material.brdf()?)?;
+    // Lambertian: one sparse dot per vertex and frame. Glossy: the view is fixed, so with a
+    // rotation cache only the first frame rotates BRDF maps.
+    let shader = if brdf.is_lambert() {
+        Shader::Lambert(args.shading.prepare(&cache)?)
+    } else {
+        Shader::Glossy(args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?)
+    };
     // The lat-long-to-working mapping (a cube's conversion table) is built once, not per frame.
     let mapping = SphereMapping::new(env.map().height(), cache.transport.param())?;
     let mut text = format!("transport prepared once in {:.1} ms\n", ms(start));
@@ -115,7 +139,10 @@ pub fn run(args: Args) -> Result<()> {
         let frame_yaw = yaw + 360.0 * k as f64 / args.frames as f64;
         let turn = rotation([frame_yaw, pitch, roll])?;
         let lighting = Lighting::encode(&env, &mapping, &turn, args.shading.light_selection())?;
-        prepared.shade_into(&lighting, &mut radiance)?;
+        match &shader {
+            Shader::Lambert(prepared) => prepared.shade_into(&lighting, &mut radiance)?,
+            Shader::Glossy(glossy) => radiance = glossy.shade(&lighting, camera.position())?.0,
+        }
         let shade_ms = ms(start);
         let start = Instant::now();
         let image = args.camera.draw(

@@ -8,10 +8,16 @@ use haarshift::product::Selection;
 use haarshift::relight::environment::Environment;
 use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
 use haarshift::relight::raster::{Mesh as RasterMesh, render};
+use haarshift::relight::brdf::DEFAULT_ELEVATIONS;
+use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
+use haarshift::relight::orient::BrdfRotation;
+use haarshift::relight::scene::GROUND_VERTICES;
 use haarshift::relight::{Brdf, PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift::{Error, Result};
+
+use crate::commands::{choice, names};
 use ndarray::ArrayView2;
 
 /// A mesh or a scene file, and the ground plane.
@@ -161,6 +167,69 @@ impl MaterialFlags {
             for mut row in albedo.rows_mut() {
                 row.assign(&ndarray::arr1(&a.map(|x| x as f32)));
             }
+        }
+        Ok(())
+    }
+}
+
+/// How a glossy BRDF is brought into each vertex's frame and truncated.
+#[derive(clap::Args, Debug)]
+pub struct GlossyFlags {
+    /// How each vertex's BRDF is rotated into its frame: `haar` (the chain rule on the Haar
+    /// coefficients), `spatial` (bilinear in pixels, then transformed), `reference` (solid-angle
+    /// integration), `direct` (the BRDF evaluated at every texel, no rotation)
+    #[arg(long, value_name = "METHOD", default_value = "haar",
+          value_parser = choice::<BrdfRotation>(names!(BrdfRotation)))]
+    pub brdf_rotation: BrdfRotation,
+
+    /// Rotate from detail level L (the thesis's level L+1: faces 2^(L+1) texels wide; finer
+    /// levels are zero) [default: the finest]
+    #[arg(long, value_name = "L")]
+    pub level: Option<usize>,
+
+    /// Detail coefficients of each rotated BRDF map kept (the largest), plus each face's
+    /// scaling coefficient [default: all]
+    #[arg(long, value_name = "K", value_parser = positive)]
+    pub keep_brdf: Option<usize>,
+
+    /// Rotate one BRDF map per bin of an N x 2N grid of directions (the mirror direction for
+    /// Phong, blended over the 4 nearest bins; the normal for view-dependent BRDFs) and keep it
+    /// for every view [default: one rotation per vertex]
+    #[arg(long, value_name = "N")]
+    pub rotation_cache: Option<usize>,
+
+    /// Outgoing elevations tabulated for a view-dependent BRDF (Blinn-Phong, MERL)
+    #[arg(long, value_name = "E", default_value_t = DEFAULT_ELEVATIONS)]
+    pub elevations: usize,
+}
+
+impl GlossyFlags {
+    /// The glossy options for `brdf`.
+    pub fn options(&self, brdf: &Brdf) -> GlossyOptions {
+        GlossyOptions {
+            brdf: brdf.clone(),
+            rotation: self.brdf_rotation,
+            level: self.level,
+            keep_brdf: self.keep_brdf,
+            cache_bins: self.rotation_cache,
+            elevations: self.elevations,
+        }
+    }
+
+    /// Refuses these flags for a Lambertian `brdf`: they would change nothing.
+    pub fn check(&self, brdf: &Brdf) -> Result<()> {
+        let set = self.brdf_rotation != BrdfRotation::default()
+            || self.level.is_some()
+            || self.keep_brdf.is_some()
+            || self.rotation_cache.is_some()
+            || self.elevations != DEFAULT_ELEVATIONS;
+        if set && brdf.is_lambert() {
+            return Err(Error::InvalidParameter {
+                name: "brdf-rotation",
+                reason: "--brdf-rotation, --level, --keep-brdf, --rotation-cache and \
+                         --elevations apply to glossy BRDFs; the BRDF is lambert"
+                    .into(),
+            });
         }
         Ok(())
     }
@@ -338,19 +407,36 @@ impl ShadingFlags {
         self.keep_light.is_some() || self.keep_visibility.is_some() || self.depth.is_some()
     }
 
-    /// `cache`'s transport prepared for shading with its albedo and `brdf` under these options.
-    pub fn prepare(&self, cache: &SceneCache, brdf: &Brdf) -> Result<PreparedTransport<f32>> {
-        if !brdf.is_lambert() {
-            return Err(Error::InvalidParameter {
-                name: "brdf",
-                reason: format!("{brdf}: this command shades lambert only"),
-            });
-        }
-        let options = ShadeOptions {
+    /// The transport's truncation.
+    pub fn options(&self) -> ShadeOptions {
+        ShadeOptions {
             keep_visibility: self.keep_visibility.map(Selection::Largest),
             depth: self.depth,
-        };
-        PreparedTransport::new(&cache.transport, cache.albedo.view(), &options)
+        }
+    }
+
+    /// `cache`'s transport prepared for Lambertian shading with its albedo.
+    pub fn prepare(&self, cache: &SceneCache) -> Result<PreparedTransport<f32>> {
+        PreparedTransport::new(&cache.transport, cache.albedo.view(), &self.options())
+    }
+
+    /// `cache`'s transport prepared for shading with `brdf` (glossy on the objects, the ground
+    /// plane Lambertian) under `glossy`.
+    pub fn prepare_glossy(
+        &self,
+        cache: &SceneCache,
+        brdf: &Brdf,
+        glossy: &GlossyFlags,
+    ) -> Result<GlossyShader<f32>> {
+        let ground = if cache.params.ground_plane { GROUND_VERTICES } else { 0 };
+        GlossyShader::new(
+            &cache.transport,
+            &cache.mesh,
+            cache.albedo.view(),
+            &self.options(),
+            &glossy.options(brdf),
+            cache.mesh.vertex_count().saturating_sub(ground),
+        )
     }
 }
 

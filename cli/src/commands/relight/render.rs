@@ -11,7 +11,8 @@ use haarshift::{Error, Result, SampleDepth};
 use ndarray::Array2;
 
 use super::flags::{
-    CameraFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs,
+    rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -69,6 +70,9 @@ pub struct Args {
     #[command(flatten)]
     pub shading: ShadingFlags,
 
+    #[command(flatten)]
+    pub glossy: GlossyFlags,
+
     /// `haar`: the sparse Haar transport and lighting. `sh`: the spherical-harmonic transfer
     /// stored by `precompute --sh-bands B` and the lighting projected onto the same bands
     #[arg(long, value_enum, default_value = "haar")]
@@ -87,6 +91,7 @@ pub fn run(args: Args) -> Result<()> {
     outputs.extend(args.vertices.as_deref());
     let mut inputs = vec![args.cache.as_path()];
     inputs.extend(args.light.env.as_deref());
+    inputs.extend(args.material.brdf_file());
     refuse_inputs(&inputs, &outputs)?;
     refuse_existing(&outputs, args.force)?;
     render_format(&args.output)?;
@@ -97,11 +102,13 @@ pub fn run(args: Args) -> Result<()> {
     let rotation = rotation(angles)?;
     let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
 
+    let brdf = args.material.brdf()?;
+    args.glossy.check(&brdf)?;
     let param = cache.transport.param();
     let shaded = match args.basis {
-        Basis::Haar => {
+        Basis::Haar if brdf.is_lambert() => {
             let start = Instant::now();
-            let prepared = args.shading.prepare(&cache, &args.material.brdf()?)?;
+            let prepared = args.shading.prepare(&cache)?;
             let prepare_ms = ms(start);
             let start = Instant::now();
             let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
@@ -120,7 +127,55 @@ pub fn run(args: Args) -> Result<()> {
                 ),
             }
         }
+        Basis::Haar => {
+            let start = Instant::now();
+            let shader =
+                args.shading
+                    .prepare_glossy(&cache, &brdf, &args.glossy)?;
+            let prepare_ms = ms(start);
+            let start = Instant::now();
+            let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
+            let encode_ms = ms(start);
+            let start = Instant::now();
+            let (radiance, report) = shader.shade(&lighting, camera.position())?;
+            let cache_note = match args.glossy.rotation_cache {
+                Some(n) => format!(
+                    "rotation cache {n} x {}: {} maps rotated in {:.1} ms, {} from the cache",
+                    2 * n,
+                    report.rotated,
+                    report.rotate_seconds * 1e3,
+                    report.maps - report.rotated
+                ),
+                None => format!("no rotation cache: {} maps rotated", report.rotated),
+            };
+            Shaded {
+                radiance,
+                encode_ms,
+                shade_ms: ms(start),
+                what: format!(
+                    "Haar triple product, {} rotated by {}{}, lighting kept {} detail \
+                     coefficients, transport {} coefficients; {cache_note}; transport prepared \
+                     once in {prepare_ms:.1} ms",
+                    brdf,
+                    args.glossy.brdf_rotation,
+                    args.glossy
+                        .level
+                        .map_or(String::new(), |l| format!(
+                            " from level {l} (thesis level {})",
+                            l + 1
+                        )),
+                    lighting.kept(),
+                    shader.transport().coefficient_count()
+                ),
+            }
+        }
         Basis::Sh => {
+            if !brdf.is_lambert() {
+                return Err(Error::InvalidParameter {
+                    name: "basis",
+                    reason: format!("{brdf}: --basis sh shades lambert only"),
+                });
+            }
             if args.shading.is_set() {
                 return Err(Error::InvalidParameter {
                     name: "basis",
