@@ -117,7 +117,9 @@ use std::f64::consts::PI;
 use ndarray::{Array3, ArrayView3, ArrayViewMut2, Axis, s};
 use rayon::prelude::*;
 
-use super::latlong::{angles, catmull_rom, continue_index, fill_grid, pixel_solid_angle};
+use super::latlong::{
+    angles, catmull_rom, continue_index, fill_grid, for_each_row, pixel_solid_angle,
+};
 use super::{LatLongMap, SphereCoefficients, SphereRotation};
 use crate::transform::{Band, pyramid};
 use crate::{Error, Result, Sample};
@@ -193,29 +195,23 @@ impl<T: Sample> SourceGradient<T> {
             &x[(r * n + c) * ch..][..ch]
         };
         let mut d_theta = vec![T::zero(); (m + 1) * n * ch];
-        d_theta
-            .par_chunks_mut(n * ch)
-            .enumerate()
-            .for_each(|(i, row)| {
-                let inv = T::from_f64(1.0 / step);
-                let i = i as isize;
-                for (j, out) in row.chunks_exact_mut(ch).enumerate() {
-                    let j = j as isize;
-                    difference(scheme, out, inv, |k| px(i + k, j));
-                }
-            });
+        for_each_row(&mut d_theta, n * ch, |i, row| {
+            let inv = T::from_f64(1.0 / step);
+            let i = i as isize;
+            for (j, out) in row.chunks_exact_mut(ch).enumerate() {
+                let j = j as isize;
+                difference(scheme, out, inv, |k| px(i + k, j));
+            }
+        });
         let mut d_phi = vec![T::zero(); m * n * ch];
-        d_phi
-            .par_chunks_mut(n * ch)
-            .enumerate()
-            .for_each(|(i, row)| {
-                let inv = T::from_f64(1.0 / (step * ((i as f64 + 0.5) * step).sin()));
-                let i = i as isize;
-                for (j, out) in row.chunks_exact_mut(ch).enumerate() {
-                    let j = j as isize;
-                    difference(scheme, out, inv, |k| px(i, j + 1 + k));
-                }
-            });
+        for_each_row(&mut d_phi, n * ch, |i, row| {
+            let inv = T::from_f64(1.0 / (step * ((i as f64 + 0.5) * step).sin()));
+            let i = i as isize;
+            for (j, out) in row.chunks_exact_mut(ch).enumerate() {
+                let j = j as isize;
+                difference(scheme, out, inv, |k| px(i, j + 1 + k));
+            }
+        });
         SourceGradient {
             scheme,
             m,
@@ -230,94 +226,122 @@ impl<T: Sample> SourceGradient<T> {
     /// `f_theta` and `f_phi / sin theta` at `(theta, phi)`, one value per channel each
     /// (step 3 of the [module docs](self)), interpolated as the scheme says.
     pub fn eval(&self, theta: f64, phi: f64, f_theta: &mut [T], f_phi_over_sin: &mut [T]) {
+        f_theta.fill(T::zero());
+        self.accumulate(theta, phi, 1.0, 0.0, f_theta);
+        f_phi_over_sin.fill(T::zero());
+        self.accumulate(theta, phi, 0.0, 1.0, f_phi_over_sin);
+    }
+
+    /// Adds `alpha f_theta + beta f_phi / sin theta` at `(theta, phi)` (`theta` in
+    /// `[0, pi]`, `phi` in `[0, 2 pi)`) to `out`: the chain rule's combination, fused with
+    /// the interpolation so that no temporary is written.
+    #[inline]
+    fn accumulate(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
         match self.scheme {
-            Scheme::Linear => self.eval_linear(theta, phi, f_theta, f_phi_over_sin),
-            Scheme::Cubic => self.eval_cubic(theta, phi, f_theta, f_phi_over_sin),
+            Scheme::Linear => self.accumulate_linear(theta, phi, alpha, beta, out),
+            Scheme::Cubic => self.accumulate_cubic(theta, phi, alpha, beta, out),
         }
     }
 
-    /// [`eval`](Self::eval) by bilinear interpolation.
-    fn eval_linear(&self, theta: f64, phi: f64, f_theta: &mut [T], f_phi_over_sin: &mut [T]) {
-        let (m, n, ch) = (self.m, self.n, self.channels);
-        let (ni, mi) = (n as isize, m as isize);
+    /// [`accumulate`](Self::accumulate) by bilinear interpolation.
+    #[inline]
+    fn accumulate_linear(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
+        let (m, n) = (self.m, self.n);
+        let wrap = |c: isize| -> usize {
+            if c < 0 {
+                (c + n as isize) as usize
+            } else if c >= n as isize {
+                c as usize - n
+            } else {
+                c as usize
+            }
+        };
+        // (entry, weight) of the four taps of each field.
+        let mut ft = [(0usize, T::zero()); 4];
+        let mut gp = [(0usize, T::zero()); 4];
         // f_theta: rows at theta = i delta, i = 0..=m; no continuation needed in theta.
+        // (Positions are at least -1, so `(x + 1) as isize - 1` is their floor.)
         let y = theta / self.step;
-        let r0 = (y.floor() as isize).clamp(0, mi - 1);
+        let r0 = (y as usize).min(m - 1);
         let fy = y - r0 as f64;
         let x = phi / self.step - 0.5;
-        let c0 = x.floor();
-        let fx = x - c0;
-        let c0 = c0 as isize;
-        f_theta.fill(T::zero());
-        for (dr, wy) in [(0, 1.0 - fy), (1, fy)] {
-            for (dc, wx) in [(0, 1.0 - fx), (1, fx)] {
-                let (r, c) = ((r0 + dr) as usize, (c0 + dc).rem_euclid(ni) as usize);
-                let src = &self.d_theta[(r * n + c) * ch..][..ch];
-                let w = T::from_f64(wy * wx);
-                for (o, &v) in f_theta.iter_mut().zip(src) {
-                    *o += w * v;
-                }
-            }
+        let c0 = (x + 1.0) as isize - 1;
+        let fx = x - c0 as f64;
+        let (ca, cb) = (wrap(c0), wrap(c0 + 1));
+        for (t, (r, wy)) in [(r0, 1.0 - fy), (r0 + 1, fy)].into_iter().enumerate() {
+            ft[2 * t] = (r * n + ca, T::from_f64(alpha * wy * (1.0 - fx)));
+            ft[2 * t + 1] = (r * n + cb, T::from_f64(alpha * wy * fx));
         }
         // f_phi / sin theta: rows at (i + 1/2) delta, columns at (j + 1) delta; over a pole
-        // the tangent component flips sign.
+        // (rows -1 and m) the row is continued half a turn away and the tangent component
+        // flips sign.
         let y = theta / self.step - 0.5;
-        let r0 = y.floor();
-        let fy = y - r0;
+        let r0 = (y + 1.0) as isize - 1;
+        let fy = y - r0 as f64;
         let x = phi / self.step - 1.0;
-        let c0 = x.floor();
-        let fx = x - c0;
-        let (r0, c0) = (r0 as isize, c0 as isize);
-        f_phi_over_sin.fill(T::zero());
-        for (dr, wy) in [(0, 1.0 - fy), (1, fy)] {
-            for (dc, wx) in [(0, 1.0 - fx), (1, fx)] {
-                let (r, c, crossed) = continue_index(r0 + dr, c0 + dc, m, n);
-                let src = &self.d_phi[(r * n + c) * ch..][..ch];
-                let w = T::from_f64(if crossed { -wy * wx } else { wy * wx });
-                for (o, &v) in f_phi_over_sin.iter_mut().zip(src) {
-                    *o += w * v;
-                }
+        let c0 = (x + 1.0) as isize - 1;
+        let fx = x - c0 as f64;
+        let half = n as isize / 2;
+        for (t, (r, wy)) in [(r0, 1.0 - fy), (r0 + 1, fy)].into_iter().enumerate() {
+            let (r, turn, w) = if r < 0 {
+                (0, half, -beta * wy)
+            } else if r >= m as isize {
+                (m - 1, half, -beta * wy)
+            } else {
+                (r as usize, 0, beta * wy)
+            };
+            gp[2 * t] = (r * n + wrap(c0 + turn), T::from_f64(w * (1.0 - fx)));
+            gp[2 * t + 1] = (r * n + wrap(c0 + 1 + turn), T::from_f64(w * fx));
+        }
+        self.apply_taps(&ft, &gp, out);
+    }
+
+    /// `out[k] += sum w d_theta[e][k] + sum w d_phi[e][k]` over the `(entry, weight)` taps
+    /// of each field, one channel at a time so that the sum stays in a register.
+    #[inline]
+    fn apply_taps(&self, ft: &[(usize, T)], gp: &[(usize, T)], out: &mut [T]) {
+        let ch = self.channels;
+        for (k, o) in out.iter_mut().enumerate() {
+            let mut acc = *o;
+            for &(e, w) in ft {
+                acc += w * self.d_theta[e * ch + k];
             }
+            for &(e, w) in gp {
+                acc += w * self.d_phi[e * ch + k];
+            }
+            *o = acc;
         }
     }
 
-    /// [`eval`](Self::eval) by Catmull-Rom interpolation over 4 x 4 edges of each field,
-    /// continued over the seam and the poles (a tangent component changes sign across a
-    /// pole: `f_theta` on the edge rows `-k` and `m + k` is minus the one on rows `k` and
-    /// `m - k` half a turn away).
-    fn eval_cubic(&self, theta: f64, phi: f64, f_theta: &mut [T], f_phi_over_sin: &mut [T]) {
+    /// [`accumulate`](Self::accumulate) by Catmull-Rom interpolation over 4 x 4 edges of
+    /// each field, continued over the seam and the poles (a tangent component changes sign
+    /// across a pole: `f_theta` on the edge rows `-k` and `m + k` is minus the one on rows
+    /// `k` and `m - k` half a turn away).
+    #[inline]
+    fn accumulate_cubic(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
         let (m, n) = (self.m as isize, self.n as isize);
         // f_theta: rows at i delta (i = 0..=m), columns at (j + 1/2) delta.
-        gather_cubic(
-            &self.d_theta,
-            self.channels,
-            theta / self.step,
-            phi / self.step - 0.5,
-            |r, c| {
-                let (r, flip) = if r < 0 {
-                    (-r, true)
-                } else if r > m {
-                    (2 * m - r, true)
-                } else {
-                    (r, false)
-                };
-                let c = if flip { c + n / 2 } else { c };
-                (r as usize * self.n + c.rem_euclid(n) as usize, flip)
-            },
-            f_theta,
-        );
+        let ft = cubic_taps((theta / self.step, phi / self.step - 0.5), alpha, |r, c| {
+            let (r, flip) = if r < 0 {
+                (-r, true)
+            } else if r > m {
+                (2 * m - r, true)
+            } else {
+                (r, false)
+            };
+            let c = if flip { c + n / 2 } else { c };
+            (r as usize * self.n + c.rem_euclid(n) as usize, flip)
+        });
         // f_phi / sin theta: rows at (i + 1/2) delta, columns at (j + 1) delta.
-        gather_cubic(
-            &self.d_phi,
-            self.channels,
-            theta / self.step - 0.5,
-            phi / self.step - 1.0,
+        let gp = cubic_taps(
+            (theta / self.step - 0.5, phi / self.step - 1.0),
+            beta,
             |r, c| {
                 let (r, c, crossed) = continue_index(r, c, self.m, self.n);
                 (r * self.n + c, crossed)
             },
-            f_phi_over_sin,
         );
+        self.apply_taps(&ft, &gp, out);
     }
 }
 
@@ -341,31 +365,28 @@ fn difference<'a, T: Sample>(scheme: Scheme, out: &mut [T], inv: T, at: impl Fn(
     }
 }
 
-/// Catmull-Rom interpolation of a staggered field `data` (`channels` values per entry) at
-/// continuous grid position `(y, x)` (entries at whole numbers). `index(r, c)` continues an
-/// entry position over seam and poles: its offset in entries and whether to negate it.
+/// The 16 `(entry, weight)` taps of `scale` times the Catmull-Rom interpolation of a
+/// staggered field at continuous grid position `(y, x)` (entries at whole numbers, `y` and
+/// `x` at least -1). `index(r, c)` continues an entry position over seam and poles: its
+/// entry and whether to negate it.
 #[inline]
-fn gather_cubic<T: Sample>(
-    data: &[T],
-    channels: usize,
-    y: f64,
-    x: f64,
+fn cubic_taps<T: Sample>(
+    (y, x): (f64, f64),
+    scale: f64,
     index: impl Fn(isize, isize) -> (usize, bool),
-    out: &mut [T],
-) {
-    let (r0, c0) = (y.floor(), x.floor());
-    let (wy, wx) = (catmull_rom(y - r0), catmull_rom(x - c0));
-    let (r0, c0) = (r0 as isize - 1, c0 as isize - 1);
-    out.fill(T::zero());
+) -> [(usize, T); 16] {
+    let (r0, c0) = ((y + 1.0) as isize - 1, (x + 1.0) as isize - 1);
+    let (wy, wx) = (catmull_rom(y - r0 as f64), catmull_rom(x - c0 as f64));
+    let (r0, c0) = (r0 - 1, c0 - 1);
+    let mut taps = [(0usize, T::zero()); 16];
     for (dr, &wr) in wy.iter().enumerate() {
+        let wr = scale * wr;
         for (dc, &wc) in wx.iter().enumerate() {
             let (at, flip) = index(r0 + dr as isize, c0 + dc as isize);
-            let w = T::from_f64(if flip { -wr * wc } else { wr * wc });
-            for (o, &v) in out.iter_mut().zip(&data[at * channels..][..channels]) {
-                *o += w * v;
-            }
+            taps[4 * dr + dc] = (at, T::from_f64(if flip { -wr * wc } else { wr * wc }));
         }
     }
+    taps
 }
 
 #[inline]
@@ -414,22 +435,17 @@ impl<'a, T: Sample> ChainRule<'a, T> {
         let tq = self.rotation.apply(tangent);
         let (big_t, big_p) = angles(q);
         // The frame at q straight from q (atan2's convention at the poles: Phi = 0).
-        let rho = q[0].hypot(q[2]);
+        let rho = (q[0] * q[0] + q[2] * q[2]).sqrt();
         let (s_p, c_p) = if rho > 0.0 {
             (q[0] / rho, q[2] / rho)
         } else {
             (0.0, 1.0)
         };
         let (s_t, c_t) = (rho, q[1].clamp(-1.0, 1.0));
-        let alpha = T::from_f64(scale * dot([c_t * s_p, -s_t, c_t * c_p], tq));
-        let beta = T::from_f64(scale * dot([c_p, 0.0, -s_p], tq));
-        let mut ft = [T::zero(); 64];
-        let mut gp = [T::zero(); 64];
-        let ch = out.len();
-        self.grad.eval(big_t, big_p, &mut ft[..ch], &mut gp[..ch]);
-        for ((o, &a), &b) in out.iter_mut().zip(&ft[..ch]).zip(&gp[..ch]) {
-            *o = alpha * a + beta * b;
-        }
+        let alpha = scale * dot([c_t * s_p, -s_t, c_t * c_p], tq);
+        let beta = scale * dot([c_p, 0.0, -s_p], tq);
+        out.fill(T::zero());
+        self.grad.accumulate(big_t, big_p, alpha, beta, out);
     }
 
     /// `V[i][j] = -delta g_theta((i + 1) delta, (j + 1/2) delta)`.

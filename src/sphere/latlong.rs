@@ -443,8 +443,8 @@ impl<T: Sample> LatLongMap<T> {
     }
 }
 
-/// An `(h, 2h, channels)` array whose pixel `(i, j)` is written by `f(i, j, channels_out)`,
-/// rows in parallel.
+/// An `(h, 2h, channels)` array whose pixel `(i, j)` is written by `f(i, j, channels_out)`
+/// ([`fill_grid`]).
 pub(crate) fn fill_pixels<T: Sample>(
     h: usize,
     channels: usize,
@@ -454,23 +454,52 @@ pub(crate) fn fill_pixels<T: Sample>(
     Ok(fill_grid((h, 2 * h, channels), f))
 }
 
+/// Grids of at most this many values (a one-channel 64 x 128 map) are filled on the calling
+/// thread: at that size rayon's task overhead is a large part of the work, and a caller that
+/// rotates many small maps (a BRDF per vertex) already runs in parallel over them. Every
+/// sphere rotation of such a map ([`rotate_map`](super::rotate_map),
+/// [`rotate_coefficients`](super::rotate_coefficients), every method) therefore runs
+/// sequentially and never touches the rayon pool; larger grids split their rows across it.
+///
+/// ```
+/// assert_eq!(haarshift::sphere::latlong::SEQUENTIAL_MAX_VALUES, 64 * 128);
+/// ```
+pub const SEQUENTIAL_MAX_VALUES: usize = 64 * 128;
+
+/// `f(i, row)` for every row `i` of `row_len` values of `data`: on the calling thread for at
+/// most [`SEQUENTIAL_MAX_VALUES`] values, otherwise rows in parallel.
+pub(crate) fn for_each_row<T: Send>(
+    data: &mut [T],
+    row_len: usize,
+    f: impl Fn(usize, &mut [T]) + Sync,
+) {
+    if data.len() <= SEQUENTIAL_MAX_VALUES {
+        data.chunks_mut(row_len)
+            .enumerate()
+            .for_each(|(i, row)| f(i, row));
+    } else {
+        data.par_chunks_mut(row_len)
+            .enumerate()
+            .for_each(|(i, row)| f(i, row));
+    }
+}
+
 /// A `(rows, cols, channels)` array whose entry `(i, j, ..)` is written by
-/// `f(i, j, channels_out)`, rows in parallel.
+/// `f(i, j, channels_out)`, rows in parallel above [`SEQUENTIAL_MAX_VALUES`].
 pub(crate) fn fill_grid<T: Sample>(
     shape: (usize, usize, usize),
     f: impl Fn(usize, usize, &mut [T]) + Sync,
 ) -> Array3<T> {
-    let channels = shape.2;
+    let (channels, row_len) = (shape.2, shape.1 * shape.2);
     let mut data = Array3::zeros(shape);
-    data.axis_iter_mut(Axis(0))
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(i, mut row)| {
-            let row = row.as_slice_mut().expect("standard layout");
+    if row_len > 0 {
+        let flat = data.as_slice_mut().expect("standard layout");
+        for_each_row(flat, row_len, |i, row| {
             for (j, px) in row.chunks_exact_mut(channels).enumerate() {
                 f(i, j, px);
             }
         });
+    }
     data
 }
 
