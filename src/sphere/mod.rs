@@ -274,4 +274,6 @@ fn resolve_level(h: usize, level: Option<usize>) -> Result<usize> {
 #[cfg(test)]
 mod level_tests;
 #[cfg(test)]
+mod lobe_tests;
+#[cfg(test)]
 mod tests;
