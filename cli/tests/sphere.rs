@@ -372,7 +372,8 @@ fn help_states_the_conventions_and_explains_every_flag() {
         "--level",
         "--samples",
         "--coefficients",
-        "[possible values: reference, bilinear, bicubic, haar]",
+        "[possible values: reference, bilinear, bicubic, haar, haar-cubic]",
+        "--method haar-cubic",
     ];
     let experiment_needles = [
         "haarshift experiment sphere",

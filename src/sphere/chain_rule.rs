@@ -64,6 +64,37 @@
 //! (the sun) the method is a derivative-domain resampling whose errors are of the size of the
 //! feature's own differences.
 //!
+//! # The higher-order scheme ([`Scheme::Cubic`], `haar-cubic`)
+//!
+//! The seed's scheme has three second-order errors, each replaced by a fourth-order one
+//! (for a map of samples at the texel centres):
+//!
+//! * step 1: `f`'s derivative on an edge from four samples across it,
+//!   `(27 (X[k] - X[k-1]) - (X[k+1] - X[k-2])) / (24 delta)`, continued over seam and poles
+//!   (the in-block difference is the level-`L` detail; the outer two come from the blocks
+//!   next to it);
+//! * step 3: Catmull-Rom interpolation of the two derivative fields over 4 x 4 edges (16
+//!   taps instead of 4), with the sign flip of a tangent component across a pole;
+//! * step 4: a difference of samples is not `delta` times the midpoint derivative but
+//!   `delta (g' + delta^2 g''' / 24)`; the third derivative along the difference comes from
+//!   second differences of the midpoint derivatives, which needs `g_theta` on the two edges
+//!   across the poles as well: `V = V_mid + (V_mid[i-1] - 2 V_mid[i] + V_mid[i+1]) / 24`,
+//!   likewise `U` along `phi` (periodic).
+//!
+//! Step 6 changes too: the plain solid-angle sum of samples is off the integral by an
+//! `O(delta^2)` term proportional to the values at the two poles, which a rotation changes
+//! (a lobe moved off the pole loses 0.5 % of its sum at 64 x 128, exponent 50), so the
+//! constant is chosen to keep the pole-corrected sum ([`sampled_integral`]), rotation
+//! invariant to `O(delta^4)`. Cost: the same chain-rule evaluations (plus the two pole rows),
+//! 16 taps each instead of 4. Individual coefficients ([`rotate_selected`]) use the seed's
+//! scheme.
+//!
+//! Measured ([`lobes`](super::lobes), 64 x 128, Phong exponents 10 and 50 about the pole
+//! and a horizon direction, pitch 30 to 90 and a compound rotation): against the analytic
+//! rotated lobe at the texel centres `haar-cubic`'s weighted RMS error is 0.37 to 0.83 times
+//! bicubic's (and 3 % to 8 % of the seed's scheme's); against the lobe's texel means, where
+//! every method carries the point-versus-mean difference of its input, 0.96 to 1.02 times.
+//!
 //! # Typos in the seed's section 4.5
 //!
 //! * (4.13) `phi' = tan^-1(R1 p / R3 p)` loses the quadrant: it is `atan2(R1 p, R3 p)`.
@@ -86,10 +117,29 @@ use std::f64::consts::PI;
 use ndarray::{Array3, ArrayView3, ArrayViewMut2, Axis, s};
 use rayon::prelude::*;
 
-use super::latlong::{angles, continue_index, fill_grid, pixel_solid_angle};
+use super::latlong::{
+    angles, catmull_rom, continue_index, fill_grid, for_each_row, pixel_solid_angle,
+};
 use super::{LatLongMap, SphereCoefficients, SphereRotation};
 use crate::transform::{Band, pyramid};
 use crate::{Error, Result, Sample};
+
+/// How the chain rule reads `f`'s derivatives and turns `g`'s into differences.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Scheme {
+    /// The seed's: two-point differences of `f`, bilinear interpolation at the pre-image,
+    /// `g`'s differences as `delta` times its midpoint derivative ([`Method::Haar`]).
+    ///
+    /// [`Method::Haar`]: super::Method::Haar
+    #[default]
+    Linear,
+    /// Higher order: four-point differences of `f`, Catmull-Rom interpolation at the
+    /// pre-image, `g`'s differences corrected by the third derivative along the difference
+    /// ([`Method::HaarCubic`]).
+    ///
+    /// [`Method::HaarCubic`]: super::Method::HaarCubic
+    Cubic,
+}
 
 /// The derivatives of a source map on its staggered edge grids (step 1 of the
 /// [module docs](self)), ready to be evaluated anywhere on the sphere.
@@ -105,6 +155,7 @@ use crate::{Error, Result, Sample};
 /// ```
 #[derive(Clone, Debug)]
 pub struct SourceGradient<T> {
+    scheme: Scheme,
     m: usize,
     n: usize,
     channels: usize,
@@ -116,8 +167,25 @@ pub struct SourceGradient<T> {
 }
 
 impl<T: Sample> SourceGradient<T> {
-    /// The derivative maps of `approx` (an approximation of `f` at the working resolution).
+    /// The derivative maps of `approx` (an approximation of `f` at the working resolution)
+    /// by the two-point differences of [`Scheme::Linear`].
     pub fn new(approx: &LatLongMap<T>) -> Self {
+        Self::with_scheme(approx, Scheme::Linear)
+    }
+
+    /// The derivative maps of `approx` by `scheme`'s differences: two-point
+    /// `(X[k] - X[k-1]) / delta`, or four-point
+    /// `(27 (X[k] - X[k-1]) - (X[k+1] - X[k-2])) / (24 delta)` (fourth order for samples).
+    ///
+    /// ```
+    /// use haarshift::sphere::{LatLongMap, chain_rule::{Scheme, SourceGradient}};
+    /// let f = LatLongMap::<f64>::from_fn(64, 1, |d, out| out[0] = d[1]).unwrap();
+    /// let grad = SourceGradient::with_scheme(&f, Scheme::Cubic);
+    /// let (mut ft, mut gp) = ([0.0], [0.0]);
+    /// grad.eval(1.0, 2.0, &mut ft, &mut gp);
+    /// assert!((ft[0] + 1.0f64.sin()).abs() < 1e-5 && gp[0].abs() < 1e-12);
+    /// ```
+    pub fn with_scheme(approx: &LatLongMap<T>, scheme: Scheme) -> Self {
         let (m, n, ch) = approx.as_array().dim();
         let x = approx.as_array();
         let x = x.as_slice().expect("maps are in standard layout");
@@ -127,34 +195,25 @@ impl<T: Sample> SourceGradient<T> {
             &x[(r * n + c) * ch..][..ch]
         };
         let mut d_theta = vec![T::zero(); (m + 1) * n * ch];
-        d_theta
-            .par_chunks_mut(n * ch)
-            .enumerate()
-            .for_each(|(i, row)| {
-                let inv = T::from_f64(1.0 / step);
-                for (j, out) in row.chunks_exact_mut(ch).enumerate() {
-                    let (below, above) =
-                        (px(i as isize, j as isize), px(i as isize - 1, j as isize));
-                    for ((o, &b), &a) in out.iter_mut().zip(below).zip(above) {
-                        *o = (b - a) * inv;
-                    }
-                }
-            });
+        for_each_row(&mut d_theta, n * ch, |i, row| {
+            let inv = T::from_f64(1.0 / step);
+            let i = i as isize;
+            for (j, out) in row.chunks_exact_mut(ch).enumerate() {
+                let j = j as isize;
+                difference(scheme, out, inv, |k| px(i + k, j));
+            }
+        });
         let mut d_phi = vec![T::zero(); m * n * ch];
-        d_phi
-            .par_chunks_mut(n * ch)
-            .enumerate()
-            .for_each(|(i, row)| {
-                let inv = T::from_f64(1.0 / (step * ((i as f64 + 0.5) * step).sin()));
-                for (j, out) in row.chunks_exact_mut(ch).enumerate() {
-                    let (right, left) =
-                        (px(i as isize, j as isize + 1), px(i as isize, j as isize));
-                    for ((o, &r), &l) in out.iter_mut().zip(right).zip(left) {
-                        *o = (r - l) * inv;
-                    }
-                }
-            });
+        for_each_row(&mut d_phi, n * ch, |i, row| {
+            let inv = T::from_f64(1.0 / (step * ((i as f64 + 0.5) * step).sin()));
+            let i = i as isize;
+            for (j, out) in row.chunks_exact_mut(ch).enumerate() {
+                let j = j as isize;
+                difference(scheme, out, inv, |k| px(i, j + 1 + k));
+            }
+        });
         SourceGradient {
+            scheme,
             m,
             n,
             channels: ch,
@@ -165,50 +224,169 @@ impl<T: Sample> SourceGradient<T> {
     }
 
     /// `f_theta` and `f_phi / sin theta` at `(theta, phi)`, one value per channel each
-    /// (step 3 of the [module docs](self)).
+    /// (step 3 of the [module docs](self)), interpolated as the scheme says.
     pub fn eval(&self, theta: f64, phi: f64, f_theta: &mut [T], f_phi_over_sin: &mut [T]) {
-        let (m, n, ch) = (self.m, self.n, self.channels);
-        let (ni, mi) = (n as isize, m as isize);
+        f_theta.fill(T::zero());
+        self.accumulate(theta, phi, 1.0, 0.0, f_theta);
+        f_phi_over_sin.fill(T::zero());
+        self.accumulate(theta, phi, 0.0, 1.0, f_phi_over_sin);
+    }
+
+    /// Adds `alpha f_theta + beta f_phi / sin theta` at `(theta, phi)` (`theta` in
+    /// `[0, pi]`, `phi` in `[0, 2 pi)`) to `out`: the chain rule's combination, fused with
+    /// the interpolation so that no temporary is written.
+    #[inline]
+    fn accumulate(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
+        match self.scheme {
+            Scheme::Linear => self.accumulate_linear(theta, phi, alpha, beta, out),
+            Scheme::Cubic => self.accumulate_cubic(theta, phi, alpha, beta, out),
+        }
+    }
+
+    /// [`accumulate`](Self::accumulate) by bilinear interpolation.
+    #[inline]
+    fn accumulate_linear(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
+        let (m, n) = (self.m, self.n);
+        let wrap = |c: isize| -> usize {
+            if c < 0 {
+                (c + n as isize) as usize
+            } else if c >= n as isize {
+                c as usize - n
+            } else {
+                c as usize
+            }
+        };
+        // (entry, weight) of the four taps of each field.
+        let mut ft = [(0usize, T::zero()); 4];
+        let mut gp = [(0usize, T::zero()); 4];
         // f_theta: rows at theta = i delta, i = 0..=m; no continuation needed in theta.
+        // (Positions are at least -1, so `(x + 1) as isize - 1` is their floor.)
         let y = theta / self.step;
-        let r0 = (y.floor() as isize).clamp(0, mi - 1);
+        let r0 = (y as usize).min(m - 1);
         let fy = y - r0 as f64;
         let x = phi / self.step - 0.5;
-        let c0 = x.floor();
-        let fx = x - c0;
-        let c0 = c0 as isize;
-        f_theta.fill(T::zero());
-        for (dr, wy) in [(0, 1.0 - fy), (1, fy)] {
-            for (dc, wx) in [(0, 1.0 - fx), (1, fx)] {
-                let (r, c) = ((r0 + dr) as usize, (c0 + dc).rem_euclid(ni) as usize);
-                let src = &self.d_theta[(r * n + c) * ch..][..ch];
-                let w = T::from_f64(wy * wx);
-                for (o, &v) in f_theta.iter_mut().zip(src) {
-                    *o += w * v;
-                }
-            }
+        let c0 = (x + 1.0) as isize - 1;
+        let fx = x - c0 as f64;
+        let (ca, cb) = (wrap(c0), wrap(c0 + 1));
+        for (t, (r, wy)) in [(r0, 1.0 - fy), (r0 + 1, fy)].into_iter().enumerate() {
+            ft[2 * t] = (r * n + ca, T::from_f64(alpha * wy * (1.0 - fx)));
+            ft[2 * t + 1] = (r * n + cb, T::from_f64(alpha * wy * fx));
         }
         // f_phi / sin theta: rows at (i + 1/2) delta, columns at (j + 1) delta; over a pole
-        // the tangent component flips sign.
+        // (rows -1 and m) the row is continued half a turn away and the tangent component
+        // flips sign.
         let y = theta / self.step - 0.5;
-        let r0 = y.floor();
-        let fy = y - r0;
+        let r0 = (y + 1.0) as isize - 1;
+        let fy = y - r0 as f64;
         let x = phi / self.step - 1.0;
-        let c0 = x.floor();
-        let fx = x - c0;
-        let (r0, c0) = (r0 as isize, c0 as isize);
-        f_phi_over_sin.fill(T::zero());
-        for (dr, wy) in [(0, 1.0 - fy), (1, fy)] {
-            for (dc, wx) in [(0, 1.0 - fx), (1, fx)] {
-                let (r, c, crossed) = continue_index(r0 + dr, c0 + dc, m, n);
-                let src = &self.d_phi[(r * n + c) * ch..][..ch];
-                let w = T::from_f64(if crossed { -wy * wx } else { wy * wx });
-                for (o, &v) in f_phi_over_sin.iter_mut().zip(src) {
-                    *o += w * v;
-                }
+        let c0 = (x + 1.0) as isize - 1;
+        let fx = x - c0 as f64;
+        let half = n as isize / 2;
+        for (t, (r, wy)) in [(r0, 1.0 - fy), (r0 + 1, fy)].into_iter().enumerate() {
+            let (r, turn, w) = if r < 0 {
+                (0, half, -beta * wy)
+            } else if r >= m as isize {
+                (m - 1, half, -beta * wy)
+            } else {
+                (r as usize, 0, beta * wy)
+            };
+            gp[2 * t] = (r * n + wrap(c0 + turn), T::from_f64(w * (1.0 - fx)));
+            gp[2 * t + 1] = (r * n + wrap(c0 + 1 + turn), T::from_f64(w * fx));
+        }
+        self.apply_taps(&ft, &gp, out);
+    }
+
+    /// `out[k] += sum w d_theta[e][k] + sum w d_phi[e][k]` over the `(entry, weight)` taps
+    /// of each field, one channel at a time so that the sum stays in a register.
+    #[inline]
+    fn apply_taps(&self, ft: &[(usize, T)], gp: &[(usize, T)], out: &mut [T]) {
+        let ch = self.channels;
+        for (k, o) in out.iter_mut().enumerate() {
+            let mut acc = *o;
+            for &(e, w) in ft {
+                acc += w * self.d_theta[e * ch + k];
+            }
+            for &(e, w) in gp {
+                acc += w * self.d_phi[e * ch + k];
+            }
+            *o = acc;
+        }
+    }
+
+    /// [`accumulate`](Self::accumulate) by Catmull-Rom interpolation over 4 x 4 edges of
+    /// each field, continued over the seam and the poles (a tangent component changes sign
+    /// across a pole: `f_theta` on the edge rows `-k` and `m + k` is minus the one on rows
+    /// `k` and `m - k` half a turn away).
+    #[inline]
+    fn accumulate_cubic(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
+        let (m, n) = (self.m as isize, self.n as isize);
+        // f_theta: rows at i delta (i = 0..=m), columns at (j + 1/2) delta.
+        let ft = cubic_taps((theta / self.step, phi / self.step - 0.5), alpha, |r, c| {
+            let (r, flip) = if r < 0 {
+                (-r, true)
+            } else if r > m {
+                (2 * m - r, true)
+            } else {
+                (r, false)
+            };
+            let c = if flip { c + n / 2 } else { c };
+            (r as usize * self.n + c.rem_euclid(n) as usize, flip)
+        });
+        // f_phi / sin theta: rows at (i + 1/2) delta, columns at (j + 1) delta.
+        let gp = cubic_taps(
+            (theta / self.step - 0.5, phi / self.step - 1.0),
+            beta,
+            |r, c| {
+                let (r, c, crossed) = continue_index(r, c, self.m, self.n);
+                (r * self.n + c, crossed)
+            },
+        );
+        self.apply_taps(&ft, &gp, out);
+    }
+}
+
+/// The derivative of `scheme` at the edge between samples `at(-1)` and `at(0)`, times
+/// `inv` (`1 / delta`, or that over `sin theta`), into `out`.
+#[inline]
+fn difference<'a, T: Sample>(scheme: Scheme, out: &mut [T], inv: T, at: impl Fn(isize) -> &'a [T]) {
+    match scheme {
+        Scheme::Linear => {
+            for ((o, &b), &a) in out.iter_mut().zip(at(0)).zip(at(-1)) {
+                *o = (b - a) * inv;
+            }
+        }
+        Scheme::Cubic => {
+            let (near, far) = (T::from_f64(27.0 / 24.0), T::from_f64(1.0 / 24.0));
+            let (a, b, c, d) = (at(-2), at(-1), at(0), at(1));
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = (near * (c[k] - b[k]) - far * (d[k] - a[k])) * inv;
             }
         }
     }
+}
+
+/// The 16 `(entry, weight)` taps of `scale` times the Catmull-Rom interpolation of a
+/// staggered field at continuous grid position `(y, x)` (entries at whole numbers, `y` and
+/// `x` at least -1). `index(r, c)` continues an entry position over seam and poles: its
+/// entry and whether to negate it.
+#[inline]
+fn cubic_taps<T: Sample>(
+    (y, x): (f64, f64),
+    scale: f64,
+    index: impl Fn(isize, isize) -> (usize, bool),
+) -> [(usize, T); 16] {
+    let (r0, c0) = ((y + 1.0) as isize - 1, (x + 1.0) as isize - 1);
+    let (wy, wx) = (catmull_rom(y - r0 as f64), catmull_rom(x - c0 as f64));
+    let (r0, c0) = (r0 - 1, c0 - 1);
+    let mut taps = [(0usize, T::zero()); 16];
+    for (dr, &wr) in wy.iter().enumerate() {
+        let wr = scale * wr;
+        for (dc, &wc) in wx.iter().enumerate() {
+            let (at, flip) = index(r0 + dr as isize, c0 + dc as isize);
+            taps[4 * dr + dc] = (at, T::from_f64(if flip { -wr * wc } else { wr * wc }));
+        }
+    }
+    taps
 }
 
 #[inline]
@@ -257,22 +435,17 @@ impl<'a, T: Sample> ChainRule<'a, T> {
         let tq = self.rotation.apply(tangent);
         let (big_t, big_p) = angles(q);
         // The frame at q straight from q (atan2's convention at the poles: Phi = 0).
-        let rho = q[0].hypot(q[2]);
+        let rho = (q[0] * q[0] + q[2] * q[2]).sqrt();
         let (s_p, c_p) = if rho > 0.0 {
             (q[0] / rho, q[2] / rho)
         } else {
             (0.0, 1.0)
         };
         let (s_t, c_t) = (rho, q[1].clamp(-1.0, 1.0));
-        let alpha = T::from_f64(scale * dot([c_t * s_p, -s_t, c_t * c_p], tq));
-        let beta = T::from_f64(scale * dot([c_p, 0.0, -s_p], tq));
-        let mut ft = [T::zero(); 64];
-        let mut gp = [T::zero(); 64];
-        let ch = out.len();
-        self.grad.eval(big_t, big_p, &mut ft[..ch], &mut gp[..ch]);
-        for ((o, &a), &b) in out.iter_mut().zip(&ft[..ch]).zip(&gp[..ch]) {
-            *o = alpha * a + beta * b;
-        }
+        let alpha = scale * dot([c_t * s_p, -s_t, c_t * c_p], tq);
+        let beta = scale * dot([c_p, 0.0, -s_p], tq);
+        out.fill(T::zero());
+        self.grad.accumulate(big_t, big_p, alpha, beta, out);
     }
 
     /// `V[i][j] = -delta g_theta((i + 1) delta, (j + 1/2) delta)`.
@@ -290,10 +463,10 @@ impl<'a, T: Sample> ChainRule<'a, T> {
 /// [module docs](self)): `V` (between rows), `U` (between columns, periodic) and `C` (mixed).
 ///
 /// ```
-/// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::DifferenceFields};
+/// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::{DifferenceFields, Scheme}};
 /// let f = LatLongMap::<f64>::from_fn(8, 1, |_, out| out[0] = 1.0).unwrap();
 /// let r = SphereRotation::from_degrees(0.0, 40.0, 0.0).unwrap();
-/// let d = DifferenceFields::rotated(&f, &r);
+/// let d = DifferenceFields::rotated(&f, &r, Scheme::Linear);
 /// assert_eq!(d.vertical().dim(), (7, 16, 1));
 /// assert!(d.horizontal().iter().all(|v| v.abs() < 1e-15)); // a constant has no differences
 /// ```
@@ -305,13 +478,41 @@ pub struct DifferenceFields<T> {
 }
 
 impl<T: Sample> DifferenceFields<T> {
-    /// The fields of `g = f(R p)` from `approx` (`f` at the working resolution).
-    pub fn rotated(approx: &LatLongMap<T>, rotation: &SphereRotation) -> Self {
+    /// The fields of `g = f(R p)` from `approx` (`f` at the working resolution) by `scheme`.
+    pub fn rotated(approx: &LatLongMap<T>, rotation: &SphereRotation, scheme: Scheme) -> Self {
         let (m, n, ch) = approx.as_array().dim();
-        let grad = SourceGradient::new(approx);
+        let grad = SourceGradient::with_scheme(approx, scheme);
         let rule = ChainRule::new(&grad, rotation);
-        let v = fill_grid((m - 1, n, ch), |i, j, out| rule.vertical(i, j, out));
-        let u = fill_grid((m, n, ch), |i, j, out| rule.horizontal(i, j, out));
+        let (v, u) = match scheme {
+            Scheme::Linear => (
+                fill_grid((m - 1, n, ch), |i, j, out| rule.vertical(i, j, out)),
+                fill_grid((m, n, ch), |i, j, out| rule.horizontal(i, j, out)),
+            ),
+            Scheme::Cubic => {
+                // Midpoint derivatives on every row edge, the two across the poles included,
+                // then the differences of samples to fourth order:
+                // X[k] - X[k+1] = -delta (g_1 + delta^2 g_3 / 24) at the edge between them,
+                // g_3 (the third derivative) from second differences of the midpoint values.
+                let step = -rule.grad.step;
+                let vm = fill_grid((m + 1, n, ch), |e, j, out| {
+                    rule.derivative(2 * e, 2 * j + 1, Along::Theta, step, out)
+                });
+                let um = fill_grid((m, n, ch), |i, j, out| {
+                    rule.derivative(2 * i + 1, 2 * j + 2, Along::Phi, step, out)
+                });
+                let w = T::from_f64(1.0 / 24.0);
+                let two = T::from_f64(2.0);
+                let v = grid_from_fn((m - 1, n, ch), |(i, j, k)| {
+                    let c = vm[[i + 1, j, k]];
+                    c + w * (vm[[i, j, k]] - two * c + vm[[i + 2, j, k]])
+                });
+                let u = grid_from_fn((m, n, ch), |(i, j, k)| {
+                    let c = um[[i, j, k]];
+                    c + w * (um[[i, (j + n - 1) % n, k]] - two * c + um[[i, (j + 1) % n, k]])
+                });
+                (v, u)
+            }
+        };
         let c = mixed_from(v.view(), u.view());
         DifferenceFields { v, u, c }
     }
@@ -477,16 +678,94 @@ pub fn set_mean_from_energy<T: Sample>(
     coeffs: &mut SphereCoefficients<T>,
     energy: &[f64],
 ) -> Result<()> {
+    set_mean(coeffs, energy, 0.0)
+}
+
+/// Sets each channel's constant so that [`sampled_integral`] of the map equals that of
+/// `samples` (the [`Scheme::Cubic`] choice of step 6), keeping every difference.
+///
+/// ```
+/// use haarshift::sphere::{LatLongMap, SphereCoefficients, chain_rule::*};
+/// let f = LatLongMap::<f64>::from_fn(16, 1, |d, out| out[0] = (4.0 * d[1]).exp()).unwrap();
+/// let mut c = SphereCoefficients::from_map(&f).unwrap();
+/// set_mean_from_sampled_integral(&mut c, &f).unwrap();
+/// let back = c.to_map().unwrap();
+/// assert!((sampled_integral(&back)[0] - sampled_integral(&f)[0]).abs() < 1e-12);
+/// ```
+pub fn set_mean_from_sampled_integral<T: Sample>(
+    coeffs: &mut SphereCoefficients<T>,
+    samples: &LatLongMap<T>,
+) -> Result<()> {
+    set_mean(
+        coeffs,
+        &sampled_integral(samples),
+        pole_weight(coeffs.height()),
+    )
+}
+
+/// The integral over the sphere of the function whose values at the texel centres the map
+/// holds, to fourth order in the texel size `delta`: `sum_ij X_ij Omega_i` (the exact row
+/// solid angles `Omega_i`) is off by `delta^2 / 24` times `(4 pi) mean(f)` (a factor common
+/// to every rotation of `f`) minus `2 pi (f_N + f_S)`, the values at the two poles (the
+/// Euler-Maclaurin end terms of the rows, `[f cos theta]` from 0 to `pi`). This returns the
+/// sum with the pole terms removed, `sum_ij X_ij Omega_i - (delta^2 / 24) 2 pi (N + S)`, with
+/// `N`, `S` the means of the first and last rows: a quantity a rotation preserves to
+/// `O(delta^4)` (the plain sum changes by `O(delta^2)` when a peak moves onto a pole).
+///
+/// ```
+/// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::sampled_integral};
+/// // exp(4 y) about the pole and turned to the horizon: the plain sums differ by 1e-3
+/// // relative, these by 2e-6.
+/// let r = SphereRotation::from_degrees(0.0, 90.0, 0.0).unwrap();
+/// let f = LatLongMap::<f64>::from_fn(64, 1, |d, out| out[0] = (4.0 * d[1]).exp()).unwrap();
+/// let g = LatLongMap::<f64>::from_fn(64, 1, |d, out| out[0] = (4.0 * r.apply(d)[1]).exp()).unwrap();
+/// let rel = |a: f64, b: f64| (a - b).abs() / b;
+/// assert!(rel(f.energy()[0], g.energy()[0]) > 5e-4);
+/// assert!(rel(sampled_integral(&f)[0], sampled_integral(&g)[0]) < 1e-5);
+/// ```
+pub fn sampled_integral<T: Sample>(samples: &LatLongMap<T>) -> Vec<f64> {
+    let a = samples.as_array();
+    let (m, n, _) = a.dim();
+    let w = pole_weight(m) * 2.0 * PI / n as f64;
+    let row_mean = |i: usize, k: usize| -> f64 {
+        a.index_axis(Axis(0), i)
+            .index_axis(Axis(1), k)
+            .iter()
+            .map(|v| v.as_f64())
+            .sum()
+    };
+    samples
+        .energy()
+        .iter()
+        .enumerate()
+        .map(|(k, e)| e - w * (row_mean(0, k) + row_mean(m - 1, k)))
+        .collect()
+}
+
+/// `delta^2 / 24` for an `m`-row map: the weight of the pole terms of [`sampled_integral`].
+fn pole_weight(m: usize) -> f64 {
+    let delta = PI / m as f64;
+    delta * delta / 24.0
+}
+
+/// Sets each channel's constant so that `sum_ij X_ij Omega_i - pole 2 pi (N + S)` (see
+/// [`sampled_integral`]; `pole = 0`: the plain solid-angle integral) equals `target`.
+fn set_mean<T: Sample>(
+    coeffs: &mut SphereCoefficients<T>,
+    target: &[f64],
+    pole: f64,
+) -> Result<()> {
     let (ch, m, n) = coeffs.as_array().dim();
-    if energy.len() != ch {
+    if target.len() != ch {
         return Err(Error::parameter(
             "energy",
-            format!("{} values for {ch} channels", energy.len()),
+            format!("{} values for {ch} channels", target.len()),
         ));
     }
     let levels = coeffs.levels();
     let mut data = coeffs.as_array().to_owned();
-    for (k, &target) in energy.iter().enumerate() {
+    let w = pole * 2.0 * PI / n as f64;
+    for (k, &target) in target.iter().enumerate() {
         let plane = data.index_axis(Axis(0), k);
         let mut rows = vec![plane[[0, 0]].as_f64() + plane[[0, 1]].as_f64()];
         for level in 0..levels {
@@ -505,8 +784,10 @@ pub fn set_mean_from_energy<T: Sample>(
             .iter()
             .enumerate()
             .map(|(i, s)| pixel_solid_angle(m, i) * s)
-            .sum();
-        let shift = T::from_f64((target - current) / (4.0 * PI));
+            .sum::<f64>()
+            - w * (rows[0] + rows[m - 1]);
+        // A constant c adds 4 pi c to the sum and 2 pi c to each pole mean.
+        let shift = T::from_f64((target - current) / (4.0 * PI * (1.0 - pole)));
         data[[k, 0, 0]] += shift;
         data[[k, 0, 1]] += shift;
     }
@@ -520,10 +801,10 @@ pub fn set_mean_from_energy<T: Sample>(
 /// [`SphereCoefficients::zero_padded`].
 ///
 /// ```
-/// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::rotate};
+/// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::{Scheme, rotate}};
 /// let f = LatLongMap::<f64>::from_fn(16, 1, |d, out| out[0] = 1.0 + d[0]).unwrap();
 /// let r = SphereRotation::from_degrees(0.0, 30.0, 0.0).unwrap();
-/// let g = rotate(&f, &r).unwrap().to_map().unwrap();
+/// let g = rotate(&f, &r, Scheme::Linear).unwrap().to_map().unwrap();
 /// // g = 1 + x(R p) and a pitch about X keeps x: g is f, to the method's accuracy.
 /// let err = (&g.as_array() - &f.as_array()).iter().fold(0.0f64, |a, v| a.max(v.abs()));
 /// assert!(err < 0.02);
@@ -531,6 +812,7 @@ pub fn set_mean_from_energy<T: Sample>(
 pub fn rotate<T: Sample>(
     approx: &LatLongMap<T>,
     rotation: &SphereRotation,
+    scheme: Scheme,
 ) -> Result<SphereCoefficients<T>> {
     let m = approx.height();
     if m < 2 || !m.is_power_of_two() {
@@ -539,9 +821,12 @@ pub fn rotate<T: Sample>(
             "the Haar method needs a height that is a power of two from 2 on",
         ));
     }
-    let fields = DifferenceFields::rotated(approx, rotation);
+    let fields = DifferenceFields::rotated(approx, rotation, scheme);
     let mut coeffs = fields.to_coefficients()?;
-    set_mean_from_energy(&mut coeffs, &approx.energy())?;
+    match scheme {
+        Scheme::Linear => set_mean_from_energy(&mut coeffs, &approx.energy())?,
+        Scheme::Cubic => set_mean_from_sampled_integral(&mut coeffs, approx)?,
+    }
     Ok(coeffs)
 }
 
@@ -569,7 +854,7 @@ pub struct CoefficientIndex {
 /// use haarshift::transform::Band;
 /// let f = LatLongMap::<f64>::from_fn(16, 1, |d, out| out[0] = d[0] * d[1]).unwrap();
 /// let r = SphereRotation::from_degrees(20.0, 50.0, 0.0).unwrap();
-/// let want = rotate(&f, &r).unwrap();
+/// let want = rotate(&f, &r, Scheme::Linear).unwrap();
 /// let at = CoefficientIndex { band: Band::Diagonal, level: 1, row: 1, column: 2 };
 /// let got = rotate_selected(&f, &r, &[at]).unwrap();
 /// assert!((got[0][0] - want.band(0, Band::Diagonal, 1).unwrap()[[1, 2]]).abs() < 1e-12);

@@ -69,7 +69,7 @@ pub fn angles(d: [f64; 3]) -> (f64, f64) {
 
 /// Catmull-Rom weights (Keys' cubic with `a = -1/2`) of the four samples around `t` in `[0, 1)`.
 #[inline]
-fn catmull_rom(t: f64) -> [f64; 4] {
+pub(crate) fn catmull_rom(t: f64) -> [f64; 4] {
     let (t2, t3) = (t * t, t * t * t);
     [
         0.5 * (-t3 + 2.0 * t2 - t),
@@ -155,6 +155,59 @@ impl<T: Sample> LatLongMap<T> {
         let data = fill_pixels(h, channels, |i, j, px| {
             let (t, p) = pixel_centre(h, i, j);
             f(direction(t, p), px)
+        })?;
+        LatLongMap::new(data)
+    }
+
+    /// The solid-angle mean of `f(direction, channels_out)` over every pixel of an `h x 2h`
+    /// map, by an `n x n` grid of stratum midpoints (`n = samples`, 1 to 64), each weighted
+    /// by its own `sin theta`: the midpoint rule, `O(1 / n^2)` per pixel for a smooth `f`,
+    /// deterministic.
+    ///
+    /// ```
+    /// use haarshift::sphere::LatLongMap;
+    /// // The mean of y over the top row's ring is close to, but below, y at its centre.
+    /// let mean = LatLongMap::<f64>::from_fn_mean(4, 1, 16, |d, out| out[0] = d[1]).unwrap();
+    /// let (t0, t1) = (0.0f64, std::f64::consts::PI / 4.0);
+    /// let exact = (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0 / (t0.cos() - t1.cos());
+    /// assert!((mean.as_array()[[0, 0, 0]] - exact).abs() < 1e-3);
+    /// assert!(LatLongMap::<f64>::from_fn_mean(4, 1, 0, |_, _| ()).is_err());
+    /// ```
+    pub fn from_fn_mean(
+        h: usize,
+        channels: usize,
+        samples: usize,
+        f: impl Fn([f64; 3], &mut [T]) + Sync,
+    ) -> Result<Self> {
+        if !(1..=64).contains(&samples) {
+            return Err(Error::parameter(
+                "samples",
+                format!("{samples} samples per axis (expected 1 to 64)"),
+            ));
+        }
+        let step = std::f64::consts::PI / h as f64;
+        let sub = step / samples as f64;
+        let data = fill_pixels(h, channels, |i, j, out| {
+            let mut acc = [0.0f64; 64];
+            let acc = &mut acc[..channels];
+            let mut value = [T::zero(); 64];
+            let value = &mut value[..channels];
+            let mut total_weight = 0.0;
+            for a in 0..samples {
+                let theta = i as f64 * step + (a as f64 + 0.5) * sub;
+                let weight = theta.sin();
+                total_weight += weight * samples as f64;
+                for b in 0..samples {
+                    let phi = j as f64 * step + (b as f64 + 0.5) * sub;
+                    f(direction(theta, phi), value);
+                    for (s, v) in acc.iter_mut().zip(value.iter()) {
+                        *s += weight * v.as_f64();
+                    }
+                }
+            }
+            for (o, s) in out.iter_mut().zip(acc.iter()) {
+                *o = T::from_f64(s / total_weight);
+            }
         })?;
         LatLongMap::new(data)
     }
@@ -390,8 +443,8 @@ impl<T: Sample> LatLongMap<T> {
     }
 }
 
-/// An `(h, 2h, channels)` array whose pixel `(i, j)` is written by `f(i, j, channels_out)`,
-/// rows in parallel.
+/// An `(h, 2h, channels)` array whose pixel `(i, j)` is written by `f(i, j, channels_out)`
+/// ([`fill_grid`]).
 pub(crate) fn fill_pixels<T: Sample>(
     h: usize,
     channels: usize,
@@ -401,23 +454,52 @@ pub(crate) fn fill_pixels<T: Sample>(
     Ok(fill_grid((h, 2 * h, channels), f))
 }
 
+/// Grids of at most this many values (a one-channel 64 x 128 map) are filled on the calling
+/// thread: at that size rayon's task overhead is a large part of the work, and a caller that
+/// rotates many small maps (a BRDF per vertex) already runs in parallel over them. Every
+/// sphere rotation of such a map ([`rotate_map`](super::rotate_map),
+/// [`rotate_coefficients`](super::rotate_coefficients), every method) therefore runs
+/// sequentially and never touches the rayon pool; larger grids split their rows across it.
+///
+/// ```
+/// assert_eq!(haarshift::sphere::latlong::SEQUENTIAL_MAX_VALUES, 64 * 128);
+/// ```
+pub const SEQUENTIAL_MAX_VALUES: usize = 64 * 128;
+
+/// `f(i, row)` for every row `i` of `row_len` values of `data`: on the calling thread for at
+/// most [`SEQUENTIAL_MAX_VALUES`] values, otherwise rows in parallel.
+pub(crate) fn for_each_row<T: Send>(
+    data: &mut [T],
+    row_len: usize,
+    f: impl Fn(usize, &mut [T]) + Sync,
+) {
+    if data.len() <= SEQUENTIAL_MAX_VALUES {
+        data.chunks_mut(row_len)
+            .enumerate()
+            .for_each(|(i, row)| f(i, row));
+    } else {
+        data.par_chunks_mut(row_len)
+            .enumerate()
+            .for_each(|(i, row)| f(i, row));
+    }
+}
+
 /// A `(rows, cols, channels)` array whose entry `(i, j, ..)` is written by
-/// `f(i, j, channels_out)`, rows in parallel.
+/// `f(i, j, channels_out)`, rows in parallel above [`SEQUENTIAL_MAX_VALUES`].
 pub(crate) fn fill_grid<T: Sample>(
     shape: (usize, usize, usize),
     f: impl Fn(usize, usize, &mut [T]) + Sync,
 ) -> Array3<T> {
-    let channels = shape.2;
+    let (channels, row_len) = (shape.2, shape.1 * shape.2);
     let mut data = Array3::zeros(shape);
-    data.axis_iter_mut(Axis(0))
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(i, mut row)| {
-            let row = row.as_slice_mut().expect("standard layout");
+    if row_len > 0 {
+        let flat = data.as_slice_mut().expect("standard layout");
+        for_each_row(flat, row_len, |i, row| {
             for (j, px) in row.chunks_exact_mut(channels).enumerate() {
                 f(i, j, px);
             }
         });
+    }
     data
 }
 

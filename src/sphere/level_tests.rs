@@ -19,7 +19,7 @@ fn smooth(h: usize) -> LatLongMap<f64> {
 
 /// Every `b x b` block of the `(H, W, C)` array replaced by its mean: the map reduced to the
 /// Haar approximation of blocks of `b` pixels.
-fn block_means(a: &Array3<f64>, b: usize) -> Array3<f64> {
+pub(super) fn block_means(a: &Array3<f64>, b: usize) -> Array3<f64> {
     let (h, w, c) = a.dim();
     Array3::from_shape_fn((h, w, c), |(i, j, k)| {
         let (i0, j0) = (i / b * b, j / b * b);

@@ -9,9 +9,14 @@
 //! | [`Method::Reference`] | ground truth: each target pixel is the solid-angle mean of `f(R p)` over the pixel, `n x n` stratified samples of the bilinear `f` ([`reference`](mod@reference)) | `n^2` lookups per pixel |
 //! | [`Method::Bilinear`], [`Method::Bicubic`] | one lookup per target pixel at `R p` ([`resample`]) | 4 or 16 taps per pixel |
 //! | [`Method::Haar`] | the chain rule on the detail coefficients at one level, exact recursive filters for the coarser ones ([`chain_rule`]) | two chain-rule evaluations per pixel of the working level |
+//! | [`Method::HaarCubic`] | the same with four-point differences of `f`, Catmull-Rom derivatives at the pre-images, third-order-corrected differences of `g` and a pole-corrected integral for the constant ([`chain_rule::Scheme::Cubic`]): bicubic's accuracy (or better) without leaving the coefficients | the same evaluations, 16 taps each instead of 4, plus the two pole rows |
 //!
 //! Every method returns pixels and coefficients ([`Rotated`]); the pixel methods transform
-//! their result forward, the Haar method inverts its coefficients.
+//! their result forward, the Haar methods invert their coefficients. Measured on analytic
+//! Phong lobes ([`lobes`]): at 64 x 128 `haar` is within 0.9x to 1.4x of `bilinear`'s error,
+//! `haar-cubic` within 0.4x to 0.85x of `bicubic`'s (against the lobe at the texel centres;
+//! against its texel means, where every method carries the same point-versus-mean
+//! difference, 0.96x to 1.02x).
 //!
 //! **Level.** [`SphereOptions::level`] `= Some(L)` computes detail levels `0..=L` only, on the
 //! `2^(L+1) x 2^(L+2)` approximation of `f` (its coefficients of levels `0..=L`); the finer
@@ -27,7 +32,7 @@
 //!
 //! **Exact yaw.** When `R` is a yaw about +Y by a whole number of columns (`k * 360 / W`
 //! degrees, the identity included), `g` is `f` with its columns turned, and every method
-//! returns exactly that ([`yaw`]; the Haar method shifts coefficients).
+//! returns exactly that ([`yaw`]; the Haar methods shift coefficients).
 //!
 //! Conventions: [`latlong`] (map geometry, seam and poles), [`rotation`] (yaw, pitch, roll),
 //! [`coefficients`] (how a 2:1 map maps onto two square Haar pyramids side by side).
@@ -50,6 +55,7 @@ pub mod experiment;
 pub mod harmonics;
 pub mod integrate;
 pub mod latlong;
+pub mod lobes;
 pub mod param;
 pub mod product;
 pub mod reference;
@@ -79,6 +85,25 @@ named_enum! {
         #[default]
         /// The chain rule in the Haar domain ([`chain_rule`]).
         Haar = "haar",
+        /// The higher-order chain rule in the Haar domain ([`chain_rule::Scheme::Cubic`]).
+        HaarCubic = "haar-cubic",
+    }
+}
+
+impl Method {
+    /// The chain-rule scheme of a Haar-domain method, `None` for a pixel method.
+    ///
+    /// ```
+    /// use haarshift::sphere::{Method, chain_rule::Scheme};
+    /// assert_eq!(Method::HaarCubic.scheme(), Some(Scheme::Cubic));
+    /// assert_eq!(Method::Bicubic.scheme(), None);
+    /// ```
+    pub fn scheme(self) -> Option<chain_rule::Scheme> {
+        match self {
+            Method::Haar => Some(chain_rule::Scheme::Linear),
+            Method::HaarCubic => Some(chain_rule::Scheme::Cubic),
+            Method::Reference | Method::Bilinear | Method::Bicubic => None,
+        }
     }
 }
 
@@ -140,7 +165,7 @@ pub fn rotate_map<T: Sample>(
     let finest = level + 1 == h.trailing_zeros() as usize;
     if let Some(k) = rotation.whole_column_yaw(map.width()) {
         let pixels = yaw::yaw_pixels(map, k);
-        let coefficients = if options.method == Method::Haar {
+        let coefficients = if options.method.scheme().is_some() {
             yaw::yaw_coefficients(&SphereCoefficients::from_map(map)?, k)?
         } else {
             SphereCoefficients::from_map(&pixels)?
@@ -154,8 +179,8 @@ pub fn rotate_map<T: Sample>(
         return with_pixels(coefficients.truncated(level)?);
     }
     let source = map.downsample(h >> (level + 1))?;
-    if options.method == Method::Haar {
-        let coefficients = chain_rule::rotate(&source, rotation)?.zero_padded(h)?;
+    if let Some(scheme) = options.method.scheme() {
+        let coefficients = chain_rule::rotate(&source, rotation, scheme)?.zero_padded(h)?;
         return with_pixels(coefficients);
     }
     let pixels = rotate_pixels(&source, rotation, options)?;
@@ -195,9 +220,9 @@ pub fn rotate_coefficients<T: Sample>(
         return yaw::yaw_coefficients(coeffs, k)?.truncated(level);
     }
     let source = coeffs.approximation(level)?;
-    let small = match options.method {
-        Method::Haar => chain_rule::rotate(&source, rotation)?,
-        _ => SphereCoefficients::from_map(&rotate_pixels(&source, rotation, options)?)?,
+    let small = match options.method.scheme() {
+        Some(scheme) => chain_rule::rotate(&source, rotation, scheme)?,
+        None => SphereCoefficients::from_map(&rotate_pixels(&source, rotation, options)?)?,
     };
     small.zero_padded(h)
 }
@@ -212,7 +237,10 @@ fn rotate_pixels<T: Sample>(
         Method::Reference => reference::reference(source, rotation, options.reference_samples),
         Method::Bilinear => resample::resample(source, rotation, Interpolation::Bilinear),
         Method::Bicubic => resample::resample(source, rotation, Interpolation::Bicubic),
-        Method::Haar => Err(Error::parameter("method", "haar is not a pixel method")),
+        Method::Haar | Method::HaarCubic => Err(Error::parameter(
+            "method",
+            format!("{} is not a pixel method", options.method),
+        )),
     }
 }
 
@@ -245,5 +273,7 @@ fn resolve_level(h: usize, level: Option<usize>) -> Result<usize> {
 
 #[cfg(test)]
 mod level_tests;
+#[cfg(test)]
+mod lobe_tests;
 #[cfg(test)]
 mod tests;

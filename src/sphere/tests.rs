@@ -170,7 +170,7 @@ fn recursive_filters_reproduce_the_forward_transform_exactly() {
 fn selected_coefficients_equal_the_recursive_ones() {
     let f = harmonic_map(16, 2);
     let r = compound();
-    let all = chain_rule::rotate(&f, &r).unwrap();
+    let all = chain_rule::rotate(&f, &r, chain_rule::Scheme::Linear).unwrap();
     let mut requests = Vec::new();
     for level in 0..4 {
         for band in [Band::Horizontal, Band::Vertical, Band::Diagonal] {
@@ -225,7 +225,7 @@ fn selected_coefficients_equal_the_recursive_ones() {
 /// smooth map against the analytic `g_theta`, `g_phi`.
 fn derivative_error(h: usize, rotation: &SphereRotation) -> f64 {
     let f = harmonic_map(h, 1);
-    let fields = DifferenceFields::rotated(&f, rotation);
+    let fields = DifferenceFields::rotated(&f, rotation, chain_rule::Scheme::Linear);
     let step = PI / h as f64;
     let analytic = |theta: f64, phi: f64, along_theta: bool| {
         let (st, ct) = theta.sin_cos();
@@ -278,8 +278,9 @@ fn chain_rule_derivatives_converge_at_second_order() {
 #[test]
 fn rotating_there_and_back_returns_the_map() {
     // Smooth map, 128 x 256, values about 0.2 to 2: each leg costs a second-order error.
-    // Measured weighted RMS: reference 2.0e-4, bilinear 1.25e-4, bicubic 1.9e-7, haar 9.5e-5;
-    // bounds 2x each (a bicubic that fell back to bilinear would be 600x over its bound).
+    // Measured weighted RMS: reference 2.0e-4, bilinear 1.25e-4, bicubic 1.9e-7, haar 9.5e-5,
+    // haar-cubic 6.4e-8; bounds 2x each (a bicubic that fell back to bilinear would be 600x
+    // over its bound, a haar-cubic that fell back to haar 700x).
     let f = harmonic_map(128, 1);
     let r = compound();
     for &method in Method::ALL {
@@ -291,6 +292,7 @@ fn rotating_there_and_back_returns_the_map() {
             Method::Bilinear => 2.5e-4,
             Method::Bicubic => 4e-7,
             Method::Haar => 2e-4,
+            Method::HaarCubic => 1.3e-7,
         };
         assert!(rms < bound, "{method}: {rms}");
     }
@@ -303,8 +305,9 @@ fn smooth_maps_rotate_accurately_and_keep_their_energy() {
     let exact = LatLongMap::<f64>::from_fn(64, 1, |d, out| out[0] = harmonic(r.apply(d))).unwrap();
     // Measured weighted RMS against the exact rotated function: reference 4.3e-4 (it
     // averages over pixels, the exact map is point-sampled), bilinear 2.7e-4, bicubic 2.6e-6,
-    // haar 2.0e-4; bounds 1.4x for the reference, 2x for the others. Energy: 4.1e-5, 8.3e-5,
-    // -2.8e-6 and 3e-15; bounds 2.5x, 2.4x, 2.1x and 1e-14.
+    // haar 2.0e-4, haar-cubic 3.6e-7; bounds 1.4x for the reference, 2x for the others.
+    // Energy: 4.1e-5, 8.3e-5, -2.8e-6, 3e-15 and -2.9e-6 (haar-cubic keeps the pole-corrected
+    // sampled integral, not the plain sum); bounds 2.5x, 2.4x, 2.1x, 1e-14 and 2x.
     for &method in Method::ALL {
         let g = rotate_map(&f, &r, &options(method)).unwrap();
         let rms = weighted_rms(&g.map, &exact).unwrap();
@@ -313,6 +316,7 @@ fn smooth_maps_rotate_accurately_and_keep_their_energy() {
             Method::Bilinear => (5.5e-4, 2e-4),
             Method::Bicubic => (5.5e-6, 6e-6),
             Method::Haar => (4e-4, 1e-14),
+            Method::HaarCubic => (7e-7, 6e-6),
         };
         assert!(rms < rms_bound, "{method}: {rms}");
         let energy = relative_energy_error(&g.map, &f);

@@ -48,6 +48,7 @@ Examples:
   haarshift sphere rotate park.hdr -o park-tilted.exr --pitch 30
   haarshift sphere rotate park.exr -o park.npy --yaw 40 --pitch -25 --roll 60 --method bicubic
   haarshift sphere rotate park.npy -o coarse.exr --pitch 90 --method haar --level 5
+  haarshift sphere rotate lobe.npy -o turned.npy --pitch 45 --method haar-cubic
   haarshift sphere rotate park.hdr -o truth.exr --pitch 30 --method reference --samples 16
   haarshift sphere rotate park.hdr -o park-coeffs.npy --yaw 10 --coefficients
 
@@ -99,7 +100,9 @@ pub struct RotateArgs {
     pub roll: f64,
 
     /// `haar`: the chain rule on the Haar detail coefficients, coarser levels by recursive
-    /// filters (no pixel lookups). `bilinear`, `bicubic`: one lookup per output pixel.
+    /// filters (no pixel lookups). `haar-cubic`: the same with four-point differences and
+    /// Catmull-Rom derivatives (bicubic's accuracy, in the Haar domain). `bilinear`,
+    /// `bicubic`: one lookup per output pixel.
     /// `reference`: ground truth, the solid-angle mean of SAMPLES x SAMPLES bilinear lookups
     /// per output pixel (slow)
     #[arg(long, default_value = "haar", value_parser = choice::<Method>(names!(Method)))]
