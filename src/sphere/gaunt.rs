@@ -99,7 +99,7 @@ pub fn selection_rules(i: usize, j: usize, k: usize) -> bool {
 
 /// Nodes and weights of the `n`-point Gauss-Legendre rule on `[-1, 1]` (exact for polynomials
 /// of degree below `2 n`).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     (0..n)
         .map(|i| {
             let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
