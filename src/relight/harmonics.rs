@@ -268,15 +268,19 @@ fn check_shading(
             ),
         ));
     }
-    check_finite(albedo.mapv(f64::from).view())?;
+    check_finite(albedo)?;
     check_finite(lighting)
 }
 
 /// An [`Error::NonFinite`] naming the first NaN or infinity of `values`.
-fn check_finite(values: ArrayView2<'_, f64>) -> Result<()> {
-    match values.indexed_iter().find(|(_, v)| !v.is_finite()) {
+fn check_finite<T: Copy + Into<f64>>(values: ArrayView2<'_, T>) -> Result<()> {
+    match values
+        .indexed_iter()
+        .map(|(at, v)| (at, (*v).into()))
+        .find(|(_, v): &(_, f64)| !v.is_finite())
+    {
         Some(((r, c), v)) => Err(Error::NonFinite {
-            value: *v,
+            value: v,
             index: vec![r, c],
         }),
         None => Ok(()),
