@@ -13,6 +13,11 @@
 //! general rotation (applied at the source's resolution). The transport is precomputed once
 //! per run with the real ray caster ([`vertex_major`], a few minutes on two cores, with a
 //! progress bar) and only when one of these benchmarks is selected; nothing is synthetic.
+//!
+//! And the spherical-harmonics baselines (`relight_sh_85860`) on a synthetic transfer of the
+//! same 85,860 vertices at `B = 4, 6, 8` bands, RGB lighting: Lambertian [`shade_sh`] (`B^2`
+//! per vertex and channel) beside the glossy Phong 50 triple product [`PhongSh::shade`] (`B^4`),
+//! every vertex glossy; and the one-off [`PhongSh::new`] (the Gaunt table).
 //! Run: `cargo bench --bench relight -- --warm-up-time 1 --measurement-time 5`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -22,7 +27,8 @@ use haarshift::product::Selection;
 use haarshift::relight::environment::{Environment, SphereMapping, downsample_solid_angle};
 use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV, Mesh, render};
 use haarshift::relight::{
-    Generator, Lighting, PreparedTransport, SceneBvh, ShadeOptions, VisibilityOptions, vertex_major,
+    Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,
+    VisibilityOptions, shade_sh, vertex_major,
 };
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::sphere::latlong::direction;
@@ -177,5 +183,48 @@ fn bench_relighting(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, bench_relighting);
+/// The glossy and Lambertian SH shadings of 85,860 vertices, synthetic transfer and lighting.
+fn bench_sh(c: &mut Criterion) {
+    let vertices = 85_860;
+    let mut group = c.benchmark_group("relight_sh_85860");
+    group.sample_size(10);
+    for bands in [4, 6, 8] {
+        let n = bands * bands;
+        let transfer = ShTransfer::new(
+            bands,
+            Array2::from_shape_fn((vertices, n), |(v, i)| {
+                (((v * 7 + i * 13) as f64 * 0.37).sin() / (1 + i) as f64) as f32
+            }),
+        )
+        .expect("transfer");
+        let albedo = Array2::from_elem((vertices, 3), 0.7f32);
+        let lighting = Array2::from_shape_fn((n, 3), |(i, c)| 1.0 / (1 + i + c) as f64);
+        let mirror = Array2::from_shape_fn((vertices, 3), |(v, k)| {
+            direction(0.1 + 3.0 * (v as f64 * 0.618_034).fract(), v as f64 * 2.4)[k]
+        });
+        group.bench_function(format!("shade_sh_lambert/bands_{bands}"), |b| {
+            b.iter(|| shade_sh(&transfer, albedo.view(), lighting.view()).expect("shades"))
+        });
+        let phong = PhongSh::new(bands, 50.0).expect("phong");
+        group.bench_function(format!("shade_sh_phong50/bands_{bands}"), |b| {
+            b.iter(|| {
+                phong
+                    .shade(
+                        &transfer,
+                        albedo.view(),
+                        lighting.view(),
+                        mirror.view(),
+                        vertices,
+                    )
+                    .expect("shades")
+            })
+        });
+        group.bench_function(format!("phong_sh_new/bands_{bands}"), |b| {
+            b.iter(|| PhongSh::new(bands, 50.0).expect("phong"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_relighting, bench_sh);
 criterion_main!(benches);

@@ -10,7 +10,7 @@
 //! | [`shadowmap`] | [`ShadowMap`], seed 003's orthographic depth buffer along one direction |
 //! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
-//! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, and its shading [`shade_sh`] |
+//! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
 //! | [`reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
@@ -55,7 +55,7 @@ pub mod visibility;
 pub use brdf::Brdf;
 pub use cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
 pub use error::SceneError;
-pub use harmonics::{ShTransfer, shade_sh};
+pub use harmonics::{PhongSh, ShTransfer, non_zonal_material, shade_sh, shade_sh_glossy};
 pub use lighting::Lighting;
 pub use mesh::{Bounds, Mesh};
 pub use raycast::{Occlusion, SceneBvh};

@@ -52,6 +52,7 @@ pub mod coefficients;
 pub mod convert;
 pub mod cube;
 pub mod experiment;
+pub mod gaunt;
 pub mod harmonics;
 pub mod integrate;
 pub mod latlong;
