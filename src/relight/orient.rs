@@ -24,6 +24,7 @@
 //! | `--brdf-rotation` | how | needs |
 //! |---|---|---|
 //! | `haar` | the chain rule on the local map's Haar coefficients from `--level L` ([`Method::Haar`]) | lat-long |
+//! | `haar-cubic` | the higher-order chain rule, still on the coefficients ([`Method::HaarCubic`]) | lat-long |
 //! | `spatial` | the local map rotated in the pixel domain, bilinear, then transformed ([`Method::Bilinear`]) | lat-long |
 //! | `reference` | rotation by solid-angle integration over each target texel ([`Method::Reference`]) | lat-long |
 //! | `direct` | no rotation: [`Brdf::evaluate`] at each global texel centre with the exact `n`, `w_o` | any |
@@ -47,6 +48,8 @@ named_enum! {
         #[default]
         /// The chain rule in the Haar domain.
         Haar = "haar",
+        /// The higher-order chain rule in the Haar domain.
+        HaarCubic = "haar-cubic",
         /// Bilinear rotation in the pixel domain.
         Spatial = "spatial",
         /// Solid-angle integration per texel.
@@ -61,6 +64,7 @@ impl BrdfRotation {
     fn method(self) -> Option<Method> {
         match self {
             BrdfRotation::Haar => Some(Method::Haar),
+            BrdfRotation::HaarCubic => Some(Method::HaarCubic),
             BrdfRotation::Spatial => Some(Method::Bilinear),
             BrdfRotation::Reference => Some(Method::Reference),
             BrdfRotation::Direct => None,

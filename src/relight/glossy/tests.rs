@@ -353,3 +353,66 @@ fn bad_inputs_are_refused() {
         "precomputed at latlong 8"
     );
 }
+
+#[test]
+fn full_coefficients_and_direct_evaluation_equal_the_reference() {
+    use crate::relight::reference::{ReferenceOptions, reference};
+    use crate::relight::visibility::{VisibilityOptions, vertex_major};
+    use crate::relight::{SceneBvh, add_ground_plane};
+    use crate::sphere::LatLongMap;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
+    let mut mesh = Mesh::load(path.as_ref()).unwrap();
+    let objects = mesh.vertex_count();
+    add_ground_plane(&mut mesh);
+    let n = 16;
+    let sky = LatLongMap::<f64>::from_fn(n, 3, |d, o| {
+        let sun = (8.0 * (d[0] * 0.6 + d[1] * 0.8 - 1.0)).exp();
+        o.copy_from_slice(&[1.0 + 20.0 * sun, 0.5 + d[2].abs(), 0.2 + 10.0 * sun]);
+    })
+    .unwrap();
+    let albedo = Array2::from_shape_fn((mesh.vertex_count(), 3), |(v, c)| {
+        0.3 + 0.1 * ((v * 7 + c) % 5) as f32
+    });
+    let eye = [0.3, 0.4, 0.9];
+    let bvh = SceneBvh::new(&mesh);
+    let param = Parameterization::new(ParamKind::LatLong, n).unwrap();
+    let (set, _) = vertex_major(&mesh, &bvh, &VisibilityOptions::new(param)).unwrap();
+    let light =
+        Lighting::from_map(&SphereMap::from_lat_long(&sky).unwrap(), Selection::All).unwrap();
+    for brdf in [
+        Brdf::Phong { exponent: 30.0 },
+        Brdf::BlinnPhong { exponent: 20.0 },
+    ] {
+        let options = ReferenceOptions {
+            brdf: brdf.clone(),
+            eye: Some(eye),
+            object_vertices: Some(objects),
+            ..ReferenceOptions::default()
+        };
+        let (want, _) = reference(&mesh, &bvh, albedo.view(), &sky, &options).unwrap();
+        let glossy = GlossyOptions {
+            brdf: brdf.clone(),
+            rotation: BrdfRotation::Direct,
+            ..GlossyOptions::default()
+        };
+        let shader = GlossyShader::<f64>::new(
+            &set,
+            &mesh,
+            albedo.view(),
+            &ShadeOptions::default(),
+            &glossy,
+            objects,
+        )
+        .unwrap();
+        let (got, _) = shader.shade(&light, eye).unwrap();
+        let rms = (want.iter().map(|x| x * x).sum::<f64>() / want.len() as f64).sqrt();
+        let worst = (&got - &want).iter().fold(0.0f64, |a, d| a.max(d.abs()));
+        assert!(worst <= 1e-6 * rms, "{brdf}: {worst:e} of RMS {rms}");
+        // The material matters: the glossy radiance is not the Lambertian one.
+        let lambert = shader.transport().shade(&light).unwrap();
+        let apart = (&lambert - &want)
+            .iter()
+            .fold(0.0f64, |a, d| a.max(d.abs()));
+        assert!(apart > 0.1 * rms, "{brdf}: {apart} of {rms}");
+    }
+}

@@ -103,6 +103,8 @@ fn a_phong_lobe_peaks_at_the_mirror_direction_and_keeps_its_integral() {
             // rotation (bilinear samples averaged) the same.
             let bound = match rotation {
                 BrdfRotation::Haar => 1e-9,
+                // Its constant preserves the pole-corrected integral instead (measured 0.8 %).
+                BrdfRotation::HaarCubic => 1.5e-2,
                 BrdfRotation::Spatial | BrdfRotation::Reference => 1.5e-2,
                 BrdfRotation::Direct => f64::INFINITY,
             };
@@ -125,6 +127,7 @@ fn the_rotations_agree_with_direct_evaluation_on_a_smooth_lobe() {
             .unwrap();
         for (rotation, bound) in [
             (BrdfRotation::Haar, 0.02),
+            (BrdfRotation::HaarCubic, 0.02),
             (BrdfRotation::Spatial, 0.02),
             (BrdfRotation::Reference, 0.02),
         ] {

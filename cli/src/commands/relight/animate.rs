@@ -13,8 +13,7 @@ use haarshift::relight::PreparedTransport;
 use haarshift::relight::glossy::GlossyShader;
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs,
-    rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 

@@ -5,12 +5,12 @@ use std::path::{Path, PathBuf};
 
 use haarshift::PlanarImage;
 use haarshift::product::Selection;
-use haarshift::relight::environment::Environment;
-use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
-use haarshift::relight::raster::{Mesh as RasterMesh, render};
 use haarshift::relight::brdf::DEFAULT_ELEVATIONS;
+use haarshift::relight::environment::Environment;
 use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
 use haarshift::relight::orient::BrdfRotation;
+use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
+use haarshift::relight::raster::{Mesh as RasterMesh, render};
 use haarshift::relight::scene::GROUND_VERTICES;
 use haarshift::relight::{Brdf, PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
@@ -235,6 +235,16 @@ impl GlossyFlags {
     }
 }
 
+/// The vertices of `cache`'s objects: all but the ground plane's, which stays Lambertian.
+pub fn object_vertices(cache: &SceneCache) -> usize {
+    let ground = if cache.params.ground_plane {
+        GROUND_VERTICES
+    } else {
+        0
+    };
+    cache.mesh.vertex_count().saturating_sub(ground)
+}
+
 /// The camera and the image.
 #[derive(clap::Args, Debug)]
 pub struct CameraFlags {
@@ -428,14 +438,13 @@ impl ShadingFlags {
         brdf: &Brdf,
         glossy: &GlossyFlags,
     ) -> Result<GlossyShader<f32>> {
-        let ground = if cache.params.ground_plane { GROUND_VERTICES } else { 0 };
         GlossyShader::new(
             &cache.transport,
             &cache.mesh,
             cache.albedo.view(),
             &self.options(),
             &glossy.options(brdf),
-            cache.mesh.vertex_count().saturating_sub(ground),
+            object_vertices(cache),
         )
     }
 }

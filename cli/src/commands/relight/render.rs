@@ -4,15 +4,17 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use haarshift::relight::brdf::mirror;
+use haarshift::relight::harmonics::{PhongSh, non_zonal_material};
 use haarshift::relight::raster::{render_format, write_render};
-use haarshift::relight::{Lighting, SceneCache, shade_sh};
+use haarshift::relight::{Brdf, Lighting, Mesh, SceneCache, shade_sh};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::Array2;
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs,
-    rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, object_vertices,
+    refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -129,9 +131,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         Basis::Haar => {
             let start = Instant::now();
-            let shader =
-                args.shading
-                    .prepare_glossy(&cache, &brdf, &args.glossy)?;
+            let shader = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
             let prepare_ms = ms(start);
             let start = Instant::now();
             let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
@@ -158,24 +158,16 @@ pub fn run(args: Args) -> Result<()> {
                      once in {prepare_ms:.1} ms",
                     brdf,
                     args.glossy.brdf_rotation,
-                    args.glossy
-                        .level
-                        .map_or(String::new(), |l| format!(
-                            " from level {l} (thesis level {})",
-                            l + 1
-                        )),
+                    args.glossy.level.map_or(String::new(), |l| format!(
+                        " from level {l} (thesis level {})",
+                        l + 1
+                    )),
                     lighting.kept(),
                     shader.transport().coefficient_count()
                 ),
             }
         }
         Basis::Sh => {
-            if !brdf.is_lambert() {
-                return Err(Error::InvalidParameter {
-                    name: "basis",
-                    reason: format!("{brdf}: --basis sh shades lambert only"),
-                });
-            }
             if args.shading.is_set() {
                 return Err(Error::InvalidParameter {
                     name: "basis",
@@ -195,7 +187,22 @@ pub fn run(args: Args) -> Result<()> {
             let lighting = SphericalHarmonics::new(transfer.bands())?.project(&map);
             let encode_ms = ms(start);
             let start = Instant::now();
-            let radiance = shade_sh(transfer, cache.albedo.view(), lighting.view())?;
+            let radiance = match brdf {
+                Brdf::Lambert => shade_sh(transfer, cache.albedo.view(), lighting.view())?,
+                Brdf::Phong { exponent } => {
+                    let mirror = mirror_directions(&cache.mesh, camera.position())?;
+                    PhongSh::new(transfer.bands(), exponent)?
+                        .shade(
+                            transfer,
+                            cache.albedo.view(),
+                            lighting.view(),
+                            mirror.view(),
+                            object_vertices(&cache),
+                        )?
+                        .mapv(|x| x as f32)
+                }
+                other => return Err(non_zonal_material(&other.to_string())),
+            };
             Shaded {
                 radiance,
                 encode_ms,
@@ -249,4 +256,26 @@ struct Shaded {
     encode_ms: f64,
     shade_ms: f64,
     what: String,
+}
+
+/// Every vertex's unit mirror direction of the view from `eye` (the normal where the eye sits
+/// on the vertex).
+fn mirror_directions(mesh: &Mesh, eye: [f64; 3]) -> Result<Array2<f64>> {
+    let (p, n) = (mesh.positions(), mesh.normals());
+    let mut out = Array2::zeros((mesh.vertex_count(), 3));
+    for (v, mut row) in out.rows_mut().into_iter().enumerate() {
+        let normal = [n[[v, 0]], n[[v, 1]], n[[v, 2]]];
+        let view: [f64; 3] = std::array::from_fn(|k| eye[k] - p[[v, k]]);
+        let len = view.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let r = if len > 0.0 {
+            mirror(normal, view.map(|x| x / len))
+        } else {
+            normal
+        };
+        let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+        for k in 0..3 {
+            row[k] = r[k] / norm;
+        }
+    }
+    Ok(out)
 }
