@@ -126,8 +126,8 @@ fn pixel_domain(
         let transport = Transport::new(&weighted, layout(param), Selection::All).unwrap();
         let rho = HaarTree::from_pixels(rgb(&r).view(), layout(param), Selection::All).unwrap();
         let triple = triple_integral(&transport, &light.tree().unwrap(), &rho).unwrap();
-        for c in 0..3 {
-            assert!((triple.value[c] - sum[c]).abs() < 1e-12 * sum[c].abs().max(1.0));
+        for (t, s) in triple.value.iter().zip(sum) {
+            assert!((t - s).abs() < 1e-12 * s.abs().max(1.0));
         }
     }
     sum

@@ -74,7 +74,7 @@ enum Shader {
     /// One sparse dot per vertex.
     Lambert(PreparedTransport<f32>),
     /// The triple product with the rotated BRDF.
-    Glossy(GlossyShader<f32>),
+    Glossy(Box<GlossyShader<f32>>),
 }
 
 /// The most frames in one animation.
@@ -126,7 +126,11 @@ pub fn run(args: Args) -> Result<()> {
     let shader = if brdf.is_lambert() {
         Shader::Lambert(args.shading.prepare(&cache)?)
     } else {
-        Shader::Glossy(args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?)
+        Shader::Glossy(Box::new(args.shading.prepare_glossy(
+            &cache,
+            &brdf,
+            &args.glossy,
+        )?))
     };
     // The lat-long-to-working mapping (a cube's conversion table) is built once, not per frame.
     let mapping = SphereMapping::new(env.map().height(), cache.transport.param())?;
