@@ -827,3 +827,67 @@ fn every_subcommand_has_an_example_in_its_help() {
     }
     let _ = text;
 }
+
+#[test]
+fn glossy_render_with_direct_evaluation_equals_the_glossy_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = sphere_on_plane(dir.path());
+    let cache = dir.path().join("s.hsr");
+    precompute(&scene, &cache, &["--resolution", "16", "--sh-bands", "4"]);
+    let env = env32();
+    let common = ["--env", p(&env), "--brdf", "phong:20", "--albedo", "0.7,0.5,0.2"];
+    let render = |name: &str, extra: &[&str]| {
+        let npy = dir.path().join(format!("{name}.npy"));
+        let png = dir.path().join(format!("{name}.png"));
+        let mut args = render_args(&cache, &png, &common);
+        args.extend(extra);
+        args.extend(["--vertices", p(&npy)]);
+        let stdout = succeeds_with_stdout(&args);
+        (read_vertices(&npy), stdout)
+    };
+    let truth = dir.path().join("truth.npy");
+    let mut args = vec!["relight", "reference", p(&scene), "--resolution", "16"];
+    args.extend(common);
+    args.extend(["--vertices", p(&truth)]);
+    succeeds(&args);
+    let truth = read_vertices(&truth);
+    let (direct, stdout) = render("direct", &["--brdf-rotation", "direct"]);
+    assert!(stdout.contains("phong:20 rotated by direct"), "{stdout}");
+    let e = relative_rms(&direct, &truth);
+    assert!(e < 1e-6, "direct: {e:.2e}");
+    // The rotations approximate it; the cache too; the material matters.
+    let (haar, stdout) = render("haar", &["--rotation-cache", "8"]);
+    assert!(stdout.contains("rotation cache 8 x 16"), "{stdout}");
+    let e = relative_rms(&haar, &truth);
+    assert!(e > 1e-4 && e < 0.2, "haar, cache 8: {e:.2e}");
+    let (sh, _) = render("sh", &["--basis", "sh"]);
+    let e = relative_rms(&sh, &truth);
+    assert!(e > 1e-3 && e < 0.5, "SH, 4 bands: {e:.2e}");
+    let lambert = dir.path().join("lambert.npy");
+    let png = dir.path().join("lambert.png");
+    let mut args = render_args(&cache, &png, &["--env", p(&env), "--albedo", "0.7,0.5,0.2"]);
+    args.extend(["--vertices", p(&lambert)]);
+    succeeds(&args);
+    assert!(relative_rms(&read_vertices(&lambert), &truth) > 0.05);
+    // Glossy flags with a Lambertian BRDF, a rotation on a cube map, a zonal-only basis.
+    let out = dir.path().join("x.png");
+    fails_cleanly(
+        &render_args(&cache, &out, &["--env", p(&env), "--rotation-cache", "8"]),
+        &["--rotation-cache", "lambert"],
+    );
+    fails_cleanly(
+        &render_args(
+            &cache,
+            &out,
+            &["--env", p(&env), "--brdf", "blinn:10", "--basis", "sh"],
+        ),
+        &["zonal", "blinn:10"],
+    );
+    let cube = dir.path().join("cube.hsr");
+    precompute(&scene, &cube, &["--resolution", "4", "--param", "cube"]);
+    fails_cleanly(
+        &render_args(&cube, &out, &["--env", p(&env), "--brdf", "phong:5"]),
+        &["haar", "--param latlong"],
+    );
+    assert!(!out.exists());
+}
