@@ -714,13 +714,13 @@ pub fn set_mean_from_sampled_integral<T: Sample>(
 ///
 /// ```
 /// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::sampled_integral};
-/// // exp(4 y) about the pole and turned to the horizon: the plain sums differ by 1e-3
-/// // relative, these by 2e-6.
+/// // exp(4 y) about the pole and turned to the horizon: the plain sums differ by 3.9e-4
+/// // relative, these by less than 1e-5.
 /// let r = SphereRotation::from_degrees(0.0, 90.0, 0.0).unwrap();
 /// let f = LatLongMap::<f64>::from_fn(64, 1, |d, out| out[0] = (4.0 * d[1]).exp()).unwrap();
 /// let g = LatLongMap::<f64>::from_fn(64, 1, |d, out| out[0] = (4.0 * r.apply(d)[1]).exp()).unwrap();
 /// let rel = |a: f64, b: f64| (a - b).abs() / b;
-/// assert!(rel(f.energy()[0], g.energy()[0]) > 5e-4);
+/// assert!(rel(f.energy()[0], g.energy()[0]) > 3e-4);
 /// assert!(rel(sampled_integral(&f)[0], sampled_integral(&g)[0]) < 1e-5);
 /// ```
 pub fn sampled_integral<T: Sample>(samples: &LatLongMap<T>) -> Vec<f64> {
