@@ -835,7 +835,14 @@ fn glossy_render_with_direct_evaluation_equals_the_glossy_reference() {
     let cache = dir.path().join("s.hsr");
     precompute(&scene, &cache, &["--resolution", "16", "--sh-bands", "4"]);
     let env = env32();
-    let common = ["--env", p(&env), "--brdf", "phong:20", "--albedo", "0.7,0.5,0.2"];
+    let common = [
+        "--env",
+        p(&env),
+        "--brdf",
+        "phong:20",
+        "--albedo",
+        "0.7,0.5,0.2",
+    ];
     let render = |name: &str, extra: &[&str]| {
         let npy = dir.path().join(format!("{name}.npy"));
         let png = dir.path().join(format!("{name}.png"));
