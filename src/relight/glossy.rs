@@ -441,9 +441,26 @@ fn bin_centre(n: usize, i: u32, j: u32) -> [f64; 3] {
     direction((i as f64 + 0.5) * step, (j as f64 + 0.5) * step)
 }
 
-/// Each face's `s x s` block of every plane of `planes` (`channels x texels`), in order.
-fn face_blocks(planes: &mut [f64], s: usize) -> std::slice::ChunksExactMut<'_, f64> {
-    planes.chunks_exact_mut(s * s)
+/// The orthonormal Haar transform, forward or inverse, of every `s x s` face block of `src`
+/// (any number of faces and planes, back to back) into the same block of `dst`.
+fn transform_faces<T: Sample>(
+    src: &[T],
+    dst: &mut [T],
+    s: usize,
+    forward: bool,
+    work: &mut Vec<T>,
+) -> Result<()> {
+    let levels = s.trailing_zeros() as usize;
+    for (from, to) in src.chunks_exact(s * s).zip(dst.chunks_exact_mut(s * s)) {
+        let from = ArrayView2::from_shape((s, s), from).expect("a face is s x s");
+        let to = ndarray::ArrayViewMut2::from_shape((s, s), to).expect("a face is s x s");
+        if forward {
+            pyramid::forward_into(from, levels, Normalization::Orthonormal, to, work)?;
+        } else {
+            pyramid::inverse_into(from, levels, Normalization::Orthonormal, to, work)?;
+        }
+    }
+    Ok(())
 }
 
 /// Truncates a function given as pixel planes (`channels x texels`) in place: forward
@@ -457,15 +474,10 @@ fn truncate_planes(
     depth: usize,
 ) -> Result<()> {
     let s = param.face_size();
-    let levels = s.trailing_zeros() as usize;
     let texels = param.texels();
     let mut work = Vec::new();
     let mut coefficients = vec![0.0f64; planes.len()];
-    for (src, dst) in face_blocks(planes, s).zip(coefficients.chunks_exact_mut(s * s)) {
-        let image = ArrayView2::from_shape((s, s), &*src).expect("a face is s x s");
-        let out = ndarray::ArrayViewMut2::from_shape((s, s), dst).expect("a face is s x s");
-        pyramid::forward_into(image, levels, Normalization::Orthonormal, out, &mut work)?;
-    }
+    transform_faces(planes, &mut coefficients, s, true, &mut work)?;
     let indices: Vec<u32> = (0..texels as u32).collect();
     let kept = match keep {
         Some(k) => select_kept(
@@ -488,12 +500,7 @@ fn truncate_planes(
             }
         }
     }
-    for (src, dst) in coefficients.chunks_exact(s * s).zip(face_blocks(planes, s)) {
-        let coeffs = ArrayView2::from_shape((s, s), src).expect("a face is s x s");
-        let out = ndarray::ArrayViewMut2::from_shape((s, s), dst).expect("a face is s x s");
-        pyramid::inverse_into(coeffs, levels, Normalization::Orthonormal, out, &mut work)?;
-    }
-    Ok(())
+    transform_faces(&coefficients, planes, s, false, &mut work)
 }
 
 /// The lighting's pixels (`3 x texels`, channel planes) as the product sees them: its kept
@@ -501,7 +508,6 @@ fn truncate_planes(
 fn light_pixels<T: Sample>(lighting: &Lighting, depth: usize) -> Result<Vec<T>> {
     let param = lighting.param();
     let s = param.face_size();
-    let levels = s.trailing_zeros() as usize;
     let texels = param.texels();
     let c = lighting.coefficients_f64();
     let mut coefficients = vec![0.0f64; 3 * texels];
@@ -513,15 +519,7 @@ fn light_pixels<T: Sample>(lighting: &Lighting, depth: usize) -> Result<Vec<T>> 
         }
     }
     let mut pixels = vec![0.0f64; 3 * texels];
-    let mut work = Vec::new();
-    for (src, dst) in coefficients
-        .chunks_exact(s * s)
-        .zip(pixels.chunks_exact_mut(s * s))
-    {
-        let coeffs = ArrayView2::from_shape((s, s), src).expect("a face is s x s");
-        let out = ndarray::ArrayViewMut2::from_shape((s, s), dst).expect("a face is s x s");
-        pyramid::inverse_into(coeffs, levels, Normalization::Orthonormal, out, &mut work)?;
-    }
+    transform_faces(&coefficients, &mut pixels, s, false, &mut Vec::new())?;
     Ok(pixels.into_iter().map(T::from_f64).collect())
 }
 
@@ -537,7 +535,6 @@ fn product_rows<T: Sample>(
     work: &mut Vec<T>,
 ) -> Result<()> {
     let s = param.face_size();
-    let levels = s.trailing_zeros() as usize;
     let texels = param.texels();
     let channels = brdf.len() / texels;
     product.resize(2 * s * s, T::zero());
@@ -551,10 +548,7 @@ fn product_rows<T: Sample>(
             for (t, p) in pixels.iter_mut().enumerate() {
                 *p = l[at + t] * b[at + t];
             }
-            let image = ArrayView2::from_shape((s, s), &*pixels).expect("a face is s x s");
-            let out = ndarray::ArrayViewMut2::from_shape((s, s), &mut *coefficients)
-                .expect("a face is s x s");
-            pyramid::forward_into(image, levels, Normalization::Orthonormal, out, work)?;
+            transform_faces(pixels, coefficients, s, true, work)?;
             for (t, &q) in coefficients.iter().enumerate() {
                 rows[at + t][c] = q;
             }

@@ -33,6 +33,9 @@
 //! approximation with detail levels `0..=L` (the thesis's level `L + 1`, faces `2^(L+1)` texels
 //! wide), finer levels zero. The thesis found its level 5 (`L = 4`) slightly better than 6.
 
+use ndarray::Array2;
+
+use super::Mesh;
 use super::brdf::{Brdf, LocalTable, mirror};
 use crate::named::named_enum;
 use crate::sphere::latlong::{angles, direction};
@@ -110,6 +113,33 @@ impl Frame {
     pub fn mirror(&self) -> [f64; 3] {
         mirror(self.normal, self.outgoing)
     }
+}
+
+/// Every vertex's unit mirror direction of the view from `eye`, `(V, 3)` (the normal where
+/// the eye sits on the vertex, so every row is a direction).
+///
+/// ```
+/// use haarshift::relight::{Mesh, orient::mirror_directions};
+/// use ndarray::array;
+/// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+///                   vec![[0, 1, 2]], None).unwrap();
+/// let r = mirror_directions(&m, [0.0, 1.0, 1.0]);
+/// assert!((r[[0, 1]] - 0.5f64.sqrt()).abs() < 1e-15 && (r[[0, 2]] + 0.5f64.sqrt()).abs() < 1e-15);
+/// assert_eq!(mirror_directions(&m, [0.0; 3]).row(0).to_vec(), vec![0.0, 1.0, 0.0]);
+/// ```
+pub fn mirror_directions(mesh: &Mesh, eye: [f64; 3]) -> Array2<f64> {
+    let (p, n) = (mesh.positions(), mesh.normals());
+    let mut out = Array2::zeros((mesh.vertex_count(), 3));
+    for (v, mut row) in out.rows_mut().into_iter().enumerate() {
+        let normal = [n[[v, 0]], n[[v, 1]], n[[v, 2]]];
+        let view = std::array::from_fn(|k| eye[k] - p[[v, k]]);
+        let r = Frame::new(normal, view)
+            .ok()
+            .and_then(|f| unit(f.mirror()))
+            .unwrap_or(normal);
+        row.assign(&ndarray::arr1(&r));
+    }
+    out
 }
 
 /// The rotation `R` with `R a = +Y` (for unit `a`), about the axis `a x Y` (the shortest

@@ -4,10 +4,10 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::relight::brdf::mirror;
 use haarshift::relight::harmonics::{PhongSh, non_zonal_material};
+use haarshift::relight::orient::mirror_directions;
 use haarshift::relight::raster::{render_format, write_render};
-use haarshift::relight::{Brdf, Lighting, Mesh, SceneCache, shade_sh};
+use haarshift::relight::{Brdf, Lighting, SceneCache, shade_sh};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::Array2;
@@ -190,7 +190,7 @@ pub fn run(args: Args) -> Result<()> {
             let radiance = match brdf {
                 Brdf::Lambert => shade_sh(transfer, cache.albedo.view(), lighting.view())?,
                 Brdf::Phong { exponent } => {
-                    let mirror = mirror_directions(&cache.mesh, camera.position())?;
+                    let mirror = mirror_directions(&cache.mesh, camera.position());
                     PhongSh::new(transfer.bands(), exponent)?
                         .shade(
                             transfer,
@@ -256,26 +256,4 @@ struct Shaded {
     encode_ms: f64,
     shade_ms: f64,
     what: String,
-}
-
-/// Every vertex's unit mirror direction of the view from `eye` (the normal where the eye sits
-/// on the vertex).
-fn mirror_directions(mesh: &Mesh, eye: [f64; 3]) -> Result<Array2<f64>> {
-    let (p, n) = (mesh.positions(), mesh.normals());
-    let mut out = Array2::zeros((mesh.vertex_count(), 3));
-    for (v, mut row) in out.rows_mut().into_iter().enumerate() {
-        let normal = [n[[v, 0]], n[[v, 1]], n[[v, 2]]];
-        let view: [f64; 3] = std::array::from_fn(|k| eye[k] - p[[v, k]]);
-        let len = view.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let r = if len > 0.0 {
-            mirror(normal, view.map(|x| x / len))
-        } else {
-            normal
-        };
-        let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
-        for k in 0..3 {
-            row[k] = r[k] / norm;
-        }
-    }
-    Ok(out)
 }
