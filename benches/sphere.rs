@@ -6,6 +6,7 @@
 //! (`-- lobe_one_channel` for the lobe only).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use haarshift::sphere::chain_rule::{Rotator, Scheme};
 use haarshift::sphere::lobes::phong;
 use haarshift::sphere::{
     LatLongMap, Method, SphereCoefficients, SphereOptions, SphereRotation, rotate_coefficients,
@@ -137,6 +138,14 @@ fn one_rotation<T: haarshift::Sample>(
         });
         group.bench_function(BenchmarkId::new("rotate_coefficients", &name), |b| {
             b.iter(|| rotate_coefficients(&coeffs, rotation, &options).expect("rotates"))
+        });
+    }
+    // The renderer's unit: the lobe prepared once, then one rotation into a vertex frame.
+    for scheme in [Scheme::Linear, Scheme::Cubic] {
+        let rotator = Rotator::new(&map, scheme).expect("a power of two");
+        let name = format!("64x128/{scheme:?}/{precision}");
+        group.bench_function(BenchmarkId::new("rotator", name), |b| {
+            b.iter(|| rotator.rotate(rotation).expect("rotates"))
         });
     }
 }

@@ -38,6 +38,7 @@ use ndarray::Array2;
 use super::Mesh;
 use super::brdf::{Brdf, LocalTable, mirror};
 use crate::named::named_enum;
+use crate::sphere::chain_rule::Rotator;
 use crate::sphere::latlong::{angles, direction};
 use crate::sphere::param::{ParamKind, Parameterization, SphereMap};
 use crate::sphere::{Method, SphereOptions, SphereRotation, rotate_map};
@@ -198,6 +199,9 @@ pub struct Orientation {
     param: Parameterization,
     rotation: BrdfRotation,
     options: SphereOptions,
+    /// For the Haar methods, each table map at the working level prepared for rotation once
+    /// ([`Rotator`]), with the block width of that level in full-resolution columns.
+    rotators: Option<(Vec<Rotator<f64>>, usize)>,
 }
 
 impl Orientation {
@@ -247,6 +251,17 @@ impl Orientation {
             // Direct evaluation reads no local map; one tiny map keeps the type simple.
             LocalTable::new(brdf, 2, 1)?
         };
+        let rotators = match method.and_then(Method::scheme) {
+            Some(scheme) => {
+                // Level L works on the 2^(L+1)-row approximation.
+                let block = level.map_or(1, |l| h >> (l + 1));
+                let prepared = (0..table.len())
+                    .map(|e| Rotator::new(&table.map(e).downsample(block)?, scheme))
+                    .collect::<Result<_>>()?;
+                Some((prepared, block))
+            }
+            None => None,
+        };
         Ok(Orientation {
             brdf: brdf.clone(),
             table,
@@ -257,6 +272,7 @@ impl Orientation {
                 level,
                 ..SphereOptions::default()
             },
+            rotators,
         })
     }
 
@@ -325,6 +341,16 @@ impl Orientation {
         let (entry, turn, tilt) = self.plan(frame)?;
         let local = self.table.map(entry);
         let columns = 2 * self.param.face_size();
+        // The prepared map, read turned, unless the level's blocks split the turn or the tilt
+        // is itself a whole-column yaw (which rotate_map does exactly).
+        if let Some((rotators, block)) = &self.rotators
+            && turn % block == 0
+            && tilt.whole_column_yaw(columns).is_none()
+        {
+            let h = self.param.face_size();
+            let coefficients = rotators[entry].rotate_turned(&tilt, turn / block)?;
+            return SphereMap::from_lat_long(&coefficients.zero_padded(h)?.to_map()?);
+        }
         let turned;
         let source = if turn == 0 {
             local

@@ -118,7 +118,7 @@ use ndarray::{Array3, ArrayView3, ArrayViewMut2, Axis, s};
 use rayon::prelude::*;
 
 use super::latlong::{
-    angles, catmull_rom, continue_index, fill_grid, for_each_row, pixel_solid_angle,
+    atan2_finite, azimuth, catmull_rom, continue_index, fill_grid, for_each_row, pixel_solid_angle,
 };
 use super::{LatLongMap, SphereCoefficients, SphereRotation};
 use crate::transform::{Band, pyramid};
@@ -160,10 +160,20 @@ pub struct SourceGradient<T> {
     n: usize,
     channels: usize,
     step: f64,
+    /// `1 / step`.
+    inverse_step: f64,
     /// `f_theta` at `(i delta, (j + 1/2) delta)`, `i` in `0..=m`: `(m + 1) x n x C`.
     d_theta: Vec<T>,
     /// `f_phi / sin theta` at `((i + 1/2) delta, (j + 1) delta)`: `m x n x C`.
     d_phi: Vec<T>,
+    /// For a zonal `f` (constant along every row: a lobe about the pole), `f_theta` of one
+    /// column, `(m + 1) x C`; `d_phi` is then zero.
+    zonal: Option<Vec<T>>,
+    /// `(sin, cos)` of `k delta / 2`, `k` in `0..=2n + 2`: every angle the target grids use.
+    trig: Vec<(f64, f64)>,
+    /// The column angles of the two target grids as flat arrays, for loops over a row:
+    /// `[sin, cos]` of `(j + 1/2) delta` (index 0) and of `(j + 1) delta` (index 1).
+    columns: [[Vec<f64>; 2]; 2],
 }
 
 impl<T: Sample> SourceGradient<T> {
@@ -212,44 +222,151 @@ impl<T: Sample> SourceGradient<T> {
                 difference(scheme, out, inv, |k| px(i, j + 1 + k));
             }
         });
+        // Zonal exactly, not nearly: the zonal path then gives what the general one would.
+        let zonal = (d_phi.iter().all(|v| *v == T::zero())
+            && d_theta
+                .chunks_exact(n * ch)
+                .all(|row| row.chunks_exact(ch).all(|px| px == &row[..ch])))
+        .then(|| {
+            d_theta
+                .chunks_exact(n * ch)
+                .flat_map(|row| row[..ch].to_vec())
+                .collect()
+        });
+        let half = 0.5 * step;
+        let trig: Vec<(f64, f64)> = (0..=2 * n + 2)
+            .map(|k| (k as f64 * half).sin_cos())
+            .collect();
+        let columns = [1, 2].map(|first| {
+            let at = |j: usize| trig[first + 2 * j];
+            [
+                (0..n).map(|j| at(j).0).collect(),
+                (0..n).map(|j| at(j).1).collect(),
+            ]
+        });
         SourceGradient {
             scheme,
             m,
             n,
             channels: ch,
             step,
+            inverse_step: 1.0 / step,
             d_theta,
             d_phi,
+            zonal,
+            trig,
+            columns,
         }
+    }
+
+    /// Whether `f` is constant along every row (a function of `theta` alone, such as a lobe
+    /// about the pole): its derivatives are then one column of `f_theta`, and a rotation
+    /// needs only the angle of each pre-image from the pole.
+    ///
+    /// ```
+    /// use haarshift::sphere::{LatLongMap, chain_rule::SourceGradient};
+    /// let lobe = LatLongMap::<f64>::from_fn(16, 1, |d, out| out[0] = d[1].max(0.0).powi(8)).unwrap();
+    /// let tilted = LatLongMap::<f64>::from_fn(16, 1, |d, out| out[0] = d[0].max(0.0)).unwrap();
+    /// assert!(SourceGradient::new(&lobe).is_zonal() && !SourceGradient::new(&tilted).is_zonal());
+    /// ```
+    pub fn is_zonal(&self) -> bool {
+        self.zonal.is_some()
     }
 
     /// `f_theta` and `f_phi / sin theta` at `(theta, phi)`, one value per channel each
     /// (step 3 of the [module docs](self)), interpolated as the scheme says.
     pub fn eval(&self, theta: f64, phi: f64, f_theta: &mut [T], f_phi_over_sin: &mut [T]) {
         f_theta.fill(T::zero());
-        self.accumulate(theta, phi, 1.0, 0.0, f_theta);
+        self.accumulate(theta, phi, 1.0, 0.0, 0, f_theta);
         f_phi_over_sin.fill(T::zero());
-        self.accumulate(theta, phi, 0.0, 1.0, f_phi_over_sin);
+        self.accumulate(theta, phi, 0.0, 1.0, 0, f_phi_over_sin);
     }
 
     /// Adds `alpha f_theta + beta f_phi / sin theta` at `(theta, phi)` (`theta` in
     /// `[0, pi]`, `phi` in `[0, 2 pi)`) to `out`: the chain rule's combination, fused with
-    /// the interpolation so that no temporary is written.
+    /// the interpolation so that no temporary is written. The fields are read `turn` columns
+    /// further on, which is reading the fields of `f` turned by `turn` columns
+    /// ([`yaw_pixels`](super::yaw::yaw_pixels)) with the same taps and weights.
     #[inline]
-    fn accumulate(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
-        match self.scheme {
-            Scheme::Linear => self.accumulate_linear(theta, phi, alpha, beta, out),
-            Scheme::Cubic => self.accumulate_cubic(theta, phi, alpha, beta, out),
+    fn accumulate(&self, theta: f64, phi: f64, alpha: f64, beta: f64, turn: usize, out: &mut [T]) {
+        match (self.scheme, &self.zonal) {
+            (Scheme::Linear, None) => self.accumulate_linear(theta, phi, alpha, beta, turn, out),
+            (Scheme::Cubic, None) => self.accumulate_cubic(theta, phi, alpha, beta, turn, out),
+            (scheme, Some(profile)) => self.accumulate_zonal(scheme, profile, theta, alpha, out),
+        }
+    }
+
+    /// [`accumulate`](Self::accumulate) of a zonal `f`: `f_phi` is zero and every column
+    /// of `f_theta` is `profile`, so the bilinear (Catmull-Rom) interpolation of the general
+    /// path reduces to a linear (cubic) one along `theta`, its weights across the columns
+    /// summing to 1; across a pole the profile continues negated (a tangent component).
+    #[inline(always)]
+    fn accumulate_zonal(
+        &self,
+        scheme: Scheme,
+        profile: &[T],
+        theta: f64,
+        alpha: f64,
+        out: &mut [T],
+    ) {
+        let (m, ch) = (self.m, self.channels);
+        let y = theta * self.inverse_step;
+        // (entry, weight) of the two or four taps along the profile.
+        let mut taps = [(0usize, T::zero()); 4];
+        let tap = |row: isize, w: f64| {
+            let (r, w) = if row < 0 {
+                (-row, -w)
+            } else if row > m as isize {
+                (2 * m as isize - row, -w)
+            } else {
+                (row, w)
+            };
+            (r as usize * ch, T::from_f64(alpha * w))
+        };
+        let count = match scheme {
+            Scheme::Linear => {
+                let r0 = (y as usize).min(m - 1);
+                let fy = y - r0 as f64;
+                taps[0] = tap(r0 as isize, 1.0 - fy);
+                taps[1] = tap(r0 as isize + 1, fy);
+                2
+            }
+            Scheme::Cubic => {
+                let r0 = (y + 1.0) as isize - 1;
+                for (dr, w) in catmull_rom(y - r0 as f64).into_iter().enumerate() {
+                    taps[dr] = tap(r0 - 1 + dr as isize, w);
+                }
+                4
+            }
+        };
+        for (k, o) in out.iter_mut().enumerate() {
+            let mut acc = *o;
+            for &(at, w) in &taps[..count] {
+                acc += w * profile[at + k];
+            }
+            *o = acc;
         }
     }
 
     /// [`accumulate`](Self::accumulate) by bilinear interpolation.
     #[inline]
-    fn accumulate_linear(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
+    fn accumulate_linear(
+        &self,
+        theta: f64,
+        phi: f64,
+        alpha: f64,
+        beta: f64,
+        turn: usize,
+        out: &mut [T],
+    ) {
         let (m, n) = (self.m, self.n);
+        // Columns from -1 to below 3n (a half turn over a pole plus the turn) onto 0..n.
         let wrap = |c: isize| -> usize {
+            let c = c + turn as isize;
             if c < 0 {
                 (c + n as isize) as usize
+            } else if c >= 2 * n as isize {
+                c as usize - 2 * n
             } else if c >= n as isize {
                 c as usize - n
             } else {
@@ -283,15 +400,15 @@ impl<T: Sample> SourceGradient<T> {
         let fx = x - c0 as f64;
         let half = n as isize / 2;
         for (t, (r, wy)) in [(r0, 1.0 - fy), (r0 + 1, fy)].into_iter().enumerate() {
-            let (r, turn, w) = if r < 0 {
+            let (r, across, w) = if r < 0 {
                 (0, half, -beta * wy)
             } else if r >= m as isize {
                 (m - 1, half, -beta * wy)
             } else {
                 (r as usize, 0, beta * wy)
             };
-            gp[2 * t] = (r * n + wrap(c0 + turn), T::from_f64(w * (1.0 - fx)));
-            gp[2 * t + 1] = (r * n + wrap(c0 + 1 + turn), T::from_f64(w * fx));
+            gp[2 * t] = (r * n + wrap(c0 + across), T::from_f64(w * (1.0 - fx)));
+            gp[2 * t + 1] = (r * n + wrap(c0 + 1 + across), T::from_f64(w * fx));
         }
         self.apply_taps(&ft, &gp, out);
     }
@@ -318,8 +435,17 @@ impl<T: Sample> SourceGradient<T> {
     /// across a pole: `f_theta` on the edge rows `-k` and `m + k` is minus the one on rows
     /// `k` and `m - k` half a turn away).
     #[inline]
-    fn accumulate_cubic(&self, theta: f64, phi: f64, alpha: f64, beta: f64, out: &mut [T]) {
+    fn accumulate_cubic(
+        &self,
+        theta: f64,
+        phi: f64,
+        alpha: f64,
+        beta: f64,
+        turn: usize,
+        out: &mut [T],
+    ) {
         let (m, n) = (self.m as isize, self.n as isize);
+        let turn = turn as isize;
         // f_theta: rows at i delta (i = 0..=m), columns at (j + 1/2) delta.
         let ft = cubic_taps((theta / self.step, phi / self.step - 0.5), alpha, |r, c| {
             let (r, flip) = if r < 0 {
@@ -329,7 +455,7 @@ impl<T: Sample> SourceGradient<T> {
             } else {
                 (r, false)
             };
-            let c = if flip { c + n / 2 } else { c };
+            let c = if flip { c + n / 2 } else { c } + turn;
             (r as usize * self.n + c.rem_euclid(n) as usize, flip)
         });
         // f_phi / sin theta: rows at (i + 1/2) delta, columns at (j + 1) delta.
@@ -337,7 +463,7 @@ impl<T: Sample> SourceGradient<T> {
             (theta / self.step - 0.5, phi / self.step - 1.0),
             beta,
             |r, c| {
-                let (r, c, crossed) = continue_index(r, c, self.m, self.n);
+                let (r, c, crossed) = continue_index(r, c + turn, self.m, self.n);
                 (r * self.n + c, crossed)
             },
         );
@@ -401,51 +527,141 @@ enum Along {
     Phi,
 }
 
+/// Where a target direction comes from: its pre-image `q = R p`, the rotated tangent
+/// `R dp/d(along)`, the angle `Theta` of `q` from the pole, the frame's azimuth `(sin, cos)`
+/// and the tangent's component along `e_Theta(q)` (step 2 of the [module docs](self)).
+struct PreImage {
+    q: [f64; 3],
+    tangent: [f64; 3],
+    theta: f64,
+    sin_phi: f64,
+    cos_phi: f64,
+    along_theta: f64,
+}
+
+/// The [`PreImage`] of the target at `(sin, cos)` of `theta` and of `phi`. Branch-free, so
+/// that a loop over a row vectorises.
+#[inline(always)]
+fn pre_image(
+    rotation: &SphereRotation,
+    (st, ct): (f64, f64),
+    (sp, cp): (f64, f64),
+    along: Along,
+) -> PreImage {
+    let p = [st * sp, ct, st * cp];
+    let tangent = match along {
+        Along::Theta => [ct * sp, -st, ct * cp],
+        Along::Phi => [st * cp, 0.0, -st * sp],
+    };
+    let q = rotation.apply(p);
+    let tq = rotation.apply(tangent);
+    // The frame at q straight from q (atan2's convention at the poles: Phi = 0).
+    let rho = (q[0] * q[0] + q[2] * q[2]).sqrt();
+    let inv = 1.0 / rho;
+    let (s_p, c_p) = if rho > 0.0 {
+        (q[0] * inv, q[2] * inv)
+    } else {
+        (0.0, 1.0)
+    };
+    let c_t = q[1].clamp(-1.0, 1.0);
+    PreImage {
+        q,
+        tangent: tq,
+        theta: atan2_finite(rho, q[1]),
+        sin_phi: s_p,
+        cos_phi: c_p,
+        along_theta: dot([c_t * s_p, -rho, c_t * c_p], tq),
+    }
+}
+
 /// The chain rule (4.15)/(4.16) for one rotation and one source.
 struct ChainRule<'a, T> {
     grad: &'a SourceGradient<T>,
     rotation: &'a SphereRotation,
-    /// `(sin, cos)` of `k delta / 2`: every angle the grids use.
-    trig: Vec<(f64, f64)>,
+    /// Columns the source is turned by before the rotation (exact, [`SourceGradient`]).
+    turn: usize,
 }
 
 impl<'a, T: Sample> ChainRule<'a, T> {
-    fn new(grad: &'a SourceGradient<T>, rotation: &'a SphereRotation) -> Self {
-        let half = 0.5 * grad.step;
-        let trig = (0..=2 * grad.n + 2)
-            .map(|k| (k as f64 * half).sin_cos())
-            .collect();
+    fn new(grad: &'a SourceGradient<T>, rotation: &'a SphereRotation, turn: usize) -> Self {
         ChainRule {
             grad,
             rotation,
-            trig,
+            turn,
         }
     }
 
     /// `scale * dg/d(along)` at the angles `(theta, phi) = (kt, kp) * delta / 2` into `out`.
+    #[inline]
     fn derivative(&self, kt: usize, kp: usize, along: Along, scale: f64, out: &mut [T]) {
-        let (st, ct) = self.trig[kt];
-        let (sp, cp) = self.trig[kp];
-        let p = [st * sp, ct, st * cp];
-        let tangent = match along {
-            Along::Theta => [ct * sp, -st, ct * cp],
-            Along::Phi => [st * cp, 0.0, -st * sp],
-        };
-        let q = self.rotation.apply(p);
-        let tq = self.rotation.apply(tangent);
-        let (big_t, big_p) = angles(q);
-        // The frame at q straight from q (atan2's convention at the poles: Phi = 0).
-        let rho = (q[0] * q[0] + q[2] * q[2]).sqrt();
-        let (s_p, c_p) = if rho > 0.0 {
-            (q[0] / rho, q[2] / rho)
-        } else {
-            (0.0, 1.0)
-        };
-        let (s_t, c_t) = (rho, q[1].clamp(-1.0, 1.0));
-        let alpha = scale * dot([c_t * s_p, -s_t, c_t * c_p], tq);
-        let beta = scale * dot([c_p, 0.0, -s_p], tq);
+        let (st, ct) = self.grad.trig[kt];
+        let (sp, cp) = self.grad.trig[kp];
+        let at = pre_image(self.rotation, (st, ct), (sp, cp), along);
         out.fill(T::zero());
-        self.grad.accumulate(big_t, big_p, alpha, beta, out);
+        if self.grad.is_zonal() {
+            // No azimuth needed: f has no phi derivative.
+            self.grad
+                .accumulate(at.theta, 0.0, scale * at.along_theta, 0.0, 0, out);
+            return;
+        }
+        let (q, tq) = (at.q, at.tangent);
+        let beta = scale * dot([at.cos_phi, 0.0, -at.sin_phi], tq);
+        let big_p = azimuth(q[0], q[2]);
+        let alpha = scale * at.along_theta;
+        self.grad
+            .accumulate(at.theta, big_p, alpha, beta, self.turn, out);
+    }
+
+    /// One row of [`derivative`](Self::derivative): `theta = kt delta / 2` and the columns
+    /// `phi = (2j + first) delta / 2` (`first` 1 or 2), `n x C` values into `row`. A zonal
+    /// source is done in two passes over chunks of the row, the geometry first (a loop the
+    /// compiler vectorises), then the interpolation; the values are those of `derivative`.
+    fn derivative_row(&self, kt: usize, first: usize, along: Along, scale: f64, row: &mut [T]) {
+        let ch = self.grad.channels;
+        let Some(profile) = &self.grad.zonal else {
+            for (j, px) in row.chunks_exact_mut(ch).enumerate() {
+                self.derivative(kt, first + 2 * j, along, scale, px);
+            }
+            return;
+        };
+        let scheme = self.grad.scheme;
+        const CHUNK: usize = 32;
+        let target = self.grad.trig[kt];
+        let [sines, cosines] = &self.grad.columns[first - 1];
+        for (c, pixels) in row.chunks_mut(CHUNK * ch).enumerate() {
+            let count = pixels.len() / ch;
+            let (mut theta, mut alpha) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
+            let columns = sines[c * CHUNK..][..count]
+                .iter()
+                .zip(&cosines[c * CHUNK..][..count]);
+            for ((t, a), (&sp, &cp)) in theta.iter_mut().zip(&mut alpha).zip(columns) {
+                let at = pre_image(self.rotation, target, (sp, cp), along);
+                (*t, *a) = (at.theta, scale * at.along_theta);
+            }
+            for ((px, &t), &a) in pixels.chunks_exact_mut(ch).zip(&theta).zip(&alpha) {
+                px.fill(T::zero());
+                self.grad.accumulate_zonal(scheme, profile, t, a, px);
+            }
+        }
+    }
+
+    /// `rows x n x C` values of `scale * dg/d(along)`, row `i` at `theta = kt(i) delta / 2`,
+    /// column `j` at `phi = (2j + first) delta / 2`.
+    fn field(
+        &self,
+        rows: usize,
+        kt: impl Fn(usize) -> usize + Sync,
+        first: usize,
+        along: Along,
+        scale: f64,
+    ) -> Array3<T> {
+        let (n, ch) = (self.grad.n, self.grad.channels);
+        let mut data = Array3::zeros((rows, n, ch));
+        let flat = data.as_slice_mut().expect("standard layout");
+        for_each_row(flat, n * ch, |i, row| {
+            self.derivative_row(kt(i), first, along, scale, row)
+        });
+        data
     }
 
     /// `V[i][j] = -delta g_theta((i + 1) delta, (j + 1/2) delta)`.
@@ -480,26 +696,27 @@ pub struct DifferenceFields<T> {
 impl<T: Sample> DifferenceFields<T> {
     /// The fields of `g = f(R p)` from `approx` (`f` at the working resolution) by `scheme`.
     pub fn rotated(approx: &LatLongMap<T>, rotation: &SphereRotation, scheme: Scheme) -> Self {
-        let (m, n, ch) = approx.as_array().dim();
-        let grad = SourceGradient::with_scheme(approx, scheme);
-        let rule = ChainRule::new(&grad, rotation);
+        Self::from_gradient(&SourceGradient::with_scheme(approx, scheme), rotation, 0)
+    }
+
+    /// The fields of `g = f_k(R p)`, `f_k` the source of `grad` turned by `turn` columns.
+    fn from_gradient(grad: &SourceGradient<T>, rotation: &SphereRotation, turn: usize) -> Self {
+        let (m, n, ch, scheme) = (grad.m, grad.n, grad.channels, grad.scheme);
+        let rule = ChainRule::new(grad, rotation, turn);
         let (v, u) = match scheme {
+            // V[i][j] = -delta g_theta((i + 1) delta, (j + 1/2) delta),
+            // U[i][j] = -delta g_phi((i + 1/2) delta, (j + 1) delta).
             Scheme::Linear => (
-                fill_grid((m - 1, n, ch), |i, j, out| rule.vertical(i, j, out)),
-                fill_grid((m, n, ch), |i, j, out| rule.horizontal(i, j, out)),
+                rule.field(m - 1, |i| 2 * i + 2, 1, Along::Theta, -grad.step),
+                rule.field(m, |i| 2 * i + 1, 2, Along::Phi, -grad.step),
             ),
             Scheme::Cubic => {
                 // Midpoint derivatives on every row edge, the two across the poles included,
                 // then the differences of samples to fourth order:
                 // X[k] - X[k+1] = -delta (g_1 + delta^2 g_3 / 24) at the edge between them,
                 // g_3 (the third derivative) from second differences of the midpoint values.
-                let step = -rule.grad.step;
-                let vm = fill_grid((m + 1, n, ch), |e, j, out| {
-                    rule.derivative(2 * e, 2 * j + 1, Along::Theta, step, out)
-                });
-                let um = fill_grid((m, n, ch), |i, j, out| {
-                    rule.derivative(2 * i + 1, 2 * j + 2, Along::Phi, step, out)
-                });
+                let vm = rule.field(m + 1, |e| 2 * e, 1, Along::Theta, -grad.step);
+                let um = rule.field(m, |i| 2 * i + 1, 2, Along::Phi, -grad.step);
                 let w = T::from_f64(1.0 / 24.0);
                 let two = T::from_f64(2.0);
                 let v = grid_from_fn((m - 1, n, ch), |(i, j, k)| {
@@ -814,20 +1031,97 @@ pub fn rotate<T: Sample>(
     rotation: &SphereRotation,
     scheme: Scheme,
 ) -> Result<SphereCoefficients<T>> {
-    let m = approx.height();
-    if m < 2 || !m.is_power_of_two() {
-        return Err(Error::shape(
-            &[m, 2 * m],
-            "the Haar method needs a height that is a power of two from 2 on",
-        ));
+    Rotator::new(approx, scheme)?.rotate(rotation)
+}
+
+/// One source map prepared for any number of rotations: its derivative fields (step 1 of
+/// the [module docs](self)) and the integral every rotation keeps (step 6) are computed once,
+/// so a rotation costs the chain rule and the filters alone. This is what a renderer needs
+/// to bring one BRDF into every vertex's frame. A zonal source (constant along every row,
+/// such as a lobe about the pole, [`SourceGradient::is_zonal`]) takes a shorter path with
+/// the same result: one angle per pre-image and a one-dimensional interpolation.
+///
+/// ```
+/// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::{Rotator, Scheme, rotate}};
+/// let lobe = LatLongMap::<f64>::from_fn(32, 1, |d, out| out[0] = d[1].max(0.0).powi(20)).unwrap();
+/// let rotator = Rotator::new(&lobe, Scheme::Linear).unwrap();
+/// assert!(rotator.is_zonal());
+/// for pitch in [10.0, 50.0, 120.0] {
+///     let r = SphereRotation::from_degrees(30.0, pitch, 0.0).unwrap();
+///     let diff = &rotator.rotate(&r).unwrap().as_array() - &rotate(&lobe, &r, Scheme::Linear).unwrap().as_array();
+///     assert!(diff.iter().all(|v| v.abs() < 1e-12));
+/// }
+/// ```
+#[derive(Clone, Debug)]
+pub struct Rotator<T> {
+    grad: SourceGradient<T>,
+    /// Per channel, what step 6 keeps: the solid-angle integral, or (cubic) the sampled one.
+    integral: Vec<f64>,
+}
+
+impl<T: Sample> Rotator<T> {
+    /// `approx` (an `m x 2m` map, `m` a power of two from 2 on) prepared for rotation by
+    /// `scheme`.
+    pub fn new(approx: &LatLongMap<T>, scheme: Scheme) -> Result<Self> {
+        let m = approx.height();
+        if m < 2 || !m.is_power_of_two() {
+            return Err(Error::shape(
+                &[m, 2 * m],
+                "the Haar method needs a height that is a power of two from 2 on",
+            ));
+        }
+        Ok(Rotator {
+            grad: SourceGradient::with_scheme(approx, scheme),
+            integral: match scheme {
+                Scheme::Linear => approx.energy(),
+                Scheme::Cubic => sampled_integral(approx),
+            },
+        })
     }
-    let fields = DifferenceFields::rotated(approx, rotation, scheme);
-    let mut coeffs = fields.to_coefficients()?;
-    match scheme {
-        Scheme::Linear => set_mean_from_energy(&mut coeffs, &approx.energy())?,
-        Scheme::Cubic => set_mean_from_sampled_integral(&mut coeffs, approx)?,
+
+    /// Rows of the source (and of every result).
+    pub fn height(&self) -> usize {
+        self.grad.m
     }
-    Ok(coeffs)
+
+    /// Whether the source is zonal ([`SourceGradient::is_zonal`]).
+    pub fn is_zonal(&self) -> bool {
+        self.grad.is_zonal()
+    }
+
+    /// The coefficients of `g = f(R p)`, as [`rotate`].
+    pub fn rotate(&self, rotation: &SphereRotation) -> Result<SphereCoefficients<T>> {
+        self.rotate_turned(rotation, 0)
+    }
+
+    /// The coefficients of `g = f_k(R p)`, with `f_k` the source turned by `turn` columns
+    /// ([`yaw_pixels`](super::yaw::yaw_pixels)`(f, turn)`): the turn is exact (the fields
+    /// are read `turn` columns on, with the taps and weights the turned source would give)
+    /// and costs nothing.
+    ///
+    /// ```
+    /// use haarshift::sphere::{LatLongMap, SphereRotation, chain_rule::{Rotator, Scheme}, yaw::yaw_pixels};
+    /// let f = LatLongMap::<f64>::from_fn(16, 1, |d, out| out[0] = (d[0] + 2.0 * d[1]).exp()).unwrap();
+    /// let r = SphereRotation::from_degrees(10.0, 40.0, -20.0).unwrap();
+    /// let turned = Rotator::new(&f, Scheme::Cubic).unwrap().rotate_turned(&r, 5).unwrap();
+    /// let want = Rotator::new(&yaw_pixels(&f, 5), Scheme::Cubic).unwrap().rotate(&r).unwrap();
+    /// let diff = &turned.as_array() - &want.as_array();
+    /// assert!(diff.iter().all(|v| v.abs() < 1e-13));
+    /// ```
+    pub fn rotate_turned(
+        &self,
+        rotation: &SphereRotation,
+        turn: usize,
+    ) -> Result<SphereCoefficients<T>> {
+        let fields = DifferenceFields::from_gradient(&self.grad, rotation, turn % self.grad.n);
+        let mut coeffs = fields.to_coefficients()?;
+        let pole = match self.grad.scheme {
+            Scheme::Linear => 0.0,
+            Scheme::Cubic => pole_weight(self.grad.m),
+        };
+        set_mean(&mut coeffs, &self.integral, pole)?;
+        Ok(coeffs)
+    }
 }
 
 /// The address of one detail coefficient in a [`SphereCoefficients`] pyramid.
@@ -885,7 +1179,7 @@ pub fn rotate_selected<T: Sample>(
         }
     }
     let grad = SourceGradient::new(approx);
-    let rule = ChainRule::new(&grad, rotation);
+    let rule = ChainRule::new(&grad, rotation, 0);
     requests
         .par_iter()
         .map(|r| Ok(footprint_coefficient(&rule, r, m, ch)))

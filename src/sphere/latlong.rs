@@ -40,7 +40,8 @@ pub fn direction(theta: f64, phi: f64) -> [f64; 3] {
 /// The angles `(theta, phi)` of a unit direction, `theta` in `[0, pi]`, `phi` in `[0, 2 pi)`.
 ///
 /// The azimuth is `atan2(x, z)`: the seed's (4.13) prints `tan^-1(x / z)`, which loses the
-/// quadrant.
+/// quadrant. The elevation is `atan2(sqrt(x^2 + z^2), y)`, which is `acos y` for a unit
+/// direction and stays accurate next to the poles; both come from [`atan2`].
 ///
 /// ```
 /// use haarshift::sphere::latlong::{angles, direction};
@@ -49,22 +50,104 @@ pub fn direction(theta: f64, phi: f64) -> [f64; 3] {
 /// ```
 #[inline]
 pub fn angles(d: [f64; 3]) -> (f64, f64) {
-    let theta = d[1].clamp(-1.0, 1.0).acos();
-    let phi = d[0].atan2(d[2]);
+    (
+        atan2((d[0] * d[0] + d[2] * d[2]).sqrt(), d[1]),
+        azimuth(d[0], d[2]),
+    )
+}
+
+/// The azimuth `atan2(x, z)` of a direction with components `x` and `z`, in `[0, 2 pi)`.
+#[inline]
+pub(crate) fn azimuth(x: f64, z: f64) -> f64 {
+    let phi = atan2(x, z);
     let phi = if phi < 0.0 {
         phi + std::f64::consts::TAU
     } else {
         phi
     };
-    // atan2 of a tiny negative x can round to exactly TAU.
-    (
-        theta,
-        if phi >= std::f64::consts::TAU {
-            0.0
-        } else {
-            phi
-        },
-    )
+    // A tiny negative angle plus TAU can round to exactly TAU.
+    if phi >= std::f64::consts::TAU {
+        0.0
+    } else {
+        phi
+    }
+}
+
+/// `atan2(y, x)` in `[-pi, pi]`, within 4e-16 of the correctly rounded value, by octant
+/// reduction to `[0, 1]`, one more reduction to `[0, tan(pi / 12)]` (`atan t = pi / 6 +
+/// atan((sqrt 3 t - 1) / (sqrt 3 + t))`) and a degree-15 odd polynomial there (a Chebyshev fit
+/// of `atan(t) / t` in `t^2`): several times faster than the C library's, which matters where
+/// every pixel of a rotation asks for two angles. The diagonals (`|y| = |x|`) are exact;
+/// signed zeros and infinities follow
+/// `f64::atan2` (`atan2(0, -1) = pi`, `atan2(-0, -1) = -pi`); NaN in, NaN out.
+///
+/// ```
+/// use haarshift::sphere::latlong::atan2;
+/// for (y, x) in [(1.0, 2.0), (-3.0, -0.5), (0.0, -1.0), (1e-300, 1.0), (5.0, 0.0)] {
+///     assert!((atan2(y, x) - f64::atan2(y, x)).abs() < 1e-15);
+/// }
+/// ```
+#[inline]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    let den = y.abs().max(x.abs());
+    if den > 0.0 && den.is_finite() {
+        atan2_finite(y, x)
+    } else {
+        // Zeros, infinities and NaN: rare, and the C library's conventions.
+        y.atan2(x)
+    }
+}
+
+/// [`atan2`] for finite `(y, x)` not both zero, branch-free (selects only), so that loops
+/// over many angles vectorise.
+#[inline(always)]
+pub(crate) fn atan2_finite(y: f64, x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, FRAC_PI_6, PI};
+    const SQRT_3: f64 = 1.732_050_807_568_877_2;
+    const TAN_PI_12: f64 = 0.267_949_192_431_122_7;
+    // atan(t) / t as a polynomial in t^2 on [0, tan^2(pi / 12)], max error 3e-16.
+    const C: [f64; 8] = [
+        0.999_999_999_999_999_2,
+        -0.333_333_333_331_666_65,
+        0.199_999_999_498_046_73,
+        -0.142_857_085_979_423_93,
+        0.111_107_952_311_751_93,
+        -0.090_813_549_009_494_98,
+        0.075_307_565_684_610_06,
+        -0.052_086_075_603_399_89,
+    ];
+    let (ay, ax) = (y.abs(), x.abs());
+    let swap = ay > ax;
+    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+    // Both quotients straight from (num, den), so the two divisions run side by side.
+    let t = num / den;
+    let reduce = num > TAN_PI_12 * den;
+    let reduced = (SQRT_3 * num - den) / (SQRT_3 * den + num);
+    // The diagonals exactly, as the C library rounds them: they are texel edges.
+    let diagonal = num == den;
+    let t = if diagonal {
+        0.0
+    } else if reduce {
+        reduced
+    } else {
+        t
+    };
+    let base = if diagonal {
+        FRAC_PI_4
+    } else if reduce {
+        FRAC_PI_6
+    } else {
+        0.0
+    };
+    // Estrin's scheme: three levels of dependent products instead of seven.
+    let u = t * t;
+    let (u2, u4) = (u * u, u * u * u * u);
+    let poly = (C[0] + C[1] * u + u2 * (C[2] + C[3] * u))
+        + u4 * (C[4] + C[5] * u + u2 * (C[6] + C[7] * u));
+    let a = base + t * poly;
+    let a = if swap { FRAC_PI_2 - a } else { a };
+    let a = if x.is_sign_negative() { PI - a } else { a };
+    if y.is_sign_negative() { -a } else { a }
 }
 
 /// Catmull-Rom weights (Keys' cubic with `a = -1/2`) of the four samples around `t` in `[0, 1)`.
