@@ -80,8 +80,9 @@ fn lobe<T: haarshift::Sample>(h: usize) -> LatLongMap<T> {
 }
 
 /// One rotation of a one-channel lobe: what a renderer pays per vertex. 64 x 128 in f32 and
-/// f64 for each method, against `direct` (writing the 8192 texels of the analytic lobe);
-/// levels 3 to 5 of a 128 x 256 map (the thesis's levels 4 to 6).
+/// f64 for each method, against `direct` (writing the 8192 texels of the analytic lobe), and
+/// by a prepared [`Rotator`]; levels 3 to 6 of a 128 x 256 map (the thesis's levels 4 to 7),
+/// prepared and not.
 fn bench_lobe(c: &mut Criterion) {
     let rotation = SphereRotation::from_degrees(40.0, -25.0, 60.0).expect("angles");
     let axis = rotation.inverse().apply([0.0, 1.0, 0.0]);
@@ -94,13 +95,22 @@ fn bench_lobe(c: &mut Criterion) {
     let map = lobe::<f32>(128);
     let coeffs = SphereCoefficients::from_map(&map).expect("power of two");
     for method in [Method::Haar, Method::HaarCubic] {
-        for level in [3, 4, 5] {
+        for level in [3, 4, 5, 6] {
+            // What the renderer pays: the level's approximation prepared once, then rotated.
+            let scheme = method.scheme().expect("a Haar method");
+            let source = map
+                .downsample(128 >> (level + 1))
+                .expect("a level of the map");
+            let rotator = Rotator::new(&source, scheme).expect("a power of two");
+            let name = format!("128x256/{method}/level-{level}/f32");
+            group.bench_function(BenchmarkId::new("rotator", &name), |b| {
+                b.iter(|| rotator.rotate(&rotation).expect("rotates"))
+            });
             let options = SphereOptions {
                 method,
                 level: Some(level),
                 ..Default::default()
             };
-            let name = format!("128x256/{method}/level-{level}/f32");
             group.bench_function(BenchmarkId::new("rotate_coefficients", name), |b| {
                 b.iter(|| rotate_coefficients(&coeffs, &rotation, &options).expect("rotates"))
             });

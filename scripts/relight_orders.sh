@@ -9,11 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scene=${1:-testdata/meshes/bunny.ply}
-cargo build --release -p haarshift-cli >&2
-hs=target/release/haarshift
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-field() { grep -F "$2" "$work/$1.time" | sed 's/.*: //'; }
+# shellcheck source=scripts/timing.sh
+source scripts/timing.sh
 start_load=$(uptime)
 for order in vertex direction; do
     args=(relight precompute "$scene" --ground-plane --param cube --resolution 32 --order "$order"

@@ -11,23 +11,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 env_map=${1:-testdata/envmaps/rooitou_park_256x128.npy}
-cargo build --release -p haarshift-cli >&2
-hs=target/release/haarshift
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
 
-# Runs `haarshift ARGS` under /usr/bin/time -v; its stdout in $work/NAME.out, time's in .time.
-timed() {
-    local name=$1
-    shift
-    echo "+ haarshift $*" >&2
-    /usr/bin/time -v "$hs" "$@" >"$work/$name.out" 2>"$work/$name.time"
-    cat "$work/$name.out" >&2
-}
-# A field of /usr/bin/time -v's report.
-field() { grep -F "$2" "$work/$1.time" | sed 's/.*: //'; }
-cpu() { echo "$(field "$1" 'User time') + $(field "$1" 'System time')" | bc; }
-peak_mib() { echo "scale=1; $(field "$1" 'Maximum resident set size') / 1024" | bc; }
+# shellcheck source=scripts/timing.sh
+source scripts/timing.sh
 
 precompute=(relight precompute testdata/scenes/cubes.json --param cube --resolution 64 --keep-visibility 414
     -o "$work/cubes.hsr")
@@ -60,8 +46,7 @@ echo
 echo "| step | wall (m:ss) | CPU s (user + sys) | peak resident MiB | what the command reports |"
 echo "|---|---|---|---|---|"
 for step in precompute render animate; do
-    report=$(tr '\n' ' ' <"$work/$step.out" | sed "s|$work/||g; s/|/\\\\|/g; s/  */ /g")
-    echo "| $step | $(field "$step" 'Elapsed (wall clock)') | $(cpu "$step") | $(peak_mib "$step") | $report |"
+    step_row "$step"
 done
 echo
 echo "Load when it ended: \`$(uptime)\`"

@@ -898,3 +898,61 @@ fn glossy_render_with_direct_evaluation_equals_the_glossy_reference() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn an_orbiting_glossy_animation_shows_new_views_from_a_filled_cache() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = small_cache(dir.path());
+    let env = env32();
+    let glossy = [
+        "--brdf",
+        "phong:20",
+        "--rotation-cache",
+        "4",
+        "--fill-cache",
+    ];
+    let view = ["--width", "24", "--height", "16", "--background", "0,0,0"];
+    let camera = ["--camera", "0,2,5", "--look-at", "0,0.5,0"];
+    let pattern = dir.path().join("o_%d.png");
+    let mut args = vec!["relight", "animate", p(&cache), "--env", p(&env), "--orbit"];
+    args.extend(["--frames", "4", "-o", p(&pattern)]);
+    args.extend(glossy.iter().chain(&view).chain(&camera));
+    let stdout = succeeds_with_stdout(&args);
+    // 4 x 8 mirror bins, rotated once ahead; every view then finds its maps.
+    assert!(
+        stdout.contains("cache filled ahead: 32 maps rotated"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.matches("(0 rotated in").count(), 4, "{stdout}");
+    assert!(stdout.contains("frame 2: camera orbit 180.00"), "{stdout}");
+    // Frame 2 is the render from the camera taken half-way round the point looked at.
+    let single = dir.path().join("half.png");
+    let mut args = render_args(&cache, &single, &["--env", p(&env)]);
+    args.extend(glossy.iter().chain(&view));
+    args.extend(["--camera", "0,2,-5", "--look-at", "0,0.5,0"]);
+    let stdout = succeeds_with_stdout(&args);
+    assert!(
+        stdout.contains("cache filled ahead: 32 maps rotated"),
+        "{stdout}"
+    );
+    let pixels = |path: PathBuf| image::open(path).unwrap().to_rgb8().into_raw();
+    let (frame, render) = (pixels(dir.path().join("o_2.png")), pixels(single));
+    let worst = frame
+        .iter()
+        .zip(&render)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap();
+    assert!(worst <= 1, "frame 2 against the render: {worst} levels");
+    // The views differ: the highlight moves with the camera.
+    assert_ne!(pixels(dir.path().join("o_0.png")), frame);
+    // Filling needs a cache, and a view-dependent BRDF's bins are not filled ahead.
+    let out = dir.path().join("x.png");
+    let mut args = render_args(&cache, &out, &["--env", p(&env), "--brdf", "phong:5"]);
+    args.push("--fill-cache");
+    fails_cleanly(&args, &["--fill-cache", "--rotation-cache"]);
+    let mut args = render_args(&cache, &out, &["--env", p(&env), "--brdf", "blinn:5"]);
+    args.extend(["--rotation-cache", "4", "--fill-cache"]);
+    fails_cleanly(&args, &["blinn:5", "depends on the view"]);
+    assert!(!out.exists());
+}

@@ -254,10 +254,10 @@ impl Brdf {
     /// assert!(a[[0, 0, 0]] > a[[1, 0, 0]] && a[[0, 0, 0]] == a[[0, 17, 0]]);
     /// ```
     pub fn local_map(&self, height: usize, theta_o: f64) -> Result<LatLongMap<f64>> {
-        if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&theta_o) {
+        if !(0.0..=std::f64::consts::PI).contains(&theta_o) {
             return Err(Error::parameter(
                 "outgoing elevation",
-                format!("{theta_o} radians: must be from 0 to pi/2"),
+                format!("{theta_o} radians: must be from 0 to pi"),
             ));
         }
         let up = [0.0, 1.0, 0.0];
@@ -302,27 +302,33 @@ pub fn check_albedo(albedo: ArrayView2<'_, f32>) -> Result<()> {
     Ok(())
 }
 
-/// The centre of elevation bin `k` of `count` over `[0, pi/2]`.
-fn elevation_of(k: usize, count: usize) -> f64 {
-    (k as f64 + 0.5) * std::f64::consts::FRAC_PI_2 / count as f64
+/// The centre of elevation bin `k` when `per_quadrant` bins span `[0, pi/2]`.
+fn elevation_of(k: usize, per_quadrant: usize) -> f64 {
+    (k as f64 + 0.5) * std::f64::consts::FRAC_PI_2 / per_quadrant as f64
 }
 
 /// A view-dependent BRDF's local copies: one map per outgoing elevation
-/// `theta_k = (k + 1/2) (pi / 2) / E`, `k = 0..E` ([`Brdf::local_map`]); a viewer at
-/// elevation `theta_o` uses the nearest, the thesis's "BRDF transformed map corresponding to
-/// that direction". A mirror-symmetric BRDF needs one map, whatever `E`.
+/// `theta_k = (k + 1/2) (pi / 2) / E`, `k = 0..2E` ([`Brdf::local_map`]): `E` above the surface
+/// and as many below it, where a vertex seen from behind has its viewer (hidden in an image,
+/// but the per-vertex radiance is the BRDF's own formula there too, as `relight reference`
+/// evaluates it); a viewer at elevation `theta_o` uses the nearest, the thesis's "BRDF
+/// transformed map corresponding to that direction". A mirror-symmetric BRDF needs one map,
+/// whatever `E`.
 ///
 /// ```
 /// use haarshift::relight::brdf::{Brdf, LocalTable};
 /// let t = LocalTable::new(&Brdf::BlinnPhong { exponent: 10.0 }, 16, 8).unwrap();
-/// assert_eq!(t.len(), 8);
+/// assert_eq!(t.len(), 16);
 /// assert_eq!(t.nearest(0.0), 0);
-/// assert_eq!(t.nearest(std::f64::consts::FRAC_PI_2), 7);
+/// assert_eq!(t.nearest(std::f64::consts::FRAC_PI_2 - 1e-9), 7);
+/// assert_eq!(t.nearest(std::f64::consts::PI), 15);
 /// assert_eq!(LocalTable::new(&Brdf::Phong { exponent: 10.0 }, 16, 8).unwrap().len(), 1);
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct LocalTable {
     maps: Vec<LatLongMap<f64>>,
+    /// Elevations per quadrant, `E`.
+    per_quadrant: usize,
 }
 
 /// Outgoing elevations of a view-dependent BRDF's [`LocalTable`] unless asked otherwise: 5.6
@@ -330,7 +336,8 @@ pub struct LocalTable {
 pub const DEFAULT_ELEVATIONS: usize = 16;
 
 impl LocalTable {
-    /// `brdf`'s local maps of `height` rows at `elevations` (1 to 1024) outgoing elevations.
+    /// `brdf`'s local maps of `height` rows at `elevations` (1 to 1024) outgoing elevations
+    /// above the surface, and as many below.
     pub fn new(brdf: &Brdf, height: usize, elevations: usize) -> Result<Self> {
         if !(1..=1024).contains(&elevations) {
             return Err(Error::parameter(
@@ -338,20 +345,15 @@ impl LocalTable {
                 format!("{elevations}: expected 1 to 1024"),
             ));
         }
-        let count = if brdf.is_mirror_symmetric() {
-            1
+        let (count, per_quadrant) = if brdf.is_mirror_symmetric() {
+            (1, 1)
         } else {
-            elevations
+            (2 * elevations, elevations)
         };
-        let mut table = LocalTable {
-            maps: Vec::with_capacity(count),
-        };
-        for k in 0..count {
-            table
-                .maps
-                .push(brdf.local_map(height, elevation_of(k, count))?);
-        }
-        Ok(table)
+        let maps = (0..count)
+            .map(|k| brdf.local_map(height, elevation_of(k, per_quadrant)))
+            .collect::<Result<_>>()?;
+        Ok(LocalTable { maps, per_quadrant })
     }
 
     /// The number of maps.
@@ -365,18 +367,16 @@ impl LocalTable {
     }
 
     /// The map of the elevation nearest `theta_o` (radians from the normal, clamped to
-    /// `[0, pi/2]`).
+    /// `[0, pi]`).
     pub fn nearest(&self, theta_o: f64) -> usize {
-        let e = self.maps.len();
-        let k = (theta_o.clamp(0.0, std::f64::consts::FRAC_PI_2) / std::f64::consts::FRAC_PI_2
-            * e as f64)
-            .floor() as usize;
-        k.min(e - 1)
+        let bins = theta_o.clamp(0.0, std::f64::consts::PI) / std::f64::consts::FRAC_PI_2
+            * self.per_quadrant as f64;
+        (bins.floor() as usize).min(self.maps.len() - 1)
     }
 
     /// The outgoing elevation of map `k`, radians from the normal.
     pub fn elevation(&self, k: usize) -> f64 {
-        elevation_of(k, self.maps.len())
+        elevation_of(k, self.per_quadrant)
     }
 
     /// Map `k`.

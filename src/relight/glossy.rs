@@ -31,6 +31,10 @@
 //! * view-dependent BRDFs: the nearest normal bin, with the viewer's elevation and azimuth
 //!   quantised as [`orient`](super::orient) does anyway (the key is the triple).
 //!
+//! A cache starts empty and fills with the bins views ask for;
+//! [`GlossyShader::fill_cache`] rotates every Phong bin ahead, so that any later view rotates
+//! nothing (`--fill-cache`).
+//!
 //! **Precision.** The product and the dot products run in `T` (f32 for speed, f64 for checks);
 //! the BRDF maps are computed in f64 and stored in `T`.
 
@@ -254,21 +258,8 @@ impl<T: Sample> GlossyShader<T> {
         };
         let start = Instant::now();
         if self.bins.is_some() {
-            let missing: Vec<MapKey> = {
-                let cache = self.cache.lock().expect("the cache lock is never poisoned");
-                uses.keys()
-                    .filter(|k| !cache.contains_key(k))
-                    .copied()
-                    .collect()
-            };
-            let filled: Vec<(MapKey, Arc<Vec<T>>)> = missing
-                .par_iter()
-                .map(|&key| Ok((key, Arc::new(self.brdf_planes(&self.frame_of(key, eye)?)?))))
-                .collect::<Result<_>>()?;
-            report.rotated = filled.len();
-            let mut cache = self.cache.lock().expect("the cache lock is never poisoned");
-            cache.extend(filled);
-            report.cached = cache.len();
+            report.rotated = self.fill(uses.keys().copied(), eye)?;
+            report.cached = self.cached();
             report.rotate_seconds = start.elapsed().as_secs_f64();
         } else {
             report.rotated = uses.len();
@@ -317,6 +308,71 @@ impl<T: Sample> GlossyShader<T> {
         }
         report.shade_seconds = start.elapsed().as_secs_f64();
         Ok((out, report))
+    }
+
+    /// Rotates every bin of a mirror-symmetric BRDF's rotation cache that it does not hold
+    /// yet (`N x 2N` maps for `--rotation-cache N`), so that every later view finds its maps
+    /// there: the precomputation of one rotation per sampled direction that Wang et al. 2006
+    /// make. Returns the maps rotated. A view-dependent BRDF's bins (normal x elevation x
+    /// turn) are too many to fill ahead and are refused, as is a shader without a cache.
+    ///
+    /// ```
+    /// # use haarshift::product::Selection;
+    /// # use haarshift::relight::{Brdf, Mesh, ShadeOptions, TransportSet};
+    /// # use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
+    /// # use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// # use ndarray::{Array2, array};
+    /// # let mesh = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+    /// #                      vec![[0, 1, 2]], None).unwrap();
+    /// # let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
+    /// # let mut set = TransportSet::new(param, Selection::All);
+    /// # for _ in 0..3 { set.push(Array2::from_elem((8, 16), 0.1f32).view()).unwrap(); }
+    /// # let albedo = Array2::from_elem((3, 3), 1.0f32);
+    /// let options = GlossyOptions { brdf: Brdf::Phong { exponent: 20.0 }, cache_bins: Some(4),
+    ///                               ..Default::default() };
+    /// let shader = GlossyShader::<f32>::new(&set, &mesh, albedo.view(), &ShadeOptions::default(),
+    ///                                       &options, 3).unwrap();
+    /// assert_eq!(shader.fill_cache().unwrap(), 4 * 8);
+    /// assert_eq!(shader.fill_cache().unwrap(), 0); // already full
+    /// ```
+    pub fn fill_cache(&self) -> Result<usize> {
+        let Some(n) = self.bins else {
+            return Err(Error::parameter(
+                "rotation cache",
+                "there is no cache to fill: give the shader cache bins",
+            ));
+        };
+        if !self.orientation.brdf().is_mirror_symmetric() {
+            return Err(Error::parameter(
+                "rotation cache",
+                format!(
+                    "{} depends on the view: its bins are filled as views need them, not ahead",
+                    self.orientation.brdf()
+                ),
+            ));
+        }
+        let (rows, columns) = (n as u32, 2 * n as u32);
+        let keys = (0..rows).flat_map(|i| (0..columns).map(move |j| MapKey::Mirror(i, j)));
+        // Mirror bins do not depend on the eye.
+        self.fill(keys, [0.0; 3])
+    }
+
+    /// Rotates the maps of `keys` the cache lacks and adds them; returns how many.
+    fn fill(&self, keys: impl Iterator<Item = MapKey>, eye: [f64; 3]) -> Result<usize> {
+        let missing: Vec<MapKey> = {
+            let cache = self.cache.lock().expect("the cache lock is never poisoned");
+            keys.filter(|k| !cache.contains_key(k)).collect()
+        };
+        let filled: Vec<(MapKey, Arc<Vec<T>>)> = missing
+            .par_iter()
+            .map(|&key| Ok((key, Arc::new(self.brdf_planes(&self.frame_of(key, eye)?)?))))
+            .collect::<Result<_>>()?;
+        let rotated = filled.len();
+        self.cache
+            .lock()
+            .expect("the cache lock is never poisoned")
+            .extend(filled);
+        Ok(rotated)
     }
 
     /// Vertex `v`'s frame as seen from `eye`.

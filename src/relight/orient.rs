@@ -15,9 +15,10 @@
 //!   elevation nearest `w_o`'s (normal at +Y, viewer at azimuth 0); `R0 = to_pole(n)` takes the
 //!   normal to +Y and `w_o` to `R0 w_o` of azimuth `phi0`; the map is first turned about the
 //!   normal by the whole number of columns nearest `-phi0` (an exact Haar-domain yaw shift,
-//!   [`sphere::yaw`](crate::sphere::yaw), for every method), then tilted by `R0`. The viewer's
-//!   azimuth is thus quantised to a column (`360 / 2H` degrees) and its elevation to the table's
-//!   step; an isotropic BRDF needs nothing else.
+//!   [`sphere::yaw`](crate::sphere::yaw), for every method), then rotated by `Y(d) R0`: the
+//!   tilt and the remaining yaw `d` (less than half a column) about the normal. Only the
+//!   viewer's elevation is quantised (to the table's step); an isotropic BRDF needs nothing
+//!   else. (A cache's bins stand for viewers at whole columns, so there `d` is 0.)
 //!
 //! [`BrdfRotation`] chooses how the tilt is computed:
 //!
@@ -28,6 +29,13 @@
 //! | `spatial` | the local map rotated in the pixel domain, bilinear, then transformed ([`Method::Bilinear`]) | lat-long |
 //! | `reference` | rotation by solid-angle integration over each target texel ([`Method::Reference`]) | lat-long |
 //! | `direct` | no rotation: [`Brdf::evaluate`] at each global texel centre with the exact `n`, `w_o` | any |
+//!
+//! **Prepared once.** For `haar` and `haar-cubic` each local map is prepared for rotation when
+//! the [`Orientation`] is made (its approximation at the level, its derivative fields: a
+//! [`Rotator`]); a vertex's lobe is then one chain-rule rotation, the column turn read from the
+//! prepared fields rather than computed (equal to turning the map and rotating it, tested).
+//! A turn that the level's blocks would split, or a tilt that is itself a whole-column yaw,
+//! goes through [`rotate_map`] instead.
 //!
 //! **Levels.** `--level L` is the sphere module's detail level: the map is rotated from its
 //! approximation with detail levels `0..=L` (the thesis's level `L + 1`, faces `2^(L+1)` texels
@@ -320,11 +328,16 @@ impl Orientation {
         let tilt = to_pole(frame.normal);
         let (theta_o, phi0) = angles(tilt.apply(frame.outgoing));
         let columns = 2 * self.param.face_size();
-        let turn = (-phi0 * columns as f64 / std::f64::consts::TAU).round() as i64;
+        let exact = -phi0 * columns as f64 / std::f64::consts::TAU;
+        let turn = exact.round();
+        // f turned by `turn` columns is f(Y(turn) w); the rest of the turn joins the tilt:
+        // g(p) = f(Y(exact) R0 p) = f_turned(Y(exact - turn) R0 p).
+        let rest = SphereRotation::from_degrees((exact - turn) * 360.0 / columns as f64, 0.0, 0.0)?;
+        let rotation = rest.after(&tilt);
         Ok((
             self.table.nearest(theta_o),
-            turn.rem_euclid(columns as i64) as usize,
-            tilt,
+            (turn as i64).rem_euclid(columns as i64) as usize,
+            rotation,
         ))
     }
 

@@ -153,6 +153,34 @@ impl Camera {
         Camera::new(position, centre, fov_degrees)
     }
 
+    /// The camera moved `degrees` about the vertical axis through the point it looks at (a
+    /// turntable seen from a circling viewer; positive turns go from +Z toward +X, the
+    /// direction of increasing azimuth).
+    ///
+    /// ```
+    /// use haarshift::relight::raster::Camera;
+    /// let c = Camera::new([0.0, 1.0, 5.0], [0.0, 1.0, 0.0], 40.0).unwrap();
+    /// let p = c.orbited(90.0).unwrap().position();
+    /// assert!((p[0] - 5.0).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12 && p[2].abs() < 1e-12);
+    /// assert_eq!(c.orbited(0.0).unwrap().position(), c.position());
+    /// ```
+    pub fn orbited(&self, degrees: f64) -> Result<Camera> {
+        if !degrees.is_finite() {
+            return Err(Error::parameter(
+                "orbit",
+                format!("{degrees} degrees is not an angle"),
+            ));
+        }
+        let (s, c) = degrees.to_radians().sin_cos();
+        let d = sub(self.position, self.look_at);
+        let turned = [
+            self.look_at[0] + c * d[0] + s * d[2],
+            self.position[1],
+            self.look_at[2] - s * d[0] + c * d[2],
+        ];
+        Camera::new(turned, self.look_at, self.fov)
+    }
+
     /// The camera's position.
     pub fn position(&self) -> [f64; 3] {
         self.position

@@ -111,6 +111,22 @@ impl SphereRotation {
         Ok(r)
     }
 
+    /// `self` applied after `first`: the rotation of matrix `M_self M_first`.
+    ///
+    /// ```
+    /// use haarshift::sphere::SphereRotation;
+    /// let (a, b) = (SphereRotation::from_degrees(30.0, 0.0, 0.0).unwrap(),
+    ///               SphereRotation::from_degrees(0.0, 40.0, 0.0).unwrap());
+    /// let p = [0.6, 0.0, 0.8];
+    /// let (q, r) = (a.after(&b).apply(p), a.apply(b.apply(p)));
+    /// assert!((0..3).all(|k| (q[k] - r[k]).abs() < 1e-15));
+    /// ```
+    pub fn after(&self, first: &SphereRotation) -> SphereRotation {
+        SphereRotation {
+            m: mul(&self.m, &first.m),
+        }
+    }
+
     /// The matrix, row-major.
     pub fn matrix(&self) -> [[f64; 3]; 3] {
         self.m

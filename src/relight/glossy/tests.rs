@@ -283,6 +283,52 @@ fn the_rotation_cache_reuses_bins_and_stays_close_to_exact_frames() {
 }
 
 #[test]
+fn a_cache_filled_ahead_serves_every_view_with_the_same_maps() {
+    let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
+    let light = lighting(param, Selection::All);
+    let options = GlossyOptions {
+        brdf: Brdf::Phong { exponent: 10.0 },
+        cache_bins: Some(8),
+        ..GlossyOptions::default()
+    };
+    let (filled, _) = shader(param, 9, &options, 9);
+    let (lazy, _) = shader(param, 9, &options, 9);
+    assert_eq!(filled.fill_cache().unwrap(), 8 * 16);
+    assert_eq!((filled.cached(), filled.fill_cache().unwrap()), (8 * 16, 0));
+    for eye in [[1.0, 3.0, 2.0], [-2.0, 2.5, 1.0], [0.5, 0.2, -3.0]] {
+        let (a, report) = filled.shade(&light, eye).unwrap();
+        assert_eq!(report.rotated, 0, "{eye:?}");
+        let (b, _) = lazy.shade(&light, eye).unwrap();
+        assert_eq!(a, b, "{eye:?}");
+    }
+    // Nothing to fill without a cache, and a view-dependent BRDF's bins are not filled ahead.
+    let none = GlossyOptions {
+        cache_bins: None,
+        ..options.clone()
+    };
+    assert_err!(
+        shader(param, 3, &none, 3).0.fill_cache(),
+        InvalidParameter {
+            name: "rotation cache",
+            ..
+        },
+        "no cache"
+    );
+    let blinn = GlossyOptions {
+        brdf: Brdf::BlinnPhong { exponent: 10.0 },
+        ..options
+    };
+    assert_err!(
+        shader(param, 3, &blinn, 3).0.fill_cache(),
+        InvalidParameter {
+            name: "rotation cache",
+            ..
+        },
+        "depends on the view"
+    );
+}
+
+#[test]
 fn bad_inputs_are_refused() {
     let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
     let (mesh, set, albedo) = scene(param, 4);

@@ -286,3 +286,22 @@ fn prepared_rotators_give_what_rotate_map_gives() {
         }
     }
 }
+
+#[test]
+fn a_vertex_seen_from_behind_takes_the_table_below_the_surface() {
+    // The viewer 11 degrees below the tangent plane. Its entry (past 90 degrees) follows the
+    // formula: measured 0.10 relative RMS at 64 elevations (the lobe there is faint and has
+    // the half vector's singularity at -w_o above the surface). The table clamped at 90
+    // degrees, as it once was, stands for the viewer on the horizon: 2.26.
+    let param = latlong(64);
+    let blinn = Brdf::BlinnPhong { exponent: 20.0 };
+    let direct = Orientation::new(&blinn, param, BrdfRotation::Direct, None, 64).unwrap();
+    let haar = Orientation::new(&blinn, param, BrdfRotation::Haar, None, 64).unwrap();
+    let below = Frame::new([0.0, 1.0, 0.0], [0.0, -0.2, -1.0]).unwrap();
+    let horizon = Frame::new([0.0, 1.0, 0.0], [0.0, -1e-4, -1.0]).unwrap();
+    let truth = direct.lobe(&below).unwrap();
+    let e = relative_rms(&haar.lobe(&below).unwrap(), &truth);
+    assert!(e < 0.2, "relative RMS {e}");
+    assert!(relative_rms(&direct.lobe(&horizon).unwrap(), &truth) > 2.0);
+    assert!(haar.quantise(&below).unwrap().0 >= 64);
+}

@@ -13,21 +13,26 @@ use haarshift::relight::PreparedTransport;
 use haarshift::relight::glossy::GlossyShader;
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, filled_note, ms,
+    refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 
 const HELP: &str = "\
 Frame k (0 to F - 1) is `relight render` with the lighting's yaw increased by k x 360 / F
 degrees (pitch and roll as given): the environment turns about +Y while the scene and the
-camera stay. The transport is prepared once; each frame encodes the lighting, shades and
-rasterises, and its time is printed. The output is one looping GIF (per-frame palette), or
+camera stay. With --orbit the lighting stays and the camera circles the point it looks at
+instead, k x 360 / F degrees about the vertical: every frame is a new view, so a glossy
+material's highlights move (with a rotation cache, a frame rotates only the BRDF maps no
+earlier frame needed; each frame prints how many). The transport is prepared once; each
+frame encodes the lighting, shades and rasterises, and its time is printed. The output is one looping GIF (per-frame palette), or
 numbered PNG files when -o holds %d or %0Nd (frame_%03d.png: frame_000.png, frame_001.png ...).
 
 Examples:
   haarshift relight animate bunny.hsr --env testdata/envmaps/rooitou_park_256x128.npy --frames 24 -o turn.gif
   haarshift relight animate bunny.hsr --env park.hdr --frames 36 --keep-light 300 --delay 80 -o turn.gif
-  haarshift relight animate bunny.hsr --env park.hdr --frames 12 -o frames/frame_%03d.png";
+  haarshift relight animate bunny.hsr --env park.hdr --frames 12 -o frames/frame_%03d.png
+  haarshift relight animate bunny.hsr --env park.hdr --brdf phong:50 --rotation-cache 64 --orbit -o orbit.gif";
 
 /// Animate a precomputed scene under a turning environment.
 #[derive(clap::Args, Debug)]
@@ -48,6 +53,10 @@ pub struct Args {
     /// Time each GIF frame is shown, milliseconds (stored in hundredths of a second)
     #[arg(long, value_name = "MS", default_value_t = 100)]
     pub delay: u32,
+
+    /// Circle the camera about the point it looks at instead of turning the lighting
+    #[arg(long)]
+    pub orbit: bool,
 
     #[command(flatten)]
     pub light: LightFlags,
@@ -123,33 +132,50 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     // Lambertian: one sparse dot per vertex and frame. Glossy: the view is fixed, so with a
     // rotation cache only the first frame rotates BRDF maps.
-    let shader = if brdf.is_lambert() {
-        Shader::Lambert(args.shading.prepare(&cache)?)
+    let (shader, filled) = if brdf.is_lambert() {
+        (Shader::Lambert(args.shading.prepare(&cache)?), None)
     } else {
-        Shader::Glossy(Box::new(args.shading.prepare_glossy(
-            &cache,
-            &brdf,
-            &args.glossy,
-        )?))
+        let (glossy, filled) = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
+        (Shader::Glossy(Box::new(glossy)), filled)
     };
     // The lat-long-to-working mapping (a cube's conversion table) is built once, not per frame.
     let mapping = SphereMapping::new(env.map().height(), cache.transport.param())?;
-    let mut text = format!("transport prepared once in {:.1} ms\n", ms(start));
+    let mut text = format!(
+        "{}transport prepared once in {:.1} ms\n",
+        filled_note(filled),
+        ms(start) - filled.map_or(0.0, |f| f.ms)
+    );
     let mut radiance = ndarray::Array2::<f32>::zeros((cache.mesh.vertex_count(), 3));
     let mut frames = Vec::with_capacity(if gif { args.frames } else { 0 });
     for k in 0..args.frames {
         let start = Instant::now();
-        let frame_yaw = yaw + 360.0 * k as f64 / args.frames as f64;
+        let step = 360.0 * k as f64 / args.frames as f64;
+        let (frame_yaw, orbit) = if args.orbit {
+            (yaw, step)
+        } else {
+            (yaw + step, 0.0)
+        };
+        let view = camera.orbited(orbit)?;
         let turn = rotation([frame_yaw, pitch, roll])?;
         let lighting = Lighting::encode(&env, &mapping, &turn, args.shading.light_selection())?;
+        let mut maps = String::new();
         match &shader {
             Shader::Lambert(prepared) => prepared.shade_into(&lighting, &mut radiance)?,
-            Shader::Glossy(glossy) => radiance = glossy.shade(&lighting, camera.position())?.0,
+            Shader::Glossy(glossy) => {
+                let report;
+                (radiance, report) = glossy.shade(&lighting, view.position())?;
+                maps = format!(
+                    ", BRDF maps {} ({} rotated in {:.1} ms)",
+                    report.maps,
+                    report.rotated,
+                    1e3 * report.rotate_seconds
+                );
+            }
         }
         let shade_ms = ms(start);
         let start = Instant::now();
         let image = args.camera.draw(
-            &camera,
+            &view,
             &cache.mesh,
             radiance.view(),
             &background,
@@ -161,8 +187,13 @@ pub fn run(args: Args) -> Result<()> {
             Some(path) => write_render(&image, path, args.camera.exposure, args.force)?,
             None => frames.push(to_srgb8(&image, args.camera.exposure)?),
         }
+        let placement = if args.orbit {
+            format!("camera orbit {orbit:.2}")
+        } else {
+            format!("yaw {frame_yaw:.2}")
+        };
         text += &format!(
-            "frame {k}: yaw {frame_yaw:.2}, lighting and shading {shade_ms:.1} ms, \
+            "frame {k}: {placement}, lighting and shading {shade_ms:.1} ms{maps}, \
              rasterisation {raster_ms:.1} ms\n"
         );
     }

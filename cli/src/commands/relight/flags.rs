@@ -198,9 +198,15 @@ pub struct GlossyFlags {
     #[arg(long, value_name = "N")]
     pub rotation_cache: Option<usize>,
 
-    /// Outgoing elevations tabulated for a view-dependent BRDF (Blinn-Phong, MERL)
+    /// Outgoing elevations tabulated above the surface for a view-dependent BRDF (Blinn-Phong,
+    /// MERL), as many again below it for vertices seen from behind
     #[arg(long, value_name = "E", default_value_t = DEFAULT_ELEVATIONS)]
     pub elevations: usize,
+
+    /// Before shading, rotate every bin of the rotation cache (N x 2N maps, Phong only), timed
+    /// on its own, so that every view finds its maps there
+    #[arg(long)]
+    pub fill_cache: bool,
 }
 
 impl GlossyFlags {
@@ -222,13 +228,20 @@ impl GlossyFlags {
             || self.level.is_some()
             || self.keep_brdf.is_some()
             || self.rotation_cache.is_some()
-            || self.elevations != DEFAULT_ELEVATIONS;
+            || self.elevations != DEFAULT_ELEVATIONS
+            || self.fill_cache;
         if set && brdf.is_lambert() {
             return Err(Error::InvalidParameter {
                 name: "brdf-rotation",
-                reason: "--brdf-rotation, --level, --keep-brdf, --rotation-cache and \
-                         --elevations apply to glossy BRDFs; the BRDF is lambert"
+                reason: "--brdf-rotation, --level, --keep-brdf, --rotation-cache, \
+                         --elevations and --fill-cache apply to glossy BRDFs; the BRDF is lambert"
                     .into(),
+            });
+        }
+        if self.fill_cache && self.rotation_cache.is_none() {
+            return Err(Error::InvalidParameter {
+                name: "fill-cache",
+                reason: "--fill-cache fills the rotation cache: give --rotation-cache N".into(),
             });
         }
         Ok(())
@@ -432,20 +445,28 @@ impl ShadingFlags {
 
     /// `cache`'s transport prepared for shading with `brdf` (glossy on the objects, the ground
     /// plane Lambertian) under `glossy`.
+    /// The glossy shader and, with `--fill-cache`, what filling its cache ahead took.
     pub fn prepare_glossy(
         &self,
         cache: &SceneCache,
         brdf: &Brdf,
         glossy: &GlossyFlags,
-    ) -> Result<GlossyShader<f32>> {
-        GlossyShader::new(
+    ) -> Result<(GlossyShader<f32>, Option<Filled>)> {
+        let shader = GlossyShader::new(
             &cache.transport,
             &cache.mesh,
             cache.albedo.view(),
             &self.options(),
             &glossy.options(brdf),
             object_vertices(cache),
-        )
+        )?;
+        if !glossy.fill_cache {
+            return Ok((shader, None));
+        }
+        let start = std::time::Instant::now();
+        let maps = shader.fill_cache()?;
+        let ms = ms(start);
+        Ok((shader, Some(Filled { maps, ms })))
     }
 }
 
@@ -462,4 +483,18 @@ fn background_map(env: &Environment, rotation: &SphereRotation) -> Result<LatLon
 /// Milliseconds since `start`.
 pub fn ms(start: std::time::Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
+}
+
+/// What `--fill-cache` did: the maps rotated and the milliseconds that took.
+#[derive(Clone, Copy, Debug)]
+pub struct Filled {
+    pub maps: usize,
+    pub ms: f64,
+}
+
+/// What `--fill-cache` did, for a command's report ("" without it).
+pub fn filled_note(filled: Option<Filled>) -> String {
+    filled.map_or(String::new(), |f| {
+        format!("cache filled ahead: {} maps rotated in {:.1} ms; ", f.maps, f.ms)
+    })
 }

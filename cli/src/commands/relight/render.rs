@@ -13,8 +13,8 @@ use haarshift::{Error, Result, SampleDepth};
 use ndarray::Array2;
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, object_vertices,
-    refuse_inputs, rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, filled_note, ms,
+    object_vertices, refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -131,8 +131,9 @@ pub fn run(args: Args) -> Result<()> {
         }
         Basis::Haar => {
             let start = Instant::now();
-            let shader = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
-            let prepare_ms = ms(start);
+            let (shader, filled) = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
+            let prepare_ms = ms(start) - filled.map_or(0.0, |f| f.ms);
+            let filled = filled_note(filled);
             let start = Instant::now();
             let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
             let encode_ms = ms(start);
@@ -140,7 +141,8 @@ pub fn run(args: Args) -> Result<()> {
             let (radiance, report) = shader.shade(&lighting, camera.position())?;
             let cache_note = match args.glossy.rotation_cache {
                 Some(n) => format!(
-                    "rotation cache {n} x {}: {} maps rotated in {:.1} ms, {} from the cache",
+                    "rotation cache {n} x {}: {filled}{} maps rotated in {:.1} ms, {} from the \
+                     cache",
                     2 * n,
                     report.rotated,
                     report.rotate_seconds * 1e3,
