@@ -927,10 +927,16 @@ fn an_orbiting_glossy_animation_shows_new_views_from_a_filled_cache() {
     assert!(stdout.contains("frame 2: camera orbit 180.00"), "{stdout}");
     // Frame 2 is the render from the camera taken half-way round the point looked at.
     let single = dir.path().join("half.png");
-    let mut args = render_args(&cache, &single, &["--env", p(&env)]);
-    args.extend(glossy.iter().chain(&view));
-    args.extend(["--camera", "0,2,-5", "--look-at", "0,0.5,0"]);
-    let stdout = succeeds_with_stdout(&args);
+    let mut extra = vec![
+        "--env",
+        p(&env),
+        "--camera",
+        "0,2,-5",
+        "--look-at",
+        "0,0.5,0",
+    ];
+    extra.extend(glossy.iter().chain(&view));
+    let stdout = succeeds_with_stdout(&render_args(&cache, &single, &extra));
     assert!(
         stdout.contains("cache filled ahead: 32 maps rotated"),
         "{stdout}"

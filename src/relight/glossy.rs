@@ -321,12 +321,12 @@ impl<T: Sample> GlossyShader<T> {
     /// # use haarshift::relight::{Brdf, Mesh, ShadeOptions, TransportSet};
     /// # use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
     /// # use haarshift::sphere::param::{ParamKind, Parameterization};
-    /// # use ndarray::{Array2, array};
+    /// # use ndarray::{Array2, Array3, array};
     /// # let mesh = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
     /// #                      vec![[0, 1, 2]], None).unwrap();
     /// # let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
     /// # let mut set = TransportSet::new(param, Selection::All);
-    /// # for _ in 0..3 { set.push(Array2::from_elem((8, 16), 0.1f32).view()).unwrap(); }
+    /// # for _ in 0..3 { set.push(Array3::from_elem((2, 8, 8), 0.1f32).view()).unwrap(); }
     /// # let albedo = Array2::from_elem((3, 3), 1.0f32);
     /// let options = GlossyOptions { brdf: Brdf::Phong { exponent: 20.0 }, cache_bins: Some(4),
     ///                               ..Default::default() };

@@ -495,6 +495,9 @@ pub struct Filled {
 /// What `--fill-cache` did, for a command's report ("" without it).
 pub fn filled_note(filled: Option<Filled>) -> String {
     filled.map_or(String::new(), |f| {
-        format!("cache filled ahead: {} maps rotated in {:.1} ms; ", f.maps, f.ms)
+        format!(
+            "cache filled ahead: {} maps rotated in {:.1} ms; ",
+            f.maps, f.ms
+        )
     })
 }
