@@ -310,8 +310,10 @@ impl<T: Sample> SourceGradient<T> {
     #[inline]
     fn accumulate(&self, theta: f64, phi: f64, alpha: f64, beta: f64, turn: usize, out: &mut [T]) {
         match (self.scheme, &self.zonal) {
-            (Scheme::Linear, None) => self.accumulate_linear(theta, phi, alpha, beta, turn, out),
-            (Scheme::Cubic, None) => self.accumulate_cubic(theta, phi, alpha, beta, turn, out),
+            (Scheme::Linear, None) => {
+                self.accumulate_linear((theta, phi), (alpha, beta), turn, out)
+            }
+            (Scheme::Cubic, None) => self.accumulate_cubic((theta, phi), (alpha, beta), turn, out),
             (scheme, Some(profile)) => self.accumulate_zonal(scheme, profile, theta, alpha, out),
         }
     }
@@ -372,10 +374,8 @@ impl<T: Sample> SourceGradient<T> {
     #[inline]
     fn accumulate_linear(
         &self,
-        theta: f64,
-        phi: f64,
-        alpha: f64,
-        beta: f64,
+        (theta, phi): (f64, f64),
+        (alpha, beta): (f64, f64),
         turn: usize,
         out: &mut [T],
     ) {
@@ -457,10 +457,8 @@ impl<T: Sample> SourceGradient<T> {
     #[inline]
     fn accumulate_cubic(
         &self,
-        theta: f64,
-        phi: f64,
-        alpha: f64,
-        beta: f64,
+        (theta, phi): (f64, f64),
+        (alpha, beta): (f64, f64),
         turn: usize,
         out: &mut [T],
     ) {
