@@ -34,8 +34,8 @@
 //! the [`Orientation`] is made (its approximation at the level, its derivative fields: a
 //! [`Rotator`]); a vertex's lobe is then one chain-rule rotation, the column turn read from the
 //! prepared fields rather than computed (equal to turning the map and rotating it, tested).
-//! A turn that the level's blocks would split, or a tilt that is itself a whole-column yaw,
-//! goes through [`rotate_map`] instead.
+//! A turn that the level's blocks would split, or a rotation that is itself a whole-column
+//! yaw, goes through [`rotate_map`] instead.
 //!
 //! **Levels.** `--level L` is the sphere module's detail level: the map is rotated from its
 //! approximation with detail levels `0..=L` (the thesis's level `L + 1`, faces `2^(L+1)` texels
@@ -316,8 +316,8 @@ impl Orientation {
     }
 
     /// For a rotated view-dependent BRDF, the table entry and the column turn the frame
-    /// uses, and the tilt `R0`; for Phong entry 0, no turn and the rotation to the mirror
-    /// direction.
+    /// uses, and the rotation `Y(d) R0` (the tilt and the rest of the turn); for Phong entry 0,
+    /// no turn and the rotation to the mirror direction.
     fn plan(&self, frame: &Frame) -> Result<(usize, usize, SphereRotation)> {
         if self.brdf.is_mirror_symmetric() {
             let r = unit(frame.mirror()).ok_or_else(|| {
@@ -351,17 +351,17 @@ impl Orientation {
                 out.copy_from_slice(&self.brdf.evaluate(n, w, wo)[..channels]);
             });
         }
-        let (entry, turn, tilt) = self.plan(frame)?;
+        let (entry, turn, rotation) = self.plan(frame)?;
         let local = self.table.map(entry);
         let columns = 2 * self.param.face_size();
-        // The prepared map, read turned, unless the level's blocks split the turn or the tilt
-        // is itself a whole-column yaw (which rotate_map does exactly).
+        // The prepared map, read turned, unless the level's blocks split the turn or the
+        // rotation is itself a whole-column yaw (which rotate_map does exactly).
         if let Some((rotators, block)) = &self.rotators
             && turn % block == 0
-            && tilt.whole_column_yaw(columns).is_none()
+            && rotation.whole_column_yaw(columns).is_none()
         {
             let h = self.param.face_size();
-            let coefficients = rotators[entry].rotate_turned(&tilt, turn / block)?;
+            let coefficients = rotators[entry].rotate_turned(&rotation, turn / block)?;
             return SphereMap::from_lat_long(&coefficients.zero_padded(h)?.to_map()?);
         }
         let turned;
@@ -372,7 +372,7 @@ impl Orientation {
             turned = rotate_map(local, &yaw, &self.options)?.map;
             &turned
         };
-        SphereMap::from_lat_long(&rotate_map(source, &tilt, &self.options)?.map)
+        SphereMap::from_lat_long(&rotate_map(source, &rotation, &self.options)?.map)
     }
 }
 

@@ -1097,11 +1097,6 @@ impl<T: Sample> Rotator<T> {
         })
     }
 
-    /// Rows of the source (and of every result).
-    pub fn height(&self) -> usize {
-        self.grad.m
-    }
-
     /// Whether the source is zonal ([`SourceGradient::is_zonal`]).
     pub fn is_zonal(&self) -> bool {
         self.grad.is_zonal()

@@ -25,8 +25,9 @@ camera stay. With --orbit the lighting stays and the camera circles the point it
 instead, k x 360 / F degrees about the vertical: every frame is a new view, so a glossy
 material's highlights move (with a rotation cache, a frame rotates only the BRDF maps no
 earlier frame needed; each frame prints how many). The transport is prepared once; each
-frame encodes the lighting, shades and rasterises, and its time is printed. The output is one looping GIF (per-frame palette), or
-numbered PNG files when -o holds %d or %0Nd (frame_%03d.png: frame_000.png, frame_001.png ...).
+frame encodes the lighting, shades and rasterises, and its time is printed. The output is
+one looping GIF (per-frame palette), or numbered PNG files when -o holds %d or %0Nd
+(frame_%03d.png: frame_000.png, frame_001.png ...).
 
 Examples:
   haarshift relight animate bunny.hsr --env testdata/envmaps/rooitou_park_256x128.npy --frames 24 -o turn.gif
@@ -130,12 +131,14 @@ pub fn run(args: Args) -> Result<()> {
     let brdf = args.material.brdf()?;
     args.glossy.check(&brdf)?;
     let start = Instant::now();
-    // Lambertian: one sparse dot per vertex and frame. Glossy: the view is fixed, so with a
-    // rotation cache only the first frame rotates BRDF maps.
+    // Lambertian: one sparse dot per vertex and frame. Glossy: with a rotation cache, a frame
+    // rotates only the maps no earlier frame (or --fill-cache) rotated: with a fixed view,
+    // the first frame's.
     let (shader, filled) = if brdf.is_lambert() {
         (Shader::Lambert(args.shading.prepare(&cache)?), None)
     } else {
-        let (glossy, filled) = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
+        let glossy = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
+        let filled = args.glossy.fill(&glossy)?;
         (Shader::Glossy(Box::new(glossy)), filled)
     };
     // The lat-long-to-working mapping (a cube's conversion table) is built once, not per frame.

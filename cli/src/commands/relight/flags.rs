@@ -246,6 +246,19 @@ impl GlossyFlags {
         }
         Ok(())
     }
+
+    /// With `--fill-cache`, fills `shader`'s rotation cache ahead and says what that took.
+    pub fn fill(&self, shader: &GlossyShader<f32>) -> Result<Option<Filled>> {
+        if !self.fill_cache {
+            return Ok(None);
+        }
+        let start = std::time::Instant::now();
+        let maps = shader.fill_cache()?;
+        Ok(Some(Filled {
+            maps,
+            ms: ms(start),
+        }))
+    }
 }
 
 /// The vertices of `cache`'s objects: all but the ground plane's, which stays Lambertian.
@@ -445,28 +458,20 @@ impl ShadingFlags {
 
     /// `cache`'s transport prepared for shading with `brdf` (glossy on the objects, the ground
     /// plane Lambertian) under `glossy`.
-    /// The glossy shader and, with `--fill-cache`, what filling its cache ahead took.
     pub fn prepare_glossy(
         &self,
         cache: &SceneCache,
         brdf: &Brdf,
         glossy: &GlossyFlags,
-    ) -> Result<(GlossyShader<f32>, Option<Filled>)> {
-        let shader = GlossyShader::new(
+    ) -> Result<GlossyShader<f32>> {
+        GlossyShader::new(
             &cache.transport,
             &cache.mesh,
             cache.albedo.view(),
             &self.options(),
             &glossy.options(brdf),
             object_vertices(cache),
-        )?;
-        if !glossy.fill_cache {
-            return Ok((shader, None));
-        }
-        let start = std::time::Instant::now();
-        let maps = shader.fill_cache()?;
-        let ms = ms(start);
-        Ok((shader, Some(Filled { maps, ms })))
+        )
     }
 }
 

@@ -131,9 +131,9 @@ pub fn run(args: Args) -> Result<()> {
         }
         Basis::Haar => {
             let start = Instant::now();
-            let (shader, filled) = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
-            let prepare_ms = ms(start) - filled.map_or(0.0, |f| f.ms);
-            let filled = filled_note(filled);
+            let shader = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
+            let prepare_ms = ms(start);
+            let filled = filled_note(args.glossy.fill(&shader)?);
             let start = Instant::now();
             let lighting = Lighting::new(&env, param, &rotation, args.shading.light_selection())?;
             let encode_ms = ms(start);
