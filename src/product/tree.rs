@@ -300,6 +300,145 @@ impl<T: Sample, const C: usize> HaarTree<T, C> {
         }
     }
 
+    /// Builds the tree of the function whose non-zero orthonormal coefficients are given
+    /// sparsely: `indices` are face-Mallat positions (`face x S^2 + row x S + col`, any order,
+    /// no repeats; `(face, 0, 0)` is the face's scaling coefficient), `values` their `C`
+    /// channels. Every given detail is kept. The cost is that of the entries and their
+    /// ancestors, not of the faces, which is what per-vertex products of sparse factors need.
+    ///
+    /// ```
+    /// use haarshift::product::{FaceLayout, HaarTree, Selection};
+    /// use ndarray::Array4;
+    /// let f = Array4::from_shape_fn((2, 8, 8, 1), |(k, i, j, _)| ((k + 3 * i) ^ j) as f64);
+    /// let full = HaarTree::<f64, 1>::from_pixels(f.view(), FaceLayout::Stacked,
+    ///     Selection::Largest(9)).unwrap();
+    /// let (indices, values) = full.sparse_coefficients();
+    /// let rebuilt = HaarTree::from_sparse(2, 8, FaceLayout::Stacked, &indices, &values).unwrap();
+    /// assert_eq!(rebuilt.to_coefficients(), full.to_coefficients());
+    /// assert_eq!(rebuilt.kept(), 9);
+    /// ```
+    pub fn from_sparse(
+        faces: usize,
+        side: usize,
+        layout: FaceLayout,
+        indices: &[u32],
+        values: &[[T; C]],
+    ) -> Result<Self> {
+        check_face_array(&[faces, side, side, C], C, "a sparse function")?;
+        let area = side * side;
+        if indices.len() != values.len()
+            || indices.iter().any(|&i| i as usize >= faces * area)
+            || values.iter().flatten().any(|v| !v.as_f64().is_finite())
+        {
+            return Err(Error::parameter(
+                "coefficients",
+                format!(
+                    "{} indices and {} values: one finite value per index below {}",
+                    indices.len(),
+                    values.len(),
+                    faces * area
+                ),
+            ));
+        }
+        let n = side.trailing_zeros();
+        let mut scaling = vec![[T::zero(); C]; faces];
+        // (face, level, Morton code of the block, band, value) for every detail.
+        let mut details = Vec::with_capacity(indices.len());
+        for (&i, &v) in indices.iter().zip(values) {
+            let (face, at) = (i as usize / area, i as usize % area);
+            match mallat_detail(at / side, at % side) {
+                None => scaling[face] = v,
+                Some((band, level, row, col)) => {
+                    details.push((NodeKey::new(face, level, row, col), band, v))
+                }
+            }
+        }
+        let mut keys: Vec<NodeKey> = Vec::with_capacity(details.len() * n as usize);
+        for &(key, ..) in &details {
+            let mut k = key;
+            keys.push(k);
+            while let Some(parent) = k.parent() {
+                keys.push(parent);
+                k = parent;
+            }
+        }
+        // Sorted by (face, level, Morton code) is breadth first with each node's children
+        // contiguous and in quadrant order: the arena's order.
+        keys.sort_unstable();
+        keys.dedup();
+        let mut nodes = vec![
+            Node {
+                mean: [T::zero(); C],
+                step: [[T::zero(); C]; 3],
+                first_child: NONE,
+                children: 0,
+            };
+            keys.len()
+        ];
+        let inv_s = T::one() / T::from_f64(side as f64);
+        for &(key, band, v) in &details {
+            let at = keys
+                .binary_search(&key)
+                .expect("every detail's node is a key");
+            let inv_b = T::from_f64((1u64 << key.level) as f64) * inv_s;
+            nodes[at].step[band] = v.map(|x| x * inv_b);
+        }
+        let signs = wavelet_signs().map(|q| q.map(T::from_f64));
+        let mut roots = vec![None; faces];
+        for at in 0..keys.len() {
+            let key = keys[at];
+            match key.parent() {
+                None => {
+                    roots[key.face as usize] = Some(at as u32);
+                    nodes[at].mean = scaling[key.face as usize].map(|x| x * inv_s);
+                }
+                Some(parent) => {
+                    let p = keys[..at]
+                        .binary_search(&parent)
+                        .expect("a node's parent sorts before it");
+                    let q = (key.morton & 3) as usize;
+                    if nodes[p].children == 0 {
+                        nodes[p].first_child = at as u32;
+                    }
+                    nodes[p].children |= 1 << q;
+                    nodes[at].mean = nodes[p].quadrant_mean(&signs[q]);
+                }
+            }
+        }
+        let positions = keys.iter().map(NodeKey::position).collect();
+        Ok(Self::from_parts(
+            faces, n, layout, scaling, roots, nodes, positions,
+        ))
+    }
+
+    /// The tree's non-zero orthonormal coefficients, ascending face-Mallat index (the
+    /// inverse of [`from_sparse`](Self::from_sparse); scaling coefficients included when
+    /// non-zero).
+    pub fn sparse_coefficients(&self) -> (Vec<u32>, Vec<[T; C]>) {
+        let s = self.side();
+        let mut entries: Vec<(u32, [T; C])> = self
+            .scaling
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.iter().any(|x| *x != T::zero()))
+            .map(|(face, v)| ((face * s * s) as u32, *v))
+            .collect();
+        for (node, pos) in self.nodes.iter().zip(&self.positions) {
+            let side = 1usize << pos.level;
+            let b = T::from_f64((s / side) as f64);
+            let (r, c) = (pos.row as usize, pos.col as usize);
+            let cells = [(r, side + c), (side + r, c), (side + r, side + c)];
+            for (step, (i, j)) in node.step.iter().zip(cells) {
+                if step.iter().any(|x| *x != T::zero()) {
+                    let index = pos.face as usize * s * s + i * s + j;
+                    entries.push((index as u32, step.map(|x| x * b)));
+                }
+            }
+        }
+        entries.sort_unstable_by_key(|e| e.0);
+        entries.into_iter().unzip()
+    }
+
     /// Number of faces.
     pub fn faces(&self) -> usize {
         self.faces
@@ -533,4 +672,66 @@ fn presence(kept: &[bool], s: usize) -> Vec<Vec<bool>> {
         }
     }
     present
+}
+
+/// The detail at Mallat position `(r, c)` of a face: `(band, level, row, col)` with band
+/// 0 = H `(row, 2^l + col)`, 1 = V `(2^l + row, col)`, 2 = D; `None` for the scaling
+/// coefficient `(0, 0)`.
+pub(crate) fn mallat_detail(r: usize, c: usize) -> Option<(usize, usize, usize, usize)> {
+    let m = r.max(c);
+    if m == 0 {
+        return None;
+    }
+    let level = (usize::BITS - 1 - m.leading_zeros()) as usize;
+    let side = 1 << level;
+    Some(if r < side {
+        (0, level, r, c - side)
+    } else if c < side {
+        (1, level, r - side, c)
+    } else {
+        (2, level, r - side, c - side)
+    })
+}
+
+/// A node's place, ordered as the arena is: face, then level, then the block's Morton code
+/// (row bits above column bits, so the last two bits are the quadrant in its parent).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct NodeKey {
+    face: u32,
+    level: u8,
+    morton: u64,
+}
+
+impl NodeKey {
+    fn new(face: usize, level: usize, row: usize, col: usize) -> Self {
+        let spread =
+            |x: usize| (0..level).fold(0u64, |acc, b| acc | (((x as u64 >> b) & 1) << (2 * b)));
+        NodeKey {
+            face: face as u32,
+            level: level as u8,
+            morton: spread(row) << 1 | spread(col),
+        }
+    }
+
+    fn parent(self) -> Option<NodeKey> {
+        (self.level > 0).then(|| NodeKey {
+            face: self.face,
+            level: self.level - 1,
+            morton: self.morton >> 2,
+        })
+    }
+
+    fn position(&self) -> NodePosition {
+        let gather = |shift: u32| {
+            (0..u32::from(self.level)).fold(0u32, |acc, b| {
+                acc | ((((self.morton >> (2 * b + shift)) & 1) as u32) << b)
+            })
+        };
+        NodePosition {
+            face: self.face,
+            level: self.level,
+            row: gather(1),
+            col: gather(0),
+        }
+    }
 }

@@ -9,8 +9,11 @@
 //! | [`raycast`] | [`Occlusion`], the any-hit query, answered by [`SceneBvh`] |
 //! | [`shadowmap`] | [`ShadowMap`], seed 003's orthographic depth buffer along one direction |
 //! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
+//! | [`sparse`] | [`SparseRows`](sparse::SparseRows): many sparse Haar functions in flat arrays |
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
 //! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
+//! | [`fields`] | [`OcclusionField`](fields::OcclusionField): an object's occlusion seen from sample points around it (seed 001) |
+//! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other; [`Jrt`](dynamic::Jrt), just-in-time radiance transfer |
 //! | [`reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
@@ -33,8 +36,10 @@
 pub mod animation;
 pub mod brdf;
 pub mod cache;
+pub mod dynamic;
 pub mod environment;
 pub mod error;
+pub mod fields;
 pub mod gallery;
 pub mod glossy;
 pub mod harmonics;
@@ -49,6 +54,7 @@ pub mod reference;
 pub mod scene;
 pub mod shade;
 pub mod shadowmap;
+pub mod sparse;
 pub mod transport;
 pub mod visibility;
 

@@ -224,16 +224,27 @@ fn merge(meshes: impl IntoIterator<Item = Mesh>) -> Mesh {
 /// assert_eq!((b.min[1], b.max[0]), (-1.0, 4.0)); // at the lowest y, side 4 x 2
 /// ```
 pub fn add_ground_plane(mesh: &mut Mesh) {
-    let b = mesh.bounds();
+    mesh.append(&ground_plane_under(&mesh.bounds()));
+}
+
+/// The ground plane [`add_ground_plane`] puts under a scene of bounding box `b`, on its own.
+///
+/// ```
+/// use haarshift::relight::{Generator, scene::ground_plane_under};
+/// let ball = Generator::Sphere { cells: 4 }.mesh().unwrap();
+/// let ground = ground_plane_under(&ball.bounds());
+/// assert_eq!((ground.vertex_count(), ground.bounds().min[1]), (33 * 33, -1.0));
+/// ```
+pub fn ground_plane_under(b: &super::Bounds) -> Mesh {
     let side = 4.0 * (b.max[0] - b.min[0]).max(b.max[2] - b.min[2]);
     let c = b.centre();
-    mesh.append(&ground(
+    ground(
         c[0] - 0.5 * side,
         c[2] + 0.5 * side,
         b.min[1],
         side,
         GROUND_CELLS,
-    ));
+    )
 }
 
 /// A procedural mesh; see the [module docs](self) for each one's geometry and size.
@@ -459,7 +470,8 @@ impl Default for Material {
 }
 
 impl Material {
-    fn albedo(&self) -> Result<[f32; 3]> {
+    /// The RGB albedo, checked to be in `[0, 1]`.
+    pub fn albedo(&self) -> Result<[f32; 3]> {
         let Material::Lambert { albedo } = self;
         if albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
             return Err(SceneError::SceneFile(format!(
@@ -475,6 +487,9 @@ impl Material {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneObject {
+    /// A name an animation path can refer to (dynamic scenes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     /// A mesh file (OBJ or PLY), relative to the scene file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<PathBuf>,
@@ -487,6 +502,21 @@ pub struct SceneObject {
     /// Material.
     #[serde(default)]
     pub material: Material,
+}
+
+impl SceneObject {
+    /// The object's mesh in its own frame (before its transform): its mesh file, relative to
+    /// `dir`, or its generator's; `k` is its place in the scene file, for the message.
+    pub fn shape(&self, dir: &Path, k: usize) -> Result<Mesh> {
+        match (&self.mesh, &self.generator) {
+            (Some(path), None) => Mesh::load(&dir.join(path)),
+            (None, Some(generator)) => generator.mesh(),
+            _ => Err(SceneError::SceneFile(format!(
+                "object {k} must have exactly one of \"mesh\" and \"generator\""
+            ))
+            .into()),
+        }
+    }
 }
 
 /// The environment lighting of a scene file.
@@ -660,16 +690,7 @@ impl SceneFile {
         let mut mesh: Option<Mesh> = None;
         let mut albedo = Array2::<f32>::zeros((0, 3));
         for (k, object) in self.objects.iter().enumerate() {
-            let shape = match (&object.mesh, &object.generator) {
-                (Some(path), None) => Mesh::load(&dir.join(path))?,
-                (None, Some(generator)) => generator.mesh()?,
-                _ => {
-                    return Err(SceneError::SceneFile(format!(
-                        "object {k} must have exactly one of \"mesh\" and \"generator\""
-                    ))
-                    .into());
-                }
-            };
+            let shape = object.shape(dir, k)?;
             let shape = object.transform.apply(&shape)?;
             let a = object.material.albedo()?;
             let rows = Array2::from_shape_fn((shape.vertex_count(), 3), |(_, c)| a[c]);

@@ -43,6 +43,7 @@ use super::lighting::Lighting;
 use super::transport::TransportSet;
 use crate::product::Selection;
 use crate::product::selection::{Candidate, keep_largest};
+use crate::product::tree::mallat_detail;
 use crate::sphere::Parameterization;
 use crate::sphere::integrate::layout;
 use crate::{Error, Result, Sample};
@@ -309,24 +310,6 @@ pub fn shade<T: Sample>(
     PreparedTransport::<T>::new(set, albedo, options)?.shade(lighting)
 }
 
-/// The detail level of the coefficient at `(r, c)` of a face's Mallat array (`None`: the
-/// scaling coefficient at `(0, 0)`), with its band (0 `H`, 1 `V`, 2 `D`) and node position.
-fn detail_of(r: usize, c: usize) -> Option<(usize, usize, usize, usize)> {
-    let m = r.max(c);
-    if m == 0 {
-        return None;
-    }
-    let level = (usize::BITS - 1 - m.leading_zeros()) as usize;
-    let side = 1 << level;
-    Some(if r < side {
-        (0, level, r, c - side)
-    } else if c < side {
-        (1, level, r - side, c)
-    } else {
-        (2, level, r - side, c - side)
-    })
-}
-
 /// Which of the coefficients at face-Mallat `indices` (`face x S^2 + row x S + col`, any
 /// order) `keep` retains: every scaling coefficient, and the details the rule of
 /// [`crate::product::selection`] picks by `magnitude2(slot)`, their squared (RGB) magnitudes.
@@ -344,7 +327,7 @@ pub(crate) fn select_kept(
     for (slot, &i) in indices.iter().enumerate() {
         let i = i as usize;
         let face = i / (s * s);
-        match detail_of((i / s) % s, i % s) {
+        match mallat_detail((i / s) % s, i % s) {
             None => kept[slot] = true,
             Some((band, level, row, col)) => pool.push(Candidate {
                 magnitude2: magnitude2(slot),

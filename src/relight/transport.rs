@@ -18,6 +18,7 @@
 use ndarray::{Array3, Array4, ArrayView3, Axis};
 
 use super::harmonics::{ShProjector, ShTransfer};
+use super::sparse::SparseRows;
 use crate::product::{HaarTree, Selection, Transport, WeightedPixels};
 use crate::sphere::Parameterization;
 use crate::sphere::integrate::layout;
@@ -42,9 +43,7 @@ use crate::{Error, Result};
 pub struct TransportSet {
     param: Parameterization,
     keep: Selection,
-    offsets: Vec<u64>,
-    indices: Vec<u32>,
-    values: Vec<f32>,
+    rows: SparseRows<f32>,
     sh: Option<ShTransfer>,
 }
 
@@ -54,9 +53,7 @@ impl TransportSet {
         TransportSet {
             param,
             keep,
-            offsets: vec![0],
-            indices: Vec::new(),
-            values: Vec::new(),
+            rows: SparseRows::new(),
             sh: None,
         }
     }
@@ -93,28 +90,24 @@ impl TransportSet {
         sh: Option<ShTransfer>,
     ) -> Result<Self> {
         let texels = param.texels() as u32;
-        let consistent = offsets.first() == Some(&0)
-            && offsets.windows(2).all(|w| w[0] <= w[1])
-            && offsets.last().copied() == Some(indices.len() as u64)
-            && indices.len() == values.len()
-            && indices.iter().all(|&i| i < texels)
-            && values.iter().all(|v| v.is_finite())
-            && sh
-                .as_ref()
-                .is_none_or(|t| t.vertex_count() + 1 == offsets.len());
-        if !consistent {
+        let vertices = offsets.len().saturating_sub(1);
+        let rows = SparseRows::from_parts(offsets, indices, values).filter(|rows| {
+            let (_, indices, values) = rows.parts();
+            indices.iter().all(|&i| i < texels)
+                && values.iter().all(|v| v.is_finite())
+                && sh.as_ref().is_none_or(|t| t.vertex_count() == vertices)
+        });
+        let Some(rows) = rows else {
             return Err(Error::parameter(
                 "transport",
                 "offsets, indices, values and transfer do not describe sparse trees of this \
                  resolution, one per vertex",
             ));
-        }
+        };
         Ok(TransportSet {
             param,
             keep,
-            offsets,
-            indices,
-            values,
+            rows,
             sh,
         })
     }
@@ -132,9 +125,7 @@ impl TransportSet {
 
     /// Appends one vertex's already encoded coefficients.
     pub(crate) fn extend(&mut self, vertex: &Encoded) {
-        self.indices.extend_from_slice(&vertex.indices);
-        self.values.extend_from_slice(&vertex.coefficients);
-        self.offsets.push(self.indices.len() as u64);
+        self.rows.push(&vertex.indices, &vertex.coefficients);
         if let Some(t) = &mut self.sh {
             t.push(&vertex.sh);
         }
@@ -157,29 +148,28 @@ impl TransportSet {
 
     /// Vertices stored.
     pub fn vertex_count(&self) -> usize {
-        self.offsets.len() - 1
+        self.rows.len()
     }
 
     /// Vertex `v`'s stored coefficients: Mallat indices and values.
     pub fn coefficients(&self, v: usize) -> (&[u32], &[f32]) {
-        let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
-        (&self.indices[a..b], &self.values[a..b])
+        self.rows.row(v)
     }
 
     /// The flat arrays: per-vertex offsets (`V + 1`), indices, values.
     pub(crate) fn parts(&self) -> (&[u64], &[u32], &[f32]) {
-        (&self.offsets, &self.indices, &self.values)
+        self.rows.parts()
     }
 
     /// Haar coefficients stored, all vertices.
     pub fn coefficient_count(&self) -> usize {
-        self.values.len()
+        self.rows.coefficient_count()
     }
 
     /// Bytes held by the coefficient arrays (the spherical-harmonic transfer included).
     pub fn stored_bytes(&self) -> usize {
         let sh = self.sh.as_ref().map_or(0, ShTransfer::stored_bytes);
-        self.offsets.len() * 8 + self.indices.len() * 4 + self.values.len() * 4 + sh
+        self.rows.bytes() + sh
     }
 
     /// Vertex `v`'s transport as a tree for [`product_integral`](crate::product::product_integral).
@@ -276,7 +266,7 @@ impl Encoder {
 
 /// Weights `values` by `weights`, transforms, keeps what `keep` picks: the non-zero kept
 /// coefficients with their Mallat indices.
-fn encode(
+pub(crate) fn encode(
     values: ArrayView3<'_, f32>,
     weights: ArrayView3<'_, f32>,
     param: Parameterization,

@@ -129,7 +129,7 @@ pub fn ray_offset(mesh: &Mesh) -> f64 {
 }
 
 /// Texel centre directions in Mallat/texel index order `(face, row, col)`.
-fn texel_directions(param: Parameterization) -> Vec<[f64; 3]> {
+pub(crate) fn texel_directions(param: Parameterization) -> Vec<[f64; 3]> {
     let s = param.face_size();
     (0..param.texels())
         .map(|t| param.texel_direction(t / (s * s), (t / s) % s, t % s))

@@ -1,6 +1,7 @@
 //! Tree structure: parent sums, the selection rule, the layouts' indices, real data.
 
 use ndarray::{Array2, Axis, s};
+use proptest::prelude::{ProptestConfig, prop_assert_eq, proptest};
 
 use super::*;
 use crate::transform::{Normalization, pyramid};
@@ -316,4 +317,50 @@ fn envmap_error_shrinks_to_zero_as_k_grows() {
     }
     assert_eq!(*errors.last().unwrap(), 0.0, "{errors:?}");
     assert!(errors[0] > errors[2] && errors[2] > errors[3], "{errors:?}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// A tree from sparse coefficients is the tree of the dense array holding them.
+    #[test]
+    fn a_tree_from_sparse_coefficients_is_the_tree_of_their_dense_array(
+        entries in proptest::collection::vec((0u32..3 * 64, -4.0f64..4.0, -4.0f64..4.0), 0..40),
+    ) {
+        let mut dense = Array4::<f64>::zeros((3, 8, 8, 2));
+        let mut seen = std::collections::BTreeMap::new();
+        for (i, a, b) in entries {
+            seen.insert(i, [a, b]);
+        }
+        let (indices, values): (Vec<u32>, Vec<[f64; 2]>) = seen.into_iter().unzip();
+        for (&i, v) in indices.iter().zip(&values) {
+            let i = i as usize;
+            for ch in 0..2 {
+                dense[[i / 64, (i / 8) % 8, i % 8, ch]] = v[ch];
+            }
+        }
+        let want = HaarTree::<f64, 2>::from_coefficients(
+            dense.view(), FaceLayout::Stacked, Selection::Threshold(0.0)).unwrap();
+        let got = HaarTree::<f64, 2>::from_sparse(3, 8, FaceLayout::Stacked, &indices, &values)
+            .unwrap();
+        prop_assert_eq!(got.to_coefficients(), dense);
+        prop_assert_eq!(got.nodes(), want.nodes());
+        prop_assert_eq!(got.positions(), want.positions());
+        prop_assert_eq!(got.kept(), want.kept());
+        let (back_i, back_v) = got.sparse_coefficients();
+        let nonzero: Vec<(u32, [f64; 2])> = indices.iter().copied().zip(values.iter().copied())
+            .filter(|(_, v)| v.iter().any(|x| *x != 0.0)).collect();
+        prop_assert_eq!(back_i.into_iter().zip(back_v).collect::<Vec<_>>(), nonzero);
+    }
+}
+
+#[test]
+fn sparse_coefficients_out_of_range_or_not_finite_are_refused() {
+    let ok = HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[3], &[[1.0]]);
+    assert!(ok.is_ok());
+    for (i, v) in [(32u32, 1.0), (3, f64::NAN)] {
+        assert!(HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[i], &[[v]]).is_err());
+    }
+    assert!(HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[1, 2], &[[1.0]]).is_err());
+    assert!(HaarTree::<f64, 1>::from_sparse(2, 6, FaceLayout::Stacked, &[], &[]).is_err());
 }

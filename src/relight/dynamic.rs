@@ -1,0 +1,1092 @@
+//! Dynamic scenes (seed 001 chapter 3): rigid objects that move, scale, turn about the
+//! vertical and are cloned at run time, each shadowing the others through its
+//! [occlusion field](super::fields), shaded by n-function product integrals and by
+//! just-in-time radiance transfer ([`Jrt`]).
+//!
+//! **What is computed.** A Lambertian vertex `v` of albedo `a` reflects
+//! `B_v = a / pi x integral of T_v x L x prod_(k != own) O_k`, seed 001 eq. 3.1-3.3 with the
+//! BRDF constant: `T_v` the vertex's own transport (its object's self-visibility, the ground
+//! plane's occlusion where the scene has one, cosine and solid angle; [`TransportSet`]
+//! semantics), `L` the lighting, `O_k` object `k`'s occlusion looked up at the vertex
+//! ([`OcclusionField::lookup`], with the options' [`Truncation`]); a vertex beyond an object's
+//! outermost shell takes `O_k = 1`. Each factor is truncated as the options say (the lighting
+//! by the caller's [`Lighting`]) and, with a `depth`, all factors are limited to the detail
+//! levels `0..depth` (seed 001 Fig. 3.5's traversal depth: every factor is then constant on
+//! blocks of side `S >> depth`, and so is their product).
+//!
+//! **Own transport and the ground.** An object's `T_v` is precomputed at its placement in the
+//! scene file, against itself and the ground plane (when the scene has one), exactly as
+//! [`vertex_major`] does for a static scene. Moving the object keeps it; turning it by `k`
+//! columns turns it ([`yaw_sparse`]). The ground's own transport sees the whole upper
+//! hemisphere; objects shadow it through their planar fields. So one object alone at its
+//! file placement, without a ground plane, is shaded exactly as the static path shades it
+//! (tested); with a ground plane, moving an object keeps the ground's occlusion of it as it
+//! was (exact for a plane much larger than the move; the experiment measures it).
+//!
+//! **Placements** ([`Placement`]): world `= Ry(turn) (s x local) + t`. An object turns about
+//! the vertical by whole columns of a lat-long parameterisation (`360 / 2N` degrees; a file's
+//! yaw is rounded to the nearest column and the rounded angle is the scene's, reference
+//! included); a cube map cannot turn (refused). Pitch and roll are refused: an occlusion
+//! field turns exactly about the vertical only (seed 001 cannot turn objects at all).
+//!
+//! **Shapes and clones.** Objects with the same mesh file or generator share one shape: one
+//! set of fields (seed 001's instancing); [`DynamicScene::clone_object`] adds an instance of an
+//! object's shape at run time, whose own transport is the original's.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use ndarray::Array2;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::fields::{FieldOptions, OcclusionField, Truncation, yaw_sparse};
+use super::lighting::Lighting;
+use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under};
+use super::shade::{select_kept, within_depth};
+use super::sparse::SparseRows;
+use super::visibility::{VisibilityOptions, ray_offset, vertex_major};
+use super::{Mesh, SceneBvh, SceneError};
+use crate::product::multiply::product;
+use crate::product::selection::Candidate;
+use crate::product::{HaarTree, IntegralOptions, Selection, Transport, product_integral};
+use crate::sphere::SphereRotation;
+use crate::sphere::integrate::layout;
+use crate::sphere::param::{ParamKind, Parameterization};
+use crate::{Error, Result, Sample};
+
+/// How a dynamic scene is precomputed and shaded; see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::dynamic::DynamicOptions;
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// let o = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 32).unwrap());
+/// assert_eq!(o.field.samples(), 29_720); // seed 001's fields
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DynamicOptions {
+    /// The occlusion fields; their parameterisation is the scene's.
+    pub field: FieldOptions,
+    /// What each vertex's own transport keeps.
+    pub keep_visibility: Selection,
+    /// Truncation of looked-up occlusion maps.
+    pub truncation: Truncation,
+    /// What just-in-time radiance transfer keeps of each vertex's fixed product.
+    pub keep_product: Selection,
+    /// Detail levels taking part, `0..=log2 S` (`None`: all).
+    pub depth: Option<usize>,
+    /// Progress bars on standard error.
+    pub progress: bool,
+}
+
+impl DynamicOptions {
+    /// Seed 001's fields, everything kept, every level.
+    pub fn new(param: Parameterization) -> Self {
+        DynamicOptions {
+            field: FieldOptions::new(param),
+            keep_visibility: Selection::All,
+            truncation: Truncation::Before,
+            keep_product: Selection::All,
+            depth: None,
+            progress: false,
+        }
+    }
+
+    /// The parameterisation of every map.
+    pub fn param(&self) -> Parameterization {
+        self.field.param
+    }
+
+    fn check(&self) -> Result<usize> {
+        let p = self.param();
+        let details = p.texels() - p.faces();
+        self.keep_visibility.limit(details)?;
+        self.keep_product.limit(details)?;
+        if let Truncation::After(keep) = self.truncation {
+            keep.limit(details)?;
+        }
+        let levels = p.face_size().trailing_zeros() as usize;
+        match self.depth {
+            Some(d) if d > levels => Err(Error::parameter(
+                "depth",
+                format!(
+                    "{d}: faces of side {} have detail levels 0 to {levels}",
+                    p.face_size()
+                ),
+            )),
+            Some(d) => Ok(d),
+            None => Ok(levels),
+        }
+    }
+}
+
+/// Where an object is: world `= Ry(turn) (scale x local) + translate`; see the
+/// [module docs](self).
+///
+/// ```
+/// use haarshift::relight::dynamic::Placement;
+/// use haarshift::relight::Transform;
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// let param = Parameterization::new(ParamKind::LatLong, 32).unwrap(); // 64 columns
+/// let t = Transform { yaw: 92.0, translate: [1.0, 0.0, 0.0], ..Transform::default() };
+/// let p = Placement::from_transform(&t, param).unwrap();
+/// assert_eq!(p.turn, 16); // 92 degrees is 16.4 columns of 5.625 degrees
+/// let w = p.to_world([0.0, 0.0, 1.0], param);
+/// assert!((w[0] - 2.0).abs() < 1e-12 && w[2].abs() < 1e-12); // +Z turned to +X, moved
+/// assert!((p.to_local(w, param)[2] - 1.0).abs() < 1e-12);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    /// Added last.
+    pub translate: [f64; 3],
+    /// Uniform scale, applied first (positive).
+    pub scale: f64,
+    /// Whole columns of the lat-long parameterisation turned about +Y.
+    pub turn: usize,
+}
+
+impl Placement {
+    /// The placement of a scene file's transform, its yaw rounded to whole columns.
+    pub fn from_transform(t: &Transform, param: Parameterization) -> Result<Self> {
+        if t.pitch != 0.0 || t.roll != 0.0 {
+            return Err(SceneError::SceneFile(format!(
+                "pitch {} and roll {}: a dynamic object turns about the vertical only (yaw)",
+                t.pitch, t.roll
+            ))
+            .into());
+        }
+        if !(t.scale.is_finite() && t.scale > 0.0) || t.translate.iter().any(|x| !x.is_finite()) {
+            return Err(SceneError::SceneFile(format!(
+                "scale {} and translate {:?}: the scale must be positive and finite, the \
+                 translation finite",
+                t.scale, t.translate
+            ))
+            .into());
+        }
+        Ok(Placement {
+            translate: t.translate,
+            scale: t.scale,
+            turn: turn_columns(t.yaw, param)?,
+        })
+    }
+
+    /// The turn in degrees.
+    pub fn yaw_degrees(&self, param: Parameterization) -> f64 {
+        self.turn as f64 * 360.0 / columns(param) as f64
+    }
+
+    fn rotation(&self, param: Parameterization) -> SphereRotation {
+        SphereRotation::from_degrees(self.yaw_degrees(param), 0.0, 0.0)
+            .expect("a whole number of columns is a finite angle")
+    }
+
+    /// A point of the object's own frame in the world.
+    pub fn to_world(&self, p: [f64; 3], param: Parameterization) -> [f64; 3] {
+        let q = self.rotation(param).apply(p.map(|x| x * self.scale));
+        std::array::from_fn(|k| q[k] + self.translate[k])
+    }
+
+    /// A world point in the object's own frame.
+    pub fn to_local(&self, p: [f64; 3], param: Parameterization) -> [f64; 3] {
+        let d = std::array::from_fn(|k| p[k] - self.translate[k]);
+        self.rotation(param)
+            .inverse()
+            .apply(d)
+            .map(|x| x / self.scale)
+    }
+
+    /// As a scene file's transform.
+    pub fn transform(&self, param: Parameterization) -> Transform {
+        Transform {
+            translate: self.translate,
+            scale: self.scale,
+            yaw: self.yaw_degrees(param),
+            ..Transform::default()
+        }
+    }
+}
+
+/// Columns of a lat-long map of `param`'s size (`2N`).
+fn columns(param: Parameterization) -> usize {
+    2 * param.face_size()
+}
+
+/// A yaw in degrees as whole columns, `0..2N`; a cube map takes no turn.
+fn turn_columns(yaw: f64, param: Parameterization) -> Result<usize> {
+    if !yaw.is_finite() || yaw.abs() > 1e6 {
+        return Err(Error::parameter(
+            "yaw",
+            format!("{yaw} degrees is not a finite angle of at most 1e6 degrees"),
+        ));
+    }
+    let w = columns(param) as f64;
+    let k = (yaw / 360.0 * w).round().rem_euclid(w) as usize;
+    if param.kind() == ParamKind::Cube && k != 0 {
+        return Err(Error::parameter(
+            "yaw",
+            format!("{yaw} degrees: turning an object's occlusion field needs --param latlong"),
+        ));
+    }
+    Ok(k)
+}
+
+/// One object of a dynamic scene.
+#[derive(Clone, Debug)]
+struct Object {
+    name: Option<String>,
+    shape: usize,
+    /// Where its own transport was computed.
+    rest: Placement,
+    placement: Placement,
+    albedo: [f32; 3],
+    transport: Arc<SparseRows<f32>>,
+    /// The shape's field turned to the placement.
+    field: Arc<OcclusionField>,
+}
+
+/// What building a dynamic scene did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BuildReport {
+    /// Rays cast for the occlusion fields, all shapes.
+    pub field_rays: u64,
+    /// Seconds building the fields.
+    pub field_seconds: f64,
+    /// Bytes of the stored field maps.
+    pub field_bytes: usize,
+    /// Rays cast for the vertices' own transport.
+    pub transport_rays: u64,
+    /// Seconds precomputing the own transport.
+    pub transport_seconds: f64,
+}
+
+/// A scene of rigid objects with occlusion fields; see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+/// use haarshift::relight::SceneFile;
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// let file: SceneFile = serde_json::from_str(r#"{"objects": [
+///     {"name": "a", "generator": {"sphere": {"cells": 2}}},
+///     {"name": "b", "generator": {"sphere": {"cells": 2}}, "transform": {"translate": [3, 0, 0]}}
+///   ], "ground_plane": true}"#).unwrap();
+/// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
+/// (options.field.circles, options.field.circle_points) = (8, 16);
+/// (options.field.shells, options.field.shell_grid) = (4, 3);
+/// let scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+/// assert_eq!((scene.object_count(), scene.shape_count()), (2, 1)); // one shape, two instances
+/// assert_eq!(scene.vertex_count(), 2 * 54 + 33 * 33);
+/// assert_eq!(scene.object_index("b"), Some(1));
+/// ```
+#[derive(Clone, Debug)]
+pub struct DynamicScene {
+    options: DynamicOptions,
+    shapes: Vec<Mesh>,
+    fields: Vec<Arc<OcclusionField>>,
+    objects: Vec<Object>,
+    ground: Option<(Mesh, Arc<SparseRows<f32>>)>,
+    /// How far lookups are lifted off their surface: the ray offset of the scene as built.
+    lift: f64,
+    /// The lighting of the scene file, path resolved.
+    pub environment: Option<EnvironmentSpec>,
+    /// The camera of the scene file.
+    pub camera: Option<CameraSpec>,
+    report: BuildReport,
+}
+
+impl DynamicScene {
+    /// Reads a JSON scene file ([`SceneFile`]) and builds it.
+    pub fn load(path: &Path, options: &DynamicOptions) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let file: SceneFile = serde_json::from_str(&text)
+            .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        Self::build(&file, dir, options).map_err(|e| e.in_file(path))
+    }
+
+    /// Builds the scene of `file` (paths relative to `dir`): every shape's fields and every
+    /// vertex's own transport.
+    pub fn build(file: &SceneFile, dir: &Path, options: &DynamicOptions) -> Result<Self> {
+        options.check()?;
+        if file.objects.is_empty() {
+            return Err(SceneError::SceneFile("a scene needs at least one object".into()).into());
+        }
+        let param = options.param();
+        let mut report = BuildReport::default();
+        let mut sources = Vec::new();
+        let mut shapes: Vec<Mesh> = Vec::new();
+        let mut placed = Vec::new();
+        let mut names: Vec<Option<String>> = Vec::new();
+        for (k, object) in file.objects.iter().enumerate() {
+            if let Some(name) = &object.name
+                && names.iter().flatten().any(|n| n == name)
+            {
+                return Err(
+                    SceneError::SceneFile(format!("two objects are named {name:?}")).into(),
+                );
+            }
+            names.push(object.name.clone());
+            let source = (object.mesh.clone(), object.generator.clone());
+            let shape = match sources.iter().position(|s| *s == source) {
+                Some(i) => i,
+                None => {
+                    shapes.push(object.shape(dir, k)?);
+                    sources.push(source);
+                    shapes.len() - 1
+                }
+            };
+            let placement =
+                Placement::from_transform(&object.transform, param).map_err(|e| match e {
+                    Error::Scene { source, .. } => {
+                        SceneError::SceneFile(format!("object {k}: {source}")).into()
+                    }
+                    other => other,
+                })?;
+            placed.push((shape, placement, object.material.albedo()?));
+        }
+        let mut fields = Vec::with_capacity(shapes.len());
+        for mesh in &shapes {
+            let (field, r) = OcclusionField::build(mesh, &options.field)?;
+            report.field_rays += r.rays;
+            report.field_seconds += r.seconds;
+            report.field_bytes += field.stored_bytes();
+            fields.push(Arc::new(field));
+        }
+        let meshes: Vec<Mesh> = placed
+            .iter()
+            .map(|&(shape, p, _)| place_mesh(&shapes[shape], &p, param))
+            .collect();
+        let ground = file.ground_plane.then(|| {
+            let mut all = meshes[0].clone();
+            for m in &meshes[1..] {
+                all.append(m);
+            }
+            ground_plane_under(&all.bounds())
+        });
+        let visibility = VisibilityOptions {
+            keep: options.keep_visibility,
+            progress: options.progress,
+            ..VisibilityOptions::new(param)
+        };
+        let own = |mesh: &Mesh, vertices: usize, report: &mut BuildReport| -> Result<_> {
+            let (set, r) = vertex_major(mesh, &SceneBvh::new(mesh), &visibility)?;
+            report.transport_rays += r.rays;
+            report.transport_seconds += r.seconds;
+            let mut rows = SparseRows::new();
+            for v in 0..vertices {
+                let (i, c) = set.coefficients(v);
+                rows.push(i, c);
+            }
+            Ok(Arc::new(rows))
+        };
+        let mut objects = Vec::with_capacity(placed.len());
+        for (k, (&(shape, placement, albedo), mesh)) in placed.iter().zip(&meshes).enumerate() {
+            let mut with_ground = mesh.clone();
+            if let Some(g) = &ground {
+                with_ground.append(g);
+            }
+            let transport = own(&with_ground, mesh.vertex_count(), &mut report)?;
+            objects.push(Object {
+                name: names[k].clone(),
+                shape,
+                rest: placement,
+                placement,
+                albedo,
+                transport,
+                field: turned(&fields[shape], placement.turn)?,
+            });
+        }
+        let ground = match ground {
+            Some(g) => {
+                let rows = own(&g, g.vertex_count(), &mut report)?;
+                Some((g, rows))
+            }
+            None => None,
+        };
+        let mut all = meshes[0].clone();
+        for m in &meshes[1..] {
+            all.append(m);
+        }
+        if let Some((g, _)) = &ground {
+            all.append(g);
+        }
+        Ok(DynamicScene {
+            options: *options,
+            lift: ray_offset(&all),
+            shapes,
+            fields,
+            objects,
+            ground,
+            environment: file.environment.clone().map(|mut e| {
+                e.path = dir.join(&e.path);
+                e
+            }),
+            camera: file.camera.clone(),
+            report,
+        })
+    }
+
+    /// The options it was built with.
+    pub fn options(&self) -> &DynamicOptions {
+        &self.options
+    }
+
+    /// What building it did.
+    pub fn report(&self) -> &BuildReport {
+        &self.report
+    }
+
+    /// The parameterisation of every map.
+    pub fn param(&self) -> Parameterization {
+        self.options.param()
+    }
+
+    /// Objects (instances).
+    pub fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Distinct shapes (each with one set of fields).
+    pub fn shape_count(&self) -> usize {
+        self.shapes.len()
+    }
+
+    /// The fields of object `k`'s shape, turned to its placement.
+    pub fn field(&self, k: usize) -> &OcclusionField {
+        &self.objects[k].field
+    }
+
+    /// The object named `name`.
+    pub fn object_index(&self, name: &str) -> Option<usize> {
+        self.objects
+            .iter()
+            .position(|o| o.name.as_deref() == Some(name))
+    }
+
+    /// Object `k`'s placement.
+    pub fn placement(&self, k: usize) -> Placement {
+        self.objects[k].placement
+    }
+
+    /// Moves object `k`; a new turn turns its field (every map: the cost of a re-formation,
+    /// not of a frame).
+    pub fn place(&mut self, k: usize, placement: Placement) -> Result<()> {
+        self.check_object(k)?;
+        if !(placement.scale.is_finite() && placement.scale > 0.0)
+            || placement.translate.iter().any(|x| !x.is_finite())
+            || placement.turn >= columns(self.param())
+            || (self.param().kind() == ParamKind::Cube && placement.turn != 0)
+        {
+            return Err(Error::parameter(
+                "placement",
+                format!(
+                    "{placement:?}: the scale must be positive, the translation finite, the \
+                     turn below {} columns (0 for a cube map)",
+                    columns(self.param())
+                ),
+            ));
+        }
+        let o = &mut self.objects[k];
+        if placement.turn != o.placement.turn {
+            o.field = turned(&self.fields[o.shape], placement.turn)?;
+        }
+        o.placement = placement;
+        Ok(())
+    }
+
+    /// Adds an instance of object `k`'s shape at `placement` (its own transport is `k`'s);
+    /// returns its index. Its vertices come after every object's, before the ground's.
+    pub fn clone_object(&mut self, k: usize, placement: Placement) -> Result<usize> {
+        self.check_object(k)?;
+        let mut copy = self.objects[k].clone();
+        copy.name = None;
+        copy.placement = copy.rest;
+        self.objects.push(copy);
+        let new = self.objects.len() - 1;
+        self.place(new, placement)?;
+        Ok(new)
+    }
+
+    fn check_object(&self, k: usize) -> Result<()> {
+        if k >= self.objects.len() {
+            return Err(Error::parameter(
+                "object",
+                format!("{k}: the scene has {} objects", self.objects.len()),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Vertices of all objects and the ground plane.
+    pub fn vertex_count(&self) -> usize {
+        self.objects
+            .iter()
+            .map(|o| self.shapes[o.shape].vertex_count())
+            .sum::<usize>()
+            + self.ground.as_ref().map_or(0, |g| g.0.vertex_count())
+    }
+
+    /// The vertices of object `k`: a range of the merged mesh's.
+    pub fn object_vertices(&self, k: usize) -> std::ops::Range<usize> {
+        let start: usize = self.objects[..k]
+            .iter()
+            .map(|o| self.shapes[o.shape].vertex_count())
+            .sum();
+        start..start + self.shapes[self.objects[k].shape].vertex_count()
+    }
+
+    /// Every object at its placement, then the ground plane, as one mesh (for the reference
+    /// and the rasteriser).
+    pub fn mesh(&self) -> Mesh {
+        let param = self.param();
+        let mut meshes = self
+            .objects
+            .iter()
+            .map(|o| place_mesh(&self.shapes[o.shape], &o.placement, param))
+            .chain(self.ground.iter().map(|g| g.0.clone()));
+        let mut out = meshes.next().expect("a scene has an object");
+        for m in meshes {
+            out.append(&m);
+        }
+        out
+    }
+
+    /// The albedo of every vertex of [`mesh`](Self::mesh), `(V, 3)`.
+    pub fn albedo(&self) -> Array2<f32> {
+        let mut rows = Vec::with_capacity(self.vertex_count());
+        for o in &self.objects {
+            rows.extend(std::iter::repeat_n(
+                o.albedo,
+                self.shapes[o.shape].vertex_count(),
+            ));
+        }
+        if let Some((g, _)) = &self.ground {
+            rows.extend(std::iter::repeat_n(
+                super::scene::GROUND_ALBEDO,
+                g.vertex_count(),
+            ));
+        }
+        Array2::from_shape_fn((rows.len(), 3), |(v, c)| rows[v][c])
+    }
+
+    /// Every vertex: its owner (`None`: the ground), its index in its owner, its world
+    /// position lifted off the surface along its normal by the scene's ray offset (where
+    /// field lookups are made; fixed at build, so that a move changes no other lookup).
+    fn receivers(&self) -> Vec<Receiver> {
+        let param = self.param();
+        let eps = self.lift;
+        let mut out = Vec::with_capacity(self.vertex_count());
+        let lift = |p: [f64; 3], n: [f64; 3]| std::array::from_fn(|k| p[k] + eps * n[k]);
+        for (k, o) in self.objects.iter().enumerate() {
+            let mesh = &self.shapes[o.shape];
+            let rot = o.placement.rotation(param);
+            let (p, n) = (mesh.positions(), mesh.normals());
+            for v in 0..mesh.vertex_count() {
+                let world = o
+                    .placement
+                    .to_world([p[[v, 0]], p[[v, 1]], p[[v, 2]]], param);
+                let normal = rot.apply([n[[v, 0]], n[[v, 1]], n[[v, 2]]]);
+                out.push(Receiver {
+                    owner: Some(k),
+                    vertex: v,
+                    point: lift(world, normal),
+                });
+            }
+        }
+        if let Some((g, _)) = &self.ground {
+            let (p, n) = (g.positions(), g.normals());
+            for v in 0..g.vertex_count() {
+                out.push(Receiver {
+                    owner: None,
+                    vertex: v,
+                    point: lift(
+                        [p[[v, 0]], p[[v, 1]], p[[v, 2]]],
+                        [n[[v, 0]], n[[v, 1]], n[[v, 2]]],
+                    ),
+                });
+            }
+        }
+        out
+    }
+
+    /// The receiver's own transport at its owner's turn, depth-limited.
+    fn own_transport(&self, r: &Receiver, depth: usize) -> Result<(Vec<u32>, Vec<f32>)> {
+        let param = self.param();
+        let (indices, values, turn) = match r.owner {
+            Some(k) => {
+                let o = &self.objects[k];
+                let (i, v) = o.transport.row(r.vertex);
+                let w = columns(param);
+                (i, v, (o.placement.turn + w - o.rest.turn) % w)
+            }
+            None => {
+                let (i, v) = self
+                    .ground
+                    .as_ref()
+                    .expect("a ground receiver")
+                    .1
+                    .row(r.vertex);
+                (i, v, 0)
+            }
+        };
+        let (i, v) = if turn == 0 {
+            (indices.to_vec(), values.to_vec())
+        } else {
+            yaw_sparse(param, indices, values, turn, Selection::Threshold(0.0))?
+        };
+        Ok(limit_depth(param, depth, i, v))
+    }
+
+    /// Object `k`'s occlusion map at the world point `x` (`None`: beyond its fields),
+    /// depth-limited.
+    fn occlusion(
+        &self,
+        k: usize,
+        x: [f64; 3],
+        depth: usize,
+        scratch: &mut Scratch,
+    ) -> Option<(Vec<u32>, Vec<f64>)> {
+        let o = &self.objects[k];
+        let local = o.placement.to_local(x, self.param());
+        o.field.blended(
+            local,
+            self.options.truncation,
+            &mut scratch.blend,
+            &mut scratch.map,
+        )?;
+        let (i, v) = &scratch.map;
+        Some(limit_depth(self.param(), depth, i.clone(), v.clone()))
+    }
+
+    /// Every vertex's outgoing radiance `(V, 3)` by the n-function product integral of its
+    /// own transport, the lighting and every other object's occlusion (issue 7's traversal),
+    /// with no reuse between frames: the oracle of [`Jrt`] and the cost it saves.
+    pub fn shade<T: Sample>(&self, lighting: &Lighting) -> Result<Array2<T>> {
+        let depth = self.check_lighting(lighting)?;
+        let param = self.param();
+        let light = light_tree::<T>(lighting, depth)?;
+        let receivers = self.receivers();
+        let albedo = self.albedo();
+        let rows: Vec<[T; 3]> = receivers
+            .par_iter()
+            .map_init(
+                || Scratch::new(param),
+                |scratch, r| -> Result<[T; 3]> {
+                    let (i, v) = self.own_transport(r, depth)?;
+                    let own = Transport::from_weighted_tree(tree(
+                        param,
+                        &i,
+                        v.iter().map(|&x| f64::from(x)),
+                    )?);
+                    let mut factors = vec![light.clone()];
+                    for k in (0..self.objects.len()).filter(|&k| Some(k) != r.owner) {
+                        if let Some((i, v)) = self.occlusion(k, r.point, depth, scratch) {
+                            factors.push(tree(param, &i, v.iter().copied())?);
+                        }
+                    }
+                    let refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
+                    let value = product_integral(&own, &refs, IntegralOptions::default())?.value;
+                    Ok(value.map(T::from_f64))
+                },
+            )
+            .collect::<Result<_>>()?;
+        Ok(radiance(&rows, &albedo))
+    }
+
+    /// The depth the options name, after checking `lighting` against the scene.
+    fn check_lighting(&self, lighting: &Lighting) -> Result<usize> {
+        if lighting.param() != self.param() {
+            return Err(Error::parameter(
+                "lighting",
+                format!(
+                    "{} {}: the scene's maps are {} {}",
+                    lighting.param().kind(),
+                    lighting.param().face_size(),
+                    self.param().kind(),
+                    self.param().face_size()
+                ),
+            ));
+        }
+        self.options.check()
+    }
+}
+
+/// One vertex as the shading sees it.
+struct Receiver {
+    owner: Option<usize>,
+    vertex: usize,
+    point: [f64; 3],
+}
+
+/// Per-thread working memory: a dense blend buffer and a sparse map.
+struct Scratch {
+    blend: Vec<f64>,
+    map: (Vec<u32>, Vec<f64>),
+}
+
+impl Scratch {
+    fn new(param: Parameterization) -> Self {
+        Scratch {
+            blend: vec![0.0; param.texels()],
+            map: (Vec::new(), Vec::new()),
+        }
+    }
+}
+
+fn turned(field: &Arc<OcclusionField>, turn: usize) -> Result<Arc<OcclusionField>> {
+    Ok(if turn == 0 {
+        field.clone()
+    } else {
+        Arc::new(field.turned(turn)?)
+    })
+}
+
+fn place_mesh(mesh: &Mesh, p: &Placement, param: Parameterization) -> Mesh {
+    let rot = p.rotation(param);
+    mesh.mapped(|q| p.to_world(q, param), |n| rot.apply(n))
+}
+
+/// The entries within the detail levels `0..depth`.
+fn limit_depth<V>(
+    param: Parameterization,
+    depth: usize,
+    indices: Vec<u32>,
+    values: Vec<V>,
+) -> (Vec<u32>, Vec<V>) {
+    let s = param.face_size();
+    if depth == s.trailing_zeros() as usize {
+        return (indices, values);
+    }
+    indices
+        .into_iter()
+        .zip(values)
+        .filter(|(i, _)| within_depth(s, depth, *i as usize))
+        .unzip()
+}
+
+/// A one-channel sparse function as a three-channel tree (every channel the same).
+fn tree<T: Sample>(
+    param: Parameterization,
+    indices: &[u32],
+    values: impl Iterator<Item = f64>,
+) -> Result<HaarTree<T, 3>> {
+    let values: Vec<[T; 3]> = values.map(|v| [T::from_f64(v); 3]).collect();
+    HaarTree::from_sparse(
+        param.faces(),
+        param.face_size(),
+        layout(param),
+        indices,
+        &values,
+    )
+}
+
+/// The lighting's kept coefficients as a tree, depth-limited.
+fn light_tree<T: Sample>(lighting: &Lighting, depth: usize) -> Result<HaarTree<T, 3>> {
+    let param = lighting.param();
+    let c = lighting.coefficients_f64();
+    let (indices, values): (Vec<u32>, Vec<[T; 3]>) = c
+        .rows()
+        .into_iter()
+        .enumerate()
+        .filter(|(i, row)| {
+            row.iter().any(|&x| x != 0.0) && within_depth(param.face_size(), depth, *i)
+        })
+        .map(|(i, row)| (i as u32, [row[0], row[1], row[2]].map(T::from_f64)))
+        .unzip();
+    HaarTree::from_sparse(
+        param.faces(),
+        param.face_size(),
+        layout(param),
+        &indices,
+        &values,
+    )
+}
+
+/// `albedo / pi x integral`, per vertex and channel.
+fn radiance<T: Sample>(integrals: &[[T; 3]], albedo: &Array2<f32>) -> Array2<T> {
+    Array2::from_shape_fn((integrals.len(), 3), |(v, c)| {
+        T::from_f64(integrals[v][c].as_f64() * f64::from(albedo[[v, c]]) / std::f64::consts::PI)
+    })
+}
+
+/// What just-in-time radiance transfer holds fixed and what varies between frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Change {
+    /// Object `k` moves (translation and scale; a turn re-forms): every other vertex's fixed
+    /// product holds its own transport, the lighting and the other objects' occlusion; object
+    /// `k`'s own vertices hold their transport and the lighting.
+    Object(usize),
+    /// The lighting changes: every vertex holds its own transport and all occlusion.
+    Lighting,
+}
+
+/// What forming or using a [`Jrt`] cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JrtReport {
+    /// Wall-clock seconds.
+    pub seconds: f64,
+    /// Coefficients of the fixed products, all vertices.
+    pub coefficients: usize,
+    /// Bytes of the fixed products.
+    pub bytes: usize,
+}
+
+/// Just-in-time radiance transfer (seed 001 sections 3.2.2 and 3.5.3): per vertex the product
+/// `T` of the factors that stay fixed while one [`Change`] varies, pruned to the options'
+/// `keep_product`; each frame is then `<T, F>` with `F` the varying factor (the looked-up map
+/// of the moving object, or the new lighting): one sparse dot product per vertex. Re-form it
+/// when the kind of change switches.
+///
+/// A vertex of the moving object sees every other object move: its `F` is their product
+/// (one lookup: a dot product; several: the n-function traversal with `T`).
+#[derive(Clone, Debug)]
+pub struct Jrt<T> {
+    change: Change,
+    products: SparseRows<[T; 3]>,
+    report: JrtReport,
+}
+
+impl<T: Sample> Jrt<T> {
+    /// Forms every vertex's fixed product for `change` in `scene`'s present placement under
+    /// `lighting` (which a [`Change::Lighting`] will replace).
+    pub fn form(scene: &DynamicScene, lighting: &Lighting, change: Change) -> Result<Self> {
+        let start = Instant::now();
+        let depth = scene.check_lighting(lighting)?;
+        let moving = match change {
+            Change::Object(k) => {
+                scene.check_object(k)?;
+                Some(k)
+            }
+            Change::Lighting => None,
+        };
+        let param = scene.param();
+        let light = light_tree::<T>(lighting, depth)?;
+        let receivers = scene.receivers();
+        let keep = scene.options.keep_product;
+        let rows: Vec<(Vec<u32>, Vec<[T; 3]>)> = receivers
+            .par_iter()
+            .map_init(
+                || (Scratch::new(param), Vec::new()),
+                |(scratch, pool), r| -> Result<_> {
+                    let (i, v) = scene.own_transport(r, depth)?;
+                    let mut factors = vec![tree::<T>(param, &i, v.iter().map(|&x| f64::from(x)))?];
+                    if moving.is_some() {
+                        factors.push(light.clone());
+                    }
+                    let fixed_occluders = (0..scene.objects.len())
+                        .filter(|&k| Some(k) != r.owner && Some(k) != moving)
+                        .filter(|_| moving.is_none() || r.owner != moving);
+                    for k in fixed_occluders {
+                        if let Some((i, v)) = scene.occlusion(k, r.point, depth, scratch) {
+                            factors.push(tree(param, &i, v.iter().copied())?);
+                        }
+                    }
+                    let refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
+                    let (indices, values) = product(&refs)?.sparse_coefficients();
+                    Ok(prune(param, keep, indices, values, pool))
+                },
+            )
+            .collect::<Result<_>>()?;
+        let mut products = SparseRows::new();
+        for (i, v) in &rows {
+            products.push(i, v);
+        }
+        let report = JrtReport {
+            seconds: start.elapsed().as_secs_f64(),
+            coefficients: products.coefficient_count(),
+            bytes: products.bytes(),
+        };
+        Ok(Jrt {
+            change,
+            products,
+            report,
+        })
+    }
+
+    /// What was held fixed.
+    pub fn change(&self) -> Change {
+        self.change
+    }
+
+    /// What forming it cost.
+    pub fn report(&self) -> &JrtReport {
+        &self.report
+    }
+
+    /// Every vertex's radiance `(V, 3)` with the moving object where `scene` has it now (every
+    /// other placement as at formation).
+    pub fn frame_moved(&self, scene: &DynamicScene) -> Result<Array2<T>> {
+        let Change::Object(moving) = self.change else {
+            return Err(Error::parameter(
+                "change",
+                "this transfer was formed for a change of lighting: use frame_lit",
+            ));
+        };
+        self.check_scene(scene)?;
+        let depth = scene.options.check()?;
+        let param = scene.param();
+        let receivers = scene.receivers();
+        let rows: Vec<[T; 3]> = receivers
+            .par_iter()
+            .enumerate()
+            .map_init(
+                || (Scratch::new(param), vec![[T::zero(); 3]; param.texels()]),
+                |(scratch, dense), (v, r)| -> Result<[T; 3]> {
+                    let (ti, tv) = self.products.row(v);
+                    let occluders: Vec<usize> = if r.owner == Some(moving) {
+                        (0..scene.objects.len()).filter(|&k| k != moving).collect()
+                    } else {
+                        vec![moving]
+                    };
+                    let mut maps = Vec::new();
+                    for k in occluders {
+                        if let Some(m) = scene.occlusion(k, r.point, depth, scratch) {
+                            maps.push(m);
+                        }
+                    }
+                    match maps.len() {
+                        0 => Ok(dot_one(param, ti, tv)),
+                        1 => Ok(dot_dense(dense, ti, tv, &maps[0].0, &maps[0].1)),
+                        _ => {
+                            let t = Transport::from_weighted_tree(HaarTree::from_sparse(
+                                param.faces(),
+                                param.face_size(),
+                                layout(param),
+                                ti,
+                                tv,
+                            )?);
+                            let trees = maps
+                                .iter()
+                                .map(|(i, v)| tree(param, i, v.iter().copied()))
+                                .collect::<Result<Vec<HaarTree<T, 3>>>>()?;
+                            let refs: Vec<&HaarTree<T, 3>> = trees.iter().collect();
+                            let value =
+                                product_integral(&t, &refs, IntegralOptions::default())?.value;
+                            Ok(value.map(T::from_f64))
+                        }
+                    }
+                },
+            )
+            .collect::<Result<_>>()?;
+        Ok(radiance(&rows, &scene.albedo()))
+    }
+
+    /// Every vertex's radiance `(V, 3)` under `lighting` (formed for [`Change::Lighting`]).
+    pub fn frame_lit(&self, scene: &DynamicScene, lighting: &Lighting) -> Result<Array2<T>> {
+        if self.change != Change::Lighting {
+            return Err(Error::parameter(
+                "change",
+                "this transfer was formed for a moving object: use frame_moved",
+            ));
+        }
+        self.check_scene(scene)?;
+        let depth = scene.check_lighting(lighting)?;
+        let param = scene.param();
+        let light = lighting.coefficients_f64();
+        let s = param.face_size();
+        let rows: Vec<[T; 3]> = (0..self.products.len())
+            .into_par_iter()
+            .map(|v| {
+                let (ti, tv) = self.products.row(v);
+                let mut acc = [0.0f64; 3];
+                for (&i, t) in ti.iter().zip(tv) {
+                    if within_depth(s, depth, i as usize) {
+                        for c in 0..3 {
+                            acc[c] += t[c].as_f64() * light[[i as usize, c]];
+                        }
+                    }
+                }
+                acc.map(T::from_f64)
+            })
+            .collect();
+        Ok(radiance(&rows, &scene.albedo()))
+    }
+
+    fn check_scene(&self, scene: &DynamicScene) -> Result<()> {
+        if scene.vertex_count() != self.products.len() {
+            return Err(Error::parameter(
+                "scene",
+                format!(
+                    "{} vertices, but the transfer was formed for {}: re-form it after cloning",
+                    scene.vertex_count(),
+                    self.products.len()
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// `indices, values` pruned to what `keep` picks (every scaling coefficient, the largest RGB
+/// magnitudes), ascending.
+fn prune<T: Sample>(
+    param: Parameterization,
+    keep: Selection,
+    indices: Vec<u32>,
+    values: Vec<[T; 3]>,
+    pool: &mut Vec<Candidate>,
+) -> (Vec<u32>, Vec<[T; 3]>) {
+    if keep == Selection::All {
+        return (indices, values);
+    }
+    let kept = select_kept(
+        param,
+        keep,
+        &indices,
+        |s| values[s].iter().map(|x| x.as_f64().powi(2)).sum(),
+        pool,
+    );
+    indices
+        .into_iter()
+        .zip(values)
+        .zip(kept)
+        .filter(|(_, k)| *k)
+        .map(|(e, _)| e)
+        .unzip()
+}
+
+/// `<T, 1>`: the constant 1 has, on each face of side `S`, only its scaling coefficient `S`.
+fn dot_one<T: Sample>(param: Parameterization, indices: &[u32], values: &[[T; 3]]) -> [T; 3] {
+    let s = param.face_size();
+    let mut acc = [0.0f64; 3];
+    for (&i, t) in indices.iter().zip(values) {
+        if (i as usize).is_multiple_of(s * s) {
+            for c in 0..3 {
+                acc[c] += t[c].as_f64() * s as f64;
+            }
+        }
+    }
+    acc.map(T::from_f64)
+}
+
+/// `<T, F>` for a sparse `T` and a sparse one-channel `F`, through a dense copy of `T`
+/// (`dense` is all zeros and is left so).
+fn dot_dense<T: Sample>(
+    dense: &mut [[T; 3]],
+    ti: &[u32],
+    tv: &[[T; 3]],
+    fi: &[u32],
+    fv: &[f64],
+) -> [T; 3] {
+    for (&i, t) in ti.iter().zip(tv) {
+        dense[i as usize] = *t;
+    }
+    let mut acc = [0.0f64; 3];
+    for (&i, &f) in fi.iter().zip(fv) {
+        let t = dense[i as usize];
+        for c in 0..3 {
+            acc[c] += t[c].as_f64() * f;
+        }
+    }
+    for &i in ti {
+        dense[i as usize] = [T::zero(); 3];
+    }
+    acc.map(T::from_f64)
+}
+
+#[cfg(test)]
+mod tests;
