@@ -297,13 +297,7 @@ pub struct DynamicScene {
 impl DynamicScene {
     /// Reads a JSON scene file ([`SceneFile`]) and builds it.
     pub fn load(path: &Path, options: &DynamicOptions) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let file: SceneFile = serde_json::from_str(&text)
-            .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))?;
-        let dir = path.parent().unwrap_or(Path::new(""));
+        let (file, dir) = SceneFile::read(path)?;
         Self::build(&file, dir, options).map_err(|e| e.in_file(path))
     }
 
@@ -640,15 +634,15 @@ impl DynamicScene {
         Ok(limit_depth(param, depth, i, v))
     }
 
-    /// Object `k`'s occlusion map at the world point `x` (`None`: beyond its fields),
-    /// depth-limited.
-    fn occlusion(
+    /// Object `k`'s occlusion map at the world point `x`, depth-limited, in `scratch.map`
+    /// (`None`: beyond its fields).
+    fn occlusion<'s>(
         &self,
         k: usize,
         x: [f64; 3],
         depth: usize,
-        scratch: &mut Scratch,
-    ) -> Option<(Vec<u32>, Vec<f64>)> {
+        scratch: &'s mut Scratch,
+    ) -> Option<(&'s [u32], &'s [f64])> {
         let o = &self.objects[k];
         let local = o.placement.to_local(x, self.param());
         o.field.blended(
@@ -657,8 +651,20 @@ impl DynamicScene {
             &mut scratch.blend,
             &mut scratch.map,
         )?;
-        let (i, v) = &scratch.map;
-        Some(limit_depth(self.param(), depth, i.clone(), v.clone()))
+        let s = self.param().face_size();
+        if depth < s.trailing_zeros() as usize {
+            let (i, v) = &mut scratch.map;
+            let mut at = 0;
+            for slot in 0..i.len() {
+                if within_depth(s, depth, i[slot] as usize) {
+                    (i[at], v[at]) = (i[slot], v[slot]);
+                    at += 1;
+                }
+            }
+            i.truncate(at);
+            v.truncate(at);
+        }
+        Some((&scratch.map.0, &scratch.map.1))
     }
 
     /// Every vertex's outgoing radiance `(V, 3)` by the n-function product integral of its
@@ -684,7 +690,7 @@ impl DynamicScene {
                     let mut factors = vec![light.clone()];
                     for k in (0..self.objects.len()).filter(|&k| Some(k) != r.owner) {
                         if let Some((i, v)) = self.occlusion(k, r.point, depth, scratch) {
-                            factors.push(tree(param, &i, v.iter().copied())?);
+                            factors.push(tree(param, i, v.iter().copied())?);
                         }
                     }
                     let refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
@@ -882,7 +888,7 @@ impl<T: Sample> Jrt<T> {
                         .filter(|_| moving.is_none() || r.owner != moving);
                     for k in fixed_occluders {
                         if let Some((i, v)) = scene.occlusion(k, r.point, depth, scratch) {
-                            factors.push(tree(param, &i, v.iter().copied())?);
+                            factors.push(tree(param, i, v.iter().copied())?);
                         }
                     }
                     let refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
@@ -937,20 +943,25 @@ impl<T: Sample> Jrt<T> {
                 || (Scratch::new(param), vec![[T::zero(); 3]; param.texels()]),
                 |(scratch, dense), (v, r)| -> Result<[T; 3]> {
                     let (ti, tv) = self.products.row(v);
-                    let occluders: Vec<usize> = if r.owner == Some(moving) {
-                        (0..scene.objects.len()).filter(|&k| k != moving).collect()
-                    } else {
-                        vec![moving]
-                    };
-                    let mut maps = Vec::new();
-                    for k in occluders {
-                        if let Some(m) = scene.occlusion(k, r.point, depth, scratch) {
-                            maps.push(m);
+                    if r.owner != Some(moving) {
+                        // The one varying factor: a dot product with the moving object's map.
+                        return Ok(match scene.occlusion(moving, r.point, depth, scratch) {
+                            None => dot_one(param, ti, tv),
+                            Some((fi, fv)) => dot_dense(dense, ti, tv, fi, fv),
+                        });
+                    }
+                    // A vertex of the moving object: every other object's map varies.
+                    let mut trees = Vec::new();
+                    let mut single = None;
+                    for k in (0..scene.objects.len()).filter(|&k| k != moving) {
+                        if let Some((fi, fv)) = scene.occlusion(k, r.point, depth, scratch) {
+                            single = Some((fi.to_vec(), fv.to_vec()));
+                            trees.push(tree::<T>(param, fi, fv.iter().copied())?);
                         }
                     }
-                    match maps.len() {
-                        0 => Ok(dot_one(param, ti, tv)),
-                        1 => Ok(dot_dense(dense, ti, tv, &maps[0].0, &maps[0].1)),
+                    Ok(match (trees.len(), single) {
+                        (0, _) => dot_one(param, ti, tv),
+                        (1, Some((fi, fv))) => dot_dense(dense, ti, tv, &fi, &fv),
                         _ => {
                             let t = Transport::from_weighted_tree(HaarTree::from_sparse(
                                 param.faces(),
@@ -959,16 +970,12 @@ impl<T: Sample> Jrt<T> {
                                 ti,
                                 tv,
                             )?);
-                            let trees = maps
-                                .iter()
-                                .map(|(i, v)| tree(param, i, v.iter().copied()))
-                                .collect::<Result<Vec<HaarTree<T, 3>>>>()?;
                             let refs: Vec<&HaarTree<T, 3>> = trees.iter().collect();
-                            let value =
-                                product_integral(&t, &refs, IntegralOptions::default())?.value;
-                            Ok(value.map(T::from_f64))
+                            product_integral(&t, &refs, IntegralOptions::default())?
+                                .value
+                                .map(T::from_f64)
                         }
-                    }
+                    })
                 },
             )
             .collect::<Result<_>>()?;

@@ -14,6 +14,7 @@
 //! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
 //! | [`fields`] | [`OcclusionField`](fields::OcclusionField): an object's occlusion seen from sample points around it (seed 001) |
 //! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other; [`Jrt`](dynamic::Jrt), just-in-time radiance transfer |
+//! | [`motion`] | [`MotionPath`](motion::MotionPath): animations of dynamic scenes, played with re-formed transfer |
 //! | [`reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
@@ -46,6 +47,7 @@ pub mod harmonics;
 pub mod lighting;
 pub mod memory;
 pub mod mesh;
+pub mod motion;
 pub mod orient;
 pub mod precompute;
 pub mod raster;

@@ -18,6 +18,8 @@
 //! | `cubes` | seed 002's "Cubes" (section 6.1.2, after Durand 2005): a wall (`z = 0`, facing `+Z`, 12.9 x 10.1, 129 x 101 cells) and in front of it, at distance `distance` (default 1.5), a `count x count` array (default 10) of cubes of side 0.6 every 1.2 across and 1.0 up, each face `cells x cells` (default 10); every cube face has its own vertices (sharp normals). The default is seed 002's Table 2 scale | 85,860 by default: `6 count^2 (cells + 1)^2 + 13,260` |
 //! | `plane_with_sphere` | a `[-3, 3]^2` ground (64 x 64 cells) with a unit sphere resting on it (a cube sphere, 16 x 16 cells a face) | 5,959 |
 //! | `sphere` | a unit sphere at the origin tessellated as a cube sphere, `cells x cells` per face, normals exact (radial) | `6 (cells + 1)^2` |
+//! | `table` | a table standing on `y = 0`: a top `[-1, 1] x [0.9, 1] x [-0.6, 0.6]` on four legs 0.08 thick at its corners, each box `cells x cells` a face | `30 (cells + 1)^2` |
+//! | `chair` | a chair standing on `y = 0`: a seat `[-0.25, 0.25] x [0.45, 0.5] x [-0.25, 0.25]`, a back `0.5` high at `z = 0.2 .. 0.25`, four legs 0.05 thick, each box `cells x cells` a face | `36 (cells + 1)^2` |
 //! | `plane_under_box` | a `[-3, 3]^2` ground (2 x 2 cells, so vertex 4 is the origin) under a box with bottom face `[-1, 1]^2` at height `height` and top at `height + 0.5` (faces 4 x 4 cells); the form-factor test | 159 |
 //!
 //! # Scene file
@@ -212,6 +214,32 @@ fn merge(meshes: impl IntoIterator<Item = Mesh>) -> Mesh {
     out
 }
 
+impl Generator {
+    /// The boxes of the furniture generators, `(min, max)` corners.
+    fn boxes(&self) -> Vec<([f64; 3], [f64; 3])> {
+        let legs = |x: f64, z: f64, t: f64, h: f64| {
+            [(-x, -z), (x - t, -z), (-x, z - t), (x - t, z - t)]
+                .map(|(a, b)| ([a, 0.0, b], [a + t, h, b + t]))
+        };
+        match self {
+            Generator::Table { .. } => {
+                let mut b = vec![([-1.0, 0.9, -0.6], [1.0, 1.0, 0.6])];
+                b.extend(legs(0.95, 0.55, 0.08, 0.9));
+                b
+            }
+            Generator::Chair { .. } => {
+                let mut b = vec![
+                    ([-0.25, 0.45, -0.25], [0.25, 0.5, 0.25]),
+                    ([-0.25, 0.5, 0.2], [0.25, 1.0, 0.25]),
+                ];
+                b.extend(legs(0.25, 0.25, 0.05, 0.45));
+                b
+            }
+            _ => Vec::new(),
+        }
+    }
+}
+
 /// Appends the ground plane described in the [module docs](self) to `mesh`.
 ///
 /// ```
@@ -277,6 +305,18 @@ pub enum Generator {
     /// A unit cube sphere at the origin.
     Sphere {
         /// Cells per side of each cube face.
+        cells: usize,
+    },
+    /// A table: a top 2 x 0.1 x 1.2 at height 0.9 to 1 on four legs 0.08 thick, standing on
+    /// `y = 0` (seed 001's dynamic-scene setting).
+    Table {
+        /// Cells per side of each box face.
+        cells: usize,
+    },
+    /// A chair: a seat 0.5 x 0.05 x 0.5 at height 0.45, four legs 0.05 thick and a back 0.5
+    /// high, standing on `y = 0`, the back towards +Z.
+    Chair {
+        /// Cells per side of each box face.
         cells: usize,
     },
     /// A ground plane under a floating box.
@@ -379,6 +419,12 @@ impl Generator {
                     6usize.saturating_mul((cells + 1).saturating_mul(cells + 1)),
                 )?;
                 cube_sphere([0.0; 3], 1.0, cells)
+            }
+            Generator::Table { cells } | Generator::Chair { cells } => {
+                let boxes = self.boxes();
+                let per_box = 6usize.saturating_mul((cells + 1).saturating_mul(cells + 1));
+                cells_ok("cells", cells, per_box.saturating_mul(boxes.len()))?;
+                merge(boxes.into_iter().map(|(lo, hi)| cuboid(lo, hi, cells)))
             }
             Generator::PlaneUnderBox { height } => {
                 positive("height", height)?;
@@ -670,18 +716,23 @@ impl Scene {
         if !is_json {
             return Ok(Scene::from_mesh(Mesh::load(path)?, false));
         }
+        let (file, dir) = SceneFile::read(path)?;
+        file.build(dir).map_err(|e| e.in_file(path))
+    }
+}
+
+impl SceneFile {
+    /// Reads a JSON scene file; returns it with the directory its relative paths start from.
+    pub fn read(path: &Path) -> Result<(SceneFile, &Path)> {
         let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
             path: path.to_path_buf(),
             source,
         })?;
         let file: SceneFile = serde_json::from_str(&text)
             .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))?;
-        let dir = path.parent().unwrap_or(Path::new(""));
-        file.build(dir).map_err(|e| e.in_file(path))
+        Ok((file, path.parent().unwrap_or(Path::new(""))))
     }
-}
 
-impl SceneFile {
     /// The scene, relative paths resolved against `dir`.
     pub fn build(&self, dir: &Path) -> Result<Scene> {
         if self.objects.is_empty() {

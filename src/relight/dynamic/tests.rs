@@ -105,7 +105,10 @@ fn at_a_sample_point_two_objects_unpruned_maps_multiply_to_the_visibility_agains
     let depth = 3;
     let mut scratch = Scratch::new(param());
     let maps: Vec<_> = (0..2)
-        .map(|k| scene.occlusion(k, x, depth, &mut scratch).unwrap())
+        .map(|k| {
+            let (i, v) = scene.occlusion(k, x, depth, &mut scratch).unwrap();
+            (i.to_vec(), v.to_vec())
+        })
         .collect();
     let trees: Vec<HaarTree<f64, 3>> = maps
         .iter()

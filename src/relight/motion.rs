@@ -1,0 +1,286 @@
+//! Animations of dynamic scenes: a path file of segments, each varying one thing (one object
+//! moving, or the lighting turning), played with just-in-time radiance transfer re-formed
+//! whenever the kind of change switches (seed 001 section 3.5.3).
+//!
+//! **Path file** (JSON, unknown keys refused):
+//!
+//! ```json
+//! { "segments": [
+//!     { "frames": 24, "object": "ball", "to": { "translate": [1.5, 0, 0.5] } },
+//!     { "frames": 24, "light_yaw": 90 },
+//!     { "frames": 12, "object": "chair", "to": { "translate": [0, 0, 1], "yaw": 45 } }
+//! ] }
+//! ```
+//!
+//! Frame 0 is the scene as its file places it. A segment of `F` frames adds frames
+//! `1..=F`: an object segment moves the named object linearly (translation, scale and yaw)
+//! from where it is to `to`; a lighting segment turns the lighting about +Y by `light_yaw`
+//! degrees in all, in equal steps. Each segment re-forms the transfer for its change; a
+//! segment that turns an object re-forms at every frame whose turn (in whole columns)
+//! differs from the last (the object's own transport turns with it).
+
+use std::path::Path;
+use std::time::Instant;
+
+use ndarray::Array2;
+use serde::{Deserialize, Serialize};
+
+use super::SceneError;
+use super::dynamic::{Change, DynamicScene, Jrt, Placement};
+use super::environment::{Environment, SphereMapping};
+use super::lighting::Lighting;
+use super::scene::Transform;
+use crate::product::Selection;
+use crate::sphere::SphereRotation;
+use crate::{Error, Result};
+
+/// The most frames a path may have.
+pub const MAX_FRAMES: usize = 3600;
+
+/// One segment of a path; see the [module docs](self).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Segment {
+    /// Frames the segment adds.
+    pub frames: usize,
+    /// The object that moves (its `name` in the scene file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object: Option<String>,
+    /// Where it goes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub to: Option<Transform>,
+    /// Degrees the lighting turns about +Y over the segment.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light_yaw: Option<f64>,
+}
+
+/// A path file's content; see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::motion::MotionPath;
+/// let p: MotionPath = serde_json::from_str(r#"{"segments": [
+///     {"frames": 3, "object": "ball", "to": {"translate": [1, 0, 0]}},
+///     {"frames": 2, "light_yaw": 90}]}"#).unwrap();
+/// assert_eq!(p.frame_count(), 1 + 3 + 2);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionPath {
+    /// The segments, played in order.
+    pub segments: Vec<Segment>,
+}
+
+/// What one frame of a path is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameState {
+    /// The segment it belongs to (frame 0: the first).
+    pub segment: usize,
+    /// What varies in its segment.
+    pub change: Change,
+    /// The moving object's placement (object segments).
+    pub placement: Option<Placement>,
+    /// The lighting's yaw added to the scene's, degrees.
+    pub light_yaw: f64,
+}
+
+/// What playing one frame did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameReport {
+    /// Frame number.
+    pub index: usize,
+    /// The frame's state.
+    pub state: FrameState,
+    /// Seconds re-forming the transfer before this frame, when it was re-formed.
+    pub reformed: Option<f64>,
+    /// Seconds encoding the varying factor and shading (the per-frame cost).
+    pub shade_seconds: f64,
+}
+
+impl MotionPath {
+    /// Reads a path file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let p: MotionPath = serde_json::from_str(&text)
+            .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))?;
+        Ok(p)
+    }
+
+    /// Frames in all, frame 0 included.
+    pub fn frame_count(&self) -> usize {
+        1 + self.segments.iter().map(|s| s.frames).sum::<usize>()
+    }
+
+    /// Every frame's state in `scene` (checked: names, placements, counts).
+    pub fn states(&self, scene: &DynamicScene) -> Result<Vec<FrameState>> {
+        let bad = |k: usize, why: String| -> Error {
+            SceneError::SceneFile(format!("path segment {k}: {why}")).into()
+        };
+        if self.segments.is_empty() {
+            return Err(SceneError::SceneFile("a path needs at least one segment".into()).into());
+        }
+        if self.frame_count() > MAX_FRAMES + 1 {
+            return Err(bad(0, format!("more than {MAX_FRAMES} frames in all")));
+        }
+        let param = scene.param();
+        let mut placements: Vec<Placement> = (0..scene.object_count())
+            .map(|k| scene.placement(k))
+            .collect();
+        let mut light = 0.0;
+        let mut out = Vec::with_capacity(self.frame_count());
+        for (k, seg) in self.segments.iter().enumerate() {
+            if seg.frames == 0 {
+                return Err(bad(k, "frames must be at least 1".into()));
+            }
+            let change = match (&seg.object, &seg.to, seg.light_yaw) {
+                (Some(name), Some(to), None) => {
+                    let object = scene
+                        .object_index(name)
+                        .ok_or_else(|| bad(k, format!("no object is named {name:?}")))?;
+                    let target =
+                        Placement::from_transform(to, param).map_err(|e| bad(k, e.to_string()))?;
+                    (object, Some(target))
+                }
+                (None, None, Some(yaw)) if yaw.is_finite() && yaw.abs() <= 1e6 => {
+                    (usize::MAX, None)
+                }
+                _ => {
+                    return Err(bad(
+                        k,
+                        "give either \"object\" and \"to\", or a finite \"light_yaw\"".into(),
+                    ));
+                }
+            };
+            let (object, target) = change;
+            if out.is_empty() {
+                out.push(FrameState {
+                    segment: 0,
+                    change: if target.is_some() {
+                        Change::Object(object)
+                    } else {
+                        Change::Lighting
+                    },
+                    placement: target.map(|_| placements[object]),
+                    light_yaw: 0.0,
+                });
+            }
+            let start_light = light;
+            let from = target.map(|_| placements[object]);
+            for f in 1..=seg.frames {
+                let t = f as f64 / seg.frames as f64;
+                let state = match (from, target) {
+                    (Some(a), Some(b)) => {
+                        let p = interpolate(&a, &b, t, 2 * param.face_size());
+                        placements[object] = p;
+                        FrameState {
+                            segment: k,
+                            change: Change::Object(object),
+                            placement: Some(p),
+                            light_yaw: light,
+                        }
+                    }
+                    _ => {
+                        light = start_light + t * seg.light_yaw.unwrap_or(0.0);
+                        FrameState {
+                            segment: k,
+                            change: Change::Lighting,
+                            placement: None,
+                            light_yaw: light,
+                        }
+                    }
+                };
+                out.push(state);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The placement a fraction `t` of the way from `a` to `b`; the turn takes the shorter way
+/// round (`w` columns in a turn) and is rounded to whole columns.
+fn interpolate(a: &Placement, b: &Placement, t: f64, w: usize) -> Placement {
+    let mut delta = b.turn as f64 - a.turn as f64;
+    if delta > w as f64 / 2.0 {
+        delta -= w as f64;
+    } else if delta < -(w as f64) / 2.0 {
+        delta += w as f64;
+    }
+    Placement {
+        translate: std::array::from_fn(|k| a.translate[k] + t * (b.translate[k] - a.translate[k])),
+        scale: a.scale + t * (b.scale - a.scale),
+        turn: (a.turn as f64 + t * delta).round().rem_euclid(w as f64) as usize % w,
+    }
+}
+
+/// Plays `path` in `scene` under `env` (its rotation `[yaw, pitch, roll]` in degrees, the
+/// lighting's yaw added per frame), the lighting truncated to `keep_light`; `frame` receives
+/// each frame's scene, per-vertex radiance, lighting rotation and report.
+pub fn play(
+    scene: &mut DynamicScene,
+    env: &Environment,
+    angles: [f64; 3],
+    keep_light: Selection,
+    path: &MotionPath,
+    mut frame: impl FnMut(&DynamicScene, &Array2<f32>, &SphereRotation, &FrameReport) -> Result<()>,
+) -> Result<()> {
+    let states = path.states(scene)?;
+    let mapping = SphereMapping::new(env.map().height(), scene.param())?;
+    let rotation = |yaw: f64| SphereRotation::from_degrees(angles[0] + yaw, angles[1], angles[2]);
+    let mut lighting = Lighting::encode(env, &mapping, &rotation(0.0)?, keep_light)?;
+    let mut jrt: Option<(usize, Jrt<f32>, usize)> = None;
+    for (index, state) in states.iter().enumerate() {
+        let turn = |k: usize, scene: &DynamicScene| scene.placement(k).turn;
+        let mut reformed = None;
+        // Re-form for a new segment, or when the moving object turns.
+        let stale = match (&jrt, state.change) {
+            (None, _) => true,
+            (Some((segment, _, t)), Change::Object(_)) => {
+                *segment != state.segment || state.placement.is_some_and(|p| p.turn != *t)
+            }
+            (Some((segment, ..)), Change::Lighting) => *segment != state.segment,
+        };
+        if let (Change::Object(k), Some(p)) = (state.change, state.placement)
+            && stale
+        {
+            scene.place(k, p)?;
+        }
+        if stale {
+            let start = Instant::now();
+            let formed = Jrt::form(scene, &lighting, state.change)?;
+            let t = match state.change {
+                Change::Object(k) => turn(k, scene),
+                Change::Lighting => 0,
+            };
+            jrt = Some((state.segment, formed, t));
+            reformed = Some(start.elapsed().as_secs_f64());
+        }
+        let (_, transfer, _) = jrt.as_ref().expect("formed above");
+        let start = Instant::now();
+        let radiance = match state.change {
+            Change::Object(k) => {
+                if let Some(p) = state.placement {
+                    scene.place(k, p)?;
+                }
+                transfer.frame_moved(scene)?
+            }
+            Change::Lighting => {
+                lighting =
+                    Lighting::encode(env, &mapping, &rotation(state.light_yaw)?, keep_light)?;
+                transfer.frame_lit(scene, &lighting)?
+            }
+        };
+        let report = FrameReport {
+            index,
+            state: *state,
+            reformed,
+            shade_seconds: start.elapsed().as_secs_f64(),
+        };
+        frame(scene, &radiance, &rotation(state.light_yaw)?, &report)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;
