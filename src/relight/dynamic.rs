@@ -47,11 +47,11 @@ use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_pla
 use super::shade::{select_kept, within_depth};
 use super::sparse::SparseRows;
 use super::visibility::{VisibilityOptions, ray_offset, vertex_major};
-use super::{Mesh, SceneBvh, SceneError};
+use super::{Mesh, ReferenceOptions, SceneBvh, SceneError};
 use crate::product::multiply::product;
 use crate::product::selection::Candidate;
 use crate::product::{HaarTree, IntegralOptions, Selection, Transport, product_integral};
-use crate::sphere::SphereRotation;
+use crate::sphere::{LatLongMap, SphereRotation};
 use crate::sphere::integrate::layout;
 use crate::sphere::param::{ParamKind, Parameterization};
 use crate::{Error, Result, Sample};
@@ -700,6 +700,24 @@ impl DynamicScene {
             )
             .collect::<Result<_>>()?;
         Ok(radiance(&rows, &albedo))
+    }
+
+    /// The ground truth of the scene as placed now: [`reference`](super::reference()) with
+    /// visibility ray-cast against every object and the ground plane, over `lighting` (a
+    /// lat-long map, rotated), no field, no Haar transform.
+    pub fn reference(&self, lighting: &LatLongMap<f64>) -> Result<Array2<f64>> {
+        let mesh = self.mesh();
+        let (radiance, _) = super::reference(
+            &mesh,
+            &SceneBvh::new(&mesh),
+            self.albedo().view(),
+            lighting,
+            &ReferenceOptions {
+                progress: self.options.progress,
+                ..ReferenceOptions::default()
+            },
+        )?;
+        Ok(radiance)
     }
 
     /// The depth the options name, after checking `lighting` against the scene.

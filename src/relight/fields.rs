@@ -63,8 +63,11 @@ use crate::sphere::param::{ParamKind, Parameterization};
 use crate::transform::{Normalization, pyramid};
 use crate::{Error, Result};
 
-/// A point is on the virtual ground plane when within this many bounding radii of it.
-pub const PLANE_TOLERANCE: f64 = 1e-3;
+/// A point is on the virtual ground plane when within this many bounding radii of it (a
+/// receiver's lookup point is lifted off its surface by a scene's ray offset, `1e-4 x` its
+/// diagonal, which can be a millionth of a large scene's but a tenth of a per cent of a
+/// small object's radius).
+pub const PLANE_TOLERANCE: f64 = 1e-2;
 
 /// The most sample points a field may have.
 pub const MAX_SAMPLES: usize = 4_000_000;

@@ -12,8 +12,10 @@ pub mod gallery;
 pub mod precompute;
 pub mod reference;
 pub mod render;
+pub mod scene;
 
-/// Relight meshes under environment maps: precompute, render, reference, animate, gallery.
+/// Relight meshes under environment maps: precompute, render, reference, animate, gallery,
+/// and dynamic scenes of moving objects (scene).
 #[derive(Subcommand, Debug)]
 pub enum RelightCommand {
     Precompute(Box<precompute::Args>),
@@ -21,6 +23,7 @@ pub enum RelightCommand {
     Reference(Box<reference::Args>),
     Animate(Box<animate::Args>),
     Gallery(Box<gallery::Args>),
+    Scene(Box<scene::Args>),
 }
 
 pub fn run(command: RelightCommand) -> Result<()> {
@@ -30,5 +33,6 @@ pub fn run(command: RelightCommand) -> Result<()> {
         RelightCommand::Reference(args) => reference::run(*args),
         RelightCommand::Animate(args) => animate::run(*args),
         RelightCommand::Gallery(args) => gallery::run(*args),
+        RelightCommand::Scene(args) => scene::run(*args),
     }
 }

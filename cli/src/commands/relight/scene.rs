@@ -1,0 +1,355 @@
+//! `haarshift relight scene`: a dynamic scene (objects with occlusion fields) as one frame or
+//! an animation.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use haarshift::product::Selection;
+use haarshift::relight::animation::{numbered_path, write_gif};
+use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+use haarshift::relight::fields::{FieldOptions, Truncation};
+use haarshift::relight::motion::{MotionPath, play};
+use haarshift::relight::raster::{render_format, to_srgb8, write_render};
+use haarshift::relight::Lighting;
+use haarshift::sphere::{ParamKind, Parameterization};
+use haarshift::{Error, Result, SampleDepth};
+use ndarray::{Array2, Array3};
+
+use super::flags::{CameraFlags, LightFlags, bytes, ms, refuse_inputs, rotation};
+use crate::commands::{choice, names, print, refuse_existing};
+
+const HELP: &str = "\
+Every object of the scene file gets occlusion fields (seed 001): from sample points on 100
+circles x 200 points on its ground plane (0.05 r to 10 r) and on 20 shells of 6 x 9 x 9
+points around it (0.2 R to 6 R), the visibility of the object over the sphere, one ray per
+texel, Haar-transformed and truncated to --keep-field. Each vertex's own transport is
+precomputed against its own object and the ground plane. A vertex's radiance is
+albedo / pi x the integral of its transport x the lighting x every other object's occlusion
+looked up where the vertex is (bilinear on the plane, trilinear between shells; beyond the
+outermost shell an object occludes nothing): an n-function product integral on sparse Haar
+coefficients. Objects move by translation, uniform scale and whole-column yaw (the scene
+file's yaw is rounded to a column of the lat-long map); pitch and roll are refused.
+
+--animate PATH.json plays segments that each move one object or turn the lighting (see the
+library's relight::motion for the file): the fixed factors' product is re-formed when the
+kind of change switches, and each frame is one sparse dot product per vertex with the varying
+factor (just-in-time radiance transfer). Every frame's times are printed: re-forming, shading,
+rasterisation. The output is a looping GIF or numbered PNGs (a pattern with %d).
+
+--method reference renders the same frames with visibility ray-cast against every object in
+its current placement (the ground truth; no field, no Haar transform).
+
+Examples:
+  haarshift relight scene testdata/scenes/table_and_chair.json -o table.png
+  haarshift relight scene testdata/scenes/table_and_chair.json --animate testdata/scenes/chair_path.json -o chair.gif
+  haarshift relight scene scene.json --resolution 64 --keep-light 200 --keep-visibility 70 --keep-field 70 -o s.png
+  haarshift relight scene scene.json --method reference --vertices truth.npy -o truth.png";
+
+/// The method the radiance is computed by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// Occlusion fields and Haar product integrals.
+    Haar,
+    /// Ray-cast visibility against the placed scene, direct quadrature.
+    Reference,
+}
+
+/// When a looked-up occlusion map is truncated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TruncateWhen {
+    /// Each sample's map is stored truncated; the lookup blends them.
+    Before,
+    /// The stored maps are blended, then the blend is truncated to --keep-field.
+    After,
+}
+
+/// Render a dynamic scene of objects shadowing each other through occlusion fields.
+#[derive(clap::Args, Debug)]
+#[command(after_help = HELP)]
+pub struct Args {
+    /// The scene file (objects with names, transforms and materials; ground plane; lighting;
+    /// camera)
+    #[arg(value_name = "SCENE.json")]
+    pub scene: PathBuf,
+
+    /// The image (.png, .exr), or with --animate a .gif or numbered .png frames (%d)
+    #[arg(short, long, value_name = "IMAGE")]
+    pub output: PathBuf,
+
+    /// Play this path file (segments moving one object or turning the lighting)
+    #[arg(long, value_name = "PATH.json")]
+    pub animate: Option<PathBuf>,
+
+    /// Also write the per-vertex radiance, (V, 3) f32 .npy ((frames, V, 3) with --animate)
+    #[arg(long, value_name = "OUT.npy")]
+    pub vertices: Option<PathBuf>,
+
+    /// How the radiance is computed
+    #[arg(long, value_enum, default_value = "haar")]
+    pub method: Method,
+
+    /// Parameterisation of every map: `latlong` N x 2N (objects can turn) or `cube` 6 x N x N
+    #[arg(long, default_value = "latlong", value_parser = choice::<ParamKind>(names!(ParamKind)))]
+    pub param: ParamKind,
+
+    /// Resolution N: lat-long N x 2N, cube 6 x N x N
+    #[arg(long, value_name = "N", default_value_t = 32)]
+    pub resolution: usize,
+
+    /// Detail coefficients of the lighting kept [default: all]
+    #[arg(long, value_name = "K")]
+    pub keep_light: Option<usize>,
+
+    /// Detail coefficients of each vertex's own transport kept [default: all]
+    #[arg(long, value_name = "K")]
+    pub keep_visibility: Option<usize>,
+
+    /// Detail coefficients of each occlusion map kept [default: all]
+    #[arg(long, value_name = "K")]
+    pub keep_field: Option<usize>,
+
+    /// Detail coefficients of each vertex's fixed product kept (animations) [default: all]
+    #[arg(long, value_name = "K")]
+    pub keep_product: Option<usize>,
+
+    /// When looked-up occlusion maps are truncated
+    #[arg(long, value_enum, default_value = "before")]
+    pub truncate: TruncateWhen,
+
+    /// Traversal depth: detail levels 0..D-1 only [default: all]
+    #[arg(long, value_name = "D")]
+    pub depth: Option<usize>,
+
+    /// Circles of the planar field
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    pub circles: usize,
+
+    /// Points per circle
+    #[arg(long, value_name = "N", default_value_t = 200)]
+    pub circle_points: usize,
+
+    /// Shells of the spherical field
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub shells: usize,
+
+    /// Points per face edge of each shell's cube grid
+    #[arg(long, value_name = "N", default_value_t = 9)]
+    pub shell_grid: usize,
+
+    /// Time each GIF frame is shown, milliseconds
+    #[arg(long, value_name = "MS", default_value_t = 100)]
+    pub delay: u32,
+
+    #[command(flatten)]
+    pub light: LightFlags,
+
+    #[command(flatten)]
+    pub camera: CameraFlags,
+
+    /// Replace the outputs if they exist
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl Args {
+    fn options(&self) -> Result<DynamicOptions> {
+        let param = Parameterization::new(self.param, self.resolution)?;
+        let largest = |k: Option<usize>| k.map_or(Selection::All, Selection::Largest);
+        Ok(DynamicOptions {
+            field: FieldOptions {
+                keep: largest(self.keep_field),
+                circles: self.circles,
+                circle_points: self.circle_points,
+                shells: self.shells,
+                shell_grid: self.shell_grid,
+                progress: true,
+                ..FieldOptions::new(param)
+            },
+            keep_visibility: largest(self.keep_visibility),
+            truncation: match self.truncate {
+                TruncateWhen::Before => Truncation::Before,
+                TruncateWhen::After => Truncation::After(largest(self.keep_field)),
+            },
+            keep_product: largest(self.keep_product),
+            depth: self.depth,
+            progress: true,
+        })
+    }
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let gif = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
+    let path = args.animate.as_deref().map(MotionPath::load).transpose()?;
+    let frame_count = path.as_ref().map_or(1, MotionPath::frame_count);
+    if path.is_none() && gif {
+        return Err(Error::InvalidParameter {
+            name: "output",
+            reason: "a .gif needs --animate PATH.json; one frame is .png or .exr".into(),
+        });
+    }
+    let frame_paths: Vec<PathBuf> = match (&path, gif) {
+        (Some(_), false) => (0..frame_count)
+            .map(|k| numbered_path(&args.output, k))
+            .collect::<Result<_>>()?,
+        _ => Vec::new(),
+    };
+    match frame_paths.first() {
+        Some(first) => render_format(first).map(|_| ())?,
+        None if !gif => render_format(&args.output).map(|_| ())?,
+        None => {}
+    }
+    let mut outputs: Vec<&Path> = if frame_paths.is_empty() {
+        vec![args.output.as_path()]
+    } else {
+        frame_paths.iter().map(PathBuf::as_path).collect()
+    };
+    outputs.extend(args.vertices.as_deref());
+    let mut inputs = vec![args.scene.as_path()];
+    inputs.extend(args.animate.as_deref());
+    inputs.extend(args.light.env.as_deref());
+    refuse_inputs(&inputs, &outputs)?;
+    refuse_existing(&outputs, args.force)?;
+    let background = args.camera.background()?;
+    let options = args.options()?;
+
+    let start = Instant::now();
+    let mut scene = DynamicScene::load(&args.scene, &options)?;
+    let build_ms = ms(start);
+    let (env, angles) = args.light.load(scene.environment.as_ref())?;
+    let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh())?;
+    let param = scene.param();
+    let r = *scene.report();
+    let mut text = format!(
+        "{}: {} objects ({} shapes), {} vertices, {} {}; fields: {} samples a shape, {} rays, \
+         {:.1} s, {} stored; own transport: {} rays, {:.1} s; built in {:.1} s\n",
+        args.scene.display(),
+        scene.object_count(),
+        scene.shape_count(),
+        scene.vertex_count(),
+        param.kind(),
+        param.face_size(),
+        options.field.samples(),
+        r.field_rays,
+        r.field_seconds,
+        bytes(r.field_bytes as u64),
+        r.transport_rays,
+        r.transport_seconds,
+        build_ms / 1e3,
+    );
+    let keep_light = args.keep_light.map_or(Selection::All, Selection::Largest);
+    let mut all_radiance: Vec<Array2<f32>> = Vec::new();
+    let mut gif_frames = Vec::new();
+    let mut draw = |scene: &DynamicScene,
+                    radiance: &Array2<f32>,
+                    turn: &haarshift::sphere::SphereRotation,
+                    index: usize,
+                    text: &mut String,
+                    what: String|
+     -> Result<()> {
+        let start = Instant::now();
+        let image = args.camera.draw(
+            &camera,
+            &scene.mesh(),
+            radiance.view(),
+            &background,
+            &env,
+            turn,
+        )?;
+        let raster_ms = ms(start);
+        match (frame_paths.get(index), gif) {
+            (Some(p), _) => write_render(&image, p, args.camera.exposure, args.force)?,
+            (None, true) => gif_frames.push(to_srgb8(&image, args.camera.exposure)?),
+            (None, false) => write_render(&image, &args.output, args.camera.exposure, args.force)?,
+        }
+        *text += &format!("{what}, rasterisation {raster_ms:.1} ms\n");
+        if args.vertices.is_some() {
+            all_radiance.push(radiance.clone());
+        }
+        Ok(())
+    };
+    let reference = |scene: &DynamicScene, turn: &haarshift::sphere::SphereRotation| {
+        let map = env.lat_long(param.face_size(), turn)?;
+        Ok::<_, Error>(scene.reference(&map)?.mapv(|x| x as f32))
+    };
+    match &path {
+        None => {
+            let turn = rotation(angles)?;
+            let start = Instant::now();
+            let (radiance, what) = match args.method {
+                Method::Haar => {
+                    let lighting = Lighting::new(&env, param, &turn, keep_light)?;
+                    (scene.shade::<f32>(&lighting)?, "n-function product integrals")
+                }
+                Method::Reference => (reference(&scene, &turn)?, "ray-cast reference"),
+            };
+            let what = format!(
+                "{}: {what} {:.1} ms",
+                args.output.display(),
+                ms(start)
+            );
+            draw(&scene, &radiance, &turn, 0, &mut text, what)?;
+        }
+        Some(path) => {
+            play(
+                &mut scene,
+                &env,
+                angles,
+                keep_light,
+                path,
+                |scene, radiance, turn, report| {
+                    let (radiance, shade) = match args.method {
+                        Method::Haar => (
+                            radiance.clone(),
+                            format!("shading {:.1} ms", report.shade_seconds * 1e3),
+                        ),
+                        Method::Reference => {
+                            let start = Instant::now();
+                            (reference(scene, turn)?, format!("reference {:.1} ms", ms(start)))
+                        }
+                    };
+                    let reformed = report
+                        .reformed
+                        .map_or(String::new(), |s| format!("re-formed in {:.1} ms, ", s * 1e3));
+                    let state = match report.state.placement {
+                        Some(p) => format!(
+                            "{:?} at {:.3?} scale {:.3} yaw {:.2}",
+                            report.state.change,
+                            p.translate,
+                            p.scale,
+                            p.yaw_degrees(param)
+                        ),
+                        None => format!("lighting yaw {:+.2}", report.state.light_yaw),
+                    };
+                    let what = format!("frame {}: {state}: {reformed}{shade}", report.index);
+                    draw(scene, &radiance, turn, report.index, &mut text, what)
+                },
+            )?;
+        }
+    }
+    if gif {
+        write_gif(&gif_frames, &args.output, args.delay, args.force)?;
+    }
+    if let Some(out) = &args.vertices {
+        match &path {
+            None => haarshift::io::write_npy(all_radiance[0].view(), SampleDepth::F32, out, args.force)?,
+            Some(_) => {
+                let (v, _) = all_radiance[0].dim();
+                let mut stack = Array3::<f32>::zeros((all_radiance.len(), v, 3));
+                for (k, r) in all_radiance.iter().enumerate() {
+                    stack.index_axis_mut(ndarray::Axis(0), k).assign(r);
+                }
+                haarshift::io::write_npy(stack.view(), SampleDepth::F32, out, args.force)?;
+            }
+        }
+    }
+    text += &format!(
+        "{}: {frame_count} frame(s) of {} x {}\n",
+        args.output.display(),
+        args.camera.width,
+        args.camera.height
+    );
+    print(&text)
+}
