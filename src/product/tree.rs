@@ -353,19 +353,7 @@ impl<T: Sample, const C: usize> HaarTree<T, C> {
                 }
             }
         }
-        let mut keys: Vec<NodeKey> = Vec::with_capacity(details.len() * n as usize);
-        for &(key, ..) in &details {
-            let mut k = key;
-            keys.push(k);
-            while let Some(parent) = k.parent() {
-                keys.push(parent);
-                k = parent;
-            }
-        }
-        // Sorted by (face, level, Morton code) is breadth first with each node's children
-        // contiguous and in quadrant order: the arena's order.
-        keys.sort_unstable();
-        keys.dedup();
+        let keys = with_ancestors(details.iter().map(|d| d.0).collect());
         let mut nodes = vec![
             Node {
                 mean: [T::zero(); C],
@@ -702,14 +690,73 @@ struct NodeKey {
     morton: u64,
 }
 
+/// The bits of `x` (below 2^32) moved to the even positions.
+fn spread_bits(x: usize) -> u64 {
+    let mut v = x as u64 & 0xFFFF_FFFF;
+    v = (v | (v << 16)) & 0x0000_FFFF_0000_FFFF;
+    v = (v | (v << 8)) & 0x00FF_00FF_00FF_00FF;
+    v = (v | (v << 4)) & 0x0F0F_0F0F_0F0F_0F0F;
+    v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+    (v | (v << 1)) & 0x5555_5555_5555_5555
+}
+
+/// `keys` and all their ancestors, sorted by (face, level, Morton code) and without repeats:
+/// breadth first with each node's children contiguous and in quadrant order, the arena's
+/// order. One sort of the given keys; the ancestors come level by level, already sorted.
+fn with_ancestors(mut keys: Vec<NodeKey>) -> Vec<NodeKey> {
+    keys.sort_unstable();
+    keys.dedup();
+    let mut out = Vec::with_capacity(keys.len() * 2);
+    for face_keys in keys.chunk_by(|a, b| a.face == b.face) {
+        let face = face_keys[0].face;
+        let finest = face_keys.last().map_or(0, |k| k.level as usize);
+        let mut levels: Vec<Vec<u64>> = vec![Vec::new(); finest + 1];
+        for k in face_keys {
+            levels[k.level as usize].push(k.morton);
+        }
+        for l in (1..=finest).rev() {
+            let merged = merge_sorted(&levels[l - 1], levels[l].iter().map(|m| m >> 2));
+            levels[l - 1] = merged;
+        }
+        for (l, mortons) in levels.iter().enumerate() {
+            out.extend(mortons.iter().map(|&morton| NodeKey {
+                face,
+                level: l as u8,
+                morton,
+            }));
+        }
+    }
+    out
+}
+
+/// The union of the ascending `a` and the ascending (repeats allowed) `b`, ascending,
+/// without repeats.
+fn merge_sorted(a: &[u64], b: impl Iterator<Item = u64>) -> Vec<u64> {
+    let mut out: Vec<u64> = Vec::with_capacity(a.len() + 8);
+    let push = |x: u64, out: &mut Vec<u64>| {
+        if out.last() != Some(&x) {
+            out.push(x);
+        }
+    };
+    let mut a = a.iter().copied().peekable();
+    for x in b {
+        while let Some(y) = a.next_if(|&y| y < x) {
+            push(y, &mut out);
+        }
+        push(x, &mut out);
+    }
+    for y in a {
+        push(y, &mut out);
+    }
+    out
+}
+
 impl NodeKey {
     fn new(face: usize, level: usize, row: usize, col: usize) -> Self {
-        let spread =
-            |x: usize| (0..level).fold(0u64, |acc, b| acc | (((x as u64 >> b) & 1) << (2 * b)));
         NodeKey {
             face: face as u32,
             level: level as u8,
-            morton: spread(row) << 1 | spread(col),
+            morton: spread_bits(row) << 1 | spread_bits(col),
         }
     }
 

@@ -41,7 +41,7 @@ use ndarray::Array2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::fields::{FieldOptions, OcclusionField, Truncation, yaw_sparse};
+use super::fields::{Blend, FieldOptions, OcclusionField, Truncation, yaw_sparse};
 use super::lighting::Lighting;
 use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under};
 use super::shade::{select_kept, within_depth};
@@ -51,9 +51,9 @@ use super::{Mesh, ReferenceOptions, SceneBvh, SceneError};
 use crate::product::multiply::product;
 use crate::product::selection::Candidate;
 use crate::product::{HaarTree, IntegralOptions, Selection, Transport, product_integral};
-use crate::sphere::{LatLongMap, SphereRotation};
 use crate::sphere::integrate::layout;
 use crate::sphere::param::{ParamKind, Parameterization};
+use crate::sphere::{LatLongMap, SphereRotation};
 use crate::{Error, Result, Sample};
 
 /// How a dynamic scene is precomputed and shaded; see the [module docs](self).
@@ -687,13 +687,14 @@ impl DynamicScene {
                         &i,
                         v.iter().map(|&x| f64::from(x)),
                     )?);
-                    let mut factors = vec![light.clone()];
+                    let mut factors = Vec::new();
                     for k in (0..self.objects.len()).filter(|&k| Some(k) != r.owner) {
                         if let Some((i, v)) = self.occlusion(k, r.point, depth, scratch) {
                             factors.push(tree(param, i, v.iter().copied())?);
                         }
                     }
-                    let refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
+                    let mut refs: Vec<&HaarTree<T, 3>> = vec![&light];
+                    refs.extend(factors.iter());
                     let value = product_integral(&own, &refs, IntegralOptions::default())?.value;
                     Ok(value.map(T::from_f64))
                 },
@@ -898,9 +899,6 @@ impl<T: Sample> Jrt<T> {
                 |(scratch, pool), r| -> Result<_> {
                     let (i, v) = scene.own_transport(r, depth)?;
                     let mut factors = vec![tree::<T>(param, &i, v.iter().map(|&x| f64::from(x)))?];
-                    if moving.is_some() {
-                        factors.push(light.clone());
-                    }
                     let fixed_occluders = (0..scene.objects.len())
                         .filter(|&k| Some(k) != r.owner && Some(k) != moving)
                         .filter(|_| moving.is_none() || r.owner != moving);
@@ -909,7 +907,10 @@ impl<T: Sample> Jrt<T> {
                             factors.push(tree(param, i, v.iter().copied())?);
                         }
                     }
-                    let refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
+                    let mut refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
+                    if moving.is_some() {
+                        refs.push(&light);
+                    }
                     let (indices, values) = product(&refs)?.sparse_coefficients();
                     Ok(prune(param, keep, indices, values, pool))
                 },
@@ -962,38 +963,42 @@ impl<T: Sample> Jrt<T> {
                 |(scratch, dense), (v, r)| -> Result<[T; 3]> {
                     let (ti, tv) = self.products.row(v);
                     if r.owner != Some(moving) {
-                        // The one varying factor: a dot product with the moving object's map.
+                        // The one varying factor: a dot product with the moving object's map;
+                        // truncated before the blend, the dot of the blend is the blend of
+                        // the samples' dots, so no map is formed.
+                        if scene.options.truncation == Truncation::Before {
+                            let o = &scene.objects[moving];
+                            let local = o.placement.to_local(r.point, param);
+                            return Ok(match o.field.lookup(local) {
+                                None => dot_one(param, ti, tv),
+                                Some(blend) => dot_blend(dense, ti, tv, &o.field, &blend, depth),
+                            });
+                        }
                         return Ok(match scene.occlusion(moving, r.point, depth, scratch) {
                             None => dot_one(param, ti, tv),
                             Some((fi, fv)) => dot_dense(dense, ti, tv, fi, fv),
                         });
                     }
-                    // A vertex of the moving object: every other object's map varies.
+                    // A vertex of the moving object: every other object's map varies; their
+                    // product (a tree of the maps alone) is the varying factor.
                     let mut trees = Vec::new();
                     let mut single = None;
                     for k in (0..scene.objects.len()).filter(|&k| k != moving) {
                         if let Some((fi, fv)) = scene.occlusion(k, r.point, depth, scratch) {
                             single = Some((fi.to_vec(), fv.to_vec()));
-                            trees.push(tree::<T>(param, fi, fv.iter().copied())?);
+                            trees.push(tree::<f64>(param, fi, fv.iter().copied())?);
                         }
                     }
-                    Ok(match (trees.len(), single) {
-                        (0, _) => dot_one(param, ti, tv),
-                        (1, Some((fi, fv))) => dot_dense(dense, ti, tv, &fi, &fv),
+                    let (fi, fv) = match (trees.len(), single) {
+                        (0, _) => return Ok(dot_one(param, ti, tv)),
+                        (1, Some(map)) => map,
                         _ => {
-                            let t = Transport::from_weighted_tree(HaarTree::from_sparse(
-                                param.faces(),
-                                param.face_size(),
-                                layout(param),
-                                ti,
-                                tv,
-                            )?);
-                            let refs: Vec<&HaarTree<T, 3>> = trees.iter().collect();
-                            product_integral(&t, &refs, IntegralOptions::default())?
-                                .value
-                                .map(T::from_f64)
+                            let refs: Vec<&HaarTree<f64, 3>> = trees.iter().collect();
+                            let (i, v) = product(&refs)?.sparse_coefficients();
+                            (i, v.into_iter().map(|c| c[0]).collect())
                         }
-                    })
+                    };
+                    Ok(dot_dense(dense, ti, tv, &fi, &fv))
                 },
             )
             .collect::<Result<_>>()?;
@@ -1084,6 +1089,45 @@ fn dot_one<T: Sample>(param: Parameterization, indices: &[u32], values: &[[T; 3]
                 acc[c] += t[c].as_f64() * s as f64;
             }
         }
+    }
+    acc.map(T::from_f64)
+}
+
+/// `<T, sum_s w_s M_s>` for the sample maps `M_s` of `field` that `blend` weighs, limited to
+/// the detail levels `0..depth`, through a dense copy of `T` (`dense` is all zeros and is
+/// left so).
+fn dot_blend<T: Sample>(
+    dense: &mut [[T; 3]],
+    ti: &[u32],
+    tv: &[[T; 3]],
+    field: &OcclusionField,
+    blend: &Blend,
+    depth: usize,
+) -> [T; 3] {
+    for (&i, t) in ti.iter().zip(tv) {
+        dense[i as usize] = *t;
+    }
+    let s = field.options().param.face_size();
+    let all = depth == s.trailing_zeros() as usize;
+    let mut acc = [0.0f64; 3];
+    for &(sample, w) in blend.samples() {
+        let (fi, fv) = field.map(sample as usize);
+        let mut part = [T::zero(); 3];
+        for (&i, &f) in fi.iter().zip(fv) {
+            if all || within_depth(s, depth, i as usize) {
+                let t = dense[i as usize];
+                let f = T::from_f64(f64::from(f));
+                for c in 0..3 {
+                    part[c] += t[c] * f;
+                }
+            }
+        }
+        for c in 0..3 {
+            acc[c] += f64::from(w) * part[c].as_f64();
+        }
+    }
+    for &i in ti {
+        dense[i as usize] = [T::zero(); 3];
     }
     acc.map(T::from_f64)
 }

@@ -26,7 +26,7 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use super::SceneError;
-use super::dynamic::{Change, DynamicScene, Jrt, Placement};
+use super::dynamic::{Change, DynamicScene, Jrt, JrtReport, Placement};
 use super::environment::{Environment, SphereMapping};
 use super::lighting::Lighting;
 use super::scene::Transform;
@@ -90,8 +90,8 @@ pub struct FrameReport {
     pub index: usize,
     /// The frame's state.
     pub state: FrameState,
-    /// Seconds re-forming the transfer before this frame, when it was re-formed.
-    pub reformed: Option<f64>,
+    /// What re-forming the transfer before this frame cost, when it was re-formed.
+    pub reformed: Option<JrtReport>,
     /// Seconds encoding the varying factor and shading (the per-frame cost).
     pub shade_seconds: f64,
 }
@@ -247,14 +247,13 @@ pub fn play(
             scene.place(k, p)?;
         }
         if stale {
-            let start = Instant::now();
             let formed = Jrt::form(scene, &lighting, state.change)?;
             let t = match state.change {
                 Change::Object(k) => turn(k, scene),
                 Change::Lighting => 0,
             };
+            reformed = Some(*formed.report());
             jrt = Some((state.segment, formed, t));
-            reformed = Some(start.elapsed().as_secs_f64());
         }
         let (_, transfer, _) = jrt.as_ref().expect("formed above");
         let start = Instant::now();

@@ -5,12 +5,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use haarshift::product::Selection;
+use haarshift::relight::Lighting;
 use haarshift::relight::animation::{numbered_path, write_gif};
 use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
 use haarshift::relight::fields::{FieldOptions, Truncation};
 use haarshift::relight::motion::{MotionPath, play};
 use haarshift::relight::raster::{render_format, to_srgb8, write_render};
-use haarshift::relight::Lighting;
 use haarshift::sphere::{ParamKind, Parameterization};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
@@ -281,15 +281,14 @@ pub fn run(args: Args) -> Result<()> {
             let (radiance, what) = match args.method {
                 Method::Haar => {
                     let lighting = Lighting::new(&env, param, &turn, keep_light)?;
-                    (scene.shade::<f32>(&lighting)?, "n-function product integrals")
+                    (
+                        scene.shade::<f32>(&lighting)?,
+                        "n-function product integrals",
+                    )
                 }
                 Method::Reference => (reference(&scene, &turn)?, "ray-cast reference"),
             };
-            let what = format!(
-                "{}: {what} {:.1} ms",
-                args.output.display(),
-                ms(start)
-            );
+            let what = format!("{}: {what} {:.1} ms", args.output.display(), ms(start));
             draw(&scene, &radiance, &turn, 0, &mut text, what)?;
         }
         Some(path) => {
@@ -307,12 +306,21 @@ pub fn run(args: Args) -> Result<()> {
                         ),
                         Method::Reference => {
                             let start = Instant::now();
-                            (reference(scene, turn)?, format!("reference {:.1} ms", ms(start)))
+                            (
+                                reference(scene, turn)?,
+                                format!("reference {:.1} ms", ms(start)),
+                            )
                         }
                     };
-                    let reformed = report
-                        .reformed
-                        .map_or(String::new(), |s| format!("re-formed in {:.1} ms, ", s * 1e3));
+                    let vertices = scene.vertex_count().max(1) as f64;
+                    let reformed = report.reformed.map_or(String::new(), |r| {
+                        format!(
+                            "re-formed in {:.1} ms ({:.0} coefficients a vertex, {}), ",
+                            r.seconds * 1e3,
+                            r.coefficients as f64 / vertices,
+                            bytes(r.bytes as u64)
+                        )
+                    });
                     let state = match report.state.placement {
                         Some(p) => format!(
                             "{:?} at {:.3?} scale {:.3} yaw {:.2}",
@@ -334,7 +342,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     if let Some(out) = &args.vertices {
         match &path {
-            None => haarshift::io::write_npy(all_radiance[0].view(), SampleDepth::F32, out, args.force)?,
+            None => {
+                haarshift::io::write_npy(all_radiance[0].view(), SampleDepth::F32, out, args.force)?
+            }
             Some(_) => {
                 let (v, _) = all_radiance[0].dim();
                 let mut stack = Array3::<f32>::zeros((all_radiance.len(), v, 3));
