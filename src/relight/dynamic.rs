@@ -41,7 +41,7 @@ use ndarray::Array2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::fields::{Blend, FieldOptions, OcclusionField, Truncation, yaw_sparse};
+use super::fields::{Blend, FieldOptions, OcclusionField, Truncation, select_rows, yaw_sparse};
 use super::lighting::Lighting;
 use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under};
 use super::shade::{select_kept, within_depth};
@@ -436,6 +436,60 @@ impl DynamicScene {
     /// The parameterisation of every map.
     pub fn param(&self) -> Parameterization {
         self.options.param()
+    }
+
+    /// The scene with every vertex's own transport re-truncated to `keep_visibility` and
+    /// every field map to `keep_field` (each can only keep fewer than the build kept): a
+    /// budget without a new build.
+    pub fn truncated(&self, keep_visibility: Selection, keep_field: Selection) -> Result<Self> {
+        let param = self.param();
+        keep_visibility.limit(param.texels() - param.faces())?;
+        let fields = self
+            .fields
+            .iter()
+            .map(|f| Ok(Arc::new(f.truncated(keep_field)?)))
+            .collect::<Result<Vec<_>>>()?;
+        let select = |rows: &SparseRows<f32>| Arc::new(select_rows(param, keep_visibility, rows));
+        let objects = self
+            .objects
+            .iter()
+            .map(|o| {
+                Ok(Object {
+                    transport: select(&o.transport),
+                    field: turned(&fields[o.shape], o.placement.turn)?,
+                    ..o.clone()
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut options = self.options;
+        options.keep_visibility = keep_visibility;
+        options.field.keep = keep_field;
+        Ok(DynamicScene {
+            options,
+            fields,
+            objects,
+            ground: self
+                .ground
+                .as_ref()
+                .map(|(g, rows)| (g.clone(), select(rows))),
+            ..self.clone()
+        })
+    }
+
+    /// Changes how the scene is shaded (none of these needs a new build): the truncation of
+    /// looked-up maps, of just-in-time transfer's fixed products, and the depth.
+    pub fn set_shading(
+        &mut self,
+        truncation: Truncation,
+        keep_product: Selection,
+        depth: Option<usize>,
+    ) -> Result<()> {
+        let mut options = self.options;
+        (options.truncation, options.keep_product, options.depth) =
+            (truncation, keep_product, depth);
+        options.check()?;
+        self.options = options;
+        Ok(())
     }
 
     /// Objects (instances).
@@ -871,6 +925,8 @@ pub struct JrtReport {
 #[derive(Clone, Debug)]
 pub struct Jrt<T> {
     change: Change,
+    /// Every object's turn at formation (a vertex's own transport turns with its object).
+    turns: Vec<usize>,
     products: SparseRows<[T; 3]>,
     report: JrtReport,
 }
@@ -927,6 +983,7 @@ impl<T: Sample> Jrt<T> {
         };
         Ok(Jrt {
             change,
+            turns: scene.objects.iter().map(|o| o.placement.turn).collect(),
             products,
             report,
         })
@@ -1037,6 +1094,14 @@ impl<T: Sample> Jrt<T> {
     }
 
     fn check_scene(&self, scene: &DynamicScene) -> Result<()> {
+        let turns: Vec<usize> = scene.objects.iter().map(|o| o.placement.turn).collect();
+        if scene.vertex_count() == self.products.len() && turns != self.turns {
+            return Err(Error::parameter(
+                "scene",
+                "an object turned since the transfer was formed: re-form it (a turn moves \
+                 the object's own transport and the fixed products that hold it)",
+            ));
+        }
         if scene.vertex_count() != self.products.len() {
             return Err(Error::parameter(
                 "scene",

@@ -372,6 +372,21 @@ impl OcclusionField {
         self.maps.bytes()
     }
 
+    /// The field with every stored map re-truncated to `keep` (which can only keep fewer
+    /// than the field was built with): the budget of an experiment without a new build.
+    pub fn truncated(&self, keep: Selection) -> Result<Self> {
+        let param = self.options.param;
+        keep.limit(param.texels() - param.faces())?;
+        Ok(OcclusionField {
+            maps: select_rows(param, keep, &self.maps),
+            options: FieldOptions {
+                keep,
+                ..self.options
+            },
+            ..self.clone()
+        })
+    }
+
     /// Columns the maps have been turned by ([`turned`](Self::turned)).
     pub fn turn(&self) -> usize {
         self.turn
@@ -528,6 +543,38 @@ pub(crate) fn blend_maps<'a>(
         indices.truncate(at);
         values.truncate(at);
     }
+}
+
+/// Every row of `rows` re-truncated to what `keep` picks of it (rule of
+/// [`crate::product::selection`]).
+pub(crate) fn select_rows(
+    param: Parameterization,
+    keep: Selection,
+    rows: &SparseRows<f32>,
+) -> SparseRows<f32> {
+    let mut out = SparseRows::new();
+    let mut pool = Vec::new();
+    let (mut idx, mut val) = (Vec::new(), Vec::new());
+    for r in 0..rows.len() {
+        let (i, v) = rows.row(r);
+        let kept = super::shade::select_kept(
+            param,
+            keep,
+            i,
+            |s| f64::from(v[s]) * f64::from(v[s]),
+            &mut pool,
+        );
+        idx.clear();
+        val.clear();
+        for ((&i, &v), k) in i.iter().zip(v).zip(kept) {
+            if k {
+                idx.push(i);
+                val.push(v);
+            }
+        }
+        out.push(&idx, &val);
+    }
+    out
 }
 
 /// Ring `k` below `x` on geometric radii `lo .. hi` (`n` of them) and the fraction towards

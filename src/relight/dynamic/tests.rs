@@ -187,8 +187,16 @@ fn just_in_time_transfer_equals_the_full_product_integral_with_unpruned_factors(
     let turned = lighting(2.5);
     let want = scene.shade::<f64>(&turned).unwrap();
     assert!(relative(&jrt.frame_lit(&scene, &turned).unwrap(), &want) < 1e-9);
-    // The wrong frame for the change is refused.
+    // The wrong frame for the change is refused, and so is a turn since formation.
     assert!(jrt.frame_moved(&scene).is_err());
+    let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
+    let turned = Placement {
+        turn: 3,
+        ..scene.placement(1)
+    };
+    scene.place(1, turned).unwrap();
+    let message = jrt.frame_moved(&scene).unwrap_err().to_string();
+    assert!(message.contains("re-form"), "{message}");
 }
 
 #[test]

@@ -18,6 +18,7 @@ use serde::Serialize;
 
 use crate::commands::refuse_output_among_inputs;
 
+pub mod dynamic;
 pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod sphere;
@@ -27,6 +28,7 @@ pub mod tradeoff;
 /// The experiments.
 #[derive(Subcommand)]
 pub enum ExperimentCommand {
+    Dynamic(dynamic::Args),
     RotationCycle(rotation_cycle::Args),
     ShiftChain(shift_chain::Args),
     Sphere(sphere::Args),
@@ -37,6 +39,7 @@ pub enum ExperimentCommand {
 /// Runs one experiment.
 pub fn run(command: ExperimentCommand) -> Result<()> {
     match command {
+        ExperimentCommand::Dynamic(args) => dynamic::run_command(args),
         ExperimentCommand::RotationCycle(args) => rotation_cycle::run(args),
         ExperimentCommand::ShiftChain(args) => shift_chain::run(args),
         ExperimentCommand::Sphere(args) => sphere::run(args),

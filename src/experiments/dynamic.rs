@@ -1,0 +1,527 @@
+//! The dynamic-scene experiment (`haarshift experiment dynamic`): occlusion fields and
+//! just-in-time radiance transfer against the ray-cast ground truth, over the map resolution,
+//! the field's sample density, the kept-coefficient budget (and whether looked-up maps are
+//! truncated before or after the blend), the traversal depth, and the time of each kind of
+//! change.
+//!
+//! **Protocol.** A scenario is a scene file, the object that moves and where it goes. For a
+//! setting, the scene is built (fields and own transport), just-in-time transfer is formed
+//! for the moving object at its file placement, the object is moved to its target, and the
+//! frame is shaded (`<T, O_moving>` per vertex). The ground truth is
+//! [`DynamicScene::reference`] of the moved scene over the environment at
+//! `reference_resolution` (ray casting against every object; no field, no transform). Errors
+//! are per-vertex radiance differences, RMS and maximum over all vertices and channels,
+//! relative to the RMS of the ground truth. The budget and depth axes re-truncate one build
+//! ([`DynamicScene::truncated`], [`DynamicScene::set_shading`]), so their times are of the
+//! shading only; the build times are those of the resolution and density axes.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use ndarray::Array2;
+use serde::Serialize;
+
+use crate::product::Selection;
+use crate::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
+use crate::relight::environment::Environment;
+use crate::relight::fields::{FieldOptions, Truncation};
+use crate::relight::{Lighting, SceneFile, Transform};
+use crate::sphere::SphereRotation;
+use crate::sphere::param::{ParamKind, Parameterization};
+use crate::{Error, Result};
+
+/// A kept-coefficient budget: lighting, each vertex's own transport, each occlusion map
+/// (`None`: all).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Budget {
+    /// Lighting details kept.
+    pub light: Option<usize>,
+    /// Own-transport details kept per vertex.
+    pub visibility: Option<usize>,
+    /// Details kept per occlusion map.
+    pub field: Option<usize>,
+}
+
+impl Budget {
+    const ALL: Budget = Budget {
+        light: None,
+        visibility: None,
+        field: None,
+    };
+
+    const fn of(light: usize, visibility: usize, field: usize) -> Budget {
+        Budget {
+            light: Some(light),
+            visibility: Some(visibility),
+            field: Some(field),
+        }
+    }
+}
+
+fn selection(k: Option<usize>) -> Selection {
+    k.map_or(Selection::All, Selection::Largest)
+}
+
+/// What to run: each axis a list; see the [module docs](self).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DynamicProtocol {
+    /// Lat-long heights `N` of the maps (the resolution axis).
+    pub resolutions: Vec<usize>,
+    /// Sample densities relative to seed 001's fields (the density axis): circles, points
+    /// per circle and shells scale by it, the shell grid by its square root.
+    pub densities: Vec<f64>,
+    /// The resolution of the budget, depth and timing axes.
+    pub base_resolution: usize,
+    /// Budgets (the budget axis), each with truncation before and after the blend.
+    pub budgets: Vec<Budget>,
+    /// The budget of the depth and timing axes.
+    pub base_budget: Budget,
+    /// The lat-long height of the ground truth's lighting.
+    pub reference_resolution: usize,
+}
+
+impl DynamicProtocol {
+    /// The default run: minutes on two cores.
+    pub fn quick() -> Self {
+        DynamicProtocol {
+            resolutions: vec![16, 32],
+            densities: vec![0.25, 0.5, 1.0],
+            base_resolution: 32,
+            budgets: vec![
+                Budget::ALL,
+                Budget::of(300, 120, 120),
+                Budget::of(200, 70, 70),
+                Budget::of(100, 30, 30),
+                Budget::of(40, 10, 10),
+            ],
+            base_budget: Budget::of(200, 70, 70),
+            reference_resolution: 64,
+        }
+    }
+
+    /// The full run: the 64 x 128 maps and twice 001's density too.
+    pub fn full() -> Self {
+        DynamicProtocol {
+            resolutions: vec![16, 32, 64],
+            densities: vec![0.25, 0.5, 1.0, 2.0],
+            reference_resolution: 128,
+            ..Self::quick()
+        }
+    }
+}
+
+/// A scene, the object that moves in it and where it goes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// Its name in the records.
+    pub name: String,
+    /// The scene file's content.
+    pub file: SceneFile,
+    /// The directory its relative paths start from.
+    pub dir: PathBuf,
+    /// The moving object's name.
+    pub moving: String,
+    /// Where it goes.
+    pub to: Transform,
+}
+
+impl Scenario {
+    /// A scenario from a scene file.
+    pub fn load(path: &Path, moving: &str, to: Transform) -> Result<Self> {
+        let (file, dir) = SceneFile::read(path)?;
+        let name = path.file_stem().map_or_else(
+            || path.display().to_string(),
+            |s| s.to_string_lossy().into(),
+        );
+        Ok(Scenario {
+            name,
+            file,
+            dir: dir.to_path_buf(),
+            moving: moving.to_owned(),
+            to,
+        })
+    }
+}
+
+/// One measured setting.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DynamicRecord {
+    /// Scenario name.
+    pub scene: String,
+    /// The axis: `resolution`, `density`, `budget`, `depth` or `change`.
+    pub axis: String,
+    /// Vertices.
+    pub vertices: usize,
+    /// Objects.
+    pub objects: usize,
+    /// Lat-long height `N` of every map.
+    pub resolution: usize,
+    /// Sample points per shape's fields.
+    pub field_samples: usize,
+    /// Lighting details kept (empty: all).
+    pub keep_light: Option<usize>,
+    /// Own-transport details kept (empty: all).
+    pub keep_visibility: Option<usize>,
+    /// Occlusion-map details kept (empty: all).
+    pub keep_field: Option<usize>,
+    /// `before` or `after` the blend.
+    pub truncation: String,
+    /// Traversal depth (detail levels `0..depth`).
+    pub depth: usize,
+    /// What varies (`object` or `lighting`).
+    pub change: String,
+    /// RMS error over vertices and channels, relative to the ground truth's RMS.
+    pub rms_relative: f64,
+    /// Largest error, relative to the ground truth's RMS.
+    pub max_relative: f64,
+    /// RMS error in radiance units.
+    pub rms: f64,
+    /// Seconds building the fields (all shapes).
+    pub field_seconds: f64,
+    /// Bytes of the stored field maps.
+    pub field_bytes: usize,
+    /// Seconds re-forming the transfer.
+    pub reform_seconds: f64,
+    /// Seconds of one frame (encoding the varying factor and the dot products).
+    pub frame_seconds: f64,
+    /// Fixed-product coefficients per vertex.
+    pub product_coefficients: f64,
+}
+
+/// Runs `protocol` on `scenario` under `env` (rotated by `angles`, degrees); `progress` is
+/// called with each record as it is made.
+pub fn run(
+    scenario: &Scenario,
+    env: &Environment,
+    angles: [f64; 3],
+    protocol: &DynamicProtocol,
+    mut progress: impl FnMut(&DynamicRecord),
+) -> Result<Vec<DynamicRecord>> {
+    let rotation = SphereRotation::from_degrees(angles[0], angles[1], angles[2])?;
+    let mut out = Vec::new();
+    let mut truth: Option<Array2<f64>> = None;
+    let mut push = |r: DynamicRecord, out: &mut Vec<DynamicRecord>| {
+        progress(&r);
+        out.push(r);
+    };
+    let mut setups: Vec<(&str, usize, f64)> = protocol
+        .resolutions
+        .iter()
+        .map(|&n| ("resolution", n, 1.0))
+        .collect();
+    setups.extend(
+        protocol
+            .densities
+            .iter()
+            .filter(|&&d| d != 1.0)
+            .map(|&d| ("density", protocol.base_resolution, d)),
+    );
+    for (axis, n, density) in setups {
+        let built = Built::new(scenario, n, density)?;
+        let truth = match &truth {
+            Some(t) => t,
+            None => truth.insert(built.truth(env, &rotation, protocol.reference_resolution)?),
+        };
+        let r = built.measure(scenario, env, &rotation, truth, axis, Budget::ALL)?;
+        push(r, &mut out);
+        if axis != "resolution" || n != protocol.base_resolution {
+            continue;
+        }
+        for budget in &protocol.budgets {
+            for truncation in [
+                Truncation::Before,
+                Truncation::After(selection(budget.field)),
+            ] {
+                if truncation != Truncation::Before && budget.field.is_none() {
+                    continue;
+                }
+                let mut b = built.with_budget(budget, truncation)?;
+                b.scene.set_shading(truncation, Selection::All, None)?;
+                let r = b.measure(scenario, env, &rotation, truth, "budget", *budget)?;
+                push(r, &mut out);
+            }
+        }
+        let base = built.with_budget(&protocol.base_budget, Truncation::Before)?;
+        let levels = n.trailing_zeros() as usize;
+        for depth in 1..=levels {
+            let mut b = base.clone();
+            b.scene
+                .set_shading(Truncation::Before, Selection::All, Some(depth))?;
+            let r = b.measure(
+                scenario,
+                env,
+                &rotation,
+                truth,
+                "depth",
+                protocol.base_budget,
+            )?;
+            push(r, &mut out);
+        }
+        let r = base.measure_lighting(env, &rotation, truth, protocol.base_budget, scenario)?;
+        push(r, &mut out);
+    }
+    Ok(out)
+}
+
+/// One build of a scenario's scene, with what it cost.
+#[derive(Clone)]
+struct Built {
+    scene: DynamicScene,
+    moving: usize,
+    target: Placement,
+    field_seconds: f64,
+}
+
+impl Built {
+    fn new(scenario: &Scenario, n: usize, density: f64) -> Result<Self> {
+        let param = Parameterization::new(ParamKind::LatLong, n)?;
+        let base = FieldOptions::new(param);
+        let scale = |x: usize, by: f64| ((x as f64 * by).round() as usize).max(2);
+        let field = FieldOptions {
+            circles: scale(base.circles, density),
+            circle_points: scale(base.circle_points, density).max(3),
+            shells: scale(base.shells, density),
+            shell_grid: scale(base.shell_grid, density.sqrt()),
+            ..base
+        };
+        let options = DynamicOptions {
+            field,
+            ..DynamicOptions::new(param)
+        };
+        let scene = DynamicScene::build(&scenario.file, &scenario.dir, &options)?;
+        let moving = scene.object_index(&scenario.moving).ok_or_else(|| {
+            Error::parameter(
+                "moving object",
+                format!(
+                    "{}: no object of {} has that name",
+                    scenario.moving, scenario.name
+                ),
+            )
+        })?;
+        let target = Placement::from_transform(&scenario.to, param)?;
+        Ok(Built {
+            field_seconds: scene.report().field_seconds,
+            scene,
+            moving,
+            target,
+        })
+    }
+
+    fn with_budget(&self, budget: &Budget, truncation: Truncation) -> Result<Self> {
+        let mut scene = self
+            .scene
+            .truncated(selection(budget.visibility), selection(budget.field))?;
+        scene.set_shading(truncation, Selection::All, None)?;
+        Ok(Built {
+            scene,
+            ..self.clone()
+        })
+    }
+
+    /// The ground truth of the moved scene.
+    fn truth(&self, env: &Environment, rotation: &SphereRotation, n: usize) -> Result<Array2<f64>> {
+        let mut moved = self.scene.clone();
+        moved.place(self.moving, self.target)?;
+        moved.reference(&env.lat_long(n, rotation)?)
+    }
+
+    fn lighting(
+        &self,
+        env: &Environment,
+        rotation: &SphereRotation,
+        budget: Budget,
+    ) -> Result<Lighting> {
+        Lighting::new(env, self.scene.param(), rotation, selection(budget.light))
+    }
+
+    fn record(
+        &self,
+        scenario: &Scenario,
+        axis: &str,
+        budget: Budget,
+        truth: &Array2<f64>,
+        got: &Array2<f32>,
+    ) -> DynamicRecord {
+        let o = self.scene.options();
+        let (rms, max) = errors(got, truth);
+        let scale = rms_of(truth);
+        DynamicRecord {
+            scene: scenario.name.clone(),
+            axis: axis.into(),
+            vertices: self.scene.vertex_count(),
+            objects: self.scene.object_count(),
+            resolution: self.scene.param().face_size(),
+            field_samples: o.field.samples(),
+            keep_light: budget.light,
+            keep_visibility: budget.visibility,
+            keep_field: budget.field,
+            truncation: match o.truncation {
+                Truncation::Before => "before".into(),
+                Truncation::After(_) => "after".into(),
+            },
+            depth: o
+                .depth
+                .unwrap_or(self.scene.param().face_size().trailing_zeros() as usize),
+            change: "object".into(),
+            rms_relative: rms / scale,
+            max_relative: max / scale,
+            rms,
+            field_seconds: self.field_seconds,
+            field_bytes: self.scene.report().field_bytes,
+            reform_seconds: 0.0,
+            frame_seconds: 0.0,
+            product_coefficients: 0.0,
+        }
+    }
+
+    /// Forms the transfer for the moving object, moves it, shades the frame.
+    fn measure(
+        &self,
+        scenario: &Scenario,
+        env: &Environment,
+        rotation: &SphereRotation,
+        truth: &Array2<f64>,
+        axis: &str,
+        budget: Budget,
+    ) -> Result<DynamicRecord> {
+        let lighting = self.lighting(env, rotation, budget)?;
+        let mut scene = self.scene.clone();
+        let start = Instant::now();
+        let jrt = Jrt::<f32>::form(&scene, &lighting, Change::Object(self.moving))?;
+        let reform = start.elapsed().as_secs_f64();
+        scene.place(self.moving, self.target)?;
+        let start = Instant::now();
+        let got = jrt.frame_moved(&scene)?;
+        let frame = start.elapsed().as_secs_f64();
+        let mut r = self.record(scenario, axis, budget, truth, &got);
+        r.reform_seconds = reform;
+        r.frame_seconds = frame;
+        r.product_coefficients = jrt.report().coefficients as f64 / scene.vertex_count() as f64;
+        Ok(r)
+    }
+
+    /// The moved scene with the transfer formed for a change of lighting.
+    fn measure_lighting(
+        &self,
+        env: &Environment,
+        rotation: &SphereRotation,
+        truth: &Array2<f64>,
+        budget: Budget,
+        scenario: &Scenario,
+    ) -> Result<DynamicRecord> {
+        let mut scene = self.scene.clone();
+        scene.place(self.moving, self.target)?;
+        let lighting = self.lighting(env, rotation, budget)?;
+        let start = Instant::now();
+        let jrt = Jrt::<f32>::form(&scene, &lighting, Change::Lighting)?;
+        let reform = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let lighting = self.lighting(env, rotation, budget)?;
+        let got = jrt.frame_lit(&scene, &lighting)?;
+        let frame = start.elapsed().as_secs_f64();
+        let mut r = Built {
+            scene,
+            ..self.clone()
+        }
+        .record(scenario, "change", budget, truth, &got);
+        r.change = "lighting".into();
+        r.reform_seconds = reform;
+        r.frame_seconds = frame;
+        r.product_coefficients = jrt.report().coefficients as f64 / r.vertices as f64;
+        Ok(r)
+    }
+}
+
+fn rms_of(a: &Array2<f64>) -> f64 {
+    (a.iter().map(|x| x * x).sum::<f64>() / a.len().max(1) as f64).sqrt()
+}
+
+/// RMS and largest absolute difference over every vertex and channel.
+fn errors(got: &Array2<f32>, truth: &Array2<f64>) -> (f64, f64) {
+    let (mut sum, mut max) = (0.0f64, 0.0f64);
+    for (a, b) in got.iter().zip(truth) {
+        let d = (f64::from(*a) - b).abs();
+        sum += d * d;
+        max = max.max(d);
+    }
+    ((sum / truth.len().max(1) as f64).sqrt(), max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sphere::LatLongMap;
+
+    #[test]
+    fn a_record_is_the_error_of_the_moved_frame_against_the_ray_cast_truth() {
+        let file: SceneFile = serde_json::from_str(
+            r#"{"objects": [
+                {"name": "a", "generator": {"plane_under_box": {"height": 0.5}}},
+                {"name": "b", "generator": {"sphere": {"cells": 2}},
+                 "transform": {"translate": [0.4, 2.0, 0.2], "scale": 0.5}}]}"#,
+        )
+        .unwrap();
+        let scenario = Scenario {
+            name: "t".into(),
+            file,
+            dir: PathBuf::from("."),
+            moving: "b".into(),
+            to: Transform {
+                translate: [-0.6, 2.2, 0.3],
+                scale: 0.5,
+                ..Transform::default()
+            },
+        };
+        let env = Environment::new(
+            LatLongMap::<f64>::from_fn(16, 3, |d, o| o.fill(0.2 + 2.0 * d[1].max(0.0).powi(4)))
+                .unwrap(),
+        );
+        let protocol = DynamicProtocol {
+            resolutions: vec![8],
+            densities: vec![1.0],
+            base_resolution: 8,
+            budgets: vec![Budget::ALL],
+            base_budget: Budget::ALL,
+            reference_resolution: 8,
+        };
+        let records = run(&scenario, &env, [0.0; 3], &protocol, |_| {}).unwrap();
+        // resolution, budget (all: before only), depths 1 to 3, the lighting change.
+        assert_eq!(records.len(), 1 + 1 + 3 + 1);
+        // Independently: the scene moved, shaded by the n-function product integral, against
+        // the reference at the working resolution.
+        let built = Built::new(&scenario, 8, 1.0).unwrap();
+        let mut moved = built.scene.clone();
+        moved.place(built.moving, built.target).unwrap();
+        let rotation = SphereRotation::identity();
+        let lighting = Lighting::new(&env, moved.param(), &rotation, Selection::All).unwrap();
+        let got = moved.shade::<f64>(&lighting).unwrap().mapv(|x| x as f32);
+        let truth = moved
+            .reference(&env.lat_long(8, &rotation).unwrap())
+            .unwrap();
+        let (rms, max) = errors(&got, &truth);
+        let r = &records[0];
+        assert!(
+            (r.rms - rms).abs() <= 1e-6 * rms.max(1e-12),
+            "{} {rms}",
+            r.rms
+        );
+        assert!((r.max_relative - max / rms_of(&truth)).abs() < 1e-6);
+        // The fields interpolate: an error, but a small one.
+        assert!(
+            r.rms_relative > 0.0 && r.rms_relative < 0.2,
+            "{}",
+            r.rms_relative
+        );
+        // Depth 0 would be face means; depth 3 is every level: the unlimited figure.
+        let full_depth = records
+            .iter()
+            .find(|r| r.axis == "depth" && r.depth == 3)
+            .unwrap();
+        assert!((full_depth.rms - records[1].rms).abs() <= 1e-6 * rms);
+        let coarse = records
+            .iter()
+            .find(|r| r.axis == "depth" && r.depth == 1)
+            .unwrap();
+        assert!(coarse.rms > full_depth.rms);
+    }
+}
