@@ -25,7 +25,10 @@ use crate::product::Selection;
 use crate::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
 use crate::relight::environment::Environment;
 use crate::relight::fields::{FieldOptions, Truncation};
-use crate::relight::{Lighting, SceneFile, Transform};
+use crate::relight::{
+    Lighting, PreparedTransport, SceneBvh, SceneFile, ShadeOptions, Transform, VisibilityOptions,
+    vertex_major,
+};
 use crate::sphere::SphereRotation;
 use crate::sphere::param::{ParamKind, Parameterization};
 use crate::{Error, Result};
@@ -143,12 +146,13 @@ impl Scenario {
     }
 }
 
-/// One measured setting.
+/// One measured setting. The `static` axis is the floor under the others: the moved scene
+/// precomputed as a static scene (its "re-form" is that precomputation).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DynamicRecord {
     /// Scenario name.
     pub scene: String,
-    /// The axis: `resolution`, `density`, `budget`, `depth` or `change`.
+    /// The axis: `resolution`, `density`, `budget`, `depth`, `change` or `static`.
     pub axis: String,
     /// Vertices.
     pub vertices: usize,
@@ -258,6 +262,8 @@ pub fn run(
             push(r, &mut out);
         }
         let r = base.measure_lighting(env, &rotation, truth, protocol.base_budget, scenario)?;
+        push(r, &mut out);
+        let r = built.measure_static(env, &rotation, truth, scenario)?;
         push(r, &mut out);
     }
     Ok(out)
@@ -400,6 +406,40 @@ impl Built {
         Ok(r)
     }
 
+    /// The floor under every field figure: the moved scene precomputed as a static scene
+    /// (own transport ray-cast against every object, issue 8's path), all coefficients kept.
+    fn measure_static(
+        &self,
+        env: &Environment,
+        rotation: &SphereRotation,
+        truth: &Array2<f64>,
+        scenario: &Scenario,
+    ) -> Result<DynamicRecord> {
+        let mut scene = self.scene.clone();
+        scene.place(self.moving, self.target)?;
+        let mesh = scene.mesh();
+        let param = scene.param();
+        let start = Instant::now();
+        let (set, _) = vertex_major(&mesh, &SceneBvh::new(&mesh), &VisibilityOptions::new(param))?;
+        let reform = start.elapsed().as_secs_f64();
+        let prepared =
+            PreparedTransport::<f32>::new(&set, scene.albedo().view(), &ShadeOptions::default())?;
+        let start = Instant::now();
+        let got = prepared.shade(&self.lighting(env, rotation, Budget::ALL)?)?;
+        let frame = start.elapsed().as_secs_f64();
+        let mut r = Built {
+            scene,
+            ..self.clone()
+        }
+        .record(scenario, "static", Budget::ALL, truth, &got);
+        r.change = "none".into();
+        (r.field_seconds, r.field_bytes) = (0.0, 0);
+        r.reform_seconds = reform;
+        r.frame_seconds = frame;
+        r.product_coefficients = set.coefficient_count() as f64 / r.vertices as f64;
+        Ok(r)
+    }
+
     /// The moved scene with the transfer formed for a change of lighting.
     fn measure_lighting(
         &self,
@@ -485,8 +525,8 @@ mod tests {
             reference_resolution: 8,
         };
         let records = run(&scenario, &env, [0.0; 3], &protocol, |_| {}).unwrap();
-        // resolution, budget (all: before only), depths 1 to 3, the lighting change.
-        assert_eq!(records.len(), 1 + 1 + 3 + 1);
+        // resolution, budget (all: before only), depths 1 to 3, the lighting change, static.
+        assert_eq!(records.len(), 1 + 1 + 3 + 1 + 1);
         // Independently: the scene moved, shaded by the n-function product integral, against
         // the reference at the working resolution.
         let built = Built::new(&scenario, 8, 1.0).unwrap();

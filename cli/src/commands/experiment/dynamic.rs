@@ -32,7 +32,8 @@ rows: resolution (lat-long N x 2N maps, seed 001's field density), density (the 
 resolution, the circles, points and shells scaled), budget (lighting / own transport /
 occlusion-map details kept, occlusion maps truncated before or after the blend), depth
 (traversal depth at the base budget), change (the transfer formed for a change of lighting
-instead). --quick: resolutions 16 and 32, densities 0.25 to 1, reference 64; --full adds 64
+instead), static (the moved scene precomputed as a static scene, no field: the floor that the
+resolution alone sets). --quick: resolutions 16 and 32, densities 0.25 to 1, reference 64; --full adds 64
 and density 2, reference 128. Errors are relative to the ground truth's RMS radiance.
 
 Writes DIR/dynamic.csv, .json and .md and DIR/dynamic-rms-time.png (error against frame
@@ -219,6 +220,7 @@ fn label(r: &DynamicRecord) -> String {
             r.truncation
         ),
         "depth" => format!("depth {}", r.depth),
+        "static" => "static precompute".into(),
         _ => format!("{} change", r.change),
     }
 }
