@@ -36,8 +36,8 @@ instead), static (the moved scene precomputed as a static scene, no field: the f
 resolution alone sets). --quick: resolutions 16 and 32, densities 0.25 to 1, reference 64; --full adds 64
 and density 2, reference 128. Errors are relative to the ground truth's RMS radiance.
 
-Writes DIR/dynamic.csv, .json and .md and DIR/dynamic-rms-time.png (error against frame
-time, Pareto frontier joined).";
+Writes DIR/dynamic.csv, .json and .md and, per scene, DIR/dynamic-SCENE-rms-time.png (error
+against frame time, Pareto frontier joined).";
 
 /// Occlusion fields and just-in-time transfer against ray casting: table, CSV, JSON, plot.
 #[derive(clap::Args, Debug)]
@@ -147,7 +147,7 @@ pub fn run_command(args: Args) -> Result<()> {
         let env = Environment::load(&env_path)?;
         bar.set_message(scenario.name.clone());
         let got = run(&scenario, &env, angles, &protocol, |r| {
-            bar.set_message(format!("{}: {} {}", r.scene, r.axis, label(r)));
+            bar.set_message(format!("{}: {}", r.scene, label(r)));
         })?;
         records.extend(got);
         bar.inc(1);
@@ -176,30 +176,40 @@ pub fn run_command(args: Args) -> Result<()> {
         2 * protocol.reference_resolution
     );
     let text = format!("{header}{}", table(&records));
-    let points: Vec<LabeledPoint> = records
-        .iter()
-        .filter(|r| r.frame_seconds > 0.0 && r.rms_relative > 0.0)
-        .map(|r| LabeledPoint {
-            label: format!("{} {}", r.axis, label(r)),
-            x: r.frame_seconds,
-            y: r.rms_relative,
-        })
-        .collect();
     let mut written = reports.write(&text, &records, &[])?;
-    if !points.is_empty() {
+    // One plot per scene: error against frame time, the Pareto frontier joined (the static
+    // precomputation left out: its cost is a new precomputation per move, not a frame).
+    let mut scenes: Vec<&str> = records.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    for scene in scenes {
+        let points: Vec<LabeledPoint> = records
+            .iter()
+            .filter(|r| r.scene == scene && r.axis != "static")
+            .filter(|r| r.frame_seconds > 0.0 && r.rms_relative > 0.0)
+            .map(|r| LabeledPoint {
+                label: label(r),
+                x: r.frame_seconds,
+                y: r.rms_relative,
+            })
+            .collect();
+        if points.is_empty() {
+            continue;
+        }
         let front: Vec<LabeledPoint> =
             frontier(&points.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>())
                 .into_iter()
                 .map(|i| points[i].clone())
                 .collect();
         let plot = log_log_scatter(
-            "dynamic scenes: error against the time of a frame",
+            &format!("{scene}: error against the time of a frame"),
             "seconds per frame",
             "RMS error / RMS radiance",
             &points,
             &front,
         )?;
-        written.push_str(&wrote(&[reports.writer().png("rms-time", &plot)?]));
+        written.push_str(&wrote(&[reports
+            .writer()
+            .png(&format!("{scene}-rms-time"), &plot)?]));
     }
     print(&format!("{text}\n{written}"))
 }
@@ -212,16 +222,16 @@ fn budget_label(l: Option<usize>, v: Option<usize>, f: Option<usize>) -> String 
 /// The setting a record varies.
 fn label(r: &DynamicRecord) -> String {
     match r.axis.as_str() {
-        "resolution" => format!("{} x {}", r.resolution, 2 * r.resolution),
-        "density" => format!("{} samples", r.field_samples),
+        "resolution" => format!("maps {} x {}", r.resolution, 2 * r.resolution),
+        "density" => format!("{} field samples", r.field_samples),
         "budget" => format!(
-            "{} {}",
+            "kept {} {}",
             budget_label(r.keep_light, r.keep_visibility, r.keep_field),
             r.truncation
         ),
         "depth" => format!("depth {}", r.depth),
-        "static" => "static precompute".into(),
-        _ => format!("{} change", r.change),
+        "static" => "static precomputation".into(),
+        _ => format!("{} changes", r.change),
     }
 }
 
