@@ -23,3 +23,6 @@ run experiment shift-chain --dx 7.5 --dy -4.5 --steps 12 --retained-precision 3 
 run experiment tradeoff --out-dir results/tradeoff --force
 run experiment stability --out-dir results/stability --force
 run experiment sphere --out-dir results/sphere --force
+# Dynamic scenes: occlusion fields and just-in-time transfer against ray casting (the
+# animations and the speed table are scripts/dynamic.sh's and scripts/dynamic_speed.sh's).
+run experiment dynamic --out-dir results/dynamic --force
