@@ -920,8 +920,33 @@ pub struct JrtReport {
 /// of the moving object, or the new lighting): one sparse dot product per vertex. Re-form it
 /// when the kind of change switches.
 ///
-/// A vertex of the moving object sees every other object move: its `F` is their product
-/// (one lookup: a dot product; several: the n-function traversal with `T`).
+/// A vertex of the moving object sees every other object move: its `F` is the product of
+/// their looked-up maps (one map: a dot product; several: their product tree, then the dot).
+///
+/// ```
+/// use haarshift::product::Selection;
+/// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
+/// use haarshift::relight::{Lighting, SceneFile};
+/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// let file: SceneFile = serde_json::from_str(r#"{"objects": [
+///     {"generator": {"sphere": {"cells": 2}}},
+///     {"generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.5, 0, 0]}}
+///   ], "ground_plane": true}"#).unwrap();
+/// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
+/// let mut options = DynamicOptions::new(param);
+/// (options.field.circles, options.field.circle_points) = (8, 16);
+/// (options.field.shells, options.field.shell_grid) = (4, 3);
+/// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+/// let sky = SphereMap::<f64>::from_fn(param, 3, |d, o| o.fill(0.2 + d[1].max(0.0))).unwrap();
+/// let light = Lighting::from_map(&sky, Selection::All).unwrap();
+/// let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
+/// // Move object 1; a frame is one dot product per vertex with its looked-up map.
+/// let moved = Placement { translate: [1.5, 0.0, 1.0], ..scene.placement(1) };
+/// scene.place(1, moved).unwrap();
+/// let fast = jrt.frame_moved(&scene).unwrap();
+/// let full = scene.shade::<f64>(&light).unwrap(); // every product integral from scratch
+/// assert!(fast.iter().zip(&full).all(|(a, b)| (a - b).abs() < 1e-9));
+/// ```
 #[derive(Clone, Debug)]
 pub struct Jrt<T> {
     change: Change,
