@@ -217,6 +217,37 @@ fn interpolate(a: &Placement, b: &Placement, t: f64, w: usize) -> Placement {
 /// Plays `path` in `scene` under `env` (its rotation `[yaw, pitch, roll]` in degrees, the
 /// lighting's yaw added per frame), the lighting truncated to `keep_light`; `frame` receives
 /// each frame's scene, per-vertex radiance, lighting rotation and report.
+///
+/// ```
+/// use haarshift::product::Selection;
+/// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+/// use haarshift::relight::environment::Environment;
+/// use haarshift::relight::motion::{MotionPath, play};
+/// use haarshift::relight::SceneFile;
+/// use haarshift::sphere::LatLongMap;
+/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// let file: SceneFile = serde_json::from_str(r#"{"objects": [
+///     {"generator": {"sphere": {"cells": 2}}},
+///     {"name": "ball", "generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.5, 0, 0]}}
+///   ]}"#).unwrap();
+/// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
+/// (options.field.circles, options.field.circle_points) = (8, 16);
+/// (options.field.shells, options.field.shell_grid) = (4, 3);
+/// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+/// let env = Environment::new(LatLongMap::<f64>::from_fn(16, 3, |d, o| o.fill(1.0 + d[1])).unwrap());
+/// let path: MotionPath = serde_json::from_str(r#"{"segments": [
+///     {"frames": 2, "object": "ball", "to": {"translate": [1.5, 0, 1]}},
+///     {"frames": 1, "light_yaw": 90}]}"#).unwrap();
+/// let mut reformed = Vec::new();
+/// play(&mut scene, &env, [0.0; 3], Selection::All, &path, |_, radiance, _, report| {
+///     assert_eq!(radiance.dim(), (108, 3));
+///     reformed.push(report.reformed.is_some());
+///     Ok(())
+/// }).unwrap();
+/// // Formed at frame 0 for the moving ball, re-formed when the lighting starts to turn.
+/// assert_eq!(reformed, [true, false, false, true]);
+/// assert_eq!(scene.placement(1).translate, [1.5, 0.0, 1.0]);
+/// ```
 pub fn play(
     scene: &mut DynamicScene,
     env: &Environment,
