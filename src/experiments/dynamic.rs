@@ -239,8 +239,7 @@ pub fn run(
                 if truncation != Truncation::Before && budget.field.is_none() {
                     continue;
                 }
-                let mut b = built.with_budget(budget, truncation)?;
-                b.scene.set_shading(truncation, Selection::All, None)?;
+                let b = built.with_budget(budget, truncation)?;
                 let r = b.measure(scenario, env, &rotation, truth, "budget", *budget)?;
                 push(r, &mut out);
             }
@@ -275,7 +274,6 @@ struct Built {
     scene: DynamicScene,
     moving: usize,
     target: Placement,
-    field_seconds: f64,
 }
 
 impl Built {
@@ -306,7 +304,6 @@ impl Built {
         })?;
         let target = Placement::from_transform(&scenario.to, param)?;
         Ok(Built {
-            field_seconds: scene.report().field_seconds,
             scene,
             moving,
             target,
@@ -320,7 +317,8 @@ impl Built {
         scene.set_shading(truncation, Selection::All, None)?;
         Ok(Built {
             scene,
-            ..self.clone()
+            moving: self.moving,
+            target: self.target,
         })
     }
 
@@ -372,7 +370,7 @@ impl Built {
             rms_relative: rms / scale,
             max_relative: max / scale,
             rms,
-            field_seconds: self.field_seconds,
+            field_seconds: self.scene.report().field_seconds,
             field_bytes: self.scene.report().field_bytes,
             reform_seconds: 0.0,
             frame_seconds: 0.0,
@@ -429,7 +427,8 @@ impl Built {
         let frame = start.elapsed().as_secs_f64();
         let mut r = Built {
             scene,
-            ..self.clone()
+            moving: self.moving,
+            target: self.target,
         }
         .record(scenario, "static", Budget::ALL, truth, &got);
         r.change = "none".into();
@@ -461,7 +460,8 @@ impl Built {
         let frame = start.elapsed().as_secs_f64();
         let mut r = Built {
             scene,
-            ..self.clone()
+            moving: self.moving,
+            target: self.target,
         }
         .record(scenario, "change", budget, truth, &got);
         r.change = "lighting".into();

@@ -43,7 +43,7 @@ use serde::{Deserialize, Serialize};
 
 use super::fields::{Blend, FieldOptions, OcclusionField, Truncation, select_rows, yaw_sparse};
 use super::lighting::Lighting;
-use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under};
+use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under, merge};
 use super::shade::{select_kept, within_depth};
 use super::sparse::SparseRows;
 use super::visibility::{VisibilityOptions, ray_offset, vertex_major};
@@ -353,13 +353,10 @@ impl DynamicScene {
             .iter()
             .map(|&(shape, p, _)| place_mesh(&shapes[shape], &p, param))
             .collect();
-        let ground = file.ground_plane.then(|| {
-            let mut all = meshes[0].clone();
-            for m in &meshes[1..] {
-                all.append(m);
-            }
-            ground_plane_under(&all.bounds())
-        });
+        let objects_mesh = merge(meshes.iter().cloned());
+        let ground = file
+            .ground_plane
+            .then(|| ground_plane_under(&objects_mesh.bounds()));
         let visibility = VisibilityOptions {
             keep: options.keep_visibility,
             progress: options.progress,
@@ -400,13 +397,7 @@ impl DynamicScene {
             }
             None => None,
         };
-        let mut all = meshes[0].clone();
-        for m in &meshes[1..] {
-            all.append(m);
-        }
-        if let Some((g, _)) = &ground {
-            all.append(g);
-        }
+        let all = merge(std::iter::once(objects_mesh).chain(ground.iter().map(|g| g.0.clone())));
         Ok(DynamicScene {
             options: *options,
             lift: ray_offset(&all),
@@ -590,16 +581,12 @@ impl DynamicScene {
     /// and the rasteriser).
     pub fn mesh(&self) -> Mesh {
         let param = self.param();
-        let mut meshes = self
-            .objects
-            .iter()
-            .map(|o| place_mesh(&self.shapes[o.shape], &o.placement, param))
-            .chain(self.ground.iter().map(|g| g.0.clone()));
-        let mut out = meshes.next().expect("a scene has an object");
-        for m in meshes {
-            out.append(&m);
-        }
-        out
+        merge(
+            self.objects
+                .iter()
+                .map(|o| place_mesh(&self.shapes[o.shape], &o.placement, param))
+                .chain(self.ground.iter().map(|g| g.0.clone())),
+        )
     }
 
     /// The albedo of every vertex of [`mesh`](Self::mesh), `(V, 3)`.
@@ -1120,13 +1107,6 @@ impl<T: Sample> Jrt<T> {
 
     fn check_scene(&self, scene: &DynamicScene) -> Result<()> {
         let turns: Vec<usize> = scene.objects.iter().map(|o| o.placement.turn).collect();
-        if scene.vertex_count() == self.products.len() && turns != self.turns {
-            return Err(Error::parameter(
-                "scene",
-                "an object turned since the transfer was formed: re-form it (a turn moves \
-                 the object's own transport and the fixed products that hold it)",
-            ));
-        }
         if scene.vertex_count() != self.products.len() {
             return Err(Error::parameter(
                 "scene",
@@ -1135,6 +1115,13 @@ impl<T: Sample> Jrt<T> {
                     scene.vertex_count(),
                     self.products.len()
                 ),
+            ));
+        }
+        if turns != self.turns {
+            return Err(Error::parameter(
+                "scene",
+                "an object turned since the transfer was formed: re-form it (a turn moves \
+                 the object's own transport and the fixed products that hold it)",
             ));
         }
         Ok(())

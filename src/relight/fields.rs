@@ -32,7 +32,7 @@
 //! field: trilinear, linear between the two shells about its radius and bilinear on their
 //! face grids. Inside the innermost circle (shell) the innermost one is used. **Beyond the
 //! outermost shell the object is taken not to occlude at all** (the lookup is `None`, the
-//! map is 1): at `6 R` the object covers at most `2 pi (1 - cos asin(1/6)) = 0.086` sr of the
+//! map is 1): at `6 R` the object covers at most `2 pi (1 - cos asin(1/6)) = 0.088` sr of the
 //! `4 pi`, so the light a receiver gains when an object crosses the boundary is at most
 //! 0.7 % of its unshadowed irradiance (an overcast sky; less under a sun that the object does
 //! not cover). Interpolating pixels or coefficients is the same (the transform is linear);
@@ -383,7 +383,8 @@ impl OcclusionField {
                 keep,
                 ..self.options
             },
-            ..self.clone()
+            frame: self.frame,
+            turn: self.turn,
         })
     }
 
@@ -412,7 +413,8 @@ impl OcclusionField {
         Ok(OcclusionField {
             maps,
             turn: k,
-            ..self.clone()
+            options: self.options,
+            frame: self.frame,
         })
     }
 
@@ -500,7 +502,7 @@ impl OcclusionField {
 
 /// The weighted sum of sparse maps, sparse (indices in first-touched order), then truncated
 /// as `truncation` says. `scratch` holds `param.texels()` zeros and is left so.
-pub(crate) fn blend_maps<'a>(
+fn blend_maps<'a>(
     param: Parameterization,
     maps: impl Iterator<Item = ((&'a [u32], &'a [f32]), f32)>,
     truncation: Truncation,
@@ -585,10 +587,9 @@ fn ring(x: f64, lo: f64, hi: f64, n: usize) -> (usize, f64) {
     }
     let u = (x / lo).ln() / (hi / lo).ln() * (n - 1) as f64;
     let k = (u.floor() as usize).min(n - 2);
-    let r = |k: usize| lo * (hi / lo).powf(k as f64 / (n - 1) as f64);
     // Linear in the distance between the two rings (the fraction of the way from one to the
     // other), not in the logarithm.
-    let (a, b) = (r(k), r(k + 1));
+    let (a, b) = (ring_radius(k, lo, hi, n), ring_radius(k + 1, lo, hi, n));
     (k, ((x - a) / (b - a)).clamp(0.0, 1.0))
 }
 

@@ -204,8 +204,8 @@ fn cylinder(base: [f64; 3], radius: f64, height: f64, segments: usize, rings: us
     mesh
 }
 
-/// All meshes appended in order.
-fn merge(meshes: impl IntoIterator<Item = Mesh>) -> Mesh {
+/// All meshes appended in order (at least one).
+pub(crate) fn merge(meshes: impl IntoIterator<Item = Mesh>) -> Mesh {
     let mut meshes = meshes.into_iter();
     let mut out = meshes.next().expect("at least one mesh");
     for m in meshes {

@@ -64,14 +64,6 @@ impl<V: Copy> SparseRows<V> {
         self.offsets.push(self.indices.len() as u64);
     }
 
-    /// Appends every row of `other`.
-    pub fn append(&mut self, other: &SparseRows<V>) {
-        for r in 0..other.len() {
-            let (i, v) = other.row(r);
-            self.push(i, v);
-        }
-    }
-
     /// Row `r`'s indices and values.
     #[inline]
     pub fn row(&self, r: usize) -> (&[u32], &[V]) {

@@ -272,14 +272,14 @@ fn bad_options_are_refused() {
     o = small(param);
     o.keep = Selection::Largest(1000);
     assert!(OcclusionField::build(&mesh, &o).is_err());
+    // No width or depth: no footprint to place the planar field by.
     let flat = Mesh::new(
         ndarray::array![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]],
         vec![[0, 1, 2]],
         None,
-    );
-    if let Ok(flat) = flat {
-        assert!(OcclusionField::build(&flat, &small(param)).is_err());
-    }
+    )
+    .unwrap();
+    assert!(OcclusionField::build(&flat, &small(param)).is_err());
     let cube = Parameterization::new(ParamKind::Cube, 4).unwrap();
     let (field, _) = OcclusionField::build(&mesh, &small(cube)).unwrap();
     assert!(field.turned(1).is_err());
