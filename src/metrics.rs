@@ -97,20 +97,60 @@ pub fn relative_rms_error<T: Sample>(
     result: ArrayView2<'_, T>,
     reference: ArrayView2<'_, T>,
 ) -> Result<f64> {
-    let difference = ErrorStats::between(result, reference, None, 1.0)?;
-    let scale = (reference
-        .iter()
-        .map(|v| v.as_f64() * v.as_f64())
-        .sum::<f64>()
-        / difference.count as f64)
-        .sqrt();
-    if scale == 0.0 {
-        return Err(Error::parameter(
-            "reference",
-            "is 0 everywhere: an error relative to its RMS is undefined",
-        ));
+    Ok(RelativeError::between(result, reference)?.rms_relative)
+}
+
+/// The per-vertex radiance error of a relighting method: RMS and largest absolute difference
+/// over all vertices and channels, in radiance units and relative to the reference's RMS
+/// (the scale of the scene, as [`relative_rms_error`] has it).
+///
+/// ```
+/// use haarshift::metrics::RelativeError;
+/// use ndarray::array;
+/// let reference = array![[3.0, 0.0], [0.0, 4.0]]; // RMS 2.5
+/// let e = RelativeError::between(array![[3.0, 0.5], [0.0, 4.0]].view(), reference.view()).unwrap();
+/// assert!((e.rms - 0.25).abs() < 1e-15 && (e.rms_relative - 0.1).abs() < 1e-15);
+/// assert!((e.max - 0.5).abs() < 1e-15 && (e.max_relative - 0.2).abs() < 1e-15);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RelativeError {
+    /// RMS difference, radiance units.
+    pub rms: f64,
+    /// Largest absolute difference, radiance units.
+    pub max: f64,
+    /// `rms` over the reference's RMS.
+    pub rms_relative: f64,
+    /// `max` over the reference's RMS.
+    pub max_relative: f64,
+}
+
+impl RelativeError {
+    /// Compares `result` with `reference` (one shape); an error when the shapes differ or the
+    /// reference is 0 everywhere.
+    pub fn between<T: Sample>(
+        result: ArrayView2<'_, T>,
+        reference: ArrayView2<'_, T>,
+    ) -> Result<Self> {
+        let difference = ErrorStats::between(result, reference, None, 1.0)?;
+        let scale = (reference
+            .iter()
+            .map(|v| v.as_f64() * v.as_f64())
+            .sum::<f64>()
+            / difference.count as f64)
+            .sqrt();
+        if scale == 0.0 {
+            return Err(Error::parameter(
+                "reference",
+                "is 0 everywhere: an error relative to its RMS is undefined",
+            ));
+        }
+        Ok(RelativeError {
+            rms: difference.rms,
+            max: difference.max_error,
+            rms_relative: difference.rms / scale,
+            max_relative: difference.max_error / scale,
+        })
     }
-    Ok(difference.rms / scale)
 }
 
 /// The pixels whose centres lie within `radius` of the array's centre `((h-1)/2, (w-1)/2)`.

@@ -21,6 +21,7 @@ use std::time::Instant;
 use ndarray::Array2;
 use serde::Serialize;
 
+use crate::metrics::RelativeError;
 use crate::product::Selection;
 use crate::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
 use crate::relight::environment::Environment;
@@ -345,11 +346,10 @@ impl Built {
         budget: Budget,
         truth: &Array2<f64>,
         got: &Array2<f32>,
-    ) -> DynamicRecord {
+    ) -> Result<DynamicRecord> {
         let o = self.scene.options();
-        let (rms, max) = errors(got, truth);
-        let scale = rms_of(truth);
-        DynamicRecord {
+        let error = RelativeError::between(got.mapv(f64::from).view(), truth.view())?;
+        Ok(DynamicRecord {
             scene: scenario.name.clone(),
             axis: axis.into(),
             vertices: self.scene.vertex_count(),
@@ -367,15 +367,15 @@ impl Built {
                 .depth
                 .unwrap_or(self.scene.param().face_size().trailing_zeros() as usize),
             change: "object".into(),
-            rms_relative: rms / scale,
-            max_relative: max / scale,
-            rms,
+            rms_relative: error.rms_relative,
+            max_relative: error.max_relative,
+            rms: error.rms,
             field_seconds: self.scene.report().field_seconds,
             field_bytes: self.scene.report().field_bytes,
             reform_seconds: 0.0,
             frame_seconds: 0.0,
             product_coefficients: 0.0,
-        }
+        })
     }
 
     /// Forms the transfer for the moving object, moves it, shades the frame.
@@ -397,7 +397,7 @@ impl Built {
         let start = Instant::now();
         let got = jrt.frame_moved(&scene)?;
         let frame = start.elapsed().as_secs_f64();
-        let mut r = self.record(scenario, axis, budget, truth, &got);
+        let mut r = self.record(scenario, axis, budget, truth, &got)?;
         r.reform_seconds = reform;
         r.frame_seconds = frame;
         r.product_coefficients = jrt.report().coefficients as f64 / scene.vertex_count() as f64;
@@ -430,7 +430,7 @@ impl Built {
             moving: self.moving,
             target: self.target,
         }
-        .record(scenario, "static", Budget::ALL, truth, &got);
+        .record(scenario, "static", Budget::ALL, truth, &got)?;
         r.change = "none".into();
         (r.field_seconds, r.field_bytes) = (0.0, 0);
         r.reform_seconds = reform;
@@ -463,28 +463,13 @@ impl Built {
             moving: self.moving,
             target: self.target,
         }
-        .record(scenario, "change", budget, truth, &got);
+        .record(scenario, "change", budget, truth, &got)?;
         r.change = "lighting".into();
         r.reform_seconds = reform;
         r.frame_seconds = frame;
         r.product_coefficients = jrt.report().coefficients as f64 / r.vertices as f64;
         Ok(r)
     }
-}
-
-fn rms_of(a: &Array2<f64>) -> f64 {
-    (a.iter().map(|x| x * x).sum::<f64>() / a.len().max(1) as f64).sqrt()
-}
-
-/// RMS and largest absolute difference over every vertex and channel.
-fn errors(got: &Array2<f32>, truth: &Array2<f64>) -> (f64, f64) {
-    let (mut sum, mut max) = (0.0f64, 0.0f64);
-    for (a, b) in got.iter().zip(truth) {
-        let d = (f64::from(*a) - b).abs();
-        sum += d * d;
-        max = max.max(d);
-    }
-    ((sum / truth.len().max(1) as f64).sqrt(), max)
 }
 
 #[cfg(test)]
@@ -538,14 +523,22 @@ mod tests {
         let truth = moved
             .reference(&env.lat_long(8, &rotation).unwrap())
             .unwrap();
-        let (rms, max) = errors(&got, &truth);
+        // By hand: the RMS and largest difference, the truth's RMS.
+        let d: Vec<f64> = got
+            .iter()
+            .zip(&truth)
+            .map(|(a, b)| f64::from(*a) - b)
+            .collect();
+        let rms = (d.iter().map(|x| x * x).sum::<f64>() / d.len() as f64).sqrt();
+        let max = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let scale = (truth.iter().map(|x| x * x).sum::<f64>() / truth.len() as f64).sqrt();
         let r = &records[0];
         assert!(
             (r.rms - rms).abs() <= 1e-6 * rms.max(1e-12),
             "{} {rms}",
             r.rms
         );
-        assert!((r.max_relative - max / rms_of(&truth)).abs() < 1e-6);
+        assert!((r.max_relative - max / scale).abs() < 1e-6);
         // The fields interpolate: an error, but a small one.
         assert!(
             r.rms_relative > 0.0 && r.rms_relative < 0.2,

@@ -7,6 +7,8 @@
 //! * [`shift_chain`]: one shift against a chain of small ones (the seed's Table 3.1).
 //! * [`stability`]: the numerical extremes, each check with its figure, tolerance and verdict.
 //! * [`tradeoff`]: every kernel and parameter through the rotation cycle; Pareto frontiers.
+//! * [`relight`]: every relighting method against the ray-cast truth over the seeds' axes;
+//!   picture grids.
 //! * [`dynamic`]: occlusion fields and just-in-time radiance transfer against the ray-cast truth.
 //! * [`output`]: CSV, JSON and PNG files side by side, written atomically.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
@@ -15,6 +17,7 @@ pub mod kernel_cycle;
 pub mod output;
 pub mod pareto;
 pub mod plot;
+pub mod relight;
 pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod stability;

@@ -106,6 +106,29 @@ fn log_range(values: impl Iterator<Item = f64>) -> Result<std::ops::Range<f64>> 
     Ok(lo / 1.5..hi * 1.5)
 }
 
+/// The grid, tick labels and axis titles of a log-log chart.
+fn draw_log_mesh<X, Y>(
+    chart: &mut ChartContext<'_, BitMapBackend<'_>, Cartesian2d<X, Y>>,
+    x_label: &str,
+    y_label: &str,
+) -> Result<()>
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType = f64>
+        + plotters::coord::ranged1d::ValueFormatter<f64>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = f64>
+        + plotters::coord::ranged1d::ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .x_label_formatter(&|v| short_number(*v))
+        .y_label_formatter(&|v| short_number(*v))
+        .label_style(("sans-serif", 16))
+        .draw()
+        .map_err(plot_error)
+}
+
 /// A log-log scatter plot of `points` with the points of `frontier` joined by a line (a Pareto
 /// frontier, say), as an RGB image.
 ///
@@ -129,15 +152,7 @@ pub fn log_log_scatter(
         let mut chart = builder
             .build_cartesian_2d(log_axis(x_range), log_axis(y_range))
             .map_err(plot_error)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .x_label_formatter(&|v| short_number(*v))
-            .y_label_formatter(&|v| short_number(*v))
-            .label_style(("sans-serif", 16))
-            .draw()
-            .map_err(plot_error)?;
+        draw_log_mesh(&mut chart, x_label, y_label)?;
         let mut sorted: Vec<(f64, f64)> = frontier.iter().map(|p| (p.x, p.y)).collect();
         sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart
@@ -168,6 +183,68 @@ pub fn log_log_scatter(
             .draw_series(points.iter().zip(offsets).filter_map(|(p, offset)| {
                 offset.map(|o| EmptyElement::at((p.x, p.y)) + Text::new(p.label.clone(), o, &style))
             }))
+            .map_err(plot_error)?;
+        Ok(())
+    })
+}
+
+/// One named polyline of a [`log_log_lines`] plot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Curve {
+    /// Legend entry.
+    pub name: String,
+    /// `(x, y)` points, joined in order of `x` (both > 0).
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Curves on log-log axes, one colour each, markers at their points and a legend (error
+/// against kept coefficients per method, say), as an RGB image.
+///
+/// ```
+/// use haarshift::experiments::plot::{Curve, log_log_lines};
+/// let c = Curve { name: "haar".into(), points: vec![(4.0, 0.5), (64.0, 0.05)] };
+/// let img = log_log_lines("error against coefficients", "coefficients", "RMS", &[c]).unwrap();
+/// assert_eq!(img.dimensions(), (1100, 700));
+/// ```
+pub fn log_log_lines(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    curves: &[Curve],
+) -> Result<RgbImage> {
+    let all = || curves.iter().flat_map(|c| c.points.iter());
+    let x_range = log_range(all().map(|p| p.0))?;
+    let y_range = log_range(all().map(|p| p.1))?;
+    render_chart(title, 50, 30, |builder| {
+        let mut chart = builder
+            .build_cartesian_2d(log_axis(x_range), log_axis(y_range))
+            .map_err(plot_error)?;
+        draw_log_mesh(&mut chart, x_label, y_label)?;
+        for (k, c) in curves.iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            let mut sorted = c.points.clone();
+            sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart
+                .draw_series(LineSeries::new(sorted.clone(), colour.stroke_width(2)))
+                .map_err(plot_error)?
+                .label(c.name.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+            chart
+                .draw_series(
+                    sorted
+                        .into_iter()
+                        .map(|p| Circle::new(p, 4, colour.filled())),
+                )
+                .map_err(plot_error)?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
             .map_err(plot_error)?;
         Ok(())
     })
@@ -318,15 +395,44 @@ pub fn labelled_tiles(
     columns: usize,
     zoom: usize,
 ) -> Result<RgbImage> {
+    // Each grey plane repeated three times: small figures, so the copies cost nothing.
+    let grey: Vec<(String, ndarray::Array3<f64>)> = tiles
+        .iter()
+        .map(|(label, t)| {
+            let rgb = ndarray::stack(ndarray::Axis(0), &[t.view(), t.view(), t.view()])
+                .expect("three planes of one shape");
+            (label.clone(), rgb)
+        })
+        .collect();
+    let grey: Vec<(String, ndarray::ArrayView3<'_, f64>)> =
+        grey.iter().map(|(l, t)| (l.clone(), t.view())).collect();
+    labelled_colour_tiles(&grey, columns, zoom)
+}
+
+/// [`labelled_tiles`] in colour: each tile is `(3, H, W)` RGB planes of 0..=255 (the picture
+/// grids of the relighting experiment: renders over their false-colour error images).
+///
+/// ```
+/// use haarshift::experiments::plot::labelled_colour_tiles;
+/// let mut red = ndarray::Array3::zeros((3, 4, 6));
+/// red.index_axis_mut(ndarray::Axis(0), 0).fill(255.0);
+/// let sheet = labelled_colour_tiles(&[("red".into(), red.view())], 1, 1).unwrap();
+/// assert_eq!(sheet.get_pixel(8, 8).0, [255, 0, 0]);
+/// ```
+pub fn labelled_colour_tiles(
+    tiles: &[(String, ndarray::ArrayView3<'_, f64>)],
+    columns: usize,
+    zoom: usize,
+) -> Result<RgbImage> {
     const GAP: usize = 8;
     const LABEL: usize = 24;
     let Some((_, first)) = tiles.first() else {
         return Err(plot_error("no tiles to draw"));
     };
-    let (th, tw) = first.dim();
-    if tiles.iter().any(|(_, t)| t.dim() != (th, tw)) || th * tw == 0 || columns * zoom == 0 {
+    let (_, th, tw) = first.dim();
+    if tiles.iter().any(|(_, t)| t.dim() != (3, th, tw)) || th * tw == 0 || columns * zoom == 0 {
         return Err(plot_error(
-            "tiles must be non-empty and of one size, columns and zoom at least 1",
+            "tiles must be non-empty RGB planes of one size, columns and zoom at least 1",
         ));
     }
     let rows = tiles.len().div_ceil(columns);
@@ -336,13 +442,16 @@ pub fn labelled_tiles(
     let size = |v: usize| u32::try_from(v).map_err(|_| plot_error("figure too large"));
     let (width, height) = (size(width)?, size(height)?);
     let mut sheet = RgbImage::from_pixel(width, height, image::Rgb([255, 255, 255]));
+    let byte = |v: f64| v.clamp(0.0, 255.0).round() as u8;
     for (k, (_, tile)) in tiles.iter().enumerate() {
         let (x0, y0) = (GAP + (k % columns) * cell_w, GAP + (k / columns) * cell_h);
-        for ((i, j), &v) in tile.indexed_iter() {
-            let g = v.clamp(0.0, 255.0).round() as u8;
-            for (di, dj) in (0..zoom).flat_map(|di| (0..zoom).map(move |dj| (di, dj))) {
-                let (x, y) = ((x0 + j * zoom + dj) as u32, (y0 + i * zoom + di) as u32);
-                sheet.put_pixel(x, y, image::Rgb([g, g, g]));
+        for i in 0..th {
+            for j in 0..tw {
+                let rgb = image::Rgb([0, 1, 2].map(|c| byte(tile[[c, i, j]])));
+                for (di, dj) in (0..zoom).flat_map(|di| (0..zoom).map(move |dj| (di, dj))) {
+                    let (x, y) = ((x0 + j * zoom + dj) as u32, (y0 + i * zoom + di) as u32);
+                    sheet.put_pixel(x, y, rgb);
+                }
             }
         }
     }

@@ -248,7 +248,7 @@ pub fn gallery(
 }
 
 /// The exposure (stops) that brings the mean luminance of `radiance` (`(V, 3)`) to 0.36.
-fn exposure_for(radiance: &Array2<f64>) -> f64 {
+pub(crate) fn exposure_for(radiance: &Array2<f64>) -> f64 {
     let luminance = radiance
         .rows()
         .into_iter()

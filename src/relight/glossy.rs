@@ -78,6 +78,10 @@ pub struct GlossyOptions {
     pub level: Option<usize>,
     /// Detail coefficients of each rotated BRDF map kept (`None`: all).
     pub keep_brdf: Option<usize>,
+    /// The coarse-to-fine cutoff of each rotated BRDF map: only its detail levels `0..L`
+    /// are kept, `4^L` coefficients per face (`None`: every level). Thesis Fig. 4.7's 4, 16,
+    /// 64 and 256 coefficients are `L` = 1 to 4.
+    pub brdf_levels: Option<usize>,
     /// Bins per axis of the rotation cache (`None`: no cache, one rotation per vertex).
     pub cache_bins: Option<usize>,
     /// Outgoing elevations of a view-dependent BRDF's local table.
@@ -91,6 +95,7 @@ impl Default for GlossyOptions {
             rotation: BrdfRotation::default(),
             level: None,
             keep_brdf: None,
+            brdf_levels: None,
             cache_bins: None,
             elevations: super::brdf::DEFAULT_ELEVATIONS,
         }
@@ -161,6 +166,7 @@ pub struct GlossyShader<T> {
     transport: PreparedTransport<T>,
     orientation: Orientation,
     keep_brdf: Option<usize>,
+    brdf_levels: usize,
     bins: Option<usize>,
     positions: Vec<[f64; 3]>,
     normals: Vec<[f64; 3]>,
@@ -204,6 +210,18 @@ impl<T: Sample> GlossyShader<T> {
         if let Some(k) = options.keep_brdf {
             Selection::Largest(k).limit(param.texels() - param.faces())?;
         }
+        let levels = param.face_size().trailing_zeros() as usize;
+        if let Some(l) = options.brdf_levels
+            && l > levels
+        {
+            return Err(Error::parameter(
+                "brdf levels",
+                format!(
+                    "{l}: faces {} texels wide have {levels} detail levels (L from 0 to {levels})",
+                    param.face_size()
+                ),
+            ));
+        }
         if let Some(n) = options.cache_bins
             && !(1..=MAX_CACHE_BINS).contains(&n)
         {
@@ -219,6 +237,7 @@ impl<T: Sample> GlossyShader<T> {
             transport,
             orientation,
             keep_brdf: options.keep_brdf,
+            brdf_levels: options.brdf_levels.unwrap_or(levels),
             bins: options.cache_bins,
             positions: rows(mesh.positions()),
             normals: rows(mesh.normals()),
@@ -472,7 +491,8 @@ impl<T: Sample> GlossyShader<T> {
         }
     }
 
-    /// The BRDF in `frame`, truncated to `--keep-brdf` and the depth, as channel planes in `T`.
+    /// The BRDF in `frame`, truncated to `--keep-brdf`, `--brdf-levels` and the depth, as
+    /// channel planes in `T`.
     fn brdf_planes(&self, frame: &Frame) -> Result<Planes<T>> {
         let map = self.orientation.lobe(frame)?;
         let param = map.param();
@@ -482,7 +502,7 @@ impl<T: Sample> GlossyShader<T> {
         for ((f, i, j, c), v) in map.as_array().indexed_iter() {
             planes[c * texels + (f * s + i) * s + j] = *v;
         }
-        let depth = self.transport.depth();
+        let depth = self.transport.depth().min(self.brdf_levels);
         let levels = s.trailing_zeros() as usize;
         if self.keep_brdf.is_some() || depth < levels {
             truncate_planes(param, &mut planes, channels, self.keep_brdf, depth)?;

@@ -67,7 +67,7 @@ pub use harmonics::{PhongSh, ShTransfer, non_zonal_material, shade_sh, shade_sh_
 pub use lighting::Lighting;
 pub use mesh::{Bounds, Mesh};
 pub use raycast::{Occlusion, SceneBvh};
-pub use reference::{ReferenceOptions, ReferenceReport, reference};
+pub use reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,

@@ -103,6 +103,8 @@ pub struct ReferenceReport {
 /// A texel of the lighting that can contribute: its centre direction, solid angle and
 /// radiance (RGB).
 struct LitTexel {
+    /// Row-major index `i x 2N + j` in the map.
+    index: usize,
     direction: [f64; 3],
     ray: [f32; 3],
     solid_angle: f64,
@@ -130,6 +132,7 @@ fn lit_texels(lighting: &LatLongMap<f64>) -> Result<Vec<LitTexel>> {
             let (theta, phi) = pixel_centre(h, i, j);
             let d = direction(theta, phi);
             out.push(LitTexel {
+                index: i * w + j,
                 direction: d,
                 ray: f32x3(d),
                 solid_angle,
@@ -170,6 +173,20 @@ pub fn reference(
     lighting: &LatLongMap<f64>,
     options: &ReferenceOptions,
 ) -> Result<(Array2<f64>, ReferenceReport)> {
+    quadrature(mesh, albedo, lighting, options, |_, origin, t| {
+        !occlusion.occluded(origin, t.ray, f32::INFINITY)
+    })
+}
+
+/// The quadrature of [`reference`] with `visible(v, origin, texel)` answering for each texel
+/// above vertex `v`'s horizon whether its ray from `origin` escapes.
+fn quadrature(
+    mesh: &Mesh,
+    albedo: ArrayView2<'_, f32>,
+    lighting: &LatLongMap<f64>,
+    options: &ReferenceOptions,
+    visible: impl Fn(usize, [f32; 3], &LitTexel) -> bool + Sync,
+) -> Result<(Array2<f64>, ReferenceReport)> {
     let vertices = mesh.vertex_count();
     if albedo.dim() != (vertices, 3) {
         return Err(Error::shape(
@@ -204,7 +221,7 @@ pub fn reference(
                     continue;
                 }
                 rays += 1;
-                if !occlusion.occluded(o, t.ray, f32::INFINITY) {
+                if visible(v, o, t) {
                     let w = cos * t.solid_angle;
                     let rho = match view {
                         Some(wo) => options.brdf.evaluate(n, t.direction, wo),
@@ -234,6 +251,130 @@ pub fn reference(
         seconds: start.elapsed().as_secs_f64(),
     };
     Ok((out, report))
+}
+
+/// Every vertex's visibility over the texels of an `N x 2N` lat-long map, one bit per texel
+/// (set: above the vertex's horizon and the ray through the texel centre escapes), cast once
+/// so that [`reference`] can be evaluated under many lightings, BRDFs and views without
+/// casting again. The rays are [`reference`]'s own, so its quadrature over these bits equals
+/// [`reference`] bit for bit.
+///
+/// ```
+/// use haarshift::relight::{Mesh, ReferenceOptions, SceneBvh, reference};
+/// use haarshift::relight::reference::ReferenceVisibility;
+/// use haarshift::sphere::LatLongMap;
+/// use ndarray::{Array2, array};
+/// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+///                   vec![[0, 1, 2]], None).unwrap();
+/// let bvh = SceneBvh::new(&m);
+/// let sky = LatLongMap::<f64>::from_fn(24, 3, |d, o| o.fill(1.0 + d[0])).unwrap();
+/// let albedo = Array2::from_elem((3, 3), 0.5f32);
+/// let bits = ReferenceVisibility::new(&m, &bvh, 24, false).unwrap();
+/// let o = ReferenceOptions::default();
+/// assert_eq!(bits.reference(&m, albedo.view(), &sky, &o).unwrap().0,
+///            reference(&m, &bvh, albedo.view(), &sky, &o).unwrap().0);
+/// ```
+#[derive(Clone, Debug)]
+pub struct ReferenceVisibility {
+    height: usize,
+    vertices: usize,
+    words: usize,
+    bits: Vec<u64>,
+    report: ReferenceReport,
+}
+
+impl ReferenceVisibility {
+    /// Casts every vertex's rays through the texel centres of an `height x 2 height` map.
+    pub fn new(
+        mesh: &Mesh,
+        occlusion: &impl Occlusion,
+        height: usize,
+        progress: bool,
+    ) -> Result<Self> {
+        let sky = LatLongMap::<f64>::from_fn(height, 1, |_, o| o[0] = 1.0)?;
+        let texels = lit_texels(&sky)?;
+        let words = (2 * height * height).div_ceil(64);
+        let vertices = mesh.vertex_count();
+        let eps = ray_offset(mesh);
+        let start = Instant::now();
+        let bar = progress_bar(progress, vertices, "reference visibility (rays)");
+        let mut bits = vec![0u64; vertices * words];
+        let rays: u64 = bits
+            .par_chunks_mut(words.max(1))
+            .enumerate()
+            .map(|(v, row)| {
+                let (origin, n) = origin_and_normal(mesh, v, eps);
+                let o = f32x3(origin);
+                let mut rays = 0;
+                for t in &texels {
+                    if dot(n, t.direction) <= 0.0 {
+                        continue;
+                    }
+                    rays += 1;
+                    if !occlusion.occluded(o, t.ray, f32::INFINITY) {
+                        row[t.index / 64] |= 1 << (t.index % 64);
+                    }
+                }
+                bar.inc(1);
+                rays
+            })
+            .sum();
+        bar.finish_and_clear();
+        Ok(ReferenceVisibility {
+            height,
+            vertices,
+            words,
+            bits,
+            report: ReferenceReport {
+                rays,
+                seconds: start.elapsed().as_secs_f64(),
+            },
+        })
+    }
+
+    /// The map height `N` the bits were cast for.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The rays cast and the seconds they took.
+    pub fn report(&self) -> ReferenceReport {
+        self.report
+    }
+
+    /// Bytes of the bits.
+    pub fn bytes(&self) -> usize {
+        self.bits.len() * 8
+    }
+
+    /// [`reference`] of `mesh` (the mesh the bits were cast for) under `lighting` (`N x 2N`,
+    /// the bits' `N`), with no ray cast: the report counts 0 rays.
+    pub fn reference(
+        &self,
+        mesh: &Mesh,
+        albedo: ArrayView2<'_, f32>,
+        lighting: &LatLongMap<f64>,
+        options: &ReferenceOptions,
+    ) -> Result<(Array2<f64>, ReferenceReport)> {
+        if lighting.height() != self.height || mesh.vertex_count() != self.vertices {
+            return Err(Error::parameter(
+                "reference visibility",
+                format!(
+                    "cast for {} vertices and {} x {} texels, asked for {} vertices and {} x {}",
+                    self.vertices,
+                    self.height,
+                    2 * self.height,
+                    mesh.vertex_count(),
+                    lighting.height(),
+                    2 * lighting.height()
+                ),
+            ));
+        }
+        let (out, report) = quadrature(mesh, albedo, lighting, options, |v, _, t| {
+            self.bits[v * self.words + t.index / 64] >> (t.index % 64) & 1 == 1
+        })?;
+        Ok((out, ReferenceReport { rays: 0, ..report }))
+    }
 }
 
 /// The unit direction from vertex `v` to the eye `e` (the normal `n` if the eye is on it).

@@ -91,7 +91,7 @@ fn pixel_domain(
     light: &Lighting,
     rho: &SphereMap<f64>,
     keep_brdf: Selection,
-    depth: usize,
+    (depth, brdf_depth): (usize, usize),
 ) -> [f64; 3] {
     let (faces, s) = (param.faces(), param.face_size());
     let mut dense = Array3::<f64>::zeros((faces, s, s));
@@ -111,14 +111,15 @@ fn pixel_domain(
         .unwrap()
         .to_pixels()
         .unwrap();
-    for m in [&mut t, &mut l, &mut r] {
+    for m in [&mut t, &mut l] {
         block_means(m, depth);
     }
+    block_means(&mut r, depth.min(brdf_depth));
     let mut sum = [0.0; 3];
     for ((f, i, j, c), &x) in l.indexed_iter() {
         sum[c] += x * t[[f, i, j, 0]] * r[[f, i, j, 0]];
     }
-    if depth == s.trailing_zeros() as usize {
+    if depth == s.trailing_zeros() as usize && brdf_depth >= depth {
         // Issue 7's triple product on the three trees gives the same.
         let rgb = |a: &ndarray::Array4<f64>| a.broadcast((faces, s, s, 3)).unwrap().to_owned();
         let ones = Array3::<f64>::ones((faces, s, s));
@@ -142,11 +143,14 @@ fn the_shading_is_the_pixel_domain_triple_product_of_the_truncated_factors() {
     let eye = [0.5, 2.0, 3.0];
     let brdf = Brdf::Phong { exponent: 12.0 };
     let orientation = Orientation::new(&brdf, param, BrdfRotation::Direct, None, 16).unwrap();
-    for (keep_light, keep_visibility, keep_brdf, depth) in [
-        (Selection::All, None, None, None),
-        (Selection::Largest(40), Some(60), Some(30), None),
-        (Selection::Largest(25), None, Some(9), Some(2)),
-        (Selection::All, Some(100), None, Some(3)),
+    for (keep_light, keep_visibility, keep_brdf, depth, brdf_levels) in [
+        (Selection::All, None, None, None, None),
+        (Selection::Largest(40), Some(60), Some(30), None, None),
+        (Selection::Largest(25), None, Some(9), Some(2), None),
+        (Selection::All, Some(100), None, Some(3), None),
+        // The thesis's coarse-to-fine cutoff: 16 coefficients per face, the rest at full depth.
+        (Selection::All, None, None, None, Some(2)),
+        (Selection::Largest(30), None, Some(20), Some(3), Some(1)),
     ] {
         let light = lighting(param, keep_light);
         let shade = ShadeOptions {
@@ -157,6 +161,7 @@ fn the_shading_is_the_pixel_domain_triple_product_of_the_truncated_factors() {
             brdf: brdf.clone(),
             rotation: BrdfRotation::Direct,
             keep_brdf,
+            brdf_levels,
             ..GlossyOptions::default()
         };
         let shader =
@@ -173,7 +178,8 @@ fn the_shading_is_the_pixel_domain_triple_product_of_the_truncated_factors() {
             let rho = orientation.lobe(&frame).unwrap();
             let keep = keep_brdf.map_or(Selection::All, Selection::Largest);
             let stored = shader.transport().coefficients(v);
-            let want = pixel_domain(param, stored, &light, &rho, keep, depth.unwrap_or(4));
+            let depths = (depth.unwrap_or(4), brdf_levels.unwrap_or(4));
+            let want = pixel_domain(param, stored, &light, &rho, keep, depths);
             for c in 0..3 {
                 let w = f64::from(albedo[[v, c]]) * want[c];
                 assert!(

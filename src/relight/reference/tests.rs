@@ -447,3 +447,53 @@ fn a_merl_table_of_phong_agrees_with_phong_to_its_quantisation() {
         "{centred} {gaps:?}"
     );
 }
+
+/// Cast once, the bits give the reference's quadrature exactly, for every lighting, BRDF and
+/// view; a map of another height or another mesh is refused.
+#[test]
+fn cached_visibility_gives_the_reference_bit_for_bit() {
+    let mesh = Generator::PlaneUnderBox { height: 0.5 }.mesh().unwrap();
+    let bvh = SceneBvh::new(&mesh);
+    let albedo = Array2::from_shape_fn((mesh.vertex_count(), 3), |(v, c)| {
+        0.2 + 0.1 * ((v + c) % 4) as f32
+    });
+    let bits = ReferenceVisibility::new(&mesh, &bvh, 12, false).unwrap();
+    assert!(bits.report().rays > 0);
+    let shadows = LatLongMap::<f64>::from_fn(12, 3, |d, o| o.fill(0.1 + d[1].max(0.0)));
+    for (lighting, options) in [
+        (sunny(12), ReferenceOptions::default()),
+        (sunny(12), glossy("phong:30", [2.0, 3.0, 1.0])),
+        (shadows.unwrap(), glossy("blinn:8", [-1.0, 2.0, 0.5])),
+    ] {
+        let options = ReferenceOptions {
+            object_vertices: Some(mesh.vertex_count() / 2),
+            ..options
+        };
+        let (want, cast) = reference(&mesh, &bvh, albedo.view(), &lighting, &options).unwrap();
+        let (got, report) = bits
+            .reference(&mesh, albedo.view(), &lighting, &options)
+            .unwrap();
+        assert_eq!(got, want);
+        assert_eq!((report.rays, cast.rays), (0, bits.report().rays));
+    }
+    // The box shadows the plane: fewer rays escape than were cast.
+    let escaped: u64 = bits.bits.iter().map(|w| u64::from(w.count_ones())).sum();
+    assert!(
+        escaped > 0 && escaped < bits.report().rays,
+        "{escaped} of {}",
+        bits.report().rays
+    );
+    assert_err!(
+        bits.reference(
+            &mesh,
+            albedo.view(),
+            &sunny(8),
+            &ReferenceOptions::default()
+        ),
+        InvalidParameter {
+            name: "reference visibility",
+            ..
+        },
+        "12 x 24 texels"
+    );
+}

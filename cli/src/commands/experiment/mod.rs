@@ -19,6 +19,7 @@ use serde::Serialize;
 use crate::commands::refuse_output_among_inputs;
 
 pub mod dynamic;
+pub mod relight;
 pub mod rotation_cycle;
 pub mod shift_chain;
 pub mod sphere;
@@ -29,6 +30,7 @@ pub mod tradeoff;
 #[derive(Subcommand)]
 pub enum ExperimentCommand {
     Dynamic(dynamic::Args),
+    Relight(relight::Args),
     RotationCycle(rotation_cycle::Args),
     ShiftChain(shift_chain::Args),
     Sphere(sphere::Args),
@@ -40,6 +42,7 @@ pub enum ExperimentCommand {
 pub fn run(command: ExperimentCommand) -> Result<()> {
     match command {
         ExperimentCommand::Dynamic(args) => dynamic::run_command(args),
+        ExperimentCommand::Relight(args) => relight::run_command(args),
         ExperimentCommand::RotationCycle(args) => rotation_cycle::run(args),
         ExperimentCommand::ShiftChain(args) => shift_chain::run(args),
         ExperimentCommand::Sphere(args) => sphere::run(args),

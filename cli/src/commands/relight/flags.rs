@@ -192,6 +192,12 @@ pub struct GlossyFlags {
     #[arg(long, value_name = "K", value_parser = positive)]
     pub keep_brdf: Option<usize>,
 
+    /// Keep only the detail levels 0..L of each rotated BRDF map, 4^L coefficients per face
+    /// (the thesis's coarse-to-fine cutoff: 4, 16, 64, 256 coefficients are L = 1 to 4)
+    /// [default: every level]
+    #[arg(long, value_name = "L")]
+    pub brdf_levels: Option<usize>,
+
     /// Rotate one BRDF map per bin of an N x 2N grid of directions (the mirror direction for
     /// Phong, blended over the 4 nearest bins; the normal for view-dependent BRDFs) and keep it
     /// for every view [default: one rotation per vertex]
@@ -217,6 +223,7 @@ impl GlossyFlags {
             rotation: self.brdf_rotation,
             level: self.level,
             keep_brdf: self.keep_brdf,
+            brdf_levels: self.brdf_levels,
             cache_bins: self.rotation_cache,
             elevations: self.elevations,
         }
@@ -227,13 +234,14 @@ impl GlossyFlags {
         let set = self.brdf_rotation != BrdfRotation::default()
             || self.level.is_some()
             || self.keep_brdf.is_some()
+            || self.brdf_levels.is_some()
             || self.rotation_cache.is_some()
             || self.elevations != DEFAULT_ELEVATIONS
             || self.fill_cache;
         if set && brdf.is_lambert() {
             return Err(Error::InvalidParameter {
                 name: "brdf-rotation",
-                reason: "--brdf-rotation, --level, --keep-brdf, --rotation-cache, \
+                reason: "--brdf-rotation, --level, --keep-brdf, --brdf-levels, --rotation-cache, \
                          --elevations and --fill-cache apply to glossy BRDFs; the BRDF is lambert"
                     .into(),
             });

@@ -1,0 +1,81 @@
+//! `haarshift experiment relight` checks its inputs and outputs before the work (the numbers
+//! are the library's, tested in `experiments::relight`).
+
+mod common;
+
+use common::{fails_cleanly, p, succeeds_with_stdout, testdata};
+
+#[test]
+fn it_refuses_stale_reports_and_bad_inputs_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("reports");
+    std::fs::create_dir_all(&out).unwrap();
+    let stale = out.join("relight.csv");
+    std::fs::write(&stale, "an earlier run\n").unwrap();
+    let scene = testdata("scenes/bunny.json");
+    let env = testdata("envmaps/rooitou_park_32x16.hdr");
+    let args = [
+        "experiment",
+        "relight",
+        "--scene",
+        p(&scene),
+        "--env",
+        p(&env),
+    ];
+    let start = std::time::Instant::now();
+    let mut stale_args = args.to_vec();
+    stale_args.extend(["--out-dir", p(&out)]);
+    fails_cleanly(&stale_args, &["relight.csv", "already exists", "--force"]);
+    assert_eq!(std::fs::read_to_string(&stale).unwrap(), "an earlier run\n");
+    let fresh = dir.path().join("fresh");
+    let missing = dir.path().join("no such scene.json");
+    fails_cleanly(
+        &[
+            "experiment",
+            "relight",
+            "--scene",
+            p(&missing),
+            "--env",
+            p(&env),
+            "--out-dir",
+            p(&fresh),
+        ],
+        &["no such scene.json"],
+    );
+    let corrupt = dir.path().join("corrupt.hdr");
+    std::fs::write(&corrupt, "#?RADIANCE\nnot a map").unwrap();
+    fails_cleanly(
+        &[
+            "experiment",
+            "relight",
+            "--scene",
+            p(&scene),
+            "--env",
+            p(&corrupt),
+            "--out-dir",
+            p(&fresh),
+        ],
+        &["corrupt.hdr"],
+    );
+    // Refused before any ray was cast.
+    assert!(start.elapsed().as_secs() < 20, "{:?}", start.elapsed());
+}
+
+#[test]
+fn its_help_states_the_protocols_and_the_axes() {
+    let help = succeeds_with_stdout(&["experiment", "relight", "--help"]);
+    for needle in [
+        "Examples:",
+        "--quick",
+        "--full",
+        "rotation",
+        "coefficients",
+        "resolution",
+        "depth",
+        "harmonics",
+        "stand-ins",
+        "512 x 1024",
+    ] {
+        assert!(help.contains(needle), "{needle}: {help}");
+    }
+}
