@@ -44,7 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             distance: 1.5,
         }
         .mesh()?,
-        "cylinder-and-bump" => Generator::CylinderAndBump {}.mesh()?,
+        "cylinder-and-bump" => Generator::CylinderAndBump { cells: 96 }.mesh()?,
         "plane-with-sphere" => Generator::PlaneWithSphere {}.mesh()?,
         other => return Err(format!("unknown scene {other}").into()),
     };

@@ -150,6 +150,10 @@ pub struct RelightProtocol {
     pub rotation_materials: Vec<Brdf>,
     /// Methods of the rotation axis.
     pub orientings: Vec<Orienting>,
+    /// The first this many settings of the rotation axis (per scene) run the `reference`
+    /// orienting of `orientings`; the others skip it (it takes minutes per render: every
+    /// texel of every vertex's map integrated over its solid angle).
+    pub reference_settings: usize,
     /// Material of the coefficient axis.
     pub coefficient_material: Brdf,
     /// Coefficients per face of the coefficient axis (powers of 4).
@@ -213,6 +217,7 @@ impl RelightProtocol {
                 other(BrdfRotation::Spatial),
                 other(BrdfRotation::Direct),
             ],
+            reference_settings: 0,
             coefficient_material: phong(50.0),
             coefficient_counts: vec![4, 16, 64, 256],
             latlong_resolutions: vec![32, 64, 128],
@@ -256,6 +261,7 @@ impl RelightProtocol {
                 Brdf::BlinnPhong { exponent: 50.0 },
             ],
             orientings,
+            reference_settings: 1,
             latlong_resolutions: vec![32, 64, 128, 256],
             cube_resolutions: vec![16, 32, 64, 128],
             resolution_materials: vec![Brdf::Lambert, phong(50.0)],
@@ -385,7 +391,7 @@ pub fn run(
             &lights_used[..1]
         };
         for (k, setting) in rotation_settings(maps, protocol)?.iter().enumerate() {
-            let (records, grid) = bench.rotation_axis(setting)?;
+            let (records, grid) = bench.rotation_axis(setting, k < protocol.reference_settings)?;
             records
                 .into_iter()
                 .for_each(|r| push(r, &mut results.records));
@@ -693,16 +699,20 @@ impl<'a> Bench<'a> {
         })
     }
 
-    /// Thesis Figs. 4.5-4.6: every orienting method, every coefficient kept; and the picture
-    /// grid of this setting.
+    /// Thesis Figs. 4.5-4.6: every orienting method (`reference` only `with_reference`),
+    /// every coefficient kept; and the picture grid of this setting.
     fn rotation_axis(
         &mut self,
         setting: &Setting<'_>,
+        with_reference: bool,
     ) -> Result<(Vec<RelightRecord>, PictureGrid)> {
         let n = self.protocol.rotation_resolution;
         let param = Parameterization::new(ParamKind::LatLong, n)?;
         let mut shaded = Vec::new();
         for o in &self.protocol.orientings.clone() {
+            if o.rotation == BrdfRotation::Reference && !with_reference {
+                continue;
+            }
             let glossy = GlossyOptions {
                 rotation: o.rotation,
                 level: o.level,

@@ -14,7 +14,7 @@
 //!
 //! | [`Generator`] | what | vertices |
 //! |---|---|---|
-//! | `cylinder_and_bump` | seed 002's "Cylinder & Bump" (section 6.1.1): on a `[-4, 4]^2` ground (96 x 96 cells) a Gaussian bump (height 1, sigma 0.6, at `(1.5, 1)`) and a cylinder (radius 0.5, height 3, 48 segments x 24 rings, capped) at `(-1.5, -1)` | 10,707 |
+//! | `cylinder_and_bump` | seed 002's "Cylinder & Bump" (section 6.1.1): on a `[-4, 4]^2` ground (`cells` x `cells`, default 96) a Gaussian bump (height 1, sigma 0.6, at `(1.5, 1)`) and a cylinder (radius 0.5, height 3, 48 segments x 24 rings, capped) at `(-1.5, -1)` | 10,707 at 96 cells |
 //! | `cubes` | seed 002's "Cubes" (section 6.1.2, after Durand 2005): a wall (`z = 0`, facing `+Z`, 12.9 x 10.1, 129 x 101 cells) and in front of it, at distance `distance` (default 1.5), a `count x count` array (default 10) of cubes of side 0.6 every 1.2 across and 1.0 up, each face `cells x cells` (default 10); every cube face has its own vertices (sharp normals). The default is seed 002's Table 2 scale | 85,860 by default: `6 count^2 (cells + 1)^2 + 13,260` |
 //! | `plane_with_sphere` | a `[-3, 3]^2` ground (64 x 64 cells) with a unit sphere resting on it (a cube sphere, 16 x 16 cells a face) | 5,959 |
 //! | `sphere` | a unit sphere at the origin tessellated as a cube sphere, `cells x cells` per face, normals exact (radial) | `6 (cells + 1)^2` |
@@ -286,8 +286,12 @@ pub fn ground_plane_under(b: &super::Bounds) -> Mesh {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Generator {
-    /// Seed 002's "Cylinder & Bump".
-    CylinderAndBump {},
+    /// Seed 002's "Cylinder & Bump": a cylinder beside a Gaussian bump on an 8 x 8 ground.
+    CylinderAndBump {
+        /// Cells per side of the ground.
+        #[serde(default = "default_ground_cells")]
+        cells: usize,
+    },
     /// Seed 002's "Cubes": an array of cubes in front of a wall.
     Cubes {
         /// Cubes per row and per column.
@@ -329,6 +333,9 @@ pub enum Generator {
 fn default_cube_count() -> usize {
     10
 }
+fn default_ground_cells() -> usize {
+    96
+}
 fn default_cube_cells() -> usize {
     10
 }
@@ -365,8 +372,9 @@ impl Generator {
             }
         };
         Ok(match *self {
-            Generator::CylinderAndBump {} => {
-                let mut g = ground(-4.0, 4.0, 0.0, 8.0, 96);
+            Generator::CylinderAndBump { cells } => {
+                cells_ok("cells", cells, (cells + 1).saturating_mul(cells + 1))?;
+                let mut g = ground(-4.0, 4.0, 0.0, 8.0, cells);
                 g = g.mapped(
                     |[x, y, z]| {
                         let r2 = (x - 1.5).powi(2) + (z - 1.0).powi(2);

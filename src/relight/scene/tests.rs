@@ -18,7 +18,11 @@ fn assert_outward(mesh: &Mesh, centre: [f64; 3]) {
 #[test]
 fn generators_have_their_documented_sizes() {
     let count = |g: Generator| g.mesh().unwrap().vertex_count();
-    assert_eq!(count(Generator::CylinderAndBump {}), 10_707);
+    assert_eq!(count(Generator::CylinderAndBump { cells: 96 }), 10_707);
+    assert_eq!(
+        count(Generator::CylinderAndBump { cells: 32 }),
+        33 * 33 + 10_707 - 97 * 97
+    );
     assert_eq!(
         count(Generator::Cubes {
             count: 10,

@@ -19,14 +19,17 @@ Examples:
 Defaults, relative to the repository's root: --scene testdata/scenes/bunny.json and
 testdata/scenes/cylinder_and_bump.json (seed 002's procedural scene), --env the four maps
 testdata/envmaps/*_1k.hdr (512 x 1024). --quick runs the first scene under the first map;
---full every scene under every map.
+--full the first scene under every map (each material; Phong 50 also under the lighting
+rotated by yaw 90, pitch 30 and from the second camera, orbited 120 degrees), the second
+under the first map.
 
 The ground truth is `relight reference`: one ray per texel of the lighting at 256 x 512
 (--quick) or 512 x 1024 (--full, the maps' native size), cast once per scene, the BRDF
 evaluated exactly in each vertex's frame. Axes, each its own table:
   rotation      the BRDF brought into each vertex frame: haar from the sphere module's levels
                 3, 4, 5 (thesis levels 4, 5, 6) and the finest, haar-cubic, spatial
-                (bilinear), reference (solid-angle integration, --full), direct (no rotation),
+                (bilinear), reference (solid-angle integration: --full, first setting only,
+                minutes per render), direct (no rotation),
                 128 x 256 maps, every coefficient kept; `vs spatial` is the thesis's metric
                 (the Haar render against the spatially rotated one)
   coefficients  each rotated BRDF map cut to 4, 16, 64, 256 coefficients per face, coarse to
