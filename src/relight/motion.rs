@@ -99,13 +99,7 @@ pub struct FrameReport {
 impl MotionPath {
     /// Reads a path file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let p: MotionPath = serde_json::from_str(&text)
-            .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))?;
-        Ok(p)
+        super::scene::read_json(path)
     }
 
     /// Frames in all, frame 0 included.

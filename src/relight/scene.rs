@@ -729,16 +729,21 @@ impl Scene {
     }
 }
 
+/// Reads a JSON file of the scene family (scene files, motion paths) into `T`; a bad file is
+/// a [`SceneError::SceneFile`] naming it.
+pub(crate) fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    serde_json::from_str(&text)
+        .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))
+}
+
 impl SceneFile {
     /// Reads a JSON scene file; returns it with the directory its relative paths start from.
     pub fn read(path: &Path) -> Result<(SceneFile, &Path)> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let file: SceneFile = serde_json::from_str(&text)
-            .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))?;
-        Ok((file, path.parent().unwrap_or(Path::new(""))))
+        Ok((read_json(path)?, path.parent().unwrap_or(Path::new(""))))
     }
 
     /// The scene, relative paths resolved against `dir`.

@@ -147,7 +147,15 @@ fn table(rows: &[&RelightRecord]) -> Table {
 
 /// A short label of a record for the plots.
 fn label(r: &RelightRecord) -> String {
-    format!("{} {} {} {}", r.axis, r.material, r.method, r.parameters)
+    let maps = match (r.axis.as_str(), r.param.as_str()) {
+        ("resolution", "cube") => format!(" cube {}", r.resolution),
+        ("resolution", _) => format!(" {} x {}", r.resolution, 2 * r.resolution),
+        _ => String::new(),
+    };
+    format!(
+        "{} {} {} {}{maps}",
+        r.axis, r.material, r.method, r.parameters
+    )
 }
 
 /// Error against relighting time over every record, the Pareto frontier joined.

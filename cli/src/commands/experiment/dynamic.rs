@@ -74,17 +74,11 @@ fn parse_scenario(s: &str) -> Result<(PathBuf, String, [f64; 3])> {
     let (Some(to), Some(name), Some(file)) = (parts.next(), parts.next(), parts.next()) else {
         return Err(bad());
     };
-    let xyz: Vec<f64> = to
-        .split(',')
-        .map(|v| v.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| bad())?;
-    match xyz[..] {
-        [x, y, z] if xyz.iter().all(|v| v.is_finite()) && !name.is_empty() => {
-            Ok((PathBuf::from(file), name.to_owned(), [x, y, z]))
-        }
-        _ => Err(bad()),
+    let xyz = crate::commands::relight::flags::triple(to).map_err(|_| bad())?;
+    if name.is_empty() {
+        return Err(bad());
     }
+    Ok((PathBuf::from(file), name.to_owned(), xyz))
 }
 
 pub fn run_command(args: Args) -> Result<()> {

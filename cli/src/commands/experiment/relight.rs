@@ -40,9 +40,11 @@ evaluated exactly in each vertex's frame. Axes, each its own table:
   depth         traversal depth 1 to 7 at 128 x 256 (seed 001's Fig. 3.5)
   harmonics     spherical harmonics of 2 to 8 bands against Haar at the same number of
                 lighting and transport coefficients, and Haar at 128 to 1024 of them
-Materials: Phong 50 (--full also Phong 10, Phong 200 and Blinn-Phong 50: analytic stand-ins
-for the thesis's measured steel, blue metallic paint and aluminium bronze), Lambert for the
-resolution and depth axes (--full also Phong 50), Lambert and Phong 10 for harmonics.
+Materials: Phong 50 (--full also Phong 10, Phong 200 and Blinn-Phong 50). The thesis's
+measured materials are not redistributable; analytic stand-ins, chosen by the width of the
+highlight and not fitted: steel = Phong 200, aluminium bronze = Phong 50, blue metallic paint
+= Blinn-Phong 50. Lambert for the resolution and depth axes (--full also Phong 50), Lambert
+and Phong 10 for harmonics.
 Errors: RMS and maximum over every vertex and channel, relative to the truth's RMS radiance
 (`rms rel`, `max rel`) and in radiance units (`rms`); `image rel` is the RMS over the pixels
 of the two renders. Times: precompute (ray casting, encoding, preparing the shader), relight

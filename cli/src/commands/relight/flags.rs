@@ -45,7 +45,7 @@ impl SceneFlags {
 }
 
 /// Three numbers `x,y,z`.
-fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
+pub fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').collect();
     let values: Vec<f64> = parts
         .iter()

@@ -7,7 +7,7 @@ use clap::Subcommand;
 use haarshift::Result;
 
 pub mod animate;
-mod flags;
+pub(crate) mod flags;
 pub mod gallery;
 pub mod precompute;
 pub mod reference;

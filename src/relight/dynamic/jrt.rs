@@ -1,0 +1,361 @@
+//! Just-in-time radiance transfer (seed 001 sections 3.2.2 and 3.5.3): per vertex the product
+//! `T` of the factors that stay fixed while one varies, formed once ([`Jrt::form`]); a frame is
+//! then one sparse dot product per vertex with the varying factor.
+
+use super::*;
+
+/// What just-in-time radiance transfer holds fixed and what varies between frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Change {
+    /// Object `k` moves (translation and scale; a turn re-forms): every other vertex's fixed
+    /// product holds its own transport, the lighting and the other objects' occlusion; object
+    /// `k`'s own vertices hold their transport and the lighting.
+    Object(usize),
+    /// The lighting changes: every vertex holds its own transport and all occlusion.
+    Lighting,
+}
+
+/// What forming or using a [`Jrt`] cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JrtReport {
+    /// Wall-clock seconds.
+    pub seconds: f64,
+    /// Coefficients of the fixed products, all vertices.
+    pub coefficients: usize,
+    /// Bytes of the fixed products.
+    pub bytes: usize,
+}
+
+/// Just-in-time radiance transfer (seed 001 sections 3.2.2 and 3.5.3): per vertex the product
+/// `T` of the factors that stay fixed while one [`Change`] varies, pruned to the options'
+/// `keep_product`; each frame is then `<T, F>` with `F` the varying factor (the looked-up map
+/// of the moving object, or the new lighting): one sparse dot product per vertex. Re-form it
+/// when the kind of change switches.
+///
+/// A vertex of the moving object sees every other object move: its `F` is the product of
+/// their looked-up maps (one map: a dot product; several: their product tree, then the dot).
+///
+/// ```
+/// use haarshift::product::Selection;
+/// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
+/// use haarshift::relight::{Lighting, SceneFile};
+/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// let file: SceneFile = serde_json::from_str(r#"{"objects": [
+///     {"generator": {"sphere": {"cells": 2}}},
+///     {"generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.5, 0, 0]}}
+///   ], "ground_plane": true}"#).unwrap();
+/// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
+/// let mut options = DynamicOptions::new(param);
+/// (options.field.circles, options.field.circle_points) = (8, 16);
+/// (options.field.shells, options.field.shell_grid) = (4, 3);
+/// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+/// let sky = SphereMap::<f64>::from_fn(param, 3, |d, o| o.fill(0.2 + d[1].max(0.0))).unwrap();
+/// let light = Lighting::from_map(&sky, Selection::All).unwrap();
+/// let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
+/// // Move object 1; a frame is one dot product per vertex with its looked-up map.
+/// let moved = Placement { translate: [1.5, 0.0, 1.0], ..scene.placement(1) };
+/// scene.place(1, moved).unwrap();
+/// let fast = jrt.frame_moved(&scene).unwrap();
+/// let full = scene.shade::<f64>(&light).unwrap(); // every product integral from scratch
+/// assert!(fast.iter().zip(&full).all(|(a, b)| (a - b).abs() < 1e-9));
+/// ```
+#[derive(Clone, Debug)]
+pub struct Jrt<T> {
+    change: Change,
+    /// Every object's turn at formation (a vertex's own transport turns with its object).
+    turns: Vec<usize>,
+    products: SparseRows<[T; 3]>,
+    report: JrtReport,
+}
+
+impl<T: Sample> Jrt<T> {
+    /// Forms every vertex's fixed product for `change` in `scene`'s present placement under
+    /// `lighting` (which a [`Change::Lighting`] will replace).
+    pub fn form(scene: &DynamicScene, lighting: &Lighting, change: Change) -> Result<Self> {
+        let start = Instant::now();
+        let depth = scene.check_lighting(lighting)?;
+        let moving = match change {
+            Change::Object(k) => {
+                scene.check_object(k)?;
+                Some(k)
+            }
+            Change::Lighting => None,
+        };
+        let param = scene.param();
+        let light = light_tree::<T>(lighting, depth)?;
+        let receivers = scene.receivers();
+        let keep = scene.options.keep_product;
+        let rows: Vec<(Vec<u32>, Vec<[T; 3]>)> = receivers
+            .par_iter()
+            .map_init(
+                || (Scratch::new(param), Vec::new()),
+                |(scratch, pool), r| -> Result<_> {
+                    let (i, v) = scene.own_transport(r, depth)?;
+                    let mut factors = vec![tree::<T>(param, &i, v.iter().map(|&x| f64::from(x)))?];
+                    let fixed_occluders = (0..scene.objects.len())
+                        .filter(|&k| Some(k) != r.owner && Some(k) != moving)
+                        .filter(|_| moving.is_none() || r.owner != moving);
+                    for k in fixed_occluders {
+                        if let Some((i, v)) = scene.occlusion(k, r.point, depth, scratch) {
+                            factors.push(tree(param, i, v.iter().copied())?);
+                        }
+                    }
+                    let mut refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
+                    if moving.is_some() {
+                        refs.push(&light);
+                    }
+                    let (indices, values) = product(&refs)?.sparse_coefficients();
+                    Ok(prune(param, keep, indices, values, pool))
+                },
+            )
+            .collect::<Result<_>>()?;
+        let mut products = SparseRows::new();
+        for (i, v) in &rows {
+            products.push(i, v);
+        }
+        let report = JrtReport {
+            seconds: start.elapsed().as_secs_f64(),
+            coefficients: products.coefficient_count(),
+            bytes: products.bytes(),
+        };
+        Ok(Jrt {
+            change,
+            turns: scene.objects.iter().map(|o| o.placement.turn).collect(),
+            products,
+            report,
+        })
+    }
+
+    /// What was held fixed.
+    pub fn change(&self) -> Change {
+        self.change
+    }
+
+    /// What forming it cost.
+    pub fn report(&self) -> &JrtReport {
+        &self.report
+    }
+
+    /// Every vertex's radiance `(V, 3)` with the moving object where `scene` has it now (every
+    /// other placement as at formation).
+    pub fn frame_moved(&self, scene: &DynamicScene) -> Result<Array2<T>> {
+        let Change::Object(moving) = self.change else {
+            return Err(Error::parameter(
+                "change",
+                "this transfer was formed for a change of lighting: use frame_lit",
+            ));
+        };
+        self.check_scene(scene)?;
+        let depth = scene.options.check()?;
+        let param = scene.param();
+        let receivers = scene.receivers();
+        let rows: Vec<[T; 3]> = receivers
+            .par_iter()
+            .enumerate()
+            .map_init(
+                || (Scratch::new(param), vec![[T::zero(); 3]; param.texels()]),
+                |(scratch, dense), (v, r)| -> Result<[T; 3]> {
+                    let (ti, tv) = self.products.row(v);
+                    if r.owner != Some(moving) {
+                        // The one varying factor: a dot product with the moving object's map;
+                        // truncated before the blend, the dot of the blend is the blend of
+                        // the samples' dots, so no map is formed.
+                        if scene.options.truncation == Truncation::Before {
+                            let o = &scene.objects[moving];
+                            let local = o.placement.to_local(r.point, param);
+                            return Ok(match o.field.lookup(local) {
+                                None => dot_one(param, ti, tv),
+                                Some(blend) => dot_blend(dense, ti, tv, &o.field, &blend, depth),
+                            });
+                        }
+                        return Ok(match scene.occlusion(moving, r.point, depth, scratch) {
+                            None => dot_one(param, ti, tv),
+                            Some((fi, fv)) => dot_dense(dense, ti, tv, fi, fv),
+                        });
+                    }
+                    // A vertex of the moving object: every other object's map varies; their
+                    // product (a tree of the maps alone) is the varying factor.
+                    let mut trees = Vec::new();
+                    let mut single = None;
+                    for k in (0..scene.objects.len()).filter(|&k| k != moving) {
+                        if let Some((fi, fv)) = scene.occlusion(k, r.point, depth, scratch) {
+                            single = Some((fi.to_vec(), fv.to_vec()));
+                            trees.push(tree::<f64>(param, fi, fv.iter().copied())?);
+                        }
+                    }
+                    let (fi, fv) = match (trees.len(), single) {
+                        (0, _) => return Ok(dot_one(param, ti, tv)),
+                        (1, Some(map)) => map,
+                        _ => {
+                            let refs: Vec<&HaarTree<f64, 3>> = trees.iter().collect();
+                            let (i, v) = product(&refs)?.sparse_coefficients();
+                            (i, v.into_iter().map(|c| c[0]).collect())
+                        }
+                    };
+                    Ok(dot_dense(dense, ti, tv, &fi, &fv))
+                },
+            )
+            .collect::<Result<_>>()?;
+        Ok(radiance(&rows, &scene.albedo()))
+    }
+
+    /// Every vertex's radiance `(V, 3)` under `lighting` (formed for [`Change::Lighting`]).
+    pub fn frame_lit(&self, scene: &DynamicScene, lighting: &Lighting) -> Result<Array2<T>> {
+        if self.change != Change::Lighting {
+            return Err(Error::parameter(
+                "change",
+                "this transfer was formed for a moving object: use frame_moved",
+            ));
+        }
+        self.check_scene(scene)?;
+        let depth = scene.check_lighting(lighting)?;
+        let param = scene.param();
+        let light = lighting.coefficients_f64();
+        let s = param.face_size();
+        let rows: Vec<[T; 3]> = (0..self.products.len())
+            .into_par_iter()
+            .map(|v| {
+                let (ti, tv) = self.products.row(v);
+                let mut acc = [0.0f64; 3];
+                for (&i, t) in ti.iter().zip(tv) {
+                    if within_depth(s, depth, i as usize) {
+                        for c in 0..3 {
+                            acc[c] += t[c].as_f64() * light[[i as usize, c]];
+                        }
+                    }
+                }
+                acc.map(T::from_f64)
+            })
+            .collect();
+        Ok(radiance(&rows, &scene.albedo()))
+    }
+
+    fn check_scene(&self, scene: &DynamicScene) -> Result<()> {
+        let turns: Vec<usize> = scene.objects.iter().map(|o| o.placement.turn).collect();
+        if scene.vertex_count() != self.products.len() {
+            return Err(Error::parameter(
+                "scene",
+                format!(
+                    "{} vertices, but the transfer was formed for {}: re-form it after cloning",
+                    scene.vertex_count(),
+                    self.products.len()
+                ),
+            ));
+        }
+        if turns != self.turns {
+            return Err(Error::parameter(
+                "scene",
+                "an object turned since the transfer was formed: re-form it (a turn moves \
+                 the object's own transport and the fixed products that hold it)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// `indices, values` pruned to what `keep` picks (every scaling coefficient, the largest RGB
+/// magnitudes), ascending.
+fn prune<T: Sample>(
+    param: Parameterization,
+    keep: Selection,
+    indices: Vec<u32>,
+    values: Vec<[T; 3]>,
+    pool: &mut Vec<Candidate>,
+) -> (Vec<u32>, Vec<[T; 3]>) {
+    if keep == Selection::All {
+        return (indices, values);
+    }
+    let kept = select_kept(
+        param,
+        keep,
+        &indices,
+        |s| values[s].iter().map(|x| x.as_f64().powi(2)).sum(),
+        pool,
+    );
+    indices
+        .into_iter()
+        .zip(values)
+        .zip(kept)
+        .filter(|(_, k)| *k)
+        .map(|(e, _)| e)
+        .unzip()
+}
+
+/// `<T, 1>`: the constant 1 has, on each face of side `S`, only its scaling coefficient `S`.
+fn dot_one<T: Sample>(param: Parameterization, indices: &[u32], values: &[[T; 3]]) -> [T; 3] {
+    let s = param.face_size();
+    let mut acc = [0.0f64; 3];
+    for (&i, t) in indices.iter().zip(values) {
+        if (i as usize).is_multiple_of(s * s) {
+            for c in 0..3 {
+                acc[c] += t[c].as_f64() * s as f64;
+            }
+        }
+    }
+    acc.map(T::from_f64)
+}
+
+/// `<T, sum_s w_s M_s>` for the sample maps `M_s` of `field` that `blend` weighs, limited to
+/// the detail levels `0..depth`, through a dense copy of `T` (`dense` is all zeros and is
+/// left so).
+fn dot_blend<T: Sample>(
+    dense: &mut [[T; 3]],
+    ti: &[u32],
+    tv: &[[T; 3]],
+    field: &OcclusionField,
+    blend: &Blend,
+    depth: usize,
+) -> [T; 3] {
+    for (&i, t) in ti.iter().zip(tv) {
+        dense[i as usize] = *t;
+    }
+    let s = field.options().param.face_size();
+    let all = depth == s.trailing_zeros() as usize;
+    let mut acc = [0.0f64; 3];
+    for &(sample, w) in blend.samples() {
+        let (fi, fv) = field.map(sample as usize);
+        let mut part = [T::zero(); 3];
+        for (&i, &f) in fi.iter().zip(fv) {
+            if all || within_depth(s, depth, i as usize) {
+                let t = dense[i as usize];
+                let f = T::from_f64(f64::from(f));
+                for c in 0..3 {
+                    part[c] += t[c] * f;
+                }
+            }
+        }
+        for c in 0..3 {
+            acc[c] += f64::from(w) * part[c].as_f64();
+        }
+    }
+    for &i in ti {
+        dense[i as usize] = [T::zero(); 3];
+    }
+    acc.map(T::from_f64)
+}
+
+/// `<T, F>` for a sparse `T` and a sparse one-channel `F`, through a dense copy of `T`
+/// (`dense` is all zeros and is left so).
+fn dot_dense<T: Sample>(
+    dense: &mut [[T; 3]],
+    ti: &[u32],
+    tv: &[[T; 3]],
+    fi: &[u32],
+    fv: &[f64],
+) -> [T; 3] {
+    for (&i, t) in ti.iter().zip(tv) {
+        dense[i as usize] = *t;
+    }
+    let mut acc = [0.0f64; 3];
+    for (&i, &f) in fi.iter().zip(fv) {
+        let t = dense[i as usize];
+        for c in 0..3 {
+            acc[c] += t[c].as_f64() * f;
+        }
+    }
+    for &i in ti {
+        dense[i as usize] = [T::zero(); 3];
+    }
+    acc.map(T::from_f64)
+}
