@@ -22,7 +22,6 @@ fn it_refuses_stale_reports_and_bad_inputs_before_any_work() {
         "--env",
         p(&env),
     ];
-    let start = std::time::Instant::now();
     let mut stale_args = args.to_vec();
     stale_args.extend(["--out-dir", p(&out)]);
     fails_cleanly(&stale_args, &["relight.csv", "already exists", "--force"]);
@@ -57,8 +56,8 @@ fn it_refuses_stale_reports_and_bad_inputs_before_any_work() {
         ],
         &["corrupt.hdr"],
     );
-    // Refused before any ray was cast.
-    assert!(start.elapsed().as_secs() < 20, "{:?}", start.elapsed());
+    // Nothing was written: every refusal came before the work.
+    assert!(!fresh.join("relight.csv").exists());
 }
 
 #[test]
