@@ -132,12 +132,7 @@ impl RelativeError {
         reference: ArrayView2<'_, T>,
     ) -> Result<Self> {
         let difference = ErrorStats::between(result, reference, None, 1.0)?;
-        let scale = (reference
-            .iter()
-            .map(|v| v.as_f64() * v.as_f64())
-            .sum::<f64>()
-            / difference.count as f64)
-            .sqrt();
+        let scale = rms(reference);
         if scale == 0.0 {
             return Err(Error::parameter(
                 "reference",
@@ -151,6 +146,16 @@ impl RelativeError {
             max_relative: difference.max_error / scale,
         })
     }
+}
+
+/// The root mean square of every value of `a` (0 when it is empty).
+///
+/// ```
+/// let a = ndarray::array![[3.0, 0.0], [0.0, 4.0]];
+/// assert!((haarshift::metrics::rms(a.view()) - 2.5).abs() < 1e-15);
+/// ```
+pub fn rms<T: Sample>(a: ArrayView2<'_, T>) -> f64 {
+    (a.iter().map(|v| v.as_f64() * v.as_f64()).sum::<f64>() / a.len().max(1) as f64).sqrt()
 }
 
 /// The pixels whose centres lie within `radius` of the array's centre `((h-1)/2, (w-1)/2)`.

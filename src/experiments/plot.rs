@@ -129,6 +129,27 @@ where
         .map_err(plot_error)
 }
 
+/// The legend of a chart's labelled series, at `position` (`None`: plotters' default).
+fn draw_legend<'a, 'b: 'a, X, Y>(
+    chart: &mut ChartContext<'a, BitMapBackend<'b>, Cartesian2d<X, Y>>,
+    position: Option<SeriesLabelPosition>,
+) -> Result<()>
+where
+    X: plotters::coord::ranged1d::Ranged,
+    Y: plotters::coord::ranged1d::Ranged,
+{
+    let mut legend = chart.configure_series_labels();
+    if let Some(p) = position {
+        legend.position(p);
+    }
+    legend
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(plot_error)
+}
+
 /// A log-log scatter plot of `points` with the points of `frontier` joined by a line (a Pareto
 /// frontier, say), as an RGB image.
 ///
@@ -239,15 +260,7 @@ pub fn log_log_lines(
                 )
                 .map_err(plot_error)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(plot_error)?;
-        Ok(())
+        draw_legend(&mut chart, Some(SeriesLabelPosition::UpperRight))
     })
 }
 
@@ -367,14 +380,7 @@ pub fn category_points(
                 .label(s.name.clone())
                 .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(plot_error)?;
-        Ok(())
+        draw_legend(&mut chart, None)
     })
 }
 

@@ -44,7 +44,7 @@ use ndarray::{Array2, Array3, Axis, s};
 use serde::Serialize;
 
 use crate::experiments::plot::labelled_colour_tiles;
-use crate::metrics::RelativeError;
+use crate::metrics::{RelativeError, rms};
 use crate::product::Selection;
 use crate::relight::environment::Environment;
 use crate::relight::glossy::{GlossyOptions, GlossyShader};
@@ -498,6 +498,7 @@ struct Bench<'a> {
     cameras: [Camera; 2],
     truth_bits: ReferenceVisibility,
     truths: HashMap<String, Array2<f64>>,
+    truth_renders: HashMap<String, PlanarImage<f32>>,
     transports: HashMap<(ParamKind, usize, bool), Precomputed>,
 }
 
@@ -522,6 +523,7 @@ impl<'a> Bench<'a> {
             cameras,
             truth_bits,
             truths: HashMap::new(),
+            truth_renders: HashMap::new(),
             transports: HashMap::new(),
         })
     }
@@ -653,7 +655,16 @@ impl<'a> Bench<'a> {
         let (w, h) = self.protocol.image;
         let black = Background::Colour([0.0; 3]);
         let got = draw(&self.subject.scene, camera, (w, h), &shaded.radiance, black)?;
-        let want = draw(&self.subject.scene, camera, (w, h), &truth, black)?;
+        // The truth's render, once per setting and camera.
+        let key = format!(
+            "{}/{:?}/{}/{}",
+            setting.light.name, setting.angles, setting.brdf, setting.camera
+        );
+        if !self.truth_renders.contains_key(&key) {
+            let image = draw(&self.subject.scene, camera, (w, h), &truth, black)?;
+            self.truth_renders.insert(key.clone(), image);
+        }
+        let want = &self.truth_renders[&key];
         let image_rms = RelativeError::between(
             got.planes()
                 .view()
@@ -741,11 +752,10 @@ impl<'a> Bench<'a> {
             .map(|(_, s)| s.radiance.clone());
         let truth = self.truth(setting)?;
         if let Some(spatial) = &spatial {
-            let scale = RelativeError::between(spatial.view(), truth.view())?;
+            // Relative to the truth's RMS, as every other figure.
+            let scale = rms(truth.view());
             for (r, s) in &mut shaded {
-                let d = RelativeError::between(s.radiance.view(), spatial.view());
-                // Relative to the truth's RMS, as every other figure.
-                r.spatial_difference = d.ok().map(|d| d.rms / (scale.rms / scale.rms_relative));
+                r.spatial_difference = Some(rms((&s.radiance - spatial).view()) / scale);
             }
         }
         let grid = self.grid(setting, &shaded, &truth)?;
