@@ -80,9 +80,10 @@ fn lobe<T: haarshift::Sample>(h: usize) -> LatLongMap<T> {
 }
 
 /// One rotation of a one-channel lobe: what a renderer pays per vertex. 64 x 128 in f32 and
-/// f64 for each method, against `direct` (writing the 8192 texels of the analytic lobe), and
-/// by a prepared [`Rotator`]; levels 3 to 6 of a 128 x 256 map (the thesis's levels 4 to 7),
-/// prepared and not.
+/// f64 for each method, against `direct` (writing the 8192 texels of the analytic lobe), by
+/// a prepared [`Rotator`], and the share of its steps 4-6 (`pyramid_of_fields`: the pyramid
+/// from a map's difference fields); levels 3 to 6 of a 128 x 256 map (the thesis's levels 4
+/// to 7), prepared and not.
 fn bench_lobe(c: &mut Criterion) {
     let rotation = SphereRotation::from_degrees(40.0, -25.0, 60.0).expect("angles");
     let axis = rotation.inverse().apply([0.0, 1.0, 0.0]);
@@ -150,6 +151,12 @@ fn one_rotation<T: haarshift::Sample>(
             b.iter(|| rotate_coefficients(&coeffs, rotation, &options).expect("rotates"))
         });
     }
+    // Steps 4-6 alone: the pyramid from a map's exact difference fields.
+    let fields = haarshift::sphere::chain_rule::DifferenceFields::of_map(&map);
+    group.bench_function(
+        BenchmarkId::new("pyramid_of_fields", format!("64x128/{precision}")),
+        |b| b.iter(|| fields.to_coefficients().expect("a pyramid")),
+    );
     // The renderer's unit: the lobe prepared once, then one rotation into a vertex frame.
     for scheme in [Scheme::Linear, Scheme::Cubic] {
         let rotator = Rotator::new(&map, scheme).expect("a power of two");

@@ -42,7 +42,9 @@
 //!    difference fields: `b = (V[2I][2J] + V[2I][2J+1]) / 4`, `a = (U[2I][2J] + U[2I+1][2J]) / 4`,
 //!    `c = C[2I][2J] / 4`, and one level coarser
 //!    `V' = h_t (3 taps `[1 2 1]`, along theta) x h_s (2 taps `[1 1]`, along phi) of V / 4`,
-//!    `U'` the same with the roles swapped, `C'` with `h_t` along both axes. Applied
+//!    `U'` the same with the roles swapped, `C'` with `h_t` along both axes, which is the
+//!    mixed difference of `V'` and `U'` exactly (`[1 2 1] * [1 -1] = [1 1] * [1 0 -1]`), so
+//!    `C` is never stored: the diagonal details read it off `V` and `U`. Applied
 //!    recursively this is the seed's `O(N)` algorithm; expanded, the weight of a level-`l`
 //!    coefficient is the tent `h_t` of (4.19) times the box `h_s` of (4.20)
 //!    ([`rotate_selected`] uses that expanded form). At the 1 x 2 root the horizontal field
@@ -67,14 +69,25 @@
 //!   the same, so the interpolation of step 3 is one-dimensional and the azimuth of the
 //!   pre-image is never needed. This is the general method's arithmetic with terms that are
 //!   exactly zero left out (the two agree to rounding, tested).
-//! * **Rows at once.** The geometry of step 2 (pre-image, frame, the angle from the pole by a
-//!   polynomial [`atan2`](super::latlong::atan2)) runs over a row of targets in a branch-free
-//!   loop the compiler vectorises, then the interpolation reads the fields.
+//!   A zonal source's geometry needs only `Theta = atan2(rho, q_y)` and
+//!   `dTheta = -(R dp)_y / rho`, each of `q` and `(R dp)_y` linear in `(sin phi, cos phi)`
+//!   along a row, with no frame at `q`.
+//! * **Rows at once.** That geometry (the angle from the pole by a polynomial
+//!   [`atan2`](super::latlong::atan2)) runs over a row of targets in a branch-free loop the
+//!   compiler vectorises, in the map's precision (an `f32` map gets `f32` geometry: within
+//!   2e-7 of the `f64` result's peak, tested), then the interpolation reads the profile. On
+//!   x86-64 with AVX2 the row is compiled for AVX2 and chosen at run time; it gives the
+//!   portable build's bits (tested).
+//! * **Two fields, not three.** `C` is read off `V` and `U` (step 5), so each level filters
+//!   two fields and stores no diagonal one.
 //!
 //! A source turned by `k` whole columns is read `k` columns on ([`Rotator::rotate_turned`]):
 //! the same taps and weights as the turned map's own fields, at no cost. Measured
-//! (`cargo bench --bench sphere -- lobe_one_channel`, 64 x 128, one channel): see the README's
-//! Performance section; the 100 microsecond target of one rotation is not reached.
+//! (`cargo bench --bench sphere -- lobe_one_channel`, 64 x 128 `f32`, one channel, one run):
+//! a prepared rotation 0.24 ms (`haar`) and 0.37 ms (`haar-cubic`), against 0.42 ms for
+//! writing the analytic lobe; steps 4-6 alone (`pyramid_of_fields`) 60 us. The target of
+//! 100 us for one rotation from the finest level is not reached; from the thesis's level 4
+//! (16 x 32 working grid) a rotation costs 17 us.
 //!
 //! # Accuracy
 //!
@@ -138,7 +151,7 @@ use ndarray::{Array3, ArrayView3, ArrayViewMut2, Axis, s};
 use rayon::prelude::*;
 
 use super::latlong::{
-    atan2_finite, azimuth, catmull_rom, continue_index, fill_grid, for_each_row, pixel_solid_angle,
+    atan2_finite, azimuth, catmull_rom, continue_index, for_each_row, pixel_solid_angle,
 };
 use super::{LatLongMap, SphereCoefficients, SphereRotation};
 use crate::transform::{Band, pyramid};
@@ -188,12 +201,12 @@ pub struct SourceGradient<T> {
     d_phi: Vec<T>,
     /// For a zonal `f` (constant along every row: a lobe about the pole), `f_theta` of one
     /// column, `(m + 1) x C`; `d_phi` is then zero.
-    zonal: Option<Vec<T>>,
+    zonal: Option<Vec<f64>>,
     /// `(sin, cos)` of `k delta / 2`, `k` in `0..=2n + 2`: every angle the target grids use.
     trig: Vec<(f64, f64)>,
     /// The column angles of the two target grids as flat arrays, for loops over a row:
     /// `[sin, cos]` of `(j + 1/2) delta` (index 0) and of `(j + 1) delta` (index 1).
-    columns: [[Vec<f64>; 2]; 2],
+    columns: [[Vec<T>; 2]; 2],
 }
 
 impl<T: Sample> SourceGradient<T> {
@@ -250,7 +263,7 @@ impl<T: Sample> SourceGradient<T> {
         .then(|| {
             d_theta
                 .chunks_exact(n * ch)
-                .flat_map(|row| row[..ch].to_vec())
+                .flat_map(|row| row[..ch].iter().map(|v| v.as_f64()))
                 .collect()
         });
         let half = 0.5 * step;
@@ -260,8 +273,8 @@ impl<T: Sample> SourceGradient<T> {
         let columns = [1, 2].map(|first| {
             let at = |j: usize| trig[first + 2 * j];
             [
-                (0..n).map(|j| at(j).0).collect(),
-                (0..n).map(|j| at(j).1).collect(),
+                (0..n).map(|j| T::from_f64(at(j).0)).collect(),
+                (0..n).map(|j| T::from_f64(at(j).1)).collect(),
             ]
         });
         SourceGradient {
@@ -314,59 +327,91 @@ impl<T: Sample> SourceGradient<T> {
                 self.accumulate_linear((theta, phi), (alpha, beta), turn, out)
             }
             (Scheme::Cubic, None) => self.accumulate_cubic((theta, phi), (alpha, beta), turn, out),
-            (scheme, Some(profile)) => self.accumulate_zonal(scheme, profile, theta, alpha, out),
+            (_, Some(profile)) => self.accumulate_zonal(profile, &[theta], &[alpha], out),
         }
     }
 
-    /// [`accumulate`](Self::accumulate) of a zonal `f`: `f_phi` is zero and every column
-    /// of `f_theta` is `profile`, so the bilinear (Catmull-Rom) interpolation of the general
-    /// path reduces to a linear (cubic) one along `theta`, its weights across the columns
-    /// summing to 1; across a pole the profile continues negated (a tangent component).
+    /// [`accumulate`](Self::accumulate) of a zonal `f` for a run of targets: adds
+    /// `alpha[j] f_theta(theta[j])` to pixel `j` of `out` (`C` values each). `f_phi` is zero
+    /// and every column of `f_theta` is `profile`, so the bilinear (Catmull-Rom)
+    /// interpolation of the general path reduces to a linear (cubic) one along `theta`, its
+    /// weights across the columns summing to 1; across a pole the profile continues negated
+    /// (a tangent component). The arithmetic is in `f64`, rounded once per value.
     #[inline(always)]
-    fn accumulate_zonal(
+    fn accumulate_zonal<A: Sample>(
         &self,
-        scheme: Scheme,
-        profile: &[T],
-        theta: f64,
-        alpha: f64,
+        profile: &[f64],
+        theta: &[A],
+        alpha: &[A],
         out: &mut [T],
     ) {
-        let (m, ch) = (self.m, self.channels);
-        let y = theta * self.inverse_step;
-        // (entry, weight) of the two or four taps along the profile.
-        let mut taps = [(0usize, T::zero()); 4];
-        let tap = |row: isize, w: f64| {
-            let (r, w) = if row < 0 {
-                (-row, -w)
-            } else if row > m as isize {
-                (2 * m as isize - row, -w)
-            } else {
-                (row, w)
+        // The common channel counts as constants, so the channel loop disappears.
+        match self.channels {
+            1 => self.accumulate_zonal_channels::<1, A>(profile, theta, alpha, out),
+            3 => self.accumulate_zonal_channels::<3, A>(profile, theta, alpha, out),
+            _ => self.accumulate_zonal_channels::<0, A>(profile, theta, alpha, out),
+        }
+    }
+
+    /// [`accumulate_zonal`](Self::accumulate_zonal) for `CH` channels (0: any number).
+    #[inline(always)]
+    fn accumulate_zonal_channels<const CH: usize, A: Sample>(
+        &self,
+        profile: &[f64],
+        theta: &[A],
+        alpha: &[A],
+        out: &mut [T],
+    ) {
+        let (m, ch) = (self.m, if CH == 0 { self.channels } else { CH });
+        let targets = out.chunks_exact_mut(ch).zip(theta.iter().zip(alpha));
+        if self.scheme == Scheme::Linear {
+            // Two taps, never across a pole (rows 0..=m hold every theta in [0, pi]). The
+            // row as an `i32` clamped into the profile, so that the loop has no bounds
+            // checks left and vectorises (gathers).
+            let profile = &profile[..(m + 1) * ch];
+            let last = m as i32 - 1;
+            let taps = |theta: A, alpha: A| {
+                let (y, alpha) = (theta.as_f64() * self.inverse_step, alpha.as_f64());
+                let r0 = (y as i32).clamp(0, last);
+                let fy = y - f64::from(r0);
+                (r0 as usize * ch, alpha * (1.0 - fy), alpha * fy)
             };
-            (r as usize * ch, T::from_f64(alpha * w))
-        };
-        let count = match scheme {
-            Scheme::Linear => {
-                let r0 = (y as usize).min(m - 1);
-                let fy = y - r0 as f64;
-                taps[0] = tap(r0 as isize, 1.0 - fy);
-                taps[1] = tap(r0 as isize + 1, fy);
-                2
-            }
-            Scheme::Cubic => {
-                let r0 = (y + 1.0) as isize - 1;
-                for (dr, w) in catmull_rom(y - r0 as f64).into_iter().enumerate() {
-                    taps[dr] = tap(r0 - 1 + dr as isize, w);
+            if CH == 1 {
+                // A plain loop over slices: no chunks of one, so that it vectorises.
+                for ((o, &theta), &alpha) in out.iter_mut().zip(theta).zip(alpha) {
+                    let (at, w0, w1) = taps(theta, alpha);
+                    *o += T::from_f64(w0 * profile[at] + w1 * profile[at + 1]);
                 }
-                4
+                return;
             }
-        };
-        for (k, o) in out.iter_mut().enumerate() {
-            let mut acc = *o;
-            for &(at, w) in &taps[..count] {
-                acc += w * profile[at + k];
+            for (px, (&theta, &alpha)) in targets {
+                let (at, w0, w1) = taps(theta, alpha);
+                for k in 0..ch {
+                    px[k] += T::from_f64(w0 * profile[at + k] + w1 * profile[at + ch + k]);
+                }
             }
-            *o = acc;
+            return;
+        }
+        for (px, (&theta, &alpha)) in targets {
+            let (y, alpha) = (theta.as_f64() * self.inverse_step, alpha.as_f64());
+            // (entry, weight) of the four taps along the profile, continued over the poles.
+            let mut taps = [(0usize, 0.0); 4];
+            let r0 = (y + 1.0) as isize - 1;
+            for (dr, w) in catmull_rom(y - r0 as f64).into_iter().enumerate() {
+                let row = r0 - 1 + dr as isize;
+                let (r, w) = if row < 0 {
+                    (-row, -w)
+                } else if row > m as isize {
+                    (2 * m as isize - row, -w)
+                } else {
+                    (row, w)
+                };
+                taps[dr] = (r as usize * ch, alpha * w);
+            }
+            for k in 0..ch {
+                let value: f64 = taps.iter().map(|&(at, w)| w * profile[at + k]).sum();
+                px[k] += T::from_f64(value);
+            }
         }
     }
 
@@ -592,6 +637,48 @@ fn pre_image(
     }
 }
 
+/// For a zonal source, the chain rule's geometry of a run of targets on one row: with
+/// `q = R p` the pre-image of the target `p`, `Theta = atan2(rho, q_y)` (`rho` the length of
+/// `(q_x, q_z)`) and `scale * dTheta/d(along) = -scale (R dp)_y / rho` into `theta` and
+/// `alpha`. That factor is the general path's `e_Theta(q) . R dp` (the two are equal because
+/// `q . R dp = 0`) with the frame at `q` never formed: 18 products fewer per target. Its size
+/// is at most `|dp| <= 1`; it is clamped there, so that a pre-image on a pole (`rho = 0`,
+/// where a zonal profile is exactly zero) gives a finite factor.
+///
+/// The target is `(sin, cos)` of `theta` and the columns' `(sin, cos)` of `phi`. The loop is
+/// branch-free, so that it vectorises.
+#[inline(always)]
+fn zonal_angles<G: Sample>(
+    rotation: &SphereRotation,
+    (st, ct): (f64, f64),
+    (sines, cosines): (&[G], &[G]),
+    along: Along,
+    scale: f64,
+    (theta, alpha): (&mut [G], &mut [G]),
+) {
+    let r = rotation.matrix();
+    let g = G::from_f64;
+    // Each of q and (R dp)_y is `a + b sin(phi) + c cos(phi)` along the row.
+    let q = r.map(|row| [row[1] * ct, row[0] * st, row[2] * st].map(g));
+    let t = match along {
+        // dp/dtheta = (cos theta sin phi, -sin theta, cos theta cos phi)
+        Along::Theta => [-r[1][1] * st, r[1][0] * ct, r[1][2] * ct],
+        // dp/dphi = (sin theta cos phi, 0, -sin theta sin phi)
+        Along::Phi => [0.0, -r[1][2] * st, r[1][0] * st],
+    }
+    .map(g);
+    let (one, tiny, scale) = (G::one(), G::min_positive_value(), g(scale));
+    let line = |[a, b, c]: [G; 3], sp: G, cp: G| a + b * sp + c * cp;
+    let targets = theta.iter_mut().zip(alpha.iter_mut());
+    for ((th, al), (&sp, &cp)) in targets.zip(sines.iter().zip(cosines)) {
+        let (qx, qy, qz) = (line(q[0], sp, cp), line(q[1], sp, cp), line(q[2], sp, cp));
+        let rho = (qx * qx + qz * qz).sqrt();
+        *th = atan2_finite(rho, qy);
+        let d = -line(t, sp, cp) / rho.max(tiny);
+        *al = scale * d.max(-one).min(one);
+    }
+}
+
 /// The chain rule (4.15)/(4.16) for one rotation and one source.
 struct ChainRule<'a, T> {
     grad: &'a SourceGradient<T>,
@@ -614,14 +701,25 @@ impl<'a, T: Sample> ChainRule<'a, T> {
     fn derivative(&self, kt: usize, kp: usize, along: Along, scale: f64, out: &mut [T]) {
         let (st, ct) = self.grad.trig[kt];
         let (sp, cp) = self.grad.trig[kp];
-        let at = pre_image(self.rotation, (st, ct), (sp, cp), along);
         out.fill(T::zero());
         if self.grad.is_zonal() {
             // No azimuth needed: f has no phi derivative.
-            self.grad
-                .accumulate(at.theta, 0.0, scale * at.along_theta, 0.0, 0, out);
+            let (mut theta, mut alpha) = ([T::zero()], [T::zero()]);
+            let columns = ([T::from_f64(sp)], [T::from_f64(cp)]);
+            let angles = (&mut theta[..], &mut alpha[..]);
+            zonal_angles(
+                self.rotation,
+                (st, ct),
+                (&columns.0, &columns.1),
+                along,
+                scale,
+                angles,
+            );
+            let (theta, alpha) = (theta[0].as_f64(), alpha[0].as_f64());
+            self.grad.accumulate(theta, 0.0, alpha, 0.0, 0, out);
             return;
         }
+        let at = pre_image(self.rotation, (st, ct), (sp, cp), along);
         let (q, tq) = (at.q, at.tangent);
         let beta = scale * dot([at.cos_phi, 0.0, -at.sin_phi], tq);
         let big_p = azimuth(q[0], q[2]);
@@ -632,8 +730,7 @@ impl<'a, T: Sample> ChainRule<'a, T> {
 
     /// One row of [`derivative`](Self::derivative): `theta = kt delta / 2` and the columns
     /// `phi = (2j + first) delta / 2` (`first` 1 or 2), `n x C` values into `row`. A zonal
-    /// source is done in two passes over chunks of the row, the geometry first (a loop the
-    /// compiler vectorises), then the interpolation; the values are those of `derivative`.
+    /// source takes [`zonal_row`](Self::zonal_row); the values are those of `derivative`.
     fn derivative_row(&self, kt: usize, first: usize, along: Along, scale: f64, row: &mut [T]) {
         let ch = self.grad.channels;
         let Some(profile) = &self.grad.zonal else {
@@ -642,24 +739,56 @@ impl<'a, T: Sample> ChainRule<'a, T> {
             }
             return;
         };
-        let scheme = self.grad.scheme;
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, the only feature `zonal_row_avx2` is compiled for.
+            unsafe { self.zonal_row_avx2(profile, (kt, first), along, scale, row) };
+            return;
+        }
+        self.zonal_row(profile, (kt, first), along, scale, row)
+    }
+
+    /// [`zonal_row`](Self::zonal_row) compiled for AVX2: four lanes of `f64`, and no fused
+    /// multiply-adds, so that every CPU gets the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn zonal_row_avx2(
+        &self,
+        profile: &[f64],
+        at: (usize, usize),
+        along: Along,
+        scale: f64,
+        row: &mut [T],
+    ) {
+        self.zonal_row(profile, at, along, scale, row)
+    }
+
+    /// A row of a zonal source's derivative in two passes over chunks of the row: the
+    /// geometry ([`zonal_angles`]), then the interpolation
+    /// ([`accumulate_zonal`](SourceGradient::accumulate_zonal)), both loops the compiler
+    /// vectorises.
+    #[inline(always)]
+    fn zonal_row(
+        &self,
+        profile: &[f64],
+        (kt, first): (usize, usize),
+        along: Along,
+        scale: f64,
+        row: &mut [T],
+    ) {
         const CHUNK: usize = 32;
+        let ch = self.grad.channels;
         let target = self.grad.trig[kt];
         let [sines, cosines] = &self.grad.columns[first - 1];
         for (c, pixels) in row.chunks_mut(CHUNK * ch).enumerate() {
             let count = pixels.len() / ch;
-            let (mut theta, mut alpha) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
-            let columns = sines[c * CHUNK..][..count]
-                .iter()
-                .zip(&cosines[c * CHUNK..][..count]);
-            for ((t, a), (&sp, &cp)) in theta.iter_mut().zip(&mut alpha).zip(columns) {
-                let at = pre_image(self.rotation, target, (sp, cp), along);
-                (*t, *a) = (at.theta, scale * at.along_theta);
-            }
-            for ((px, &t), &a) in pixels.chunks_exact_mut(ch).zip(&theta).zip(&alpha) {
-                px.fill(T::zero());
-                self.grad.accumulate_zonal(scheme, profile, t, a, px);
-            }
+            let (mut theta, mut alpha) = ([T::zero(); CHUNK], [T::zero(); CHUNK]);
+            let columns = (&sines[c * CHUNK..][..count], &cosines[c * CHUNK..][..count]);
+            let out = (&mut theta[..count], &mut alpha[..count]);
+            zonal_angles(self.rotation, target, columns, along, scale, out);
+            pixels.fill(T::zero());
+            let (theta, alpha) = (&theta[..count], &alpha[..count]);
+            self.grad.accumulate_zonal(profile, theta, alpha, pixels);
         }
     }
 
@@ -708,7 +837,6 @@ impl<'a, T: Sample> ChainRule<'a, T> {
 pub struct DifferenceFields<T> {
     v: Array3<T>,
     u: Array3<T>,
-    c: Array3<T>,
 }
 
 impl<T: Sample> DifferenceFields<T> {
@@ -737,19 +865,27 @@ impl<T: Sample> DifferenceFields<T> {
                 let um = rule.field(m, |i| 2 * i + 1, 2, Along::Phi, -grad.step);
                 let w = T::from_f64(1.0 / 24.0);
                 let two = T::from_f64(2.0);
-                let v = grid_from_fn((m - 1, n, ch), |(i, j, k)| {
-                    let c = vm[[i + 1, j, k]];
-                    c + w * (vm[[i, j, k]] - two * c + vm[[i + 2, j, k]])
+                let (vm, um, len) = (flat(&vm), flat(&um), n * ch);
+                let v = rows_from_fn((m - 1, n, ch), |i, out| {
+                    let (above, here, below) =
+                        (row(vm, len, i), row(vm, len, i + 1), row(vm, len, i + 2));
+                    for (e, o) in out.iter_mut().enumerate() {
+                        let c = here[e];
+                        *o = c + w * (above[e] - two * c + below[e]);
+                    }
                 });
-                let u = grid_from_fn((m, n, ch), |(i, j, k)| {
-                    let c = um[[i, j, k]];
-                    c + w * (um[[i, (j + n - 1) % n, k]] - two * c + um[[i, (j + 1) % n, k]])
+                let u = rows_from_fn((m, n, ch), |i, out| {
+                    let here = row(um, len, i);
+                    for (e, o) in out.iter_mut().enumerate() {
+                        let c = here[e];
+                        let (left, right) = (here[before(e, ch, len)], here[after(e, ch, len)]);
+                        *o = c + w * (left - two * c + right);
+                    }
                 });
                 (v, u)
             }
         };
-        let c = mixed_from(v.view(), u.view());
-        DifferenceFields { v, u, c }
+        DifferenceFields { v, u }
     }
 
     /// The exact differences of a map `x` (the identity a rotation's fields approximate).
@@ -765,12 +901,20 @@ impl<T: Sample> DifferenceFields<T> {
     pub fn of_map(x: &LatLongMap<T>) -> Self {
         let a = x.as_array();
         let (m, n, ch) = a.dim();
-        let v = grid_from_fn((m - 1, n, ch), |(i, j, k)| a[[i, j, k]] - a[[i + 1, j, k]]);
-        let u = grid_from_fn((m, n, ch), |(i, j, k)| {
-            a[[i, j, k]] - a[[i, (j + 1) % n, k]]
+        let (x, len) = (flat_view(&a), n * ch);
+        let v = rows_from_fn((m - 1, n, ch), |i, out| {
+            let (here, below) = (row(x, len, i), row(x, len, i + 1));
+            for ((o, &a), &b) in out.iter_mut().zip(here).zip(below) {
+                *o = a - b;
+            }
         });
-        let c = mixed_from(v.view(), u.view());
-        DifferenceFields { v, u, c }
+        let u = rows_from_fn((m, n, ch), |i, out| {
+            let here = row(x, len, i);
+            for (e, o) in out.iter_mut().enumerate() {
+                *o = here[e] - here[after(e, ch, len)];
+            }
+        });
+        DifferenceFields { v, u }
     }
 
     /// `V`: `(m - 1, n, C)`, `V[i][j] = X[i][j] - X[i+1][j]`.
@@ -783,9 +927,11 @@ impl<T: Sample> DifferenceFields<T> {
         self.u.view()
     }
 
-    /// `C`: `(m - 1, n, C)`, `C[i][j] = X[i][j] - X[i][j+1] - X[i+1][j] + X[i+1][j+1]`.
-    pub fn diagonal(&self) -> ArrayView3<'_, T> {
-        self.c.view()
+    /// `C`: `(m - 1, n, C)`, `C[i][j] = X[i][j] - X[i][j+1] - X[i+1][j] + X[i+1][j+1]`, the
+    /// mean of its two expressions in `V` and `U` (step 4). Not stored: the diagonal
+    /// details read it where they need it (step 5).
+    pub fn diagonal(&self) -> Array3<T> {
+        mixed_from(&self.v, &self.u)
     }
 
     /// Rows of the grid the fields live on.
@@ -794,62 +940,110 @@ impl<T: Sample> DifferenceFields<T> {
     }
 
     /// Writes the details of the level whose blocks are 2 x 2 cells of this grid into the
-    /// per-channel planes of `out` (step 5).
+    /// per-channel planes of `out` (step 5): `b = (V[2I][2J] + V[2I][2J+1]) / 4`,
+    /// `a = (U[2I][2J] + U[2I+1][2J]) / 4` and `c = C[2I][2J] / 4`, `C` from `V` and `U`.
     fn write_details(&self, out: &mut Array3<T>) {
-        let (m, _, ch) = self.u.dim();
+        let (m, n, ch) = self.u.dim();
         let level = (m / 2).trailing_zeros() as usize;
-        let quarter = T::from_f64(0.25);
+        let (quarter, eighth) = (T::from_f64(0.25), T::from_f64(0.125));
         let size = (out.dim().1, out.dim().2);
         let levels = size.0.trailing_zeros() as usize;
+        let (v, u, len) = (flat(&self.v), flat(&self.u), n * ch);
         for k in 0..ch {
             let mut plane = out.index_axis_mut(Axis(0), k);
-            let mut band = |b: Band, f: &dyn Fn(usize, usize) -> T| {
+            // Row i of band b is written by `f(i, row)`; entry 2 j ch + k of a grid row is
+            // column 2j, channel k.
+            let mut band = |b: Band, f: &dyn Fn(usize, &mut [T])| {
                 let (rows, cols) =
                     pyramid::band_ranges(size, levels, b, level).expect("level exists");
                 let mut view: ArrayViewMut2<'_, T> = plane.slice_mut(s![rows, cols]);
-                for ((i, j), o) in view.indexed_iter_mut() {
-                    *o = f(i, j) * quarter;
+                for (i, mut band_row) in view.rows_mut().into_iter().enumerate() {
+                    f(
+                        i,
+                        band_row
+                            .as_slice_mut()
+                            .expect("rows of a plane are contiguous"),
+                    );
                 }
             };
-            band(Band::Vertical, &|i, j| {
-                self.v[[2 * i, 2 * j, k]] + self.v[[2 * i, 2 * j + 1, k]]
+            let pairs = |r| pairs(r, ch);
+            band(Band::Vertical, &move |i, out| {
+                for (o, p) in out.iter_mut().zip(pairs(row(v, len, 2 * i))) {
+                    *o = quarter * (p[k] + p[ch + k]);
+                }
             });
-            band(Band::Horizontal, &|i, j| {
-                self.u[[2 * i, 2 * j, k]] + self.u[[2 * i + 1, 2 * j, k]]
+            band(Band::Horizontal, &move |i, out| {
+                let (r0, r1) = (row(u, len, 2 * i), row(u, len, 2 * i + 1));
+                for (o, (p0, p1)) in out.iter_mut().zip(pairs(r0).zip(pairs(r1))) {
+                    *o = quarter * (p0[k] + p1[k]);
+                }
             });
-            band(Band::Diagonal, &|i, j| self.c[[2 * i, 2 * j, k]]);
+            band(Band::Diagonal, &move |i, out| {
+                let (vr, u0, u1) = (
+                    row(v, len, 2 * i),
+                    row(u, len, 2 * i),
+                    row(u, len, 2 * i + 1),
+                );
+                let rows = pairs(vr).zip(pairs(u0).zip(pairs(u1)));
+                for (o, (pv, (p0, p1))) in out.iter_mut().zip(rows) {
+                    *o = eighth * (pv[k] - pv[ch + k] + p0[k] - p1[k]);
+                }
+            });
         }
     }
 
-    /// The fields one level coarser (the recursive filters (4.21)-(4.22), step 5).
+    /// The fields one level coarser (the recursive filters (4.21)-(4.22), step 5):
+    /// `V' = h_t (along theta) x h_s (along phi) of V / 4`, `U'` with the roles swapped.
+    /// The seed's third recursion, `C' = h_t x h_t of C / 4`, is not needed: it is the mixed
+    /// difference of `V'` and `U'` exactly (`h_t` applied to a difference along an axis is
+    /// the difference of `h_s` applied along it: `[1 2 1] * [1 -1] = [1 1] * [1 0 -1]`), so
+    /// `C` is read off `V` and `U` at every level.
     fn coarser(&self) -> Self {
-        let (m, n, ch) = self.u.dim();
+        // The common channel counts as constants, so that the loops over a row vectorise.
+        match self.u.dim().2 {
+            1 => self.coarser_with::<1>(),
+            3 => self.coarser_with::<3>(),
+            _ => self.coarser_with::<0>(),
+        }
+    }
+
+    /// [`coarser`](Self::coarser) for `CH` channels (0: any number).
+    fn coarser_with<const CH: usize>(&self) -> Self {
+        let (m, n, channels) = self.u.dim();
+        let ch = if CH == 0 { channels } else { CH };
         let (mh, nh) = (m / 2, n / 2);
         let q = T::from_f64(0.25);
         let two = T::from_f64(2.0);
-        let v = grid_from_fn((mh.saturating_sub(1), nh, ch), |(i, j, k)| {
-            let col = |c: usize| {
-                self.v[[2 * i, c, k]] + two * self.v[[2 * i + 1, c, k]] + self.v[[2 * i + 2, c, k]]
-            };
-            q * (col(2 * j) + col(2 * j + 1))
+        let (v, u, len) = (flat(&self.v), flat(&self.u), n * ch);
+        let (pairs, after_pairs) = (|r| pairs(r, ch), |r| after_pairs(r, ch));
+        let v = rows_from_fn((mh.saturating_sub(1), nh, ch), move |i, out| {
+            let (a, b, d) = (
+                row(v, len, 2 * i),
+                row(v, len, 2 * i + 1),
+                row(v, len, 2 * i + 2),
+            );
+            let rows = pairs(a).zip(pairs(b).zip(pairs(d)));
+            for (o, (a, (b, d))) in out.chunks_exact_mut(ch).zip(rows) {
+                for k in 0..ch {
+                    let c0 = a[k] + two * b[k] + d[k];
+                    let c1 = a[ch + k] + two * b[ch + k] + d[ch + k];
+                    o[k] = q * (c0 + c1);
+                }
+            }
         });
-        let u = grid_from_fn((mh, nh, ch), |(i, j, k)| {
-            let row = |r: usize| {
-                self.u[[r, 2 * j, k]]
-                    + two * self.u[[r, 2 * j + 1, k]]
-                    + self.u[[r, (2 * j + 2) % n, k]]
-            };
-            q * (row(2 * i) + row(2 * i + 1))
+        let u = rows_from_fn((mh, nh, ch), move |i, out| {
+            let (a, b) = (row(u, len, 2 * i), row(u, len, 2 * i + 1));
+            let rows = (pairs(a).zip(after_pairs(a))).zip(pairs(b).zip(after_pairs(b)));
+            for (o, ((a, a2), (b, b2))) in out.chunks_exact_mut(ch).zip(rows) {
+                for k in 0..ch {
+                    // `[1 2 1]` along each row from column 2j.
+                    let t0 = a[k] + two * a[ch + k] + a2[k];
+                    let t1 = b[k] + two * b[ch + k] + b2[k];
+                    o[k] = q * (t0 + t1);
+                }
+            }
         });
-        let c = grid_from_fn((mh.saturating_sub(1), nh, ch), |(i, j, k)| {
-            let row = |r: usize| {
-                self.c[[r, 2 * j, k]]
-                    + two * self.c[[r, 2 * j + 1, k]]
-                    + self.c[[r, (2 * j + 2) % n, k]]
-            };
-            q * (row(2 * i) + two * row(2 * i + 1) + row(2 * i + 2))
-        });
-        DifferenceFields { v, u, c }
+        DifferenceFields { v, u }
     }
 
     /// All detail levels of the `m x 2m` pyramid these fields describe, the root's two
@@ -881,25 +1075,74 @@ impl<T: Sample> DifferenceFields<T> {
     }
 }
 
-/// `Array3::from_shape_fn` with the rows computed in parallel.
-fn grid_from_fn<T: Sample>(
+/// A `(rows, n, C)` grid whose row `i` (`n x C` values, column-major within the row as
+/// everywhere here: entry `j C + k`) is written by `f(i, row)`, rows in parallel for large
+/// grids ([`for_each_row`]).
+fn rows_from_fn<T: Sample>(
     shape: (usize, usize, usize),
-    f: impl Fn((usize, usize, usize)) -> T + Sync,
+    f: impl Fn(usize, &mut [T]) + Sync,
 ) -> Array3<T> {
-    fill_grid(shape, |i, j, out| {
-        for (k, o) in out.iter_mut().enumerate() {
-            *o = f((i, j, k));
-        }
-    })
+    let mut data = Array3::zeros(shape);
+    let len = shape.1 * shape.2;
+    if len > 0 {
+        for_each_row(data.as_slice_mut().expect("standard layout"), len, f);
+    }
+    data
+}
+
+/// The column pairs `(2j, 2j + 1)` of a grid row of `ch` channels, as chunks: loops over
+/// them have no bounds checks and vectorise.
+#[inline]
+fn pairs<T>(row: &[T], ch: usize) -> std::slice::ChunksExact<'_, T> {
+    row.chunks_exact(2 * ch)
+}
+
+/// The column pairs `(2j + 2, 2j + 3)` of a periodic grid row: [`pairs`] one pair on.
+#[inline]
+fn after_pairs<T>(row: &[T], ch: usize) -> impl Iterator<Item = &[T]> {
+    let (first, rest) = row.split_at(2 * ch);
+    pairs(rest, ch).chain(std::iter::once(first))
+}
+
+/// The values of a grid of this module (always built in standard layout).
+fn flat<T>(a: &Array3<T>) -> &[T] {
+    a.as_slice().expect("standard layout")
+}
+
+/// The values of a standard-layout view.
+fn flat_view<'a, T>(a: &ArrayView3<'a, T>) -> &'a [T] {
+    a.to_slice().expect("maps are in standard layout")
+}
+
+/// Row `i` of a grid with rows of `len` values.
+#[inline]
+fn row<T>(values: &[T], len: usize, i: usize) -> &[T] {
+    &values[i * len..][..len]
+}
+
+/// The entry one column on from entry `e` of a periodic row of `len` values, `ch` a column.
+#[inline]
+fn after(e: usize, ch: usize, len: usize) -> usize {
+    if e + ch < len { e + ch } else { e + ch - len }
+}
+
+/// The entry one column back from entry `e` of a periodic row.
+#[inline]
+fn before(e: usize, ch: usize, len: usize) -> usize {
+    if e >= ch { e - ch } else { e + len - ch }
 }
 
 /// `C = (V[i][j] - V[i][j+1] + U[i][j] - U[i+1][j]) / 2`, the mixed difference from both
 /// first-difference fields (step 4).
-fn mixed_from<T: Sample>(v: ArrayView3<'_, T>, u: ArrayView3<'_, T>) -> Array3<T> {
+fn mixed_from<T: Sample>(v: &Array3<T>, u: &Array3<T>) -> Array3<T> {
     let (rows, n, ch) = v.dim();
     let half = T::from_f64(0.5);
-    grid_from_fn((rows, n, ch), |(i, j, k)| {
-        half * (v[[i, j, k]] - v[[i, (j + 1) % n, k]] + u[[i, j, k]] - u[[i + 1, j, k]])
+    let (v, u, len) = (flat(v), flat(u), n * ch);
+    rows_from_fn((rows, n, ch), |i, out| {
+        let (vr, u0, u1) = (row(v, len, i), row(u, len, i), row(u, len, i + 1));
+        for (e, o) in out.iter_mut().enumerate() {
+            *o = half * (vr[e] - vr[after(e, ch, len)] + u0[e] - u1[e]);
+        }
     })
 }
 
@@ -998,9 +1241,9 @@ fn set_mean<T: Sample>(
         ));
     }
     let levels = coeffs.levels();
-    let mut data = coeffs.as_array().to_owned();
     let w = pole * 2.0 * PI / n as f64;
     for (k, &target) in target.iter().enumerate() {
+        let data = coeffs.as_array();
         let plane = data.index_axis(Axis(0), k);
         let mut rows = vec![plane[[0, 0]].as_f64() + plane[[0, 1]].as_f64()];
         for level in 0..levels {
@@ -1023,10 +1266,8 @@ fn set_mean<T: Sample>(
             - w * (rows[0] + rows[m - 1]);
         // A constant c adds 4 pi c to the sum and 2 pi c to each pole mean.
         let shift = T::from_f64((target - current) / (4.0 * PI * (1.0 - pole)));
-        data[[k, 0, 0]] += shift;
-        data[[k, 0, 1]] += shift;
+        coeffs.shift_mean(k, shift)?;
     }
-    *coeffs = SphereCoefficients::from_array(data)?;
     Ok(())
 }
 
@@ -1262,4 +1503,48 @@ fn footprint_coefficient<T: Sample>(
         }
     };
     acc.iter().map(|a| T::from_f64(a / norm)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The zonal rows compiled for AVX2 give the portable build's bits (no fused
+    /// multiply-adds, the same operations in wider registers), for both precisions, both
+    /// schemes and both fields. On a CPU without AVX2 there is only one build to run.
+    #[test]
+    fn the_avx2_build_of_a_zonal_row_gives_the_portable_bits() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            same_bits::<f32>();
+            same_bits::<f64>();
+        } else {
+            eprintln!("no AVX2 on this CPU: only the portable build runs");
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    fn same_bits<T: Sample>() {
+        let lobe = LatLongMap::<T>::from_fn(32, 2, |d, out| {
+            out[0] = T::from_f64(d[1].max(0.0).powi(20));
+            out[1] = T::from_f64((2.0 * d[1]).exp());
+        })
+        .unwrap();
+        let rotation = SphereRotation::from_degrees(25.0, -70.0, 40.0).unwrap();
+        for scheme in [Scheme::Linear, Scheme::Cubic] {
+            let grad = SourceGradient::with_scheme(&lobe, scheme);
+            let profile = grad.zonal.as_ref().expect("a zonal source");
+            let rule = ChainRule::new(&grad, &rotation, 0);
+            for (kt, first, along) in [(3, 1, Along::Theta), (6, 2, Along::Phi)] {
+                let mut portable = vec![T::zero(); 64 * 2];
+                let mut wide = portable.clone();
+                rule.zonal_row(profile, (kt, first), along, -0.1, &mut portable);
+                // SAFETY: the caller checked that the CPU has AVX2.
+                unsafe { rule.zonal_row_avx2(profile, (kt, first), along, -0.1, &mut wide) };
+                let bits = |v: &[T]| v.iter().map(|x| x.as_f64().to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&portable), bits(&wide), "{scheme:?} {kt}");
+                assert!(portable.iter().any(|v| v.abs() > T::from_f64(1e-3)));
+            }
+        }
+    }
 }

@@ -55,9 +55,29 @@ impl<T: Sample> SphereCoefficients<T> {
         let (c, h, w) = data.dim();
         check_pyramid_shape(h, w, c)?;
         ensure_finite(&data)?;
-        Ok(SphereCoefficients {
-            data: data.as_standard_layout().into_owned(),
-        })
+        let data = if data.is_standard_layout() {
+            data
+        } else {
+            data.as_standard_layout().into_owned()
+        };
+        Ok(SphereCoefficients { data })
+    }
+
+    /// Adds `shift` to channel `channel`'s mean (both scaling coefficients of the 1 x 2
+    /// root), every detail kept; refused if the result is not finite.
+    pub(crate) fn shift_mean(&mut self, channel: usize, shift: T) -> Result<()> {
+        let (a, b) = (
+            self.data[[channel, 0, 0]] + shift,
+            self.data[[channel, 0, 1]] + shift,
+        );
+        if !(a.is_finite() && b.is_finite()) {
+            return Err(Error::NonFinite {
+                value: shift.as_f64(),
+                index: vec![channel, 0, 0],
+            });
+        }
+        (self.data[[channel, 0, 0]], self.data[[channel, 0, 1]]) = (a, b);
+        Ok(())
     }
 
     /// Forward transform of every channel of `map` (`H` must be a power of two).

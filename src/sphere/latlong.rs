@@ -99,9 +99,10 @@ pub fn atan2(y: f64, x: f64) -> f64 {
 }
 
 /// [`atan2`] for finite `(y, x)` not both zero, branch-free (selects only), so that loops
-/// over many angles vectorise.
+/// over many angles vectorise. In `f32` (the chain rule's geometry for `f32` maps) the same
+/// polynomial is evaluated in `f32`: within a few ulp of `f32`.
 #[inline(always)]
-pub(crate) fn atan2_finite(y: f64, x: f64) -> f64 {
+pub(crate) fn atan2_finite<F: Sample>(y: F, x: F) -> F {
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, FRAC_PI_6, PI};
     const SQRT_3: f64 = 1.732_050_807_568_877_2;
     const TAN_PI_12: f64 = 0.267_949_192_431_122_7;
@@ -116,37 +117,39 @@ pub(crate) fn atan2_finite(y: f64, x: f64) -> f64 {
         0.075_307_565_684_610_06,
         -0.052_086_075_603_399_89,
     ];
+    let k = F::from_f64;
+    let c = C.map(k);
     let (ay, ax) = (y.abs(), x.abs());
     let swap = ay > ax;
     let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
     // Both quotients straight from (num, den), so the two divisions run side by side.
     let t = num / den;
-    let reduce = num > TAN_PI_12 * den;
-    let reduced = (SQRT_3 * num - den) / (SQRT_3 * den + num);
+    let reduce = num > k(TAN_PI_12) * den;
+    let reduced = (k(SQRT_3) * num - den) / (k(SQRT_3) * den + num);
     // The diagonals exactly, as the C library rounds them: they are texel edges.
     let diagonal = num == den;
     let t = if diagonal {
-        0.0
+        F::zero()
     } else if reduce {
         reduced
     } else {
         t
     };
     let base = if diagonal {
-        FRAC_PI_4
+        k(FRAC_PI_4)
     } else if reduce {
-        FRAC_PI_6
+        k(FRAC_PI_6)
     } else {
-        0.0
+        F::zero()
     };
     // Estrin's scheme: three levels of dependent products instead of seven.
     let u = t * t;
     let (u2, u4) = (u * u, u * u * u * u);
-    let poly = (C[0] + C[1] * u + u2 * (C[2] + C[3] * u))
-        + u4 * (C[4] + C[5] * u + u2 * (C[6] + C[7] * u));
+    let poly = (c[0] + c[1] * u + u2 * (c[2] + c[3] * u))
+        + u4 * (c[4] + c[5] * u + u2 * (c[6] + c[7] * u));
     let a = base + t * poly;
-    let a = if swap { FRAC_PI_2 - a } else { a };
-    let a = if x.is_sign_negative() { PI - a } else { a };
+    let a = if swap { k(FRAC_PI_2) - a } else { a };
+    let a = if x.is_sign_negative() { k(PI) - a } else { a };
     if y.is_sign_negative() { -a } else { a }
 }
 
