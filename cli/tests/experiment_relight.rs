@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{fails_cleanly, p, succeeds_with_stdout, testdata};
+use common::{fails_cleanly, p, succeeds_with_stdout, testdata, usage_error};
 
 #[test]
 fn it_refuses_stale_reports_and_bad_inputs_before_any_work() {
@@ -76,5 +76,15 @@ fn its_help_states_the_protocols_and_the_axes() {
         "512 x 1024",
     ] {
         assert!(help.contains(needle), "{needle}: {help}");
+    }
+}
+
+#[test]
+fn quick_is_the_default_and_cannot_be_asked_for_with_full() {
+    for command in ["relight", "dynamic"] {
+        usage_error(
+            &["experiment", command, "--quick", "--full"],
+            &["--quick", "--full"],
+        );
     }
 }

@@ -135,10 +135,14 @@ impl MotionPath {
                         .ok_or_else(|| bad(k, format!("no object is named {name:?}")))?;
                     let target =
                         Placement::from_transform(to, param).map_err(|e| bad(k, e.to_string()))?;
-                    (object, Some(target))
+                    Move::Object {
+                        object,
+                        from: placements[object],
+                        target,
+                    }
                 }
                 (None, None, Some(yaw)) if yaw.is_finite() && yaw.abs() <= 1e6 => {
-                    (usize::MAX, None)
+                    Move::Lighting { yaw }
                 }
                 _ => {
                     return Err(bad(
@@ -147,48 +151,73 @@ impl MotionPath {
                     ));
                 }
             };
-            let (object, target) = change;
             if out.is_empty() {
+                // Frame 0: the scene as given, the first segment's kind of change.
                 out.push(FrameState {
                     segment: 0,
-                    change: if target.is_some() {
-                        Change::Object(object)
-                    } else {
-                        Change::Lighting
-                    },
-                    placement: target.map(|_| placements[object]),
+                    change: change.kind(),
+                    placement: change.start(),
                     light_yaw: 0.0,
                 });
             }
             let start_light = light;
-            let from = target.map(|_| placements[object]);
             for f in 1..=seg.frames {
                 let t = f as f64 / seg.frames as f64;
-                let state = match (from, target) {
-                    (Some(a), Some(b)) => {
-                        let p = interpolate(&a, &b, t, 2 * param.face_size());
-                        placements[object] = p;
-                        FrameState {
-                            segment: k,
-                            change: Change::Object(object),
-                            placement: Some(p),
-                            light_yaw: light,
-                        }
+                let placement = match change {
+                    Move::Object {
+                        object,
+                        from,
+                        target,
+                    } => {
+                        placements[object] = interpolate(&from, &target, t, 2 * param.face_size());
+                        Some(placements[object])
                     }
-                    _ => {
-                        light = start_light + t * seg.light_yaw.unwrap_or(0.0);
-                        FrameState {
-                            segment: k,
-                            change: Change::Lighting,
-                            placement: None,
-                            light_yaw: light,
-                        }
+                    Move::Lighting { yaw } => {
+                        light = start_light + t * yaw;
+                        None
                     }
                 };
-                out.push(state);
+                out.push(FrameState {
+                    segment: k,
+                    change: change.kind(),
+                    placement,
+                    light_yaw: light,
+                });
             }
         }
         Ok(out)
+    }
+}
+
+/// What one path segment changes: an object's placement (from where the segment finds it to
+/// `target`), or the lighting's yaw (by `yaw` degrees).
+#[derive(Clone, Copy)]
+enum Move {
+    Object {
+        object: usize,
+        from: Placement,
+        target: Placement,
+    },
+    Lighting {
+        yaw: f64,
+    },
+}
+
+impl Move {
+    /// The kind of change a frame of this segment records.
+    fn kind(&self) -> Change {
+        match *self {
+            Move::Object { object, .. } => Change::Object(object),
+            Move::Lighting { .. } => Change::Lighting,
+        }
+    }
+
+    /// The moving object's placement when the segment starts.
+    fn start(&self) -> Option<Placement> {
+        match *self {
+            Move::Object { from, .. } => Some(from),
+            Move::Lighting { .. } => None,
+        }
     }
 }
 

@@ -55,6 +55,10 @@ pub struct Args {
     #[arg(long)]
     pub full: bool,
 
+    /// The quick protocol (the default, stated)
+    #[arg(long, conflicts_with = "full")]
+    pub quick: bool,
+
     #[command(flatten)]
     pub output: OutputFlags,
 }
