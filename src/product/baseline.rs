@@ -8,7 +8,7 @@
 //!   a tree ([`multiply`](super::multiply)), then that with the next, and so on, and end with a
 //!   two-function product integral.
 //!
-//! All return the same number as [`product_integral`](super::product_integral) (tested),
+//! All return the same number as [`product_integral`] (tested),
 //! in the same normalisation: the weighted pixel sum, f64.
 
 use ndarray::{ArrayView4, Axis, Zip};

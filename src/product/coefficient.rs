@@ -7,7 +7,7 @@
 //! level `j0` (they all lie on one path of the quadtree, so the functions at `j0` share one
 //! node) and (2) the numbers of `H`, `V` and `D` wavelets at level `j0` have the same parity
 //! (their product is then the box of that node). Then, in the continuous normalisation of
-//! [`basis`](super::basis),
+//! [`basis`],
 //!
 //! `C = s x 2^(sum of levels - 2 j0)`,
 //!
@@ -18,7 +18,7 @@
 //! [`discrete_integral_coefficient`] `= 2^((2 - N) n) C`.
 //!
 //! [`integral_coefficient_by_products`] computes the same number a second way, multiplying the
-//! functions two at a time with [`basis::product`](super::basis::product) (seed 001's lemmas
+//! functions two at a time with [`basis::product`] (seed 001's lemmas
 //! 2-7); the tests check both against the brute-force pixel sum.
 
 use super::basis::{self, BasisFunction, Scaled, quadrant_sign};

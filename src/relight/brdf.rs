@@ -15,9 +15,9 @@
 //! Lambertian surface and the specular colour of a glossy one. A measured BRDF has its own
 //! colour ([`Brdf::channels`] is 3), which the albedo scales.
 //!
-//! **Lambert** leaves the integral as a per-vertex constant ([`Brdf::vertex_factors`]) and
+//! **Lambert** leaves the integral as a per-vertex constant (`1 / pi`, [`Brdf::evaluate`]) and
 //! what is left is the double product integral `<T_v, L>` of the transport and the lighting
-//! ([`super::shade`]): the triple product with `rho` constant, whose tree has only scaling
+//! ([`fn@super::shade`]): the triple product with `rho` constant, whose tree has only scaling
 //! coefficients.
 //!
 //! **Glossy BRDFs** depend on `w_i` and on `w_o` (fixed per vertex by the camera). In the

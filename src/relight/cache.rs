@@ -12,7 +12,7 @@
 //! | `H` | header, JSON: [`CacheHeader`] (the parameters, the counts, the scene hash, the scene file's environment and camera) |
 //! | | positions `V x 3` f64, normals `V x 3` f64, triangles `T x 3` u32, albedo `V x 3` f32 |
 //! | | transport: offsets `V + 1` u64, indices `N` u32, values `N` f32 ([`TransportSet`]) |
-//! | | with `sh_bands = B` in the parameters: the spherical-harmonic transfer `V x B^2` f32 ([`ShTransfer`](super::harmonics::ShTransfer)) |
+//! | | with `sh_bands = B` in the parameters: the spherical-harmonic transfer `V x B^2` f32 ([`ShTransfer`]) |
 //!
 //! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
 //! environment and camera in the header; a version-1 file is refused like any other version.

@@ -6,7 +6,7 @@
 //! **What is computed.** A Lambertian vertex `v` of albedo `a` reflects
 //! `B_v = a / pi x integral of T_v x L x prod_(k != own) O_k`, seed 001 eq. 3.1-3.3 with the
 //! BRDF constant: `T_v` the vertex's own transport (its object's self-visibility, the ground
-//! plane's occlusion where the scene has one, cosine and solid angle; [`TransportSet`]
+//! plane's occlusion where the scene has one, cosine and solid angle; [`TransportSet`](super::transport::TransportSet)
 //! semantics), `L` the lighting, `O_k` object `k`'s occlusion looked up at the vertex
 //! ([`OcclusionField::lookup`], with the options' [`Truncation`]); a vertex beyond an object's
 //! outermost shell takes `O_k = 1`. Each factor is truncated as the options say (the lighting

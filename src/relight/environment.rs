@@ -37,7 +37,7 @@
 //! For a cube of face side `S`, the map is first downsampled to the lat-long height
 //! `min(2 S, H')`, `H'` the largest power of two at most `H`, and then converted by
 //! [`convert`](crate::sphere::convert) (solid-angle integration over each cube texel, with its
-//! [`default_samples`](crate::sphere::convert::default_samples)).
+//! [`default_samples`]).
 
 use std::path::Path;
 

@@ -8,7 +8,7 @@
 //! (`*.hdr`, `*.exr`, `*.npy` in the directory, in name order):
 //! * the per-vertex radiance three ways: Haar with the lighting truncated to `K` detail
 //!   coefficients ([`Lighting`] and [`PreparedTransport`]), spherical harmonics of `B` bands
-//!   ([`shade_sh`]), and the [`reference`] quadrature at the same `N`;
+//!   ([`shade_sh`]), and the [`fn@reference`] quadrature at the same `N`;
 //! * `NAME.png`: the three renders side by side, Haar | SH | reference, each `W x H`, all at one
 //!   exposure: the one that brings the reference's mean vertex luminance to 0.18 x 2 (mid grey
 //!   one stop up);

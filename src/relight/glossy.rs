@@ -9,7 +9,7 @@
 //! `--keep-visibility`, the lighting to `--keep-light`, the BRDF to `--keep-brdf` (the `K`
 //! largest orthonormal details by RGB magnitude plus each face's scaling coefficient, the rule
 //! of [`crate::product::selection`]), and all three to the detail levels `0..depth`. Vertices
-//! from `object_vertices` on (the ground plane) stay Lambertian ([`super::shade`]).
+//! from `object_vertices` on (the ground plane) stay Lambertian ([`fn@super::shade`]).
 //!
 //! **How.** The triple product of the three truncated functions is the integral of the
 //! product of their reconstructions, so `B_v = a_v <T_v, Q>` with `Q` the orthonormal Haar

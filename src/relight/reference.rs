@@ -9,7 +9,7 @@
 //!
 //! the sum over every texel `t` with centre direction `w_t` and exact solid angle `dOmega_t`
 //! ([`sphere::latlong`](crate::sphere::latlong)), `V(v, t)` one ray through the texel centre
-//! from the offset origin `p_v + eps n_v` ([`ray_offset`](super::ray_offset)), through the
+//! from the offset origin `p_v + eps n_v` ([`ray_offset`]), through the
 //! [`Occlusion`] trait, and `rho` evaluated analytically at `(w_t, w_o,v)` in the vertex's own
 //! frame ([`Brdf::evaluate`]): no local copy, no rotation. For a Lambertian vertex `rho = 1/pi`
 //! leaves the sum as `a_v / pi x sum_t L(t) V(v, t) max(0, n_v . w_t) dOmega_t`, which is
@@ -255,9 +255,9 @@ fn quadrature(
 
 /// Every vertex's visibility over the texels of an `N x 2N` lat-long map, one bit per texel
 /// (set: above the vertex's horizon and the ray through the texel centre escapes), cast once
-/// so that [`reference`] can be evaluated under many lightings, BRDFs and views without
-/// casting again. The rays are [`reference`]'s own, so its quadrature over these bits equals
-/// [`reference`] bit for bit.
+/// so that [`fn@reference`] can be evaluated under many lightings, BRDFs and views without
+/// casting again. The rays are [`fn@reference`]'s own, so its quadrature over these bits equals
+/// [`fn@reference`] bit for bit.
 ///
 /// ```
 /// use haarshift::relight::{Mesh, ReferenceOptions, SceneBvh, reference};
@@ -347,7 +347,7 @@ impl ReferenceVisibility {
         self.bits.len() * 8
     }
 
-    /// [`reference`] of `mesh` (the mesh the bits were cast for) under `lighting` (`N x 2N`,
+    /// [`fn@reference`] of `mesh` (the mesh the bits were cast for) under `lighting` (`N x 2N`,
     /// the bits' `N`), with no ray cast: the report counts 0 rays.
     pub fn reference(
         &self,

@@ -62,7 +62,7 @@
 //!
 //! A renderer brings one BRDF into every vertex's frame: the same source, a new rotation each
 //! time. [`Rotator`] does step 1 and the source's share of step 6 once; a rotation then costs
-//! steps 2-5 alone. Two things make those cheap:
+//! steps 2-5 alone. Three things make those cheap:
 //!
 //! * **Zonal sources** (constant along every row, such as a Phong lobe about +Y; detected
 //!   exactly, [`SourceGradient::is_zonal`]): `f_phi` is zero and every column of `f_theta` is

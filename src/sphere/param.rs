@@ -6,7 +6,7 @@
 //! | [`ParamKind`] | faces | texel `(face, row, col)` | solid angle |
 //! |---|---|---|---|
 //! | [`ParamKind::LatLong`] | 2 of `H x H` | lat-long pixel `(row, face H + col)` of the `H x 2H` map: face 0 is `phi in [0, pi)`, face 1 `[pi, 2 pi)` ([`latlong`](super::latlong)) | `(2 pi / W)(cos theta_row - cos theta_row+1)` |
-//! | [`ParamKind::Cube`] | 6 of `S x S` | texel `(row, col)` of cube face `face` ([`cube`](super::cube)) | the spherical quadrilateral's, exact |
+//! | [`ParamKind::Cube`] | 6 of `S x S` | texel `(row, col)` of cube face `face` ([`cube`]) | the spherical quadrilateral's, exact |
 //!
 //! The lat-long faces are the halves of the map, the same two square pyramids that
 //! [`SphereCoefficients`](super::SphereCoefficients) holds side by side. A [`SphereMap`]

@@ -277,7 +277,7 @@ fn exact_rotation(side: usize, deg: f64, f: impl Fn(f64, f64) -> f64) -> Array2<
 }
 
 /// Two Gaussian blobs well inside the disk, rotated exactly by `deg`: the smooth reference
-/// image of [`switch_accuracy`].
+/// image of `switch_accuracy`.
 ///
 /// ```
 /// let b = haarshift::experiments::stability::angle::smooth_blob(64, 90.0);
