@@ -83,7 +83,8 @@
 //!
 //! A source turned by `k` whole columns is read `k` columns on ([`Rotator::rotate_turned`]):
 //! the same taps and weights as the turned map's own fields, at no cost. Measured
-//! (`cargo bench --bench sphere -- lobe_one_channel`, 64 x 128 `f32`, one channel, one run):
+//! (`cargo bench --bench sphere -- lobe_one_channel`, 64 x 128 `f32`, one channel, one run,
+//! `results/sphere/lobe_one_channel.txt`):
 //! a prepared rotation 0.24 ms (`haar`) and 0.37 ms (`haar-cubic`), against 0.42 ms for
 //! writing the analytic lobe; steps 4-6 alone (`pyramid_of_fields`) 60 us. The target of
 //! 100 us for one rotation from the finest level is not reached; from the thesis's level 4
@@ -152,6 +153,7 @@ use rayon::prelude::*;
 
 use super::latlong::{
     atan2_finite, azimuth, catmull_rom, continue_index, for_each_row, pixel_solid_angle,
+    rows_from_fn,
 };
 use super::{LatLongMap, SphereCoefficients, SphereRotation};
 use crate::transform::{Band, pyramid};
@@ -367,7 +369,7 @@ impl<T: Sample> SourceGradient<T> {
         if self.scheme == Scheme::Linear {
             // Two taps, never across a pole (rows 0..=m hold every theta in [0, pi]). The
             // row as an `i32` clamped into the profile, so that the loop has no bounds
-            // checks left and vectorises (gathers).
+            // checks left. (The lookup stays scalar: the compiler does not gather here.)
             let profile = &profile[..(m + 1) * ch];
             let last = m as i32 - 1;
             let taps = |theta: A, alpha: A| {
@@ -377,7 +379,7 @@ impl<T: Sample> SourceGradient<T> {
                 (r0 as usize * ch, alpha * (1.0 - fy), alpha * fy)
             };
             if CH == 1 {
-                // A plain loop over slices: no chunks of one, so that it vectorises.
+                // A plain loop over slices, without the chunks of one of the general loop.
                 for ((o, &theta), &alpha) in out.iter_mut().zip(theta).zip(alpha) {
                     let (at, w0, w1) = taps(theta, alpha);
                     *o += T::from_f64(w0 * profile[at] + w1 * profile[at + 1]);
@@ -702,7 +704,7 @@ impl<'a, T: Sample> ChainRule<'a, T> {
         let (st, ct) = self.grad.trig[kt];
         let (sp, cp) = self.grad.trig[kp];
         out.fill(T::zero());
-        if self.grad.is_zonal() {
+        if let Some(profile) = &self.grad.zonal {
             // No azimuth needed: f has no phi derivative.
             let (mut theta, mut alpha) = ([T::zero()], [T::zero()]);
             let columns = ([T::from_f64(sp)], [T::from_f64(cp)]);
@@ -715,8 +717,7 @@ impl<'a, T: Sample> ChainRule<'a, T> {
                 scale,
                 angles,
             );
-            let (theta, alpha) = (theta[0].as_f64(), alpha[0].as_f64());
-            self.grad.accumulate(theta, 0.0, alpha, 0.0, 0, out);
+            self.grad.accumulate_zonal(profile, &theta, &alpha, out);
             return;
         }
         let at = pre_image(self.rotation, (st, ct), (sp, cp), along);
@@ -765,8 +766,8 @@ impl<'a, T: Sample> ChainRule<'a, T> {
 
     /// A row of a zonal source's derivative in two passes over chunks of the row: the
     /// geometry ([`zonal_angles`]), then the interpolation
-    /// ([`accumulate_zonal`](SourceGradient::accumulate_zonal)), both loops the compiler
-    /// vectorises.
+    /// ([`accumulate_zonal`](SourceGradient::accumulate_zonal)); the first vectorises, the
+    /// second is a table lookup per target.
     #[inline(always)]
     fn zonal_row(
         &self,
@@ -945,7 +946,7 @@ impl<T: Sample> DifferenceFields<T> {
     fn write_details(&self, out: &mut Array3<T>) {
         let (m, n, ch) = self.u.dim();
         let level = (m / 2).trailing_zeros() as usize;
-        let (quarter, eighth) = (T::from_f64(0.25), T::from_f64(0.125));
+        let quarter = T::from_f64(0.25);
         let size = (out.dim().1, out.dim().2);
         let levels = size.0.trailing_zeros() as usize;
         let (v, u, len) = (flat(&self.v), flat(&self.u), n * ch);
@@ -986,7 +987,7 @@ impl<T: Sample> DifferenceFields<T> {
                 );
                 let rows = pairs(vr).zip(pairs(u0).zip(pairs(u1)));
                 for (o, (pv, (p0, p1))) in out.iter_mut().zip(rows) {
-                    *o = eighth * (pv[k] - pv[ch + k] + p0[k] - p1[k]);
+                    *o = quarter * mixed(pv[k], pv[ch + k], p0[k], p1[k]);
                 }
             });
         }
@@ -1075,23 +1076,8 @@ impl<T: Sample> DifferenceFields<T> {
     }
 }
 
-/// A `(rows, n, C)` grid whose row `i` (`n x C` values, column-major within the row as
-/// everywhere here: entry `j C + k`) is written by `f(i, row)`, rows in parallel for large
-/// grids ([`for_each_row`]).
-fn rows_from_fn<T: Sample>(
-    shape: (usize, usize, usize),
-    f: impl Fn(usize, &mut [T]) + Sync,
-) -> Array3<T> {
-    let mut data = Array3::zeros(shape);
-    let len = shape.1 * shape.2;
-    if len > 0 {
-        for_each_row(data.as_slice_mut().expect("standard layout"), len, f);
-    }
-    data
-}
-
 /// The column pairs `(2j, 2j + 1)` of a grid row of `ch` channels, as chunks: loops over
-/// them have no bounds checks and vectorise.
+/// them have no bounds checks.
 #[inline]
 fn pairs<T>(row: &[T], ch: usize) -> std::slice::ChunksExact<'_, T> {
     row.chunks_exact(2 * ch)
@@ -1136,14 +1122,20 @@ fn before(e: usize, ch: usize, len: usize) -> usize {
 /// first-difference fields (step 4).
 fn mixed_from<T: Sample>(v: &Array3<T>, u: &Array3<T>) -> Array3<T> {
     let (rows, n, ch) = v.dim();
-    let half = T::from_f64(0.5);
     let (v, u, len) = (flat(v), flat(u), n * ch);
     rows_from_fn((rows, n, ch), |i, out| {
         let (vr, u0, u1) = (row(v, len, i), row(u, len, i), row(u, len, i + 1));
         for (e, o) in out.iter_mut().enumerate() {
-            *o = half * (vr[e] - vr[after(e, ch, len)] + u0[e] - u1[e]);
+            *o = mixed(vr[e], vr[after(e, ch, len)], u0[e], u1[e]);
         }
     })
+}
+
+/// `C[i][j]` from `V[i][j]`, `V[i][j+1]`, `U[i][j]` and `U[i+1][j]`: the mean of its two
+/// expressions (step 4).
+#[inline(always)]
+fn mixed<T: Sample>(v0: T, v1: T, u0: T, u1: T) -> T {
+    T::from_f64(0.5) * (v0 - v1 + u0 - u1)
 }
 
 /// Sets each channel's constant so that the solid-angle integral of the map equals

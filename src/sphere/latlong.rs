@@ -576,15 +576,24 @@ pub(crate) fn fill_grid<T: Sample>(
     shape: (usize, usize, usize),
     f: impl Fn(usize, usize, &mut [T]) + Sync,
 ) -> Array3<T> {
-    let (channels, row_len) = (shape.2, shape.1 * shape.2);
+    rows_from_fn(shape, |i, row| {
+        for (j, px) in row.chunks_exact_mut(shape.2).enumerate() {
+            f(i, j, px);
+        }
+    })
+}
+
+/// A `(rows, cols, channels)` array whose row `i` (`cols x channels` values, entry
+/// `j channels + k`) is written by `f(i, row)`, rows in parallel above
+/// [`SEQUENTIAL_MAX_VALUES`].
+pub(crate) fn rows_from_fn<T: Sample>(
+    shape: (usize, usize, usize),
+    f: impl Fn(usize, &mut [T]) + Sync,
+) -> Array3<T> {
     let mut data = Array3::zeros(shape);
-    if row_len > 0 {
-        let flat = data.as_slice_mut().expect("standard layout");
-        for_each_row(flat, row_len, |i, row| {
-            for (j, px) in row.chunks_exact_mut(channels).enumerate() {
-                f(i, j, px);
-            }
-        });
+    let len = shape.1 * shape.2;
+    if len > 0 {
+        for_each_row(data.as_slice_mut().expect("standard layout"), len, f);
     }
     data
 }
