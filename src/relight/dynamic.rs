@@ -366,11 +366,7 @@ impl DynamicScene {
             let (set, r) = vertex_major(mesh, &SceneBvh::new(mesh), &visibility)?;
             report.transport_rays += r.rays;
             report.transport_seconds += r.seconds;
-            let mut rows = SparseRows::new();
-            for v in 0..vertices {
-                let (i, c) = set.coefficients(v);
-                rows.push(i, c);
-            }
+            let rows: SparseRows<f32> = (0..vertices).map(|v| set.coefficients(v)).collect();
             Ok(Arc::new(rows))
         };
         let mut objects = Vec::with_capacity(placed.len());

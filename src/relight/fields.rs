@@ -317,10 +317,7 @@ impl OcclusionField {
             })
             .collect::<Result<Vec<_>>>()?;
         bar.finish_and_clear();
-        let mut maps = SparseRows::new();
-        for (indices, values) in encoded.iter().flatten() {
-            maps.push(indices, values);
-        }
+        let maps: SparseRows<f32> = encoded.iter().flatten().map(|(i, v)| (i, v)).collect();
         let report = FieldReport {
             rays: (points.len() * directions.len()) as u64,
             seconds: start.elapsed().as_secs_f64(),
@@ -406,10 +403,7 @@ impl OcclusionField {
                 yaw_sparse(param, indices, values, delta, self.options.keep)
             })
             .collect::<Result<_>>()?;
-        let mut maps = SparseRows::new();
-        for (i, v) in &rows {
-            maps.push(i, v);
-        }
+        let maps: SparseRows<f32> = rows.iter().map(|(i, v)| (i, v)).collect();
         Ok(OcclusionField {
             maps,
             turn: k,

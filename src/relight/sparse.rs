@@ -32,6 +32,27 @@ impl<V: Copy> Default for SparseRows<V> {
     }
 }
 
+/// Rows from `(indices, values)` pairs, one row each, in order.
+///
+/// ```
+/// use haarshift::relight::sparse::SparseRows;
+/// let rows: SparseRows<f32> = [(vec![1u32, 4], vec![0.5f32, 2.0]), (vec![], vec![])]
+///     .iter()
+///     .map(|(i, v)| (i, v))
+///     .collect();
+/// assert_eq!(rows.len(), 2);
+/// assert_eq!(rows.row(0), (&[1u32, 4][..], &[0.5f32, 2.0][..]));
+/// ```
+impl<V: Copy, I: AsRef<[u32]>, W: AsRef<[V]>> FromIterator<(I, W)> for SparseRows<V> {
+    fn from_iter<It: IntoIterator<Item = (I, W)>>(rows: It) -> Self {
+        let mut out = SparseRows::new();
+        for (indices, values) in rows {
+            out.push(indices.as_ref(), values.as_ref());
+        }
+        out
+    }
+}
+
 impl<V: Copy> SparseRows<V> {
     /// No rows.
     pub fn new() -> Self {

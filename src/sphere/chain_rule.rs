@@ -85,10 +85,11 @@
 //! the same taps and weights as the turned map's own fields, at no cost. Measured
 //! (`cargo bench --bench sphere -- lobe_one_channel`, 64 x 128 `f32`, one channel, one run,
 //! `results/sphere/lobe_one_channel.txt`):
-//! a prepared rotation 0.24 ms (`haar`) and 0.37 ms (`haar-cubic`), against 0.42 ms for
-//! writing the analytic lobe; steps 4-6 alone (`pyramid_of_fields`) 60 us. The target of
-//! 100 us for one rotation from the finest level is not reached; from the thesis's level 4
-//! (16 x 32 working grid) a rotation costs 17 us.
+//! a prepared rotation 0.14 ms (`haar`) and 0.35 ms (`haar-cubic`), against 0.44 ms for
+//! writing the analytic lobe; steps 4-6 alone (`pyramid_of_fields`) 15 us, channel by
+//! channel so that the column pairs are `[T; 2]` chunks. The target of 100 us for one
+//! rotation from the finest level is not reached; from the thesis's level 4 (16 x 32
+//! working grid) a rotation costs 12 us.
 //!
 //! # Accuracy
 //!
@@ -148,7 +149,9 @@
 
 use std::f64::consts::PI;
 
-use ndarray::{Array3, ArrayView3, ArrayViewMut2, Axis, s};
+use ndarray::{
+    Array2, Array3, ArrayBase, ArrayView3, ArrayViewMut2, Axis, CowArray, Data, Dimension, Ix2, s,
+};
 use rayon::prelude::*;
 
 use super::latlong::{
@@ -203,7 +206,7 @@ pub struct SourceGradient<T> {
     d_phi: Vec<T>,
     /// For a zonal `f` (constant along every row: a lobe about the pole), `f_theta` of one
     /// column, `(m + 1) x C`; `d_phi` is then zero.
-    zonal: Option<Vec<f64>>,
+    zonal: Option<Vec<T>>,
     /// `(sin, cos)` of `k delta / 2`, `k` in `0..=2n + 2`: every angle the target grids use.
     trig: Vec<(f64, f64)>,
     /// The column angles of the two target grids as flat arrays, for loops over a row:
@@ -265,7 +268,7 @@ impl<T: Sample> SourceGradient<T> {
         .then(|| {
             d_theta
                 .chunks_exact(n * ch)
-                .flat_map(|row| row[..ch].iter().map(|v| v.as_f64()))
+                .flat_map(|row| row[..ch].to_vec())
                 .collect()
         });
         let half = 0.5 * step;
@@ -338,15 +341,10 @@ impl<T: Sample> SourceGradient<T> {
     /// and every column of `f_theta` is `profile`, so the bilinear (Catmull-Rom)
     /// interpolation of the general path reduces to a linear (cubic) one along `theta`, its
     /// weights across the columns summing to 1; across a pole the profile continues negated
-    /// (a tangent component). The arithmetic is in `f64`, rounded once per value.
+    /// (a tangent component). The linear scheme computes in `T` (its two taps need no
+    /// more), the cubic one in `f64`, rounded once per value.
     #[inline(always)]
-    fn accumulate_zonal<A: Sample>(
-        &self,
-        profile: &[f64],
-        theta: &[A],
-        alpha: &[A],
-        out: &mut [T],
-    ) {
+    fn accumulate_zonal<A: Sample>(&self, profile: &[T], theta: &[A], alpha: &[A], out: &mut [T]) {
         // The common channel counts as constants, so the channel loop disappears.
         match self.channels {
             1 => self.accumulate_zonal_channels::<1, A>(profile, theta, alpha, out),
@@ -359,41 +357,17 @@ impl<T: Sample> SourceGradient<T> {
     #[inline(always)]
     fn accumulate_zonal_channels<const CH: usize, A: Sample>(
         &self,
-        profile: &[f64],
+        profile: &[T],
         theta: &[A],
         alpha: &[A],
         out: &mut [T],
     ) {
         let (m, ch) = (self.m, if CH == 0 { self.channels } else { CH });
-        let targets = out.chunks_exact_mut(ch).zip(theta.iter().zip(alpha));
         if self.scheme == Scheme::Linear {
-            // Two taps, never across a pole (rows 0..=m hold every theta in [0, pi]). The
-            // row as an `i32` clamped into the profile, so that the loop has no bounds
-            // checks left. (The lookup stays scalar: the compiler does not gather here.)
-            let profile = &profile[..(m + 1) * ch];
-            let last = m as i32 - 1;
-            let taps = |theta: A, alpha: A| {
-                let (y, alpha) = (theta.as_f64() * self.inverse_step, alpha.as_f64());
-                let r0 = (y as i32).clamp(0, last);
-                let fy = y - f64::from(r0);
-                (r0 as usize * ch, alpha * (1.0 - fy), alpha * fy)
-            };
-            if CH == 1 {
-                // A plain loop over slices, without the chunks of one of the general loop.
-                for ((o, &theta), &alpha) in out.iter_mut().zip(theta).zip(alpha) {
-                    let (at, w0, w1) = taps(theta, alpha);
-                    *o += T::from_f64(w0 * profile[at] + w1 * profile[at + 1]);
-                }
-                return;
-            }
-            for (px, (&theta, &alpha)) in targets {
-                let (at, w0, w1) = taps(theta, alpha);
-                for k in 0..ch {
-                    px[k] += T::from_f64(w0 * profile[at + k] + w1 * profile[at + ch + k]);
-                }
-            }
+            self.interpolate_zonal_linear::<CH, A>(profile, theta, alpha, out);
             return;
         }
+        let targets = out.chunks_exact_mut(ch).zip(theta.iter().zip(alpha));
         for (px, (&theta, &alpha)) in targets {
             let (y, alpha) = (theta.as_f64() * self.inverse_step, alpha.as_f64());
             // (entry, weight) of the four taps along the profile, continued over the poles.
@@ -411,8 +385,57 @@ impl<T: Sample> SourceGradient<T> {
                 taps[dr] = (r as usize * ch, alpha * w);
             }
             for k in 0..ch {
-                let value: f64 = taps.iter().map(|&(at, w)| w * profile[at + k]).sum();
+                let value: f64 = taps
+                    .iter()
+                    .map(|&(at, w)| w * profile[at + k].as_f64())
+                    .sum();
                 px[k] += T::from_f64(value);
+            }
+        }
+    }
+
+    /// The linear interpolation of [`accumulate_zonal`](Self::accumulate_zonal): two taps,
+    /// never across a pole (rows `0..=m` hold every `theta` in `[0, pi]`), in `T`. A chunk
+    /// of targets at a time: first each target's row and weights, in a loop without lookups
+    /// that vectorises, then the lookups, two loads and three operations a value.
+    #[inline(always)]
+    fn interpolate_zonal_linear<const CH: usize, A: Sample>(
+        &self,
+        profile: &[T],
+        theta: &[A],
+        alpha: &[A],
+        out: &mut [T],
+    ) {
+        const CHUNK: usize = 32;
+        let (m, ch) = (self.m, if CH == 0 { self.channels } else { CH });
+        let profile = &profile[..(m + 1) * ch];
+        let (inverse_step, last) = (T::from_f64(self.inverse_step), T::from_f64((m - 1) as f64));
+        let chunks = theta.chunks(CHUNK).zip(alpha.chunks(CHUNK));
+        for ((theta, alpha), out) in chunks.zip(out.chunks_mut(CHUNK * ch)) {
+            let (mut at, mut w0, mut w1) = ([0u32; CHUNK], [T::zero(); CHUNK], [T::zero(); CHUNK]);
+            let taps = at.iter_mut().zip(w0.iter_mut().zip(w1.iter_mut()));
+            for ((at, (w0, w1)), (&theta, &alpha)) in taps.zip(theta.iter().zip(alpha)) {
+                let y = T::from_f64(theta.as_f64()) * inverse_step;
+                // theta is finite (atan2), so is y: the row is in 0..m and exact.
+                let r = y.floor().min(last).max(T::zero());
+                let (fy, alpha) = (y - r, T::from_f64(alpha.as_f64()));
+                *at = r.as_f64() as u32 * ch as u32;
+                *w0 = alpha * (T::one() - fy);
+                *w1 = alpha * fy;
+            }
+            let taps = at.iter().zip(w0.iter().zip(&w1));
+            if CH == 1 {
+                for (o, (&at, (&w0, &w1))) in out.iter_mut().zip(taps) {
+                    let at = at as usize;
+                    *o += w0 * profile[at] + w1 * profile[at + 1];
+                }
+                continue;
+            }
+            for (px, (&at, (&w0, &w1))) in out.chunks_exact_mut(ch).zip(taps) {
+                let (here, next) = profile[at as usize..].split_at(ch);
+                for k in 0..ch {
+                    px[k] += w0 * here[k] + w1 * next[k];
+                }
             }
         }
     }
@@ -755,7 +778,7 @@ impl<'a, T: Sample> ChainRule<'a, T> {
     #[target_feature(enable = "avx2")]
     fn zonal_row_avx2(
         &self,
-        profile: &[f64],
+        profile: &[T],
         at: (usize, usize),
         along: Along,
         scale: f64,
@@ -771,7 +794,7 @@ impl<'a, T: Sample> ChainRule<'a, T> {
     #[inline(always)]
     fn zonal_row(
         &self,
-        profile: &[f64],
+        profile: &[T],
         (kt, first): (usize, usize),
         along: Along,
         scale: f64,
@@ -935,118 +958,6 @@ impl<T: Sample> DifferenceFields<T> {
         mixed_from(&self.v, &self.u)
     }
 
-    /// Rows of the grid the fields live on.
-    fn rows(&self) -> usize {
-        self.u.dim().0
-    }
-
-    /// Writes the details of the level whose blocks are 2 x 2 cells of this grid into the
-    /// per-channel planes of `out` (step 5): `b = (V[2I][2J] + V[2I][2J+1]) / 4`,
-    /// `a = (U[2I][2J] + U[2I+1][2J]) / 4` and `c = C[2I][2J] / 4`, `C` from `V` and `U`.
-    fn write_details(&self, out: &mut Array3<T>) {
-        let (m, n, ch) = self.u.dim();
-        let level = (m / 2).trailing_zeros() as usize;
-        let quarter = T::from_f64(0.25);
-        let size = (out.dim().1, out.dim().2);
-        let levels = size.0.trailing_zeros() as usize;
-        let (v, u, len) = (flat(&self.v), flat(&self.u), n * ch);
-        for k in 0..ch {
-            let mut plane = out.index_axis_mut(Axis(0), k);
-            // Row i of band b is written by `f(i, row)`; entry 2 j ch + k of a grid row is
-            // column 2j, channel k.
-            let mut band = |b: Band, f: &dyn Fn(usize, &mut [T])| {
-                let (rows, cols) =
-                    pyramid::band_ranges(size, levels, b, level).expect("level exists");
-                let mut view: ArrayViewMut2<'_, T> = plane.slice_mut(s![rows, cols]);
-                for (i, mut band_row) in view.rows_mut().into_iter().enumerate() {
-                    f(
-                        i,
-                        band_row
-                            .as_slice_mut()
-                            .expect("rows of a plane are contiguous"),
-                    );
-                }
-            };
-            let pairs = |r| pairs(r, ch);
-            band(Band::Vertical, &move |i, out| {
-                for (o, p) in out.iter_mut().zip(pairs(row(v, len, 2 * i))) {
-                    *o = quarter * (p[k] + p[ch + k]);
-                }
-            });
-            band(Band::Horizontal, &move |i, out| {
-                let (r0, r1) = (row(u, len, 2 * i), row(u, len, 2 * i + 1));
-                for (o, (p0, p1)) in out.iter_mut().zip(pairs(r0).zip(pairs(r1))) {
-                    *o = quarter * (p0[k] + p1[k]);
-                }
-            });
-            band(Band::Diagonal, &move |i, out| {
-                let (vr, u0, u1) = (
-                    row(v, len, 2 * i),
-                    row(u, len, 2 * i),
-                    row(u, len, 2 * i + 1),
-                );
-                let rows = pairs(vr).zip(pairs(u0).zip(pairs(u1)));
-                for (o, (pv, (p0, p1))) in out.iter_mut().zip(rows) {
-                    *o = quarter * mixed(pv[k], pv[ch + k], p0[k], p1[k]);
-                }
-            });
-        }
-    }
-
-    /// The fields one level coarser (the recursive filters (4.21)-(4.22), step 5):
-    /// `V' = h_t (along theta) x h_s (along phi) of V / 4`, `U'` with the roles swapped.
-    /// The seed's third recursion, `C' = h_t x h_t of C / 4`, is not needed: it is the mixed
-    /// difference of `V'` and `U'` exactly (`h_t` applied to a difference along an axis is
-    /// the difference of `h_s` applied along it: `[1 2 1] * [1 -1] = [1 1] * [1 0 -1]`), so
-    /// `C` is read off `V` and `U` at every level.
-    fn coarser(&self) -> Self {
-        // The common channel counts as constants, so that the loops over a row vectorise.
-        match self.u.dim().2 {
-            1 => self.coarser_with::<1>(),
-            3 => self.coarser_with::<3>(),
-            _ => self.coarser_with::<0>(),
-        }
-    }
-
-    /// [`coarser`](Self::coarser) for `CH` channels (0: any number).
-    fn coarser_with<const CH: usize>(&self) -> Self {
-        let (m, n, channels) = self.u.dim();
-        let ch = if CH == 0 { channels } else { CH };
-        let (mh, nh) = (m / 2, n / 2);
-        let q = T::from_f64(0.25);
-        let two = T::from_f64(2.0);
-        let (v, u, len) = (flat(&self.v), flat(&self.u), n * ch);
-        let (pairs, after_pairs) = (|r| pairs(r, ch), |r| after_pairs(r, ch));
-        let v = rows_from_fn((mh.saturating_sub(1), nh, ch), move |i, out| {
-            let (a, b, d) = (
-                row(v, len, 2 * i),
-                row(v, len, 2 * i + 1),
-                row(v, len, 2 * i + 2),
-            );
-            let rows = pairs(a).zip(pairs(b).zip(pairs(d)));
-            for (o, (a, (b, d))) in out.chunks_exact_mut(ch).zip(rows) {
-                for k in 0..ch {
-                    let c0 = a[k] + two * b[k] + d[k];
-                    let c1 = a[ch + k] + two * b[ch + k] + d[ch + k];
-                    o[k] = q * (c0 + c1);
-                }
-            }
-        });
-        let u = rows_from_fn((mh, nh, ch), move |i, out| {
-            let (a, b) = (row(u, len, 2 * i), row(u, len, 2 * i + 1));
-            let rows = (pairs(a).zip(after_pairs(a))).zip(pairs(b).zip(after_pairs(b)));
-            for (o, ((a, a2), (b, b2))) in out.chunks_exact_mut(ch).zip(rows) {
-                for k in 0..ch {
-                    // `[1 2 1]` along each row from column 2j.
-                    let t0 = a[k] + two * a[ch + k] + a2[k];
-                    let t1 = b[k] + two * b[ch + k] + b2[k];
-                    o[k] = q * (t0 + t1);
-                }
-            }
-        });
-        DifferenceFields { v, u }
-    }
-
     /// All detail levels of the `m x 2m` pyramid these fields describe, the root's two
     /// scaling coefficients set to `(+d/2, -d/2)` with `d` their difference from the root
     /// field (the constant is fixed later by [`set_mean_from_energy`]).
@@ -1059,39 +970,144 @@ impl<T: Sample> DifferenceFields<T> {
             ));
         }
         let mut out = Array3::zeros((ch, m, n));
-        self.write_details(&mut out);
-        let mut fields = self.coarser();
-        while fields.rows() > 1 {
-            fields.write_details(&mut out);
-            fields = fields.coarser();
-        }
         let half = T::from_f64(0.5);
-        for k in 0..ch {
+        for (k, mut plane) in out.axis_iter_mut(Axis(0)).enumerate() {
+            // One channel at a time (a view when there is one channel), so that the column
+            // pairs of a row are `[T; 2]` chunks.
+            let mut fields = ChannelFields {
+                v: channel(&self.v, k),
+                u: channel(&self.u, k),
+            };
+            while fields.u.nrows() > 1 {
+                let (v, u) = fields.next_level(&mut plane);
+                fields = ChannelFields {
+                    v: v.into(),
+                    u: u.into(),
+                };
+            }
             // At the 1 x 2 root, U[0][0] = A0 - A1 and U[0][1] = A1 - A0.
-            let d = half * (fields.u[[0, 0, k]] - fields.u[[0, 1, k]]);
-            out[[k, 0, 0]] = half * d;
-            out[[k, 0, 1]] = -half * d;
+            let d = half * (fields.u[[0, 0]] - fields.u[[0, 1]]);
+            plane[[0, 0]] = half * d;
+            plane[[0, 1]] = -half * d;
         }
         SphereCoefficients::from_array(out)
     }
 }
 
-/// The column pairs `(2j, 2j + 1)` of a grid row of `ch` channels, as chunks: loops over
-/// them have no bounds checks.
-#[inline]
-fn pairs<T>(row: &[T], ch: usize) -> std::slice::ChunksExact<'_, T> {
-    row.chunks_exact(2 * ch)
+/// One channel's `V` and `U` (step 5 runs channel by channel).
+struct ChannelFields<'a, T> {
+    v: CowArray<'a, T, Ix2>,
+    u: CowArray<'a, T, Ix2>,
 }
 
-/// The column pairs `(2j + 2, 2j + 3)` of a periodic grid row: [`pairs`] one pair on.
+impl<T: Sample> ChannelFields<'_, T> {
+    /// One level of step 5: writes the details of the level whose blocks are 2 x 2 cells of
+    /// this grid into `plane`, `b = (V[2I][2J] + V[2I][2J+1]) / 4`,
+    /// `a = (U[2I][2J] + U[2I+1][2J]) / 4` and `c = C[2I][2J] / 4` (`C` from `V` and `U`),
+    /// and returns the fields `(V', U')` one level coarser (the recursive filters (4.21)-(4.22)):
+    /// `V' = h_t (along theta) x h_s (along phi) of V / 4`, `U'` with the roles swapped.
+    /// The seed's third recursion, `C' = h_t x h_t of C / 4`, is not needed: it is the mixed
+    /// difference of `V'` and `U'` exactly (`h_t` applied to a difference along an axis is
+    /// the difference of `h_s` applied along it: `[1 2 1] * [1 -1] = [1 1] * [1 0 -1]`), so
+    /// `C` is read off `V` and `U` at every level.
+    fn next_level(&self, plane: &mut ArrayViewMut2<'_, T>) -> (Array2<T>, Array2<T>) {
+        let (m, n) = self.u.dim();
+        let (mh, nh) = (m / 2, n / 2);
+        let (q, two) = (T::from_f64(0.25), T::from_f64(2.0));
+        let (v, u) = (flat(&self.v), flat(&self.u));
+        let level = mh.trailing_zeros() as usize;
+        let size = plane.dim();
+        let levels = size.0.trailing_zeros() as usize;
+        // Row i of band b is written by `f(i, row)`.
+        let mut band = |b: Band, f: &dyn Fn(usize, &mut [T])| {
+            let (rows, cols) = pyramid::band_ranges(size, levels, b, level).expect("level exists");
+            let mut view = plane.slice_mut(s![rows, cols]);
+            for (i, mut band_row) in view.rows_mut().into_iter().enumerate() {
+                f(
+                    i,
+                    band_row.as_slice_mut().expect("plane rows are contiguous"),
+                );
+            }
+        };
+        band(Band::Vertical, &|i, out| {
+            for (o, p) in out.iter_mut().zip(pairs(row(v, n, 2 * i))) {
+                *o = q * (p[0] + p[1]);
+            }
+        });
+        band(Band::Horizontal, &|i, out| {
+            let (u0, u1) = (pairs(row(u, n, 2 * i)), pairs(row(u, n, 2 * i + 1)));
+            for (o, (p0, p1)) in out.iter_mut().zip(u0.iter().zip(u1)) {
+                *o = q * (p0[0] + p1[0]);
+            }
+        });
+        band(Band::Diagonal, &|i, out| {
+            let vr = pairs(row(v, n, 2 * i));
+            let (u0, u1) = (pairs(row(u, n, 2 * i)), pairs(row(u, n, 2 * i + 1)));
+            for (o, (pv, (p0, p1))) in out.iter_mut().zip(vr.iter().zip(u0.iter().zip(u1))) {
+                *o = q * mixed(pv[0], pv[1], p0[0], p1[0]);
+            }
+        });
+        let v = rows_of((mh.saturating_sub(1), nh), |i, out| {
+            let (a, b, d) = (
+                pairs(row(v, n, 2 * i)),
+                pairs(row(v, n, 2 * i + 1)),
+                pairs(row(v, n, 2 * i + 2)),
+            );
+            for (o, (a, (b, d))) in out.iter_mut().zip(a.iter().zip(b.iter().zip(d))) {
+                let c0 = a[0] + two * b[0] + d[0];
+                let c1 = a[1] + two * b[1] + d[1];
+                *o = q * (c0 + c1);
+            }
+        });
+        let u = rows_of((mh, nh), |i, out| {
+            let (a, b) = (row(u, n, 2 * i), row(u, n, 2 * i + 1));
+            // `[1 2 1]` along each row from column 2j: columns 2j, 2j + 1 and the next pair's
+            // first (periodic).
+            let cell = |a: [T; 3], b: [T; 3]| {
+                let t0 = a[0] + two * a[1] + a[2];
+                let t1 = b[0] + two * b[1] + b[2];
+                q * (t0 + t1)
+            };
+            let (last, out) = out.split_last_mut().expect("a row has columns");
+            let (here, next) = (
+                pairs(a).iter().zip(pairs(b)),
+                pairs(&a[2..]).iter().zip(pairs(&b[2..])),
+            );
+            for (o, ((a, b), (a2, b2))) in out.iter_mut().zip(here.zip(next)) {
+                *o = cell([a[0], a[1], a2[0]], [b[0], b[1], b2[0]]);
+            }
+            *last = cell([a[n - 2], a[n - 1], a[0]], [b[n - 2], b[n - 1], b[0]]);
+        });
+        (v, u)
+    }
+}
+
+/// Channel `k` of a grid in standard layout: a view when it is the only one.
+fn channel<T: Sample>(a: &Array3<T>, k: usize) -> CowArray<'_, T, Ix2> {
+    let view = a.index_axis(Axis(2), k);
+    if view.is_standard_layout() {
+        view.into()
+    } else {
+        view.as_standard_layout().into_owned().into()
+    }
+}
+
+/// The column pairs `(2j, 2j + 1)` of a one-channel row (a trailing odd entry left out).
 #[inline]
-fn after_pairs<T>(row: &[T], ch: usize) -> impl Iterator<Item = &[T]> {
-    let (first, rest) = row.split_at(2 * ch);
-    pairs(rest, ch).chain(std::iter::once(first))
+fn pairs<T>(row: &[T]) -> &[[T; 2]] {
+    row.as_chunks::<2>().0
+}
+
+/// A `(rows, cols)` array whose row `i` is written by `f(i, row)`: [`rows_from_fn`] of one
+/// channel.
+fn rows_of<T: Sample>(shape: (usize, usize), f: impl Fn(usize, &mut [T]) + Sync) -> Array2<T> {
+    rows_from_fn((shape.0, shape.1, 1), f)
+        .into_shape_with_order(shape)
+        .expect("one channel")
 }
 
 /// The values of a grid of this module (always built in standard layout).
-fn flat<T>(a: &Array3<T>) -> &[T] {
+fn flat<T, S: Data<Elem = T>, D: Dimension>(a: &ArrayBase<S, D>) -> &[T] {
     a.as_slice().expect("standard layout")
 }
 

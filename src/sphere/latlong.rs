@@ -122,19 +122,17 @@ pub(crate) fn atan2_finite<F: Sample>(y: F, x: F) -> F {
     let (ay, ax) = (y.abs(), x.abs());
     let swap = ay > ax;
     let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
-    // Both quotients straight from (num, den), so the two divisions run side by side.
-    let t = num / den;
+    // One division, of the reduced or the plain quotient (a vector of angles pays for each
+    // division every lane takes).
     let reduce = num > k(TAN_PI_12) * den;
-    let reduced = (k(SQRT_3) * num - den) / (k(SQRT_3) * den + num);
+    let (top, bottom) = if reduce {
+        (k(SQRT_3) * num - den, k(SQRT_3) * den + num)
+    } else {
+        (num, den)
+    };
     // The diagonals exactly, as the C library rounds them: they are texel edges.
     let diagonal = num == den;
-    let t = if diagonal {
-        F::zero()
-    } else if reduce {
-        reduced
-    } else {
-        t
-    };
+    let t = if diagonal { F::zero() } else { top / bottom };
     let base = if diagonal {
         k(FRAC_PI_4)
     } else if reduce {

@@ -110,10 +110,7 @@ impl<T: Sample> Jrt<T> {
                 },
             )
             .collect::<Result<_>>()?;
-        let mut products = SparseRows::new();
-        for (i, v) in &rows {
-            products.push(i, v);
-        }
+        let products: SparseRows<[T; 3]> = rows.iter().map(|(i, v)| (i, v)).collect();
         let report = JrtReport {
             seconds: start.elapsed().as_secs_f64(),
             coefficients: products.coefficient_count(),
