@@ -287,6 +287,10 @@ pub fn play(
     for (index, state) in states.iter().enumerate() {
         let turn = |k: usize, scene: &DynamicScene| scene.placement(k).turn;
         let mut reformed = None;
+        // The moving object where this frame has it, once: a re-formation needs its turn.
+        if let (Change::Object(k), Some(p)) = (state.change, state.placement) {
+            scene.place(k, p)?;
+        }
         // Re-form for a new segment, or when the moving object turns.
         let stale = match (&jrt, state.change) {
             (None, _) => true,
@@ -295,11 +299,6 @@ pub fn play(
             }
             (Some((segment, ..)), Change::Lighting) => *segment != state.segment,
         };
-        if let (Change::Object(k), Some(p)) = (state.change, state.placement)
-            && stale
-        {
-            scene.place(k, p)?;
-        }
         if stale {
             let formed = Jrt::form(scene, &lighting, state.change)?;
             let t = match state.change {
@@ -312,12 +311,7 @@ pub fn play(
         let (_, transfer, _) = jrt.as_ref().expect("formed above");
         let start = Instant::now();
         let radiance = match state.change {
-            Change::Object(k) => {
-                if let Some(p) = state.placement {
-                    scene.place(k, p)?;
-                }
-                transfer.frame_moved(scene)?
-            }
+            Change::Object(_) => transfer.frame_moved(scene)?,
             Change::Lighting => {
                 lighting =
                     Lighting::encode(env, &mapping, &rotation(state.light_yaw)?, keep_light)?;
