@@ -62,7 +62,7 @@
 //!
 //! A renderer brings one BRDF into every vertex's frame: the same source, a new rotation each
 //! time. [`Rotator`] does step 1 and the source's share of step 6 once; a rotation then costs
-//! steps 2-5 alone. Three things make those cheap:
+//! steps 2-5 alone. Four things make those cheap:
 //!
 //! * **Zonal sources** (constant along every row, such as a Phong lobe about +Y; detected
 //!   exactly, [`SourceGradient::is_zonal`]): `f_phi` is zero and every column of `f_theta` is
@@ -76,8 +76,15 @@
 //!   [`atan2`](super::latlong::atan2)) runs over a row of targets in a branch-free loop the
 //!   compiler vectorises, in the map's precision (an `f32` map gets `f32` geometry: within
 //!   2e-7 of the `f64` result's peak, tested), then the interpolation reads the profile. On
-//!   x86-64 with AVX2 the row is compiled for AVX2 and chosen at run time; it gives the
-//!   portable build's bits (tested).
+//!   x86-64 with AVX2 the row is compiled for AVX2 and chosen at run time, and a one-channel
+//!   `f32` row gathers its profile taps eight at a time; it gives the portable build's bits
+//!   (tested).
+//! * **Nothing where the lobe is zero.** A clamped-cosine lobe (Phong, Blinn-Phong) is zero
+//!   on a hemisphere or more, and so is its profile past some row. A target whose pre-image
+//!   lies there (`cos Theta` beyond a bound with the taps' reach as margin) would read only
+//!   zeros: whole rows (`q_y` swings within `a -+ sqrt(b^2 + c^2)` along a row) and chunks of
+//!   16 targets are written as zeros without their angles (exactly the computed values,
+//!   tested).
 //! * **Two fields, not three.** `C` is read off `V` and `U` (step 5), so each level filters
 //!   two fields and stores no diagonal one.
 //!
@@ -147,6 +154,7 @@
 //! * Section 4.5.2 says the diagonal coefficients are convolved "in both directions by `h_s`";
 //!   the mixed difference needs the tent `h_t` in both directions.
 
+use std::any::Any;
 use std::f64::consts::PI;
 
 use ndarray::{
@@ -205,8 +213,8 @@ pub struct SourceGradient<T> {
     /// `f_phi / sin theta` at `((i + 1/2) delta, (j + 1) delta)`: `m x n x C`.
     d_phi: Vec<T>,
     /// For a zonal `f` (constant along every row: a lobe about the pole), `f_theta` of one
-    /// column, `(m + 1) x C`; `d_phi` is then zero.
-    zonal: Option<Vec<T>>,
+    /// column; `d_phi` is then zero.
+    zonal: Option<ZonalProfile<T>>,
     /// `(sin, cos)` of `k delta / 2`, `k` in `0..=2n + 2`: every angle the target grids use.
     trig: Vec<(f64, f64)>,
     /// The column angles of the two target grids as flat arrays, for loops over a row:
@@ -266,10 +274,11 @@ impl<T: Sample> SourceGradient<T> {
                 .chunks_exact(n * ch)
                 .all(|row| row.chunks_exact(ch).all(|px| px == &row[..ch])))
         .then(|| {
-            d_theta
+            let values: Vec<T> = d_theta
                 .chunks_exact(n * ch)
                 .flat_map(|row| row[..ch].to_vec())
-                .collect()
+                .collect();
+            ZonalProfile::new(values, ch, step, scheme)
         });
         let half = 0.5 * step;
         let trig: Vec<(f64, f64)> = (0..=2 * n + 2)
@@ -314,59 +323,65 @@ impl<T: Sample> SourceGradient<T> {
     /// `f_theta` and `f_phi / sin theta` at `(theta, phi)`, one value per channel each
     /// (step 3 of the [module docs](self)), interpolated as the scheme says.
     pub fn eval(&self, theta: f64, phi: f64, f_theta: &mut [T], f_phi_over_sin: &mut [T]) {
-        f_theta.fill(T::zero());
-        self.accumulate(theta, phi, 1.0, 0.0, 0, f_theta);
-        f_phi_over_sin.fill(T::zero());
-        self.accumulate(theta, phi, 0.0, 1.0, 0, f_phi_over_sin);
+        self.write(theta, phi, 1.0, 0.0, 0, f_theta);
+        self.write(theta, phi, 0.0, 1.0, 0, f_phi_over_sin);
     }
 
-    /// Adds `alpha f_theta + beta f_phi / sin theta` at `(theta, phi)` (`theta` in
-    /// `[0, pi]`, `phi` in `[0, 2 pi)`) to `out`: the chain rule's combination, fused with
+    /// Writes `alpha f_theta + beta f_phi / sin theta` at `(theta, phi)` (`theta` in
+    /// `[0, pi]`, `phi` in `[0, 2 pi)`) into `out`: the chain rule's combination, fused with
     /// the interpolation so that no temporary is written. The fields are read `turn` columns
     /// further on, which is reading the fields of `f` turned by `turn` columns
     /// ([`yaw_pixels`](super::yaw::yaw_pixels)) with the same taps and weights.
     #[inline]
-    fn accumulate(&self, theta: f64, phi: f64, alpha: f64, beta: f64, turn: usize, out: &mut [T]) {
-        match (self.scheme, &self.zonal) {
-            (Scheme::Linear, None) => {
-                self.accumulate_linear((theta, phi), (alpha, beta), turn, out)
-            }
-            (Scheme::Cubic, None) => self.accumulate_cubic((theta, phi), (alpha, beta), turn, out),
-            (_, Some(profile)) => self.accumulate_zonal(profile, &[theta], &[alpha], out),
+    fn write(&self, theta: f64, phi: f64, alpha: f64, beta: f64, turn: usize, out: &mut [T]) {
+        if let Some(zonal) = &self.zonal {
+            return self.interpolate_zonal(zonal, &[theta], &[alpha], out);
+        }
+        out.fill(T::zero());
+        match self.scheme {
+            Scheme::Linear => self.accumulate_linear((theta, phi), (alpha, beta), turn, out),
+            Scheme::Cubic => self.accumulate_cubic((theta, phi), (alpha, beta), turn, out),
         }
     }
 
-    /// [`accumulate`](Self::accumulate) of a zonal `f` for a run of targets: adds
-    /// `alpha[j] f_theta(theta[j])` to pixel `j` of `out` (`C` values each). `f_phi` is zero
+    /// [`write`](Self::write) of a zonal `f` for a run of targets: writes
+    /// `alpha[j] f_theta(theta[j])` into pixel `j` of `out` (`C` values each). `f_phi` is zero
     /// and every column of `f_theta` is `profile`, so the bilinear (Catmull-Rom)
     /// interpolation of the general path reduces to a linear (cubic) one along `theta`, its
     /// weights across the columns summing to 1; across a pole the profile continues negated
     /// (a tangent component). The linear scheme computes in `T` (its two taps need no
     /// more), the cubic one in `f64`, rounded once per value.
     #[inline(always)]
-    fn accumulate_zonal<A: Sample>(&self, profile: &[T], theta: &[A], alpha: &[A], out: &mut [T]) {
+    fn interpolate_zonal<A: Sample>(
+        &self,
+        profile: &ZonalProfile<T>,
+        theta: &[A],
+        alpha: &[A],
+        out: &mut [T],
+    ) {
         // The common channel counts as constants, so the channel loop disappears.
         match self.channels {
-            1 => self.accumulate_zonal_channels::<1, A>(profile, theta, alpha, out),
-            3 => self.accumulate_zonal_channels::<3, A>(profile, theta, alpha, out),
-            _ => self.accumulate_zonal_channels::<0, A>(profile, theta, alpha, out),
+            1 => self.interpolate_zonal_channels::<1, A>(profile, theta, alpha, out),
+            3 => self.interpolate_zonal_channels::<3, A>(profile, theta, alpha, out),
+            _ => self.interpolate_zonal_channels::<0, A>(profile, theta, alpha, out),
         }
     }
 
-    /// [`accumulate_zonal`](Self::accumulate_zonal) for `CH` channels (0: any number).
+    /// [`interpolate_zonal`](Self::interpolate_zonal) for `CH` channels (0: any number).
     #[inline(always)]
-    fn accumulate_zonal_channels<const CH: usize, A: Sample>(
+    fn interpolate_zonal_channels<const CH: usize, A: Sample>(
         &self,
-        profile: &[T],
+        profile: &ZonalProfile<T>,
         theta: &[A],
         alpha: &[A],
         out: &mut [T],
     ) {
         let (m, ch) = (self.m, if CH == 0 { self.channels } else { CH });
         if self.scheme == Scheme::Linear {
-            self.interpolate_zonal_linear::<CH, A>(profile, theta, alpha, out);
+            self.interpolate_zonal_linear::<CH, A>(&profile.spans, theta, alpha, out);
             return;
         }
+        let profile = &profile.values;
         let targets = out.chunks_exact_mut(ch).zip(theta.iter().zip(alpha));
         for (px, (&theta, &alpha)) in targets {
             let (y, alpha) = (theta.as_f64() * self.inverse_step, alpha.as_f64());
@@ -389,26 +404,27 @@ impl<T: Sample> SourceGradient<T> {
                     .iter()
                     .map(|&(at, w)| w * profile[at + k].as_f64())
                     .sum();
-                px[k] += T::from_f64(value);
+                px[k] = T::from_f64(value);
             }
         }
     }
 
-    /// The linear interpolation of [`accumulate_zonal`](Self::accumulate_zonal): two taps,
+    /// The linear interpolation of [`interpolate_zonal`](Self::interpolate_zonal): two taps,
     /// never across a pole (rows `0..=m` hold every `theta` in `[0, pi]`), in `T`. A chunk
     /// of targets at a time: first each target's row and weights, in a loop without lookups
-    /// that vectorises, then the lookups, two loads and three operations a value.
+    /// that vectorises, then the lookups: each reads one span of two neighbouring rows
+    /// ([`ZonalProfile::spans`]) and takes three operations a value.
     #[inline(always)]
     fn interpolate_zonal_linear<const CH: usize, A: Sample>(
         &self,
-        profile: &[T],
+        spans: &[T],
         theta: &[A],
         alpha: &[A],
         out: &mut [T],
     ) {
         const CHUNK: usize = 32;
         let (m, ch) = (self.m, if CH == 0 { self.channels } else { CH });
-        let profile = &profile[..(m + 1) * ch];
+        let spans = &spans[..2 * m * ch];
         let (inverse_step, last) = (T::from_f64(self.inverse_step), T::from_f64((m - 1) as f64));
         let chunks = theta.chunks(CHUNK).zip(alpha.chunks(CHUNK));
         for ((theta, alpha), out) in chunks.zip(out.chunks_mut(CHUNK * ch)) {
@@ -419,22 +435,16 @@ impl<T: Sample> SourceGradient<T> {
                 // theta is finite (atan2), so is y: the row is in 0..m and exact.
                 let r = y.floor().min(last).max(T::zero());
                 let (fy, alpha) = (y - r, T::from_f64(alpha.as_f64()));
-                *at = r.as_f64() as u32 * ch as u32;
+                // Through i32, which converts in vector registers (u32 does not).
+                *at = (r.truncate_i32() * ch as i32) as u32;
                 *w0 = alpha * (T::one() - fy);
                 *w1 = alpha * fy;
             }
             let taps = at.iter().zip(w0.iter().zip(&w1));
-            if CH == 1 {
-                for (o, (&at, (&w0, &w1))) in out.iter_mut().zip(taps) {
-                    let at = at as usize;
-                    *o += w0 * profile[at] + w1 * profile[at + 1];
-                }
-                continue;
-            }
             for (px, (&at, (&w0, &w1))) in out.chunks_exact_mut(ch).zip(taps) {
-                let (here, next) = profile[at as usize..].split_at(ch);
+                let (here, next) = spans[2 * at as usize..][..2 * ch].split_at(ch);
                 for k in 0..ch {
-                    px[k] += w0 * here[k] + w1 * next[k];
+                    px[k] = w0 * here[k] + w1 * next[k];
                 }
             }
         }
@@ -662,45 +672,191 @@ fn pre_image(
     }
 }
 
-/// For a zonal source, the chain rule's geometry of a run of targets on one row: with
-/// `q = R p` the pre-image of the target `p`, `Theta = atan2(rho, q_y)` (`rho` the length of
-/// `(q_x, q_z)`) and `scale * dTheta/d(along) = -scale (R dp)_y / rho` into `theta` and
-/// `alpha`. That factor is the general path's `e_Theta(q) . R dp` (the two are equal because
-/// `q . R dp = 0`) with the frame at `q` never formed: 18 products fewer per target. Its size
-/// is at most `|dp| <= 1`; it is clamped there, so that a pre-image on a pole (`rho = 0`,
-/// where a zonal profile is exactly zero) gives a finite factor.
-///
-/// The target is `(sin, cos)` of `theta` and the columns' `(sin, cos)` of `phi`. The loop is
-/// branch-free, so that it vectorises.
-#[inline(always)]
-fn zonal_angles<G: Sample>(
-    rotation: &SphereRotation,
-    (st, ct): (f64, f64),
-    (sines, cosines): (&[G], &[G]),
-    along: Along,
-    scale: f64,
-    (theta, alpha): (&mut [G], &mut [G]),
-) {
-    let r = rotation.matrix();
-    let g = G::from_f64;
-    // Each of q and (R dp)_y is `a + b sin(phi) + c cos(phi)` along the row.
-    let q = r.map(|row| [row[1] * ct, row[0] * st, row[2] * st].map(g));
-    let t = match along {
-        // dp/dtheta = (cos theta sin phi, -sin theta, cos theta cos phi)
-        Along::Theta => [-r[1][1] * st, r[1][0] * ct, r[1][2] * ct],
-        // dp/dphi = (sin theta cos phi, 0, -sin theta sin phi)
-        Along::Phi => [0.0, -r[1][2] * st, r[1][0] * st],
+/// A zonal source's `f_theta` along one column, and where it can be nonzero.
+#[derive(Clone, Debug)]
+struct ZonalProfile<T> {
+    /// `f_theta` at `theta = i delta`, `i` in `0..=m`: `(m + 1) x C`.
+    values: Vec<T>,
+    /// Rows `r` and `r + 1` of `values` side by side for each `r` in `0..m`: `m x 2 x C`, so
+    /// that a linear tap pair is one contiguous read.
+    spans: Vec<T>,
+    /// `(low, high)`: a target whose pre-image has `cos Theta = q_y` outside `[low, high]`
+    /// reads only zero rows of `values`, so its value is exactly zero and is not computed.
+    /// Every clamped-cosine lobe (Phong, Blinn-Phong about their axes) is zero on a
+    /// hemisphere or more.
+    cos_bounds: (f64, f64),
+}
+
+impl<T: Sample> ZonalProfile<T> {
+    /// The profile `values` (`C` channels, rows `delta` apart) for `scheme`'s interpolation,
+    /// and its bounds: past the first and last nonzero rows by the rows the taps reach (one
+    /// for the linear scheme's pair, two for the cubic one's four,
+    /// [`SourceGradient::interpolate_zonal`]) and a hundredth of a row more, so that the
+    /// rounding of the computed angle never matters; no bound where that would reach a pole,
+    /// across which the taps fold back.
+    fn new(values: Vec<T>, ch: usize, step: f64, scheme: Scheme) -> Self {
+        let m = values.len() / ch - 1;
+        let reach = match scheme {
+            Scheme::Linear => 1.01,
+            Scheme::Cubic => 2.01,
+        };
+        let nonzero = |i: &usize| values[i * ch..][..ch].iter().any(|v| *v != T::zero());
+        let cos_bounds = match (0..=m).find(nonzero) {
+            // A constant source: every derivative is zero.
+            None => (f64::INFINITY, f64::NEG_INFINITY),
+            Some(first) => {
+                let last = (first..=m).rev().find(nonzero).unwrap_or(first);
+                let (near, far) = (first as f64 - reach, last as f64 + reach);
+                let high = if near > 0.0 {
+                    (near * step).cos()
+                } else {
+                    f64::INFINITY
+                };
+                let low = if far < m as f64 {
+                    (far * step).cos()
+                } else {
+                    f64::NEG_INFINITY
+                };
+                (low, high)
+            }
+        };
+        let spans = (0..m)
+            .flat_map(|r| values[r * ch..(r + 2) * ch].iter().copied())
+            .collect();
+        ZonalProfile {
+            values,
+            spans,
+            cos_bounds,
+        }
     }
-    .map(g);
-    let (one, tiny, scale) = (G::one(), G::min_positive_value(), g(scale));
-    let line = |[a, b, c]: [G; 3], sp: G, cp: G| a + b * sp + c * cp;
-    let targets = theta.iter_mut().zip(alpha.iter_mut());
-    for ((th, al), (&sp, &cp)) in targets.zip(sines.iter().zip(cosines)) {
-        let (qx, qy, qz) = (line(q[0], sp, cp), line(q[1], sp, cp), line(q[2], sp, cp));
-        let rho = (qx * qx + qz * qz).sqrt();
-        *th = atan2_finite(rho, qy);
-        let d = -line(t, sp, cp) / rho.max(tiny);
-        *al = scale * d.max(-one).min(one);
+}
+
+/// For a zonal source, the chain rule's geometry along one row of targets: with `q = R p` the
+/// pre-image of the target `p`, `Theta = atan2(rho, q_y)` (`rho` the length of `(q_x, q_z)`)
+/// and `scale * dTheta/d(along) = -scale (R dp)_y / rho`. That factor is the general path's
+/// `e_Theta(q) . R dp` (the two are equal because `q . R dp = 0`) with the frame at `q` never
+/// formed: 18 products fewer per target. Its size is at most `|dp| <= 1`; it is clamped
+/// there, so that a pre-image on a pole (`rho = 0`, where a zonal profile is exactly zero)
+/// gives a finite factor. Along the row each of `q` and `(R dp)_y` is
+/// `a + b sin(phi) + c cos(phi)`: the row's coefficients are formed once, in `G`.
+struct ZonalRow<G> {
+    /// `[a, b, c]` of `q_x`, `q_y`, `q_z`.
+    q: [[G; 3]; 3],
+    /// `[a, b, c]` of `(R dp)_y`.
+    t: [G; 3],
+    scale: G,
+}
+
+impl<G: Sample> ZonalRow<G> {
+    /// The row at `(sin, cos)` of `theta`, for the derivative `along`, times `scale`.
+    #[inline(always)]
+    fn new(rotation: &SphereRotation, (st, ct): (f64, f64), along: Along, scale: f64) -> Self {
+        let r = rotation.matrix();
+        let g = G::from_f64;
+        let q = r.map(|row| [row[1] * ct, row[0] * st, row[2] * st].map(g));
+        let t = match along {
+            // dp/dtheta = (cos theta sin phi, -sin theta, cos theta cos phi)
+            Along::Theta => [-r[1][1] * st, r[1][0] * ct, r[1][2] * ct],
+            // dp/dphi = (sin theta cos phi, 0, -sin theta sin phi)
+            Along::Phi => [0.0, -r[1][2] * st, r[1][0] * st],
+        }
+        .map(g);
+        ZonalRow {
+            q,
+            t,
+            scale: g(scale),
+        }
+    }
+
+    #[inline(always)]
+    fn line([a, b, c]: [G; 3], sp: G, cp: G) -> G {
+        a + b * sp + c * cp
+    }
+
+    /// Whether some target of the row may have its pre-image's `q_y` in `[low, high]`: along
+    /// the row `q_y = a + b sin(phi) + c cos(phi)` stays within `a -+ sqrt(b^2 + c^2)`.
+    #[inline(always)]
+    fn may_reach(&self, (low, high): (G, G)) -> bool {
+        let [a, b, c] = self.q[1];
+        let swing = (b * b + c * c).sqrt();
+        a + swing >= low && a - swing <= high
+    }
+
+    /// Whether any target at the columns' `(sin, cos)` of `phi` has its pre-image's `q_y` in
+    /// `[low, high]`. No early exit, so that the loop vectorises.
+    #[inline(always)]
+    fn reaches(&self, (sines, cosines): (&[G], &[G]), (low, high): (G, G)) -> bool {
+        let targets = sines.iter().zip(cosines);
+        targets.fold(false, |any, (&sp, &cp)| {
+            let qy = Self::line(self.q[1], sp, cp);
+            any | ((qy >= low) & (qy <= high))
+        })
+    }
+
+    /// `Theta` and the factor of each target at the columns' `(sin, cos)` of `phi` into
+    /// `theta` and `alpha`. Branch-free, so that the loop vectorises.
+    #[inline(always)]
+    fn angles(&self, (sines, cosines): (&[G], &[G]), (theta, alpha): (&mut [G], &mut [G])) {
+        let (one, tiny, q, t) = (G::one(), G::min_positive_value(), self.q, self.t);
+        let targets = theta.iter_mut().zip(alpha.iter_mut());
+        for ((th, al), (&sp, &cp)) in targets.zip(sines.iter().zip(cosines)) {
+            let qx = Self::line(q[0], sp, cp);
+            let (qy, qz) = (Self::line(q[1], sp, cp), Self::line(q[2], sp, cp));
+            let rho = (qx * qx + qz * qz).sqrt();
+            *th = atan2_finite(rho, qy);
+            let d = -Self::line(t, sp, cp) / rho.max(tiny);
+            *al = self.scale * d.max(-one).min(one);
+        }
+    }
+}
+
+/// Targets of a zonal row computed together: one AVX2 vector of `f32` twice over.
+const ZONAL_CHUNK: usize = 16;
+
+/// [`SourceGradient::interpolate_zonal`] of one channel of `f32` by the linear scheme, for
+/// one chunk: the rows, weights and two taps of eight targets at a time, the taps gathered
+/// from `spans` ([`ZonalProfile::spans`]) by the rows found. The operations of the portable
+/// loop in the same order and with no fused multiply-adds, so the same bits; the rows are
+/// clamped to `0..m` exactly as there, which keeps every gathered index in `spans`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn interpolate_f32_avx2(
+    spans: &[f32],
+    inverse_step: f32,
+    (theta, alpha): (&[f32; ZONAL_CHUNK], &[f32; ZONAL_CHUNK]),
+    out: &mut [f32; ZONAL_CHUNK],
+) {
+    use std::arch::x86_64::*;
+    let m = spans.len() / 2;
+    // Every row index is in 0..m, so every gathered index (2 row + 0 or 1) is in spans.
+    assert!(m >= 1 && m < 1 << 24, "a profile of {m} rows");
+    let (last, zero, one) = (
+        _mm256_set1_ps((m - 1) as f32),
+        _mm256_setzero_ps(),
+        _mm256_set1_ps(1.0),
+    );
+    let step = _mm256_set1_ps(inverse_step);
+    for k in (0..ZONAL_CHUNK).step_by(8) {
+        let (theta, alpha, out) = (&theta[k..k + 8], &alpha[k..k + 8], &mut out[k..k + 8]);
+        // SAFETY: the loads and the store touch the eight values of the slices above; every
+        // gathered index (`at` and `at + 1`) is below 2m = spans.len() (the assertion above
+        // and the clamp of the rows).
+        unsafe {
+            let y = _mm256_mul_ps(_mm256_loadu_ps(theta.as_ptr()), step);
+            // floor, then min and max as the portable loop (a NaN takes the last row there too).
+            let r = _mm256_max_ps(_mm256_min_ps(_mm256_floor_ps(y), last), zero);
+            let fy = _mm256_sub_ps(y, r);
+            let a = _mm256_loadu_ps(alpha.as_ptr());
+            let (w0, w1) = (
+                _mm256_mul_ps(a, _mm256_sub_ps(one, fy)),
+                _mm256_mul_ps(a, fy),
+            );
+            let at = _mm256_slli_epi32::<1>(_mm256_cvttps_epi32(r));
+            let here = _mm256_i32gather_ps::<4>(spans.as_ptr(), at);
+            let next = _mm256_i32gather_ps::<4>(spans.as_ptr().add(1), at);
+            let value = _mm256_add_ps(_mm256_mul_ps(w0, here), _mm256_mul_ps(w1, next));
+            _mm256_storeu_ps(out.as_mut_ptr(), value);
+        }
     }
 }
 
@@ -726,21 +882,13 @@ impl<'a, T: Sample> ChainRule<'a, T> {
     fn derivative(&self, kt: usize, kp: usize, along: Along, scale: f64, out: &mut [T]) {
         let (st, ct) = self.grad.trig[kt];
         let (sp, cp) = self.grad.trig[kp];
-        out.fill(T::zero());
-        if let Some(profile) = &self.grad.zonal {
+        if let Some(zonal) = &self.grad.zonal {
             // No azimuth needed: f has no phi derivative.
             let (mut theta, mut alpha) = ([T::zero()], [T::zero()]);
             let columns = ([T::from_f64(sp)], [T::from_f64(cp)]);
-            let angles = (&mut theta[..], &mut alpha[..]);
-            zonal_angles(
-                self.rotation,
-                (st, ct),
-                (&columns.0, &columns.1),
-                along,
-                scale,
-                angles,
-            );
-            self.grad.accumulate_zonal(profile, &theta, &alpha, out);
+            let row = ZonalRow::new(self.rotation, (st, ct), along, scale);
+            row.angles((&columns.0, &columns.1), (&mut theta, &mut alpha));
+            self.grad.interpolate_zonal(zonal, &theta, &alpha, out);
             return;
         }
         let at = pre_image(self.rotation, (st, ct), (sp, cp), along);
@@ -749,7 +897,7 @@ impl<'a, T: Sample> ChainRule<'a, T> {
         let big_p = azimuth(q[0], q[2]);
         let alpha = scale * at.along_theta;
         self.grad
-            .accumulate(at.theta, big_p, alpha, beta, self.turn, out);
+            .write(at.theta, big_p, alpha, beta, self.turn, out);
     }
 
     /// One row of [`derivative`](Self::derivative): `theta = kt delta / 2` and the columns
@@ -769,50 +917,84 @@ impl<'a, T: Sample> ChainRule<'a, T> {
             unsafe { self.zonal_row_avx2(profile, (kt, first), along, scale, row) };
             return;
         }
-        self.zonal_row(profile, (kt, first), along, scale, row)
+        self.zonal_row::<false>(profile, (kt, first), along, scale, row)
     }
 
-    /// [`zonal_row`](Self::zonal_row) compiled for AVX2: four lanes of `f64`, and no fused
+    /// [`zonal_row`](Self::zonal_row) compiled for AVX2: four lanes of `f64`, eight of `f32`
+    /// (whose one-channel linear lookups gather, [`interpolate_f32_avx2`]), and no fused
     /// multiply-adds, so that every CPU gets the same bits.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn zonal_row_avx2(
         &self,
-        profile: &[T],
+        profile: &ZonalProfile<T>,
         at: (usize, usize),
         along: Along,
         scale: f64,
         row: &mut [T],
     ) {
-        self.zonal_row(profile, at, along, scale, row)
+        self.zonal_row::<true>(profile, at, along, scale, row)
     }
 
     /// A row of a zonal source's derivative in two passes over chunks of the row: the
-    /// geometry ([`zonal_angles`]), then the interpolation
-    /// ([`accumulate_zonal`](SourceGradient::accumulate_zonal)); the first vectorises, the
-    /// second is a table lookup per target.
+    /// geometry ([`ZonalRow::angles`]), then the interpolation
+    /// ([`interpolate_zonal`](SourceGradient::interpolate_zonal)); the first vectorises, the
+    /// second is a table lookup per target. A chunk whose pre-images all lie where the
+    /// profile is zero ([`ZonalProfile::cos_bounds`]) is zero without either.
+    /// `AVX2` says the caller runs on an AVX2 CPU.
     #[inline(always)]
-    fn zonal_row(
+    fn zonal_row<const AVX2: bool>(
         &self,
-        profile: &[T],
+        profile: &ZonalProfile<T>,
         (kt, first): (usize, usize),
         along: Along,
         scale: f64,
         row: &mut [T],
     ) {
-        const CHUNK: usize = 32;
         let ch = self.grad.channels;
-        let target = self.grad.trig[kt];
+        let geometry = ZonalRow::<T>::new(self.rotation, self.grad.trig[kt], along, scale);
+        let (low, high) = profile.cos_bounds;
+        let bounds = (T::from_f64(low), T::from_f64(high));
+        if !geometry.may_reach(bounds) {
+            row.fill(T::zero());
+            return;
+        }
         let [sines, cosines] = &self.grad.columns[first - 1];
-        for (c, pixels) in row.chunks_mut(CHUNK * ch).enumerate() {
+        let (mut theta, mut alpha) = ([T::zero(); ZONAL_CHUNK], [T::zero(); ZONAL_CHUNK]);
+        for (c, pixels) in row.chunks_mut(ZONAL_CHUNK * ch).enumerate() {
             let count = pixels.len() / ch;
-            let (mut theta, mut alpha) = ([T::zero(); CHUNK], [T::zero(); CHUNK]);
-            let columns = (&sines[c * CHUNK..][..count], &cosines[c * CHUNK..][..count]);
-            let out = (&mut theta[..count], &mut alpha[..count]);
-            zonal_angles(self.rotation, target, columns, along, scale, out);
-            pixels.fill(T::zero());
-            let (theta, alpha) = (&theta[..count], &alpha[..count]);
-            self.grad.accumulate_zonal(profile, theta, alpha, pixels);
+            let at = c * ZONAL_CHUNK;
+            let columns = (&sines[at..][..count], &cosines[at..][..count]);
+            if !geometry.reaches(columns, bounds) {
+                pixels.fill(T::zero());
+                continue;
+            }
+            if count < ZONAL_CHUNK {
+                let (theta, alpha) = (&mut theta[..count], &mut alpha[..count]);
+                geometry.angles(columns, (&mut *theta, &mut *alpha));
+                self.grad.interpolate_zonal(profile, theta, alpha, pixels);
+                continue;
+            }
+            geometry.angles(columns, (&mut theta[..], &mut alpha[..]));
+            #[cfg(target_arch = "x86_64")]
+            if AVX2 && ch == 1 && self.grad.scheme == Scheme::Linear {
+                // One channel of f32 (the types checked at run time; nothing is cast).
+                let spans = (&profile.spans as &dyn Any).downcast_ref::<Vec<f32>>();
+                let angles = (&theta as &dyn Any).downcast_ref::<[f32; ZONAL_CHUNK]>();
+                let factors = (&alpha as &dyn Any).downcast_ref::<[f32; ZONAL_CHUNK]>();
+                let out = <&mut [T; ZONAL_CHUNK]>::try_from(&mut *pixels).ok();
+                let out =
+                    out.and_then(|o| (o as &mut dyn Any).downcast_mut::<[f32; ZONAL_CHUNK]>());
+                if let (Some(spans), Some(theta), Some(alpha), Some(out)) =
+                    (spans, angles, factors, out)
+                {
+                    let step = self.grad.inverse_step as f32;
+                    // SAFETY: `AVX2` is true only in `zonal_row_avx2`, which runs on AVX2 CPUs.
+                    unsafe { interpolate_f32_avx2(spans, step, (theta, alpha), out) };
+                    continue;
+                }
+            }
+            self.grad.interpolate_zonal(profile, &theta, &alpha, pixels);
         }
     }
 
@@ -1531,27 +1713,89 @@ mod tests {
         }
     }
 
+    /// Two channels, and one (whose `f32` linear lookups gather in the AVX2 build), on rows
+    /// whose chunks are partly skipped.
     #[cfg(target_arch = "x86_64")]
     fn same_bits<T: Sample>() {
-        let lobe = LatLongMap::<T>::from_fn(32, 2, |d, out| {
+        let two = LatLongMap::<T>::from_fn(32, 2, |d, out| {
             out[0] = T::from_f64(d[1].max(0.0).powi(20));
             out[1] = T::from_f64((2.0 * d[1]).exp());
         })
         .unwrap();
+        let one = LatLongMap::<T>::from_fn(32, 1, |d, out| {
+            out[0] = T::from_f64(d[1].max(0.0).powi(20));
+        })
+        .unwrap();
         let rotation = SphereRotation::from_degrees(25.0, -70.0, 40.0).unwrap();
-        for scheme in [Scheme::Linear, Scheme::Cubic] {
-            let grad = SourceGradient::with_scheme(&lobe, scheme);
+        for (lobe, scheme) in [
+            (&two, Scheme::Linear),
+            (&two, Scheme::Cubic),
+            (&one, Scheme::Linear),
+        ] {
+            let ch = lobe.channels();
+            let grad = SourceGradient::with_scheme(lobe, scheme);
             let profile = grad.zonal.as_ref().expect("a zonal source");
             let rule = ChainRule::new(&grad, &rotation, 0);
-            for (kt, first, along) in [(3, 1, Along::Theta), (6, 2, Along::Phi)] {
-                let mut portable = vec![T::zero(); 64 * 2];
+            let mut largest = T::zero();
+            for (kt, first, along) in [
+                (3, 1, Along::Theta),
+                (6, 2, Along::Phi),
+                (40, 1, Along::Theta),
+            ] {
+                let mut portable = vec![T::zero(); 64 * ch];
                 let mut wide = portable.clone();
-                rule.zonal_row(profile, (kt, first), along, -0.1, &mut portable);
+                rule.zonal_row::<false>(profile, (kt, first), along, -0.1, &mut portable);
                 // SAFETY: the caller checked that the CPU has AVX2.
                 unsafe { rule.zonal_row_avx2(profile, (kt, first), along, -0.1, &mut wide) };
                 let bits = |v: &[T]| v.iter().map(|x| x.as_f64().to_bits()).collect::<Vec<_>>();
-                assert_eq!(bits(&portable), bits(&wide), "{scheme:?} {kt}");
-                assert!(portable.iter().any(|v| v.abs() > T::from_f64(1e-3)));
+                assert_eq!(bits(&portable), bits(&wide), "{scheme:?} {ch} {kt}");
+                largest = portable.iter().fold(largest, |a, v| a.max(v.abs()));
+            }
+            assert!(largest > T::from_f64(1e-3));
+        }
+    }
+
+    /// Rows and chunks whose pre-images all lie where the profile is zero are written as
+    /// zeros without being computed; computing them gives exactly those zeros. A Phong lobe
+    /// (zero below its horizon: a lower bound on `cos Theta`) and a ring (zero near both
+    /// poles: both bounds), both schemes, both precisions, rotations that tilt the zero
+    /// region across the grid.
+    #[test]
+    fn skipping_where_the_profile_is_zero_changes_no_value() {
+        skips_exactly::<f32>();
+        skips_exactly::<f64>();
+    }
+
+    fn skips_exactly<T: Sample>() {
+        let phong = LatLongMap::<T>::from_fn(32, 1, |d, out| {
+            out[0] = T::from_f64(d[1].max(0.0).powi(20));
+        })
+        .unwrap();
+        let ring = LatLongMap::<T>::from_fn(32, 1, |d, out| {
+            out[0] = T::from_f64((0.4 - d[1].abs()).max(0.0));
+        })
+        .unwrap();
+        for (lobe, both) in [(&phong, false), (&ring, true)] {
+            for scheme in [Scheme::Linear, Scheme::Cubic] {
+                let grad = SourceGradient::with_scheme(lobe, scheme);
+                let (low, high) = grad.zonal.as_ref().expect("zonal").cos_bounds;
+                assert!(low > -1.0 && low < 0.0, "{low}");
+                assert_eq!(high.is_finite(), both, "{high}");
+                let mut everything = grad.clone();
+                everything.zonal.as_mut().expect("zonal").cos_bounds =
+                    (f64::NEG_INFINITY, f64::INFINITY);
+                for (yaw, pitch, roll) in
+                    [(0.0, 0.0, 0.0), (25.0, -70.0, 40.0), (10.0, 120.0, -15.0)]
+                {
+                    let r = SphereRotation::from_degrees(yaw, pitch, roll).unwrap();
+                    let skipped = DifferenceFields::from_gradient(&grad, &r, 3);
+                    let computed = DifferenceFields::from_gradient(&everything, &r, 3);
+                    assert_eq!(skipped.v, computed.v, "{scheme:?} {pitch}");
+                    assert_eq!(skipped.u, computed.u, "{scheme:?} {pitch}");
+                    // Not every value is zero: the comparison is of something.
+                    let mut values = computed.v.iter().chain(computed.u.iter());
+                    assert!(values.any(|v| v.abs() > T::from_f64(1e-4)));
+                }
             }
         }
     }
