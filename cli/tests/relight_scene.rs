@@ -312,8 +312,8 @@ fn a_stale_or_damaged_field_file_fails_cleanly_naming_it_until_force_replaces_it
         &["sphere-cells-3.hsf", "built with other options", "keep"],
     );
     fails(
-        &["--shells", "7"],
-        &["sphere-cells-3.hsf", "shells 6 (asked: 7)"],
+        &["--param", "cube"],
+        &["sphere-cells-3.hsf", r#"param "latlong" (asked: "cube")"#],
     );
     // A flipped byte, a cut, another magic, another version.
     let mut flipped = good.clone();
