@@ -3,7 +3,7 @@
 # played along a path (a small object moves, a large one moves, the lighting turns) with
 # looked-up occlusion maps truncated before and after the blend, and one object's fields at
 # seed 001's size.
-# Usage: scripts/dynamic_speed.sh   (from the repository root; about four minutes on two cores)
+# Usage: scripts/dynamic_speed.sh   (from the repository root; about six minutes on two cores)
 set -euo pipefail
 source "$(dirname "$0")/timing.sh"
 out=results/dynamic
@@ -28,3 +28,5 @@ timed fields relight scene testdata/scenes/bunny.json --param cube --resolution 
   step_row speed_after
   step_row fields
 } > "$out/speed.md"
+# The same fields written to a field file and loaded from it (its own section of speed.md).
+"$(dirname "$0")/dynamic_fields.sh"

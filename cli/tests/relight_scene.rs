@@ -219,3 +219,171 @@ fn bad_scene_and_path_files_fail_cleanly_naming_the_file() {
     ];
     fails_cleanly(&args, &["latlong"]);
 }
+
+/// `relight scene` with `--fields-dir DIR` and the coarse fields, writing the radiance to
+/// `vertices`; returns what it printed.
+fn run_with_fields(scene: &Path, dir: &Path, vertices: &Path, extra: &[&str]) -> String {
+    let out = vertices.with_extension("png");
+    let mut args = vec!["--fields-dir", p(dir), "--vertices", p(vertices)];
+    args.extend(extra);
+    run_scene(scene, &out, &COARSE, &args)
+}
+
+#[test]
+fn a_fields_directory_is_written_once_then_loaded_and_renders_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = two_spheres(dir.path());
+    let fields = dir.path().join("fields");
+    let (first, second, fresh) = (
+        dir.path().join("first.npy"),
+        dir.path().join("second.npy"),
+        dir.path().join("fresh.npy"),
+    );
+    let stdout = run_with_fields(&scene, &fields, &first, &[]);
+    // Both spheres are one shape: one file, named after the generator.
+    let file = fields.join("sphere-cells-3.hsf");
+    let size = std::fs::metadata(&file).unwrap().len();
+    assert!(
+        stdout.contains(": 0 loaded in 0.00 s, 1 written, "),
+        "{stdout}"
+    );
+    assert!(!stdout.contains(" 0 rays"), "{stdout}");
+    let stdout = run_with_fields(&scene, &fields, &second, &[]);
+    assert!(stdout.contains(", 0 rays, 0.0 s,"), "{stdout}");
+    assert!(stdout.contains(": 1 loaded in "), "{stdout}");
+    assert!(stdout.contains(", 0 written, "), "{stdout}");
+    // The size printed is the file's (12 x 24 + 6 x 6 x 16 maps at 8 x 16 texels).
+    let kib = format!("{:.1} KiB on disk", size as f64 / 1024.0);
+    assert!(stdout.contains(&kib), "{kib} in {stdout}");
+    assert_eq!(std::fs::metadata(&file).unwrap().len(), size);
+    run_scene(
+        &scene,
+        &dir.path().join("fresh.png"),
+        &COARSE,
+        &["--vertices", p(&fresh)],
+    );
+    let (a, b, c) = (read_npy(&first), read_npy(&second), read_npy(&fresh));
+    assert_eq!(a.shape(), &[2 * 96 + 33 * 33, 3]);
+    assert!(a.iter().any(|&x| x > 0.0));
+    assert_eq!(a, b);
+    assert_eq!(a, c);
+}
+
+#[test]
+fn a_stale_or_damaged_field_file_fails_cleanly_naming_it_until_force_replaces_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = two_spheres(dir.path());
+    let fields = dir.path().join("fields");
+    let npy = dir.path().join("v.npy");
+    run_with_fields(&scene, &fields, &npy, &[]);
+    let file = fields.join("sphere-cells-3.hsf");
+    let good = std::fs::read(&file).unwrap();
+    let args = |extra: &[&'static str]| {
+        let mut a: Vec<String> = [
+            "relight",
+            "scene",
+            p(&scene),
+            "-o",
+            p(&dir.path().join("x.png")),
+            "--fields-dir",
+            p(&fields),
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend(
+            SMALL
+                .iter()
+                .chain(&COARSE)
+                .chain(extra)
+                .map(|s| s.to_string()),
+        );
+        a
+    };
+    let fails = |extra: &[&'static str], needles: &[&str]| {
+        let a = args(extra);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        fails_cleanly(&a, needles);
+        assert!(!dir.path().join("x.png").exists());
+    };
+    // Other field flags than the file's.
+    fails(
+        &["--keep-field", "10"],
+        &["sphere-cells-3.hsf", "built with other options", "keep"],
+    );
+    fails(
+        &["--param", "cube"],
+        &["sphere-cells-3.hsf", r#"param "latlong" (asked: "cube")"#],
+    );
+    // A flipped byte, a cut, another magic, another version.
+    let mut flipped = good.clone();
+    flipped[good.len() / 2] ^= 1;
+    let mut version = good.clone();
+    version[8] = 9;
+    let damaged: [(Vec<u8>, &[&str]); 4] = [
+        (
+            flipped,
+            &["sphere-cells-3.hsf", "damaged", "checksum mismatch"],
+        ),
+        (
+            good[..good.len() - 100].to_vec(),
+            &["sphere-cells-3.hsf", "damaged"],
+        ),
+        (
+            b"HSRCACHE and more".to_vec(),
+            &["not a haarshift occlusion field file"],
+        ),
+        (version, &["sphere-cells-3.hsf", "format version 9"]),
+    ];
+    for (bytes, needles) in &damaged {
+        std::fs::write(&file, bytes).unwrap();
+        fails(&[], needles);
+        assert_eq!(
+            &std::fs::read(&file).unwrap(),
+            bytes,
+            "refused, left as it was"
+        );
+    }
+    // --force builds it again and replaces it; the next run loads it.
+    let a = args(&["--force"]);
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    let stdout = succeeds_with_stdout(&a);
+    assert!(stdout.contains("0 loaded in 0.00 s, 1 written"), "{stdout}");
+    assert_eq!(std::fs::read(&file).unwrap(), good);
+    // A mesh file changed after its fields were built.
+    let obj = dir.path().join("tetra.obj");
+    let tetra = |top: f64| {
+        format!("v 0 0 0\nv 1 0 0\nv 0 {top} 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    };
+    std::fs::write(&obj, tetra(1.0)).unwrap();
+    let scene = dir.path().join("tetra.json");
+    std::fs::write(
+        &scene,
+        r#"{"objects": [{"mesh": "tetra.obj"}], "environment": {"path": "env.hdr"}}"#,
+    )
+    .unwrap();
+    std::fs::copy(
+        testdata("envmaps/rooitou_park_32x16.hdr"),
+        dir.path().join("env.hdr"),
+    )
+    .unwrap();
+    run_with_fields(&scene, &fields, &dir.path().join("t.npy"), &[]);
+    assert!(fields.join("tetra.hsf").exists());
+    std::fs::write(&obj, tetra(2.0)).unwrap();
+    let mut a = vec!["relight", "scene", p(&scene), "-o"];
+    let out = dir.path().join("t2.png");
+    a.extend([p(&out), "--fields-dir", p(&fields)]);
+    a.extend(SMALL);
+    a.extend(COARSE);
+    fails_cleanly(
+        &a,
+        &[
+            "tetra.hsf",
+            "built for another mesh",
+            "mesh tetra.obj: 4 vertices",
+        ],
+    );
+    // A fields directory that is a file.
+    a[6] = p(&obj);
+    fails_cleanly(&a, &["tetra.obj"]);
+}

@@ -28,6 +28,7 @@ use std::path::Path;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
+use super::framed::{Format, put_all};
 use super::harmonics::ShTransfer;
 use super::scene::{CameraSpec, EnvironmentSpec};
 use super::transport::TransportSet;
@@ -39,7 +40,13 @@ use crate::{Error, Result};
 /// The format version this build reads and writes.
 pub const CACHE_VERSION: u32 = 2;
 
-const MAGIC: &[u8; 8] = b"HSRCACHE";
+const FORMAT: Format = Format {
+    magic: b"HSRCACHE",
+    version: CACHE_VERSION,
+    name: "scene cache",
+    corrupt: SceneError::CacheCorrupt,
+    other_version: |found, expected| SceneError::CacheVersion { found, expected },
+};
 
 /// [`Selection`] as recorded in a cache header.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -173,10 +180,6 @@ pub fn scene_hash(mesh: &Mesh) -> u32 {
     h.finalize()
 }
 
-fn corrupt(reason: impl Into<String>) -> Error {
-    SceneError::CacheCorrupt(reason.into()).into()
-}
-
 impl SceneCache {
     /// Bundles the parts, checking that they describe the same vertices and that `params`
     /// names the transport's parameterisation and spherical-harmonic bands.
@@ -237,41 +240,22 @@ impl SceneCache {
             environment: self.environment.clone(),
             camera: self.camera.clone(),
         };
-        let json = serde_json::to_vec(&header).expect("the header serialises");
-        let mut body = Vec::with_capacity(8 + json.len() + self.transport.stored_bytes());
-        body.extend_from_slice(&(json.len() as u64).to_le_bytes());
-        body.extend_from_slice(&json);
-        self.mesh
-            .positions()
-            .iter()
-            .chain(self.mesh.normals().iter())
-            .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
-        self.mesh
-            .triangles()
-            .iter()
-            .flatten()
-            .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
-        self.albedo
-            .iter()
-            .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
-        offsets
-            .iter()
-            .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
-        indices
-            .iter()
-            .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
-        values
-            .iter()
-            .chain(self.transport.sh().map_or(&[][..], |t| t.as_slice()))
-            .for_each(|x| body.extend_from_slice(&x.to_le_bytes()));
-        let checksum = crc32fast::hash(&body);
-        crate::io::write_file_atomically(path, force, |w| {
-            w.write_all(MAGIC)?;
-            w.write_all(&CACHE_VERSION.to_le_bytes())?;
-            w.write_all(&checksum.to_le_bytes())?;
-            w.write_all(&body)
-        })?;
-        Ok((16 + body.len()) as u64)
+        let sh = self.transport.sh().map_or(&[][..], |t| t.as_slice());
+        let sizes = [
+            self.mesh.positions().len() * 16,
+            self.transport.stored_bytes(),
+        ];
+        FORMAT.write(path, force, &header, sizes.iter().sum(), |body| {
+            put_all(
+                body,
+                self.mesh.positions().iter().chain(self.mesh.normals()),
+            );
+            put_all(body, self.mesh.triangles().iter().flatten());
+            put_all(body, &self.albedo);
+            put_all(body, offsets);
+            put_all(body, indices);
+            put_all(body, values.iter().chain(sh));
+        })
     }
 
     /// Reads a cache, refusing a damaged file or another version; see the [module docs](self).
@@ -299,55 +283,33 @@ impl SceneCache {
     }
 
     fn parse(bytes: &[u8]) -> Result<Self> {
-        if bytes.len() < 8 || &bytes[..8] != MAGIC {
-            return Err(corrupt("not a haarshift scene cache"));
-        }
-        if bytes.len() < 24 {
-            return Err(corrupt("cut short"));
-        }
-        let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-        if version != CACHE_VERSION {
-            return Err(SceneError::CacheVersion {
-                found: version,
-                expected: CACHE_VERSION,
-            }
-            .into());
-        }
-        let checksum = u32::from_le_bytes(bytes[12..16].try_into().expect("4 bytes"));
-        let body = &bytes[16..];
-        if crc32fast::hash(body) != checksum {
-            return Err(corrupt("checksum mismatch"));
-        }
-        let mut r = Reader { bytes: body };
-        let header_len = r.u64s(1)?[0] as usize;
-        let header: CacheHeader = serde_json::from_slice(r.take(header_len)?)
-            .map_err(|e| corrupt(format!("header: {e}")))?;
+        let (header, mut r) = FORMAT.open::<CacheHeader>(bytes)?;
         let (v, t, n) = (header.vertices, header.triangles, header.coefficients);
         let positions =
-            Array2::from_shape_vec((v, 3), r.f64s(3 * v)?).map_err(|e| corrupt(e.to_string()))?;
+            Array2::from_shape_vec((v, 3), r.f64s(3 * v)?).map_err(|e| r.corrupt(e.to_string()))?;
         let normals =
-            Array2::from_shape_vec((v, 3), r.f64s(3 * v)?).map_err(|e| corrupt(e.to_string()))?;
+            Array2::from_shape_vec((v, 3), r.f64s(3 * v)?).map_err(|e| r.corrupt(e.to_string()))?;
         let flat = r.u32s(3 * t)?;
         let triangles = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         let albedo =
-            Array2::from_shape_vec((v, 3), r.f32s(3 * v)?).map_err(|e| corrupt(e.to_string()))?;
+            Array2::from_shape_vec((v, 3), r.f32s(3 * v)?).map_err(|e| r.corrupt(e.to_string()))?;
         let offsets = r.u64s(v + 1)?;
         let indices = r.u32s(n)?;
         let values = r.f32s(n)?;
         let sh = match header.params.sh_bands {
             Some(b) => {
-                let per_vertex = b.checked_mul(b).ok_or_else(|| corrupt("size overflows"))?;
+                let per_vertex = b
+                    .checked_mul(b)
+                    .ok_or_else(|| r.corrupt("size overflows"))?;
                 let flat = r.f32s(
                     v.checked_mul(per_vertex)
-                        .ok_or_else(|| corrupt("size overflows"))?,
+                        .ok_or_else(|| r.corrupt("size overflows"))?,
                 )?;
                 Some(ShTransfer::from_flat(b, flat)?)
             }
             None => None,
         };
-        if !r.bytes.is_empty() {
-            return Err(corrupt("bytes after the transport"));
-        }
+        r.finish("transport")?;
         let mesh = Mesh::new(positions, triangles, Some(normals))?;
         let kind: ParamKind = header.params.param.parse()?;
         let param = Parameterization::new(kind, header.params.resolution)?;
@@ -364,43 +326,6 @@ impl SceneCache {
         cache.camera = header.camera;
         Ok(cache)
     }
-}
-
-/// Reads little-endian arrays off the front of a byte slice.
-struct Reader<'a> {
-    bytes: &'a [u8],
-}
-
-macro_rules! read_array {
-    ($name:ident, $t:ty) => {
-        fn $name(&mut self, count: usize) -> Result<Vec<$t>> {
-            const W: usize = std::mem::size_of::<$t>();
-            let raw = self.take(
-                count
-                    .checked_mul(W)
-                    .ok_or_else(|| corrupt("size overflows"))?,
-            )?;
-            Ok(raw
-                .chunks_exact(W)
-                .map(|c| <$t>::from_le_bytes(c.try_into().expect("W bytes")))
-                .collect())
-        }
-    };
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8]> {
-        if n > self.bytes.len() {
-            return Err(corrupt("cut short"));
-        }
-        let (head, tail) = self.bytes.split_at(n);
-        self.bytes = tail;
-        Ok(head)
-    }
-    read_array!(u64s, u64);
-    read_array!(u32s, u32);
-    read_array!(f64s, f64);
-    read_array!(f32s, f32);
 }
 
 #[cfg(test)]

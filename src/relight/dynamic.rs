@@ -41,6 +41,7 @@ use ndarray::Array2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::fields::file::{FieldOrigin, FieldStore};
 use super::fields::{Blend, FieldOptions, OcclusionField, Truncation, select_rows, yaw_sparse};
 use super::lighting::Lighting;
 use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under, merge};
@@ -254,6 +255,14 @@ pub struct BuildReport {
     pub field_seconds: f64,
     /// Bytes of the stored field maps.
     pub field_bytes: usize,
+    /// Shapes whose fields were read from a field file.
+    pub fields_loaded: usize,
+    /// Field files written (shapes whose file was absent or replaced).
+    pub fields_written: usize,
+    /// Bytes of the field files read or written.
+    pub field_file_bytes: u64,
+    /// Seconds reading and checking field files.
+    pub field_load_seconds: f64,
     /// Rays cast for the vertices' own transport.
     pub transport_rays: u64,
     /// Seconds precomputing the own transport.
@@ -297,13 +306,68 @@ pub struct DynamicScene {
 impl DynamicScene {
     /// Reads a JSON scene file ([`SceneFile`]) and builds it.
     pub fn load(path: &Path, options: &DynamicOptions) -> Result<Self> {
+        Self::load_with(path, options, None)
+    }
+
+    /// [`load`](Self::load), with the fields of [`build_with`](Self::build_with).
+    ///
+    /// ```
+    /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+    /// use haarshift::relight::fields::file::FieldStore;
+    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let scene = dir.path().join("ball.json");
+    /// std::fs::write(&scene, r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
+    /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
+    /// (options.field.circles, options.field.circle_points) = (3, 6);
+    /// (options.field.shells, options.field.shell_grid) = (2, 2);
+    /// let mut store = FieldStore::new(dir.path(), false);
+    /// DynamicScene::load_with(&scene, &options, Some(&mut store)).unwrap();
+    /// assert!(dir.path().join("sphere-cells-2.hsf").exists());
+    /// ```
+    pub fn load_with(
+        path: &Path,
+        options: &DynamicOptions,
+        store: Option<&mut FieldStore>,
+    ) -> Result<Self> {
         let (file, dir) = SceneFile::read(path)?;
-        Self::build(&file, dir, options).map_err(|e| e.in_file(path))
+        Self::build_with(&file, dir, options, store).map_err(|e| e.in_file(path))
     }
 
     /// Builds the scene of `file` (paths relative to `dir`): every shape's fields and every
     /// vertex's own transport.
     pub fn build(file: &SceneFile, dir: &Path, options: &DynamicOptions) -> Result<Self> {
+        Self::build_with(file, dir, options, None)
+    }
+
+    /// [`build`](Self::build), with every shape's fields read from `store` when its file
+    /// there matches, else built and written to it ([`FieldStore::field`]).
+    ///
+    /// ```
+    /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+    /// use haarshift::relight::fields::file::FieldStore;
+    /// use haarshift::relight::SceneFile;
+    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// let file: SceneFile = serde_json::from_str(
+    ///     r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
+    /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
+    /// (options.field.circles, options.field.circle_points) = (3, 6);
+    /// (options.field.shells, options.field.shell_grid) = (2, 2);
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let mut store = FieldStore::new(dir.path(), false);
+    /// let here = std::path::Path::new(".");
+    /// let first = DynamicScene::build_with(&file, here, &options, Some(&mut store)).unwrap();
+    /// assert_eq!((first.report().fields_written, first.report().fields_loaded), (1, 0));
+    /// let second = DynamicScene::build_with(&file, here, &options, Some(&mut store)).unwrap();
+    /// assert_eq!((second.report().fields_loaded, second.report().field_rays), (1, 0));
+    /// assert_eq!(second.field(0), first.field(0));
+    /// ```
+    pub fn build_with(
+        file: &SceneFile,
+        dir: &Path,
+        options: &DynamicOptions,
+        mut store: Option<&mut FieldStore>,
+    ) -> Result<Self> {
         options.check()?;
         if file.objects.is_empty() {
             return Err(SceneError::SceneFile("a scene needs at least one object".into()).into());
@@ -342,10 +406,36 @@ impl DynamicScene {
             placed.push((shape, placement, object.material.albedo()?));
         }
         let mut fields = Vec::with_capacity(shapes.len());
-        for mesh in &shapes {
-            let (field, r) = OcclusionField::build(mesh, &options.field)?;
-            report.field_rays += r.rays;
-            report.field_seconds += r.seconds;
+        for (mesh, (path, generator)) in shapes.iter().zip(&sources) {
+            let (field, origin) = match store.as_deref_mut() {
+                Some(store) => {
+                    store.field(mesh, path.as_deref(), generator.as_ref(), &options.field)?
+                }
+                None => {
+                    let (field, r) = OcclusionField::build(mesh, &options.field)?;
+                    (
+                        field,
+                        FieldOrigin::Built {
+                            report: r,
+                            bytes: 0,
+                        },
+                    )
+                }
+            };
+            match origin {
+                FieldOrigin::Built { report: r, bytes } => {
+                    report.field_rays += r.rays;
+                    report.field_seconds += r.seconds;
+                    // Nothing is written without a store.
+                    report.fields_written += usize::from(store.is_some());
+                    report.field_file_bytes += bytes;
+                }
+                FieldOrigin::Loaded { bytes, seconds } => {
+                    report.fields_loaded += 1;
+                    report.field_file_bytes += bytes;
+                    report.field_load_seconds += seconds;
+                }
+            }
             report.field_bytes += field.stored_bytes();
             fields.push(Arc::new(field));
         }

@@ -1,10 +1,12 @@
-//! What can be wrong with a scene: its mesh, its scene file or its cache.
+//! What can be wrong with a scene: its mesh, its scene file, its cache or an occlusion field
+//! file.
 //!
 //! [`SceneError`] names the problem; [`crate::Error::Scene`] adds the file it was found in (when
 //! there is one), so the CLI prints one line such as
 //! `bunny.ply: triangle 12 refers to vertex 2000 but there are 1839 vertices`.
 
-/// A problem with a scene's content: a mesh, a scene file or a scene cache.
+/// A problem with a scene's content: a mesh, a scene file, a scene cache or an occlusion field
+/// file.
 ///
 /// ```
 /// use haarshift::relight::SceneError;
@@ -59,4 +61,21 @@ pub enum SceneError {
     /// The cache file was made for another scene or with other parameters.
     #[error("scene cache was made for another scene ({0}); compute it again")]
     CacheMismatch(String),
+    /// The occlusion field file is damaged: its checksum does not match, it is cut short, or
+    /// what it holds is not a field.
+    #[error("occlusion field file is damaged ({0}); build it again")]
+    FieldCorrupt(String),
+    /// The occlusion field file was written by another version of the format.
+    #[error(
+        "occlusion field file has format version {found}, this build reads version {expected}; build it again"
+    )]
+    FieldVersion {
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads and writes.
+        expected: u32,
+    },
+    /// The occlusion field file was built for another mesh or with other field options.
+    #[error("occlusion field file was built {0}; build it again")]
+    FieldMismatch(String),
 }

@@ -44,11 +44,15 @@
 //! map turned by `k` columns ([`yaw_sparse`]); the sample points do not move, the lookup
 //! turns the query point into the object's frame instead (001's "rotation of the ring
 //! index", without restricting the angle to the ring's spacing).
+//!
+//! **On disk** ([`file`]): a field is written to a checksummed `.hsf` file whose header records
+//! everything that decides its maps, and read back only for the same mesh and options.
 
 use std::time::Instant;
 
 use ndarray::{Array2, Array3, Axis, s};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use super::Mesh;
 use super::raycast::{Occlusion, SceneBvh};
@@ -186,7 +190,8 @@ impl FieldOptions {
 }
 
 /// The frame the samples are placed in, from the object's mesh.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FieldFrame {
     /// Centre of the bounding box.
     pub centre: [f64; 3],
@@ -687,6 +692,8 @@ pub fn yaw_sparse(
     let ones = Array3::<f32>::ones((2, h, h));
     encode(turned.view(), ones.view(), param, keep)
 }
+
+pub mod file;
 
 #[cfg(test)]
 mod tests;

@@ -12,11 +12,11 @@
 //! | [`sparse`] | [`SparseRows`](sparse::SparseRows): many sparse Haar functions in flat arrays |
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
 //! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
-//! | [`fields`] | [`OcclusionField`](fields::OcclusionField): an object's occlusion seen from sample points around it (seed 001) |
+//! | [`fields`] | [`OcclusionField`](fields::OcclusionField): an object's occlusion seen from sample points around it (seed 001); on disk, the `.hsf` file ([`fields::file`]) |
 //! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other; [`Jrt`](dynamic::Jrt), just-in-time radiance transfer |
 //! | [`motion`] | [`MotionPath`](motion::MotionPath): animations of dynamic scenes, played with re-formed transfer |
 //! | [`mod@reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
-//! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file |
+//! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file (its framing, `framed`, is shared with the `.hsf` field file) |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
 //! | [`lighting`] | [`Lighting`]: the environment's kept Haar coefficients, RGB, in Mallat order |
 //! | [`brdf`] | [`Brdf`]: Lambert, Phong, Blinn-Phong; local copies of a BRDF |
@@ -41,6 +41,7 @@ pub mod dynamic;
 pub mod environment;
 pub mod error;
 pub mod fields;
+mod framed;
 pub mod gallery;
 pub mod glossy;
 pub mod harmonics;

@@ -8,6 +8,7 @@ use haarshift::product::Selection;
 use haarshift::relight::Lighting;
 use haarshift::relight::animation::{numbered_path, write_gif};
 use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+use haarshift::relight::fields::file::FieldStore;
 use haarshift::relight::fields::{FieldOptions, Truncation};
 use haarshift::relight::motion::{MotionPath, play};
 use haarshift::relight::raster::{render_format, to_srgb8, write_render};
@@ -36,6 +37,14 @@ kind of change switches, and each frame is one sparse dot product per vertex wit
 factor (just-in-time radiance transfer). Every frame's times are printed: re-forming, shading,
 rasterisation. The output is a looping GIF or numbered PNGs (a pattern with %d).
 
+--fields-dir DIR keeps each shape's fields in DIR (created if absent), one checksummed file
+a shape named after its mesh file or generator (bunny.hsf, sphere-cells-3.hsf): a file built
+for the same mesh with the same field flags (--param, --resolution, --keep-field, --circles,
+--circle-points, --shells, --shell-grid) is loaded instead of casting its rays; an absent one
+is built and written. A file that does not match (another mesh, other flags, damaged, another
+format version) stops the command with the reason before anything is written; --force builds
+it again and replaces it. The run prints the files' size and the time loading took.
+
 --method reference renders the same frames with visibility ray-cast against every object in
 its current placement (the ground truth; no field, no Haar transform).
 
@@ -43,7 +52,9 @@ Examples:
   haarshift relight scene testdata/scenes/table_and_chair.json -o table.png
   haarshift relight scene testdata/scenes/table_and_chair.json --animate testdata/scenes/chair_path.json -o chair.gif
   haarshift relight scene scene.json --resolution 64 --keep-light 200 --keep-visibility 70 --keep-field 70 -o s.png
-  haarshift relight scene scene.json --method reference --vertices truth.npy -o truth.png";
+  haarshift relight scene scene.json --method reference --vertices truth.npy -o truth.png
+  haarshift relight scene testdata/scenes/bunny.json --param cube --resolution 64 --keep-field 120 --fields-dir fields -o bunny.png
+      (the first run builds fields/bunny.hsf; the same command again loads it)";
 
 /// The method the radiance is computed by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -136,6 +147,10 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = 9)]
     pub shell_grid: usize,
 
+    /// Load each shape's fields from DIR when its file matches; build and write absent ones
+    #[arg(long, value_name = "DIR")]
+    pub fields_dir: Option<PathBuf>,
+
     /// Time each GIF frame is shown, milliseconds
     #[arg(long, value_name = "MS", default_value_t = 100)]
     pub delay: u32,
@@ -146,7 +161,7 @@ pub struct Args {
     #[command(flatten)]
     pub camera: CameraFlags,
 
-    /// Replace the outputs if they exist
+    /// Replace the outputs if they exist (and field files that do not match)
     #[arg(long)]
     pub force: bool,
 }
@@ -214,17 +229,32 @@ pub fn run(args: Args) -> Result<()> {
     refuse_existing(&outputs, args.force)?;
     let background = args.camera.background()?;
     let options = args.options()?;
+    let mut store = args
+        .fields_dir
+        .as_ref()
+        .map(|dir| FieldStore::new(dir, args.force));
+    store.as_ref().map(FieldStore::prepare).transpose()?;
 
     let start = Instant::now();
-    let mut scene = DynamicScene::load(&args.scene, &options)?;
+    let mut scene = DynamicScene::load_with(&args.scene, &options, store.as_mut())?;
     let build_ms = ms(start);
     let (env, angles) = args.light.load(scene.environment.as_ref())?;
     let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh())?;
     let param = scene.param();
     let r = *scene.report();
+    let files = store.as_ref().map_or(String::new(), |s| {
+        format!(
+            "; field files in {}: {} loaded in {:.2} s, {} written, {} on disk",
+            s.dir().display(),
+            r.fields_loaded,
+            r.field_load_seconds,
+            r.fields_written,
+            bytes(r.field_file_bytes)
+        )
+    });
     let mut text = format!(
         "{}: {} objects ({} shapes), {} vertices, {} {}; fields: {} samples a shape, {} rays, \
-         {:.1} s, {} stored; own transport: {} rays, {:.1} s; built in {:.1} s\n",
+         {:.1} s, {} stored{files}; own transport: {} rays, {:.1} s; built in {:.1} s\n",
         args.scene.display(),
         scene.object_count(),
         scene.shape_count(),
