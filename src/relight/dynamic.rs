@@ -14,6 +14,13 @@
 //! levels `0..depth` (seed 001 Fig. 3.5's traversal depth: every factor is then constant on
 //! blocks of side `S >> depth`, and so is their product).
 //!
+//! **Glossy materials** (a scene file's `phong` or `blinn` [`Material`](super::Material), or
+//! [`DynamicScene::set_brdf`]): the BRDF in the vertex's frame, seen from the
+//! [eye](DynamicScene::eye), is one more factor, `B_v = a x integral of T_v x L x prod O_k x
+//! rho_v`, `rho_v` the lobe of [`Orientation::lobe`] (by [`GlossyOptions::rotation`], in the
+//! vertex's exact frame) in Haar coefficients; [`reference`](DynamicScene::reference) evaluates
+//! the BRDF analytically per texel. The ground plane stays Lambertian.
+//!
 //! **Own transport and the ground.** An object's `T_v` is precomputed at its placement in the
 //! scene file, against itself and the ground plane (when the scene has one), exactly as
 //! [`vertex_major`] does for a static scene. Moving the object keeps it; turning it by `k`
