@@ -575,6 +575,13 @@ impl Material {
     }
 
     /// The BRDF, its exponent checked as `--brdf` checks it (the same grammar: `phong:EXP`).
+    ///
+    /// ```
+    /// use haarshift::relight::{Brdf, Material};
+    /// let m = Material::Blinn { albedo: [0.5; 3], exponent: 12.0 };
+    /// assert_eq!(m.brdf().unwrap(), Brdf::BlinnPhong { exponent: 12.0 });
+    /// assert!(Material::Phong { albedo: [0.5; 3], exponent: f64::NAN }.brdf().is_err());
+    /// ```
     pub fn brdf(&self) -> Result<Brdf> {
         let spec = match self {
             Material::Lambert { .. } => return Ok(Brdf::Lambert),

@@ -128,6 +128,21 @@ impl DynamicScene {
     }
 
     /// Moves the eye glossy vertices are seen from (the camera of a [`Change::View`]).
+    ///
+    /// ```
+    /// # use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+    /// # use haarshift::relight::SceneFile;
+    /// # use haarshift::sphere::{ParamKind, Parameterization};
+    /// # let file: SceneFile = serde_json::from_str(
+    /// #     r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
+    /// # let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
+    /// # (options.field.circles, options.field.circle_points) = (4, 8);
+    /// # (options.field.shells, options.field.shell_grid) = (2, 2);
+    /// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+    /// assert_eq!(scene.eye(), None); // the file has no camera
+    /// scene.set_eye([0.0, 2.0, 6.0]).unwrap();
+    /// assert_eq!(scene.eye(), Some([0.0, 2.0, 6.0]));
+    /// ```
     pub fn set_eye(&mut self, eye: [f64; 3]) -> Result<()> {
         if !eye.iter().all(|x| x.is_finite()) {
             return Err(Error::parameter(
