@@ -386,4 +386,89 @@ fn a_stale_or_damaged_field_file_fails_cleanly_naming_it_until_force_replaces_it
     // A fields directory that is a file.
     a[6] = p(&obj);
     fails_cleanly(&a, &["tetra.obj"]);
+
+/// A box over a plane, alone (no field between objects), with `material` and a camera.
+fn glossy_box(dir: &Path, name: &str, material: &str) -> PathBuf {
+    let path = dir.join(name);
+    let env = testdata("envmaps/rooitou_park_32x16.hdr");
+    std::fs::write(
+        &path,
+        format!(
+            r#"{{"objects": [{{"generator": {{"plane_under_box": {{"height": 0.4}}}},
+                  "material": {material}}}],
+              "environment": {{"path": "{}"}},
+              "camera": {{"position": [2, 3, 5], "look_at": [0, 0, 0]}}}}"#,
+            env.display()
+        ),
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn glossy_materials_come_from_the_scene_file_or_brdf_and_agree_with_the_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let phong = r#"{"brdf": "phong", "exponent": 20, "albedo": [0.9, 0.9, 0.9]}"#;
+    let lambert = r#"{"brdf": "lambert", "albedo": [0.9, 0.9, 0.9]}"#;
+    let (glossy, matte) = (
+        glossy_box(dir.path(), "g.json", phong),
+        glossy_box(dir.path(), "l.json", lambert),
+    );
+    let npy = |name: &str| dir.path().join(name);
+    let run = |scene: &Path, name: &str, extra: &[&str]| {
+        let out = npy(&format!("{name}.npy"));
+        let mut args = vec!["--vertices", p(&out)];
+        args.extend(extra);
+        run_scene(scene, &npy(&format!("{name}.png")), &COARSE, &args);
+        read_npy(&out)
+    };
+    let direct = ["--brdf-rotation", "direct"];
+    let haar = run(&glossy, "h", &direct);
+    let truth = run(&glossy, "t", &["--method", "reference"]);
+    let rms = |a: &ndarray::ArrayD<f32>| {
+        (a.iter().map(|x| f64::from(*x).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+    };
+    let worst = |a: &ndarray::ArrayD<f32>, b: &ndarray::ArrayD<f32>| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| f64::from((x - y).abs()))
+            .fold(0.0, f64::max)
+            / rms(b)
+    };
+    // f32 output: agreement to its precision (measured 5.1e-7).
+    assert!(worst(&haar, &truth) < 1e-5, "{}", worst(&haar, &truth));
+    // --brdf gives every object its BRDF: the Lambertian file made glossy is the glossy file.
+    let made = run(
+        &matte,
+        "m",
+        &["--brdf", "phong:20", "--brdf-rotation", "direct"],
+    );
+    assert_eq!(made, haar);
+    let flat = run(&glossy, "f", &["--brdf", "lambert"]);
+    assert!(worst(&flat, &truth) > 0.05, "{}", worst(&flat, &truth));
+    // Bad materials and flags: one line each.
+    let bad = [
+        (
+            r#"{"brdf": "chrome", "albedo": [1, 1, 1]}"#,
+            "unknown variant",
+        ),
+        (
+            r#"{"brdf": "phong", "exponent": -1, "albedo": [1, 1, 1]}"#,
+            "from 0",
+        ),
+    ];
+    for (k, (material, needle)) in bad.iter().enumerate() {
+        let scene = glossy_box(dir.path(), &format!("bad{k}.json"), material);
+        let out = npy(&format!("bad{k}.png"));
+        let mut args = vec!["relight", "scene", p(&scene), "-o", p(&out)];
+        args.extend(SMALL);
+        args.extend(COARSE);
+        fails_cleanly(&args, &[needle]);
+    }
+    let out = npy("cache.png");
+    let mut args = vec!["relight", "scene", p(&glossy), "-o", p(&out)];
+    args.extend(SMALL);
+    args.extend(COARSE);
+    args.extend(["--rotation-cache", "4"]);
+    fails_cleanly(&args, &["--rotation-cache"]);
 }

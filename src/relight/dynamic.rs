@@ -14,6 +14,13 @@
 //! levels `0..depth` (seed 001 Fig. 3.5's traversal depth: every factor is then constant on
 //! blocks of side `S >> depth`, and so is their product).
 //!
+//! **Glossy materials** (a scene file's `phong` or `blinn` [`Material`](super::Material), or
+//! [`DynamicScene::set_brdf`]): the BRDF in the vertex's frame, seen from the
+//! [eye](DynamicScene::eye), is one more factor, `B_v = a x integral of T_v x L x prod O_k x
+//! rho_v`, `rho_v` the lobe of [`Orientation::lobe`] (by [`GlossyOptions::rotation`], in the
+//! vertex's exact frame) in Haar coefficients; [`reference`](DynamicScene::reference) evaluates
+//! the BRDF analytically per texel. The ground plane stays Lambertian.
+//!
 //! **Own transport and the ground.** An object's `T_v` is precomputed at its placement in the
 //! scene file, against itself and the ground plane (when the scene has one), exactly as
 //! [`vertex_major`] does for a static scene. Moving the object keeps it; turning it by `k`
@@ -41,9 +48,13 @@ use ndarray::Array2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::brdf::Brdf;
 use super::fields::file::{FieldOrigin, FieldStore};
 use super::fields::{Blend, FieldOptions, OcclusionField, Truncation, select_rows, yaw_sparse};
+use super::glossy::GlossyOptions;
 use super::lighting::Lighting;
+use super::orient::Orientation;
+use super::reference::ReferenceVisibility;
 use super::scene::{CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under, merge};
 use super::shade::{select_kept, within_depth};
 use super::sparse::SparseRows;
@@ -241,6 +252,10 @@ struct Object {
     rest: Placement,
     placement: Placement,
     albedo: [f32; 3],
+    /// Its material's BRDF, with the orientation that brings it into vertex frames (`None`:
+    /// Lambertian).
+    brdf: Brdf,
+    orientation: Option<Arc<Orientation>>,
     transport: Arc<SparseRows<f32>>,
     /// The shape's field turned to the placement.
     field: Arc<OcclusionField>,
@@ -300,6 +315,10 @@ pub struct DynamicScene {
     pub environment: Option<EnvironmentSpec>,
     /// The camera of the scene file.
     pub camera: Option<CameraSpec>,
+    /// Where glossy vertices are seen from (the file's camera position unless set).
+    eye: Option<[f64; 3]>,
+    /// How glossy BRDFs are brought into vertex frames and truncated.
+    glossy: GlossyOptions,
     report: BuildReport,
 }
 
@@ -403,7 +422,13 @@ impl DynamicScene {
                     }
                     other => other,
                 })?;
-            placed.push((shape, placement, object.material.albedo()?));
+            let brdf = object.material.brdf().map_err(|e| match e {
+                Error::Scene { source, .. } => {
+                    SceneError::SceneFile(format!("object {k}: {source}")).into()
+                }
+                other => other,
+            })?;
+            placed.push((shape, placement, object.material.albedo()?, brdf));
         }
         let mut fields = Vec::with_capacity(shapes.len());
         for (mesh, (path, generator)) in shapes.iter().zip(&sources) {
@@ -441,7 +466,7 @@ impl DynamicScene {
         }
         let meshes: Vec<Mesh> = placed
             .iter()
-            .map(|&(shape, p, _)| place_mesh(&shapes[shape], &p, param))
+            .map(|(shape, p, _, _)| place_mesh(&shapes[*shape], p, param))
             .collect();
         let objects_mesh = merge(meshes.iter().cloned());
         let ground = file
@@ -460,7 +485,9 @@ impl DynamicScene {
             Ok(Arc::new(rows))
         };
         let mut objects = Vec::with_capacity(placed.len());
-        for (k, (&(shape, placement, albedo), mesh)) in placed.iter().zip(&meshes).enumerate() {
+        for (k, ((shape, placement, albedo, brdf), mesh)) in
+            placed.into_iter().zip(&meshes).enumerate()
+        {
             let mut with_ground = mesh.clone();
             if let Some(g) = &ground {
                 with_ground.append(g);
@@ -472,6 +499,8 @@ impl DynamicScene {
                 rest: placement,
                 placement,
                 albedo,
+                brdf,
+                orientation: None,
                 transport,
                 field: turned(&fields[shape], placement.turn)?,
             });
@@ -484,7 +513,7 @@ impl DynamicScene {
             None => None,
         };
         let all = merge(std::iter::once(objects_mesh).chain(ground.iter().map(|g| g.0.clone())));
-        Ok(DynamicScene {
+        let mut scene = DynamicScene {
             options: *options,
             lift: ray_offset(&all),
             shapes,
@@ -495,9 +524,13 @@ impl DynamicScene {
                 e.path = dir.join(&e.path);
                 e
             }),
+            eye: file.camera.as_ref().map(|c| c.position),
             camera: file.camera.clone(),
+            glossy: GlossyOptions::default(),
             report,
-        })
+        };
+        scene.orient()?;
+        Ok(scene)
     }
 
     /// The options it was built with.
@@ -714,19 +747,24 @@ impl DynamicScene {
                     owner: Some(k),
                     vertex: v,
                     point: lift(world, normal),
+                    position: world,
+                    normal,
                 });
             }
         }
         if let Some((g, _)) = &self.ground {
             let (p, n) = (g.positions(), g.normals());
             for v in 0..g.vertex_count() {
+                let (position, normal) = (
+                    [p[[v, 0]], p[[v, 1]], p[[v, 2]]],
+                    [n[[v, 0]], n[[v, 1]], n[[v, 2]]],
+                );
                 out.push(Receiver {
                     owner: None,
                     vertex: v,
-                    point: lift(
-                        [p[[v, 0]], p[[v, 1]], p[[v, 2]]],
-                        [n[[v, 0]], n[[v, 1]], n[[v, 2]]],
-                    ),
+                    point: lift(position, normal),
+                    position,
+                    normal,
                 });
             }
         }
@@ -802,7 +840,7 @@ impl DynamicScene {
         let param = self.param();
         let light = light_tree::<T>(lighting, depth)?;
         let receivers = self.receivers();
-        let albedo = self.albedo();
+        let reflectance = self.reflectance();
         let rows: Vec<[T; 3]> = receivers
             .par_iter()
             .map_init(
@@ -820,6 +858,7 @@ impl DynamicScene {
                             factors.push(tree(param, i, v.iter().copied())?);
                         }
                     }
+                    factors.extend(self.brdf_tree(r, depth)?);
                     let mut refs: Vec<&HaarTree<T, 3>> = vec![&light];
                     refs.extend(factors.iter());
                     let value = product_integral(&own, &refs, IntegralOptions::default())?.value;
@@ -827,25 +866,47 @@ impl DynamicScene {
                 },
             )
             .collect::<Result<_>>()?;
-        Ok(radiance(&rows, &albedo))
+        Ok(radiance(&rows, &reflectance))
     }
 
     /// The ground truth of the scene as placed now: [`reference`](super::reference()) with
     /// visibility ray-cast against every object and the ground plane, over `lighting` (a
-    /// lat-long map, rotated), no field, no Haar transform.
+    /// lat-long map, rotated), no field, no Haar transform; a glossy object's BRDF evaluated
+    /// analytically per texel toward the [eye](Self::eye), as `relight reference --brdf` does.
     pub fn reference(&self, lighting: &LatLongMap<f64>) -> Result<Array2<f64>> {
         let mesh = self.mesh();
-        let (radiance, _) = super::reference(
-            &mesh,
-            &SceneBvh::new(&mesh),
-            self.albedo().view(),
-            lighting,
-            &ReferenceOptions {
-                progress: self.options.progress,
+        let bvh = SceneBvh::new(&mesh);
+        let albedo = self.albedo();
+        let lambert = ReferenceOptions {
+            progress: self.options.progress,
+            ..ReferenceOptions::default()
+        };
+        let mut glossy: Vec<&Brdf> = Vec::new();
+        for o in self.objects.iter().filter(|o| !o.brdf.is_lambert()) {
+            if !glossy.contains(&&o.brdf) {
+                glossy.push(&o.brdf);
+            }
+        }
+        if glossy.is_empty() {
+            return Ok(super::reference(&mesh, &bvh, albedo.view(), lighting, &lambert)?.0);
+        }
+        // The rays once; then one quadrature per material, each vertex taking its own's.
+        let eye = self.glossy_eye()?;
+        let bits = ReferenceVisibility::new(&mesh, &bvh, lighting.height(), lambert.progress)?;
+        let mut out = bits.reference(&mesh, albedo.view(), lighting, &lambert)?.0;
+        for brdf in glossy {
+            let options = ReferenceOptions {
+                brdf: brdf.clone(),
+                eye: Some(eye),
                 ..ReferenceOptions::default()
-            },
-        )?;
-        Ok(radiance)
+            };
+            let (shaded, _) = bits.reference(&mesh, albedo.view(), lighting, &options)?;
+            for k in (0..self.objects.len()).filter(|&k| self.objects[k].brdf == *brdf) {
+                let rows = ndarray::s![self.object_vertices(k), ..];
+                out.slice_mut(rows).assign(&shaded.slice(rows));
+            }
+        }
+        Ok(out)
     }
 
     /// The depth the options name, after checking `lighting` against the scene.
@@ -871,6 +932,9 @@ struct Receiver {
     owner: Option<usize>,
     vertex: usize,
     point: [f64; 3],
+    /// On the surface, and the unit normal: a glossy vertex's frame.
+    position: [f64; 3],
+    normal: [f64; 3],
 }
 
 /// Per-thread working memory: a dense blend buffer and a sparse map.
@@ -935,11 +999,11 @@ fn tree<T: Sample>(
     )
 }
 
-/// The lighting's kept coefficients as a tree, depth-limited.
-fn light_tree<T: Sample>(lighting: &Lighting, depth: usize) -> Result<HaarTree<T, 3>> {
+/// The lighting's kept coefficients, depth-limited, sparse and ascending.
+fn light_sparse<T: Sample>(lighting: &Lighting, depth: usize) -> (Vec<u32>, Vec<[T; 3]>) {
     let param = lighting.param();
-    let c = lighting.coefficients_f64();
-    let (indices, values): (Vec<u32>, Vec<[T; 3]>) = c
+    lighting
+        .coefficients_f64()
         .rows()
         .into_iter()
         .enumerate()
@@ -947,7 +1011,13 @@ fn light_tree<T: Sample>(lighting: &Lighting, depth: usize) -> Result<HaarTree<T
             row.iter().any(|&x| x != 0.0) && within_depth(param.face_size(), depth, *i)
         })
         .map(|(i, row)| (i as u32, [row[0], row[1], row[2]].map(T::from_f64)))
-        .unzip();
+        .unzip()
+}
+
+/// The lighting's kept coefficients as a tree, depth-limited.
+fn light_tree<T: Sample>(lighting: &Lighting, depth: usize) -> Result<HaarTree<T, 3>> {
+    let param = lighting.param();
+    let (indices, values) = light_sparse::<T>(lighting, depth);
     HaarTree::from_sparse(
         param.faces(),
         param.face_size(),
@@ -957,13 +1027,14 @@ fn light_tree<T: Sample>(lighting: &Lighting, depth: usize) -> Result<HaarTree<T
     )
 }
 
-/// `albedo / pi x integral`, per vertex and channel.
-fn radiance<T: Sample>(integrals: &[[T; 3]], albedo: &Array2<f32>) -> Array2<T> {
+/// `reflectance x integral`, per vertex and channel ([`DynamicScene::reflectance`]).
+fn radiance<T: Sample>(integrals: &[[T; 3]], reflectance: &Array2<f64>) -> Array2<T> {
     Array2::from_shape_fn((integrals.len(), 3), |(v, c)| {
-        T::from_f64(integrals[v][c].as_f64() * f64::from(albedo[[v, c]]) / std::f64::consts::PI)
+        T::from_f64(integrals[v][c].as_f64() * reflectance[[v, c]])
     })
 }
 
+mod glossy;
 mod jrt;
 pub use jrt::{Change, Jrt, JrtReport};
 

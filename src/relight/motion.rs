@@ -297,13 +297,13 @@ pub fn play(
             (Some((segment, _, t)), Change::Object(_)) => {
                 *segment != state.segment || state.placement.is_some_and(|p| p.turn != *t)
             }
-            (Some((segment, ..)), Change::Lighting) => *segment != state.segment,
+            (Some((segment, ..)), Change::Lighting | Change::View) => *segment != state.segment,
         };
         if stale {
             let formed = Jrt::form(scene, &lighting, state.change)?;
             let t = match state.change {
                 Change::Object(k) => turn(k, scene),
-                Change::Lighting => 0,
+                Change::Lighting | Change::View => 0,
             };
             reformed = Some(*formed.report());
             jrt = Some((state.segment, formed, t));
@@ -317,6 +317,7 @@ pub fn play(
                     Lighting::encode(env, &mapping, &rotation(state.light_yaw)?, keep_light)?;
                 transfer.frame_lit(scene, &lighting)?
             }
+            Change::View => transfer.frame_view(scene)?,
         };
         let report = FrameReport {
             index,

@@ -43,7 +43,8 @@
 //!   `generator` (one of the table's names with its settings, `{}` for the defaults);
 //!   `transform` (optional: scale, then rotate by `R = Rz(roll) Ry(yaw) Rx(pitch)` in degrees,
 //!   the sphere module's convention, then translate); `material` (optional, default Lambertian
-//!   albedo `[0.8, 0.8, 0.8]`). Objects are merged in order, vertices numbered as they come.
+//!   albedo `[0.8, 0.8, 0.8]`; `{"brdf": "phong", "exponent": 20, "albedo": [..]}` and
+//!   `"blinn"` are glossy, [`Material`]). Objects are merged in order, vertices numbered as they come.
 //! * `ground_plane` (default `false`): [`add_ground_plane`] after all objects, albedo
 //!   [`GROUND_ALBEDO`].
 //! * `environment` (optional): the lighting's path and its rotation `g(p) = f(R p)`.
@@ -55,7 +56,7 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use super::mesh::{cross, dot};
-use super::{Mesh, SceneError};
+use super::{Brdf, Mesh, SceneError};
 use crate::sphere::SphereRotation;
 use crate::{Error, Result};
 
@@ -504,7 +505,22 @@ impl Transform {
     }
 }
 
-/// A surface's material (this issue: Lambertian only).
+/// The albedo of the default material.
+const DEFAULT_ALBEDO: [f32; 3] = [0.8, 0.8, 0.8];
+
+/// A surface's material: its BRDF (the `brdf` tag, [`Brdf`]'s `--brdf` names) and its RGB
+/// albedo, the diffuse colour of a Lambertian surface and the specular colour of a glossy one.
+/// Glossy materials are shaded in dynamic scenes ([`DynamicScene`](super::dynamic::DynamicScene));
+/// a static scene ([`Scene`]) takes its BRDF from `--brdf` and refuses them.
+///
+/// ```
+/// use haarshift::relight::{Brdf, Material};
+/// let m: Material = serde_json::from_str(
+///     r#"{"brdf": "phong", "exponent": 20, "albedo": [0.9, 0.9, 0.9]}"#).unwrap();
+/// assert_eq!(m.brdf().unwrap(), Brdf::Phong { exponent: 20.0 });
+/// let bad = Material::Phong { albedo: [1.0; 3], exponent: -1.0 };
+/// assert!(bad.brdf().unwrap_err().to_string().contains("from 0"));
+/// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "brdf", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Material {
@@ -513,20 +529,42 @@ pub enum Material {
         /// RGB albedo, each in `[0, 1]`.
         albedo: [f32; 3],
     },
+    /// Energy-normalised Phong ([`Brdf::Phong`]).
+    Phong {
+        /// RGB specular albedo, each in `[0, 1]`.
+        albedo: [f32; 3],
+        /// Shininess, `0..=`[`MAX_EXPONENT`](super::brdf::MAX_EXPONENT).
+        exponent: f64,
+    },
+    /// Energy-normalised Blinn-Phong ([`Brdf::BlinnPhong`]).
+    Blinn {
+        /// RGB specular albedo, each in `[0, 1]`.
+        albedo: [f32; 3],
+        /// Shininess, `0..=`[`MAX_EXPONENT`](super::brdf::MAX_EXPONENT).
+        exponent: f64,
+    },
 }
 
 impl Default for Material {
     fn default() -> Self {
         Material::Lambert {
-            albedo: [0.8, 0.8, 0.8],
+            albedo: DEFAULT_ALBEDO,
         }
     }
 }
 
 impl Material {
     /// The RGB albedo, checked to be in `[0, 1]`.
+    ///
+    /// ```
+    /// use haarshift::relight::Material;
+    /// assert_eq!(Material::default().albedo().unwrap(), [0.8; 3]);
+    /// assert!(Material::Lambert { albedo: [2.0, 0.0, 0.0] }.albedo().is_err());
+    /// ```
     pub fn albedo(&self) -> Result<[f32; 3]> {
-        let Material::Lambert { albedo } = self;
+        let (Material::Lambert { albedo }
+        | Material::Phong { albedo, .. }
+        | Material::Blinn { albedo, .. }) = self;
         if albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
             return Err(SceneError::SceneFile(format!(
                 "albedo {albedo:?}: every channel must be in [0, 1]"
@@ -534,6 +572,24 @@ impl Material {
             .into());
         }
         Ok(*albedo)
+    }
+
+    /// The BRDF, its exponent checked as `--brdf` checks it (the same grammar: `phong:EXP`).
+    ///
+    /// ```
+    /// use haarshift::relight::{Brdf, Material};
+    /// let m = Material::Blinn { albedo: [0.5; 3], exponent: 12.0 };
+    /// assert_eq!(m.brdf().unwrap(), Brdf::BlinnPhong { exponent: 12.0 });
+    /// assert!(Material::Phong { albedo: [0.5; 3], exponent: f64::NAN }.brdf().is_err());
+    /// ```
+    pub fn brdf(&self) -> Result<Brdf> {
+        let spec = match self {
+            Material::Lambert { .. } => return Ok(Brdf::Lambert),
+            Material::Phong { exponent, .. } => format!("phong:{exponent}"),
+            Material::Blinn { exponent, .. } => format!("blinn:{exponent}"),
+        };
+        spec.parse::<Brdf>()
+            .map_err(|e| SceneError::SceneFile(format!("material: {e}")).into())
     }
 }
 
@@ -663,8 +719,8 @@ impl Scene {
             camera: None,
             ground_plane: false,
         };
-        let Material::Lambert { albedo } = Material::default();
-        scene.albedo = Array2::from_shape_fn((scene.mesh.vertex_count(), 3), |(_, c)| albedo[c]);
+        scene.albedo =
+            Array2::from_shape_fn((scene.mesh.vertex_count(), 3), |(_, c)| DEFAULT_ALBEDO[c]);
         if ground_plane {
             scene.add_ground_plane();
         }
@@ -757,6 +813,13 @@ impl SceneFile {
             let shape = object.shape(dir, k)?;
             let shape = object.transform.apply(&shape)?;
             let a = object.material.albedo()?;
+            if !object.material.brdf()?.is_lambert() {
+                return Err(SceneError::SceneFile(format!(
+                    "object {k}: a glossy material is shaded in dynamic scenes (relight scene); \
+                     a static scene takes its BRDF from --brdf"
+                ))
+                .into());
+            }
             let rows = Array2::from_shape_fn((shape.vertex_count(), 3), |(_, c)| a[c]);
             albedo
                 .append(ndarray::Axis(0), rows.view())

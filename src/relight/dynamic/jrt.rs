@@ -9,11 +9,17 @@ use super::*;
 #[serde(rename_all = "snake_case")]
 pub enum Change {
     /// Object `k` moves (translation and scale; a turn re-forms): every other vertex's fixed
-    /// product holds its own transport, the lighting and the other objects' occlusion; object
-    /// `k`'s own vertices hold their transport and the lighting.
+    /// product holds its own transport, the lighting, the other objects' occlusion and its
+    /// BRDF; object `k`'s own vertices hold their transport and the lighting (a glossy one's
+    /// view, so its BRDF, moves with it).
     Object(usize),
-    /// The lighting changes: every vertex holds its own transport and all occlusion.
+    /// The lighting changes: every vertex holds its own transport, all occlusion and its
+    /// BRDF.
     Lighting,
+    /// The eye moves ([`DynamicScene::set_eye`]): every vertex holds its own transport, the
+    /// lighting and all occlusion; a frame re-orients each glossy vertex's BRDF toward the new
+    /// eye and takes one dot product with it (a Lambertian vertex's radiance does not change).
+    View,
 }
 
 /// What forming or using a [`Jrt`] cost.
@@ -65,6 +71,8 @@ pub struct Jrt<T> {
     change: Change,
     /// Every object's turn at formation (a vertex's own transport turns with its object).
     turns: Vec<usize>,
+    /// Every placement at formation (a change of view holds them all).
+    placements: Vec<Placement>,
     products: SparseRows<[T; 3]>,
     report: JrtReport,
 }
@@ -80,7 +88,7 @@ impl<T: Sample> Jrt<T> {
                 scene.check_object(k)?;
                 Some(k)
             }
-            Change::Lighting => None,
+            Change::Lighting | Change::View => None,
         };
         let param = scene.param();
         let light = light_tree::<T>(lighting, depth)?;
@@ -101,8 +109,12 @@ impl<T: Sample> Jrt<T> {
                             factors.push(tree(param, i, v.iter().copied())?);
                         }
                     }
+                    // The BRDF is fixed unless the view of it varies.
+                    if change != Change::View && (moving.is_none() || r.owner != moving) {
+                        factors.extend(scene.brdf_tree(r, depth)?);
+                    }
                     let mut refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
-                    if moving.is_some() {
+                    if change != Change::Lighting {
                         refs.push(&light);
                     }
                     let (indices, values) = product(&refs)?.sparse_coefficients();
@@ -119,6 +131,7 @@ impl<T: Sample> Jrt<T> {
         Ok(Jrt {
             change,
             turns: scene.objects.iter().map(|o| o.placement.turn).collect(),
+            placements: scene.objects.iter().map(|o| o.placement).collect(),
             products,
             report,
         })
@@ -138,10 +151,7 @@ impl<T: Sample> Jrt<T> {
     /// other placement as at formation).
     pub fn frame_moved(&self, scene: &DynamicScene) -> Result<Array2<T>> {
         let Change::Object(moving) = self.change else {
-            return Err(Error::parameter(
-                "change",
-                "this transfer was formed for a change of lighting: use frame_lit",
-            ));
+            return Err(self.wrong_frame());
         };
         self.check_scene(scene)?;
         let depth = scene.options.check()?;
@@ -171,6 +181,11 @@ impl<T: Sample> Jrt<T> {
                             Some((fi, fv)) => dot_dense(dense, ti, tv, fi, fv),
                         });
                     }
+                    if let Some(value) =
+                        moving_glossy(scene, r, moving, depth, scratch, dense, ti, tv)?
+                    {
+                        return Ok(value);
+                    }
                     // A vertex of the moving object: every other object's map varies; their
                     // product (a tree of the maps alone) is the varying factor.
                     let mut trees = Vec::new();
@@ -194,16 +209,13 @@ impl<T: Sample> Jrt<T> {
                 },
             )
             .collect::<Result<_>>()?;
-        Ok(radiance(&rows, &scene.albedo()))
+        Ok(radiance(&rows, &scene.reflectance()))
     }
 
     /// Every vertex's radiance `(V, 3)` under `lighting` (formed for [`Change::Lighting`]).
     pub fn frame_lit(&self, scene: &DynamicScene, lighting: &Lighting) -> Result<Array2<T>> {
         if self.change != Change::Lighting {
-            return Err(Error::parameter(
-                "change",
-                "this transfer was formed for a moving object: use frame_moved",
-            ));
+            return Err(self.wrong_frame());
         }
         self.check_scene(scene)?;
         let depth = scene.check_lighting(lighting)?;
@@ -225,7 +237,86 @@ impl<T: Sample> Jrt<T> {
                 acc.map(T::from_f64)
             })
             .collect();
-        Ok(radiance(&rows, &scene.albedo()))
+        Ok(radiance(&rows, &scene.reflectance()))
+    }
+
+    /// Every vertex's radiance `(V, 3)` seen from `scene`'s [eye](DynamicScene::eye) (formed
+    /// for [`Change::View`]; every placement as at formation): per glossy vertex the BRDF in
+    /// its new frame and one sparse dot product with the fixed product.
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt};
+    /// use haarshift::relight::{Lighting, SceneFile};
+    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
+    ///     {"generator": {"sphere": {"cells": 2}},
+    ///      "material": {"brdf": "phong", "exponent": 10, "albedo": [0.9, 0.9, 0.9]}},
+    ///     {"generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.5, 0, 0]}}
+    ///   ], "camera": {"position": [0, 2, 6], "look_at": [0, 0, 0]}}"#).unwrap();
+    /// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
+    /// let mut options = DynamicOptions::new(param);
+    /// (options.field.circles, options.field.circle_points) = (8, 16);
+    /// (options.field.shells, options.field.shell_grid) = (4, 3);
+    /// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+    /// let sky = SphereMap::<f64>::from_fn(param, 3, |d, o| o.fill(0.2 + d[1].max(0.0))).unwrap();
+    /// let light = Lighting::from_map(&sky, Selection::All).unwrap();
+    /// let jrt = Jrt::<f64>::form(&scene, &light, Change::View).unwrap();
+    /// scene.set_eye([5.0, 1.0, 1.0]).unwrap(); // the camera moves
+    /// let fast = jrt.frame_view(&scene).unwrap();
+    /// let full = scene.shade::<f64>(&light).unwrap();
+    /// assert!(fast.iter().zip(&full).all(|(a, b)| (a - b).abs() < 1e-9));
+    /// ```
+    pub fn frame_view(&self, scene: &DynamicScene) -> Result<Array2<T>> {
+        if self.change != Change::View {
+            return Err(self.wrong_frame());
+        }
+        self.check_scene(scene)?;
+        if scene
+            .objects
+            .iter()
+            .map(|o| o.placement)
+            .ne(self.placements.iter().copied())
+        {
+            return Err(Error::parameter(
+                "scene",
+                "an object moved since the transfer was formed for a change of view: re-form it",
+            ));
+        }
+        let depth = scene.options.check()?;
+        let param = scene.param();
+        let rows: Vec<[T; 3]> = scene
+            .receivers()
+            .par_iter()
+            .enumerate()
+            .map_init(
+                || vec![[T::zero(); 3]; param.texels()],
+                |dense, (v, r)| -> Result<[T; 3]> {
+                    let (ti, tv) = self.products.row(v);
+                    Ok(match scene.brdf_sparse(r, depth)? {
+                        Some((fi, fv)) => dot_dense(dense, ti, tv, &fi, &fv),
+                        None => dot_one(param, ti, tv),
+                    })
+                },
+            )
+            .collect::<Result<_>>()?;
+        Ok(radiance(&rows, &scene.reflectance()))
+    }
+
+    /// The refusal of a frame of another kind than the transfer was formed for.
+    fn wrong_frame(&self) -> Error {
+        let use_instead = match self.change {
+            Change::Object(_) => "frame_moved",
+            Change::Lighting => "frame_lit",
+            Change::View => "frame_view",
+        };
+        Error::parameter(
+            "change",
+            format!(
+                "this transfer was formed for {:?}: use {use_instead}",
+                self.change
+            ),
+        )
     }
 
     fn check_scene(&self, scene: &DynamicScene) -> Result<()> {
@@ -332,14 +423,31 @@ fn dot_blend<T: Sample>(
     acc.map(T::from_f64)
 }
 
-/// `<T, F>` for a sparse `T` and a sparse one-channel `F`, through a dense copy of `T`
-/// (`dense` is all zeros and is left so).
-fn dot_dense<T: Sample>(
+/// A sparse factor's value: one channel for every colour, or RGB.
+trait Channels: Copy {
+    fn channel(self, c: usize) -> f64;
+}
+
+impl Channels for f64 {
+    fn channel(self, _: usize) -> f64 {
+        self
+    }
+}
+
+impl Channels for [f64; 3] {
+    fn channel(self, c: usize) -> f64 {
+        self[c]
+    }
+}
+
+/// `<T, F>` for a sparse `T` and a sparse `F` (one channel or RGB), through a dense copy of
+/// `T` (`dense` is all zeros and is left so).
+fn dot_dense<T: Sample, F: Channels>(
     dense: &mut [[T; 3]],
     ti: &[u32],
     tv: &[[T; 3]],
     fi: &[u32],
-    fv: &[f64],
+    fv: &[F],
 ) -> [T; 3] {
     for (&i, t) in ti.iter().zip(tv) {
         dense[i as usize] = *t;
@@ -348,11 +456,44 @@ fn dot_dense<T: Sample>(
     for (&i, &f) in fi.iter().zip(fv) {
         let t = dense[i as usize];
         for c in 0..3 {
-            acc[c] += t[c].as_f64() * f;
+            acc[c] += t[c].as_f64() * f.channel(c);
         }
     }
     for &i in ti {
         dense[i as usize] = [T::zero(); 3];
     }
     acc.map(T::from_f64)
+}
+
+/// A glossy vertex of the moving object: its view moves with it, so its fixed product holds
+/// its transport and the lighting only and the varying factor is every other object's map
+/// times its BRDF re-oriented where it now is: that product's tree, then the dot. `None`: the
+/// vertex is not glossy (or not the moving object's).
+#[allow(clippy::too_many_arguments)]
+fn moving_glossy<T: Sample>(
+    scene: &DynamicScene,
+    r: &Receiver,
+    moving: usize,
+    depth: usize,
+    scratch: &mut Scratch,
+    dense: &mut [[T; 3]],
+    ti: &[u32],
+    tv: &[[T; 3]],
+) -> Result<Option<[T; 3]>> {
+    if r.owner != Some(moving) {
+        return Ok(None);
+    }
+    let Some(brdf) = scene.brdf_tree::<f64>(r, depth)? else {
+        return Ok(None);
+    };
+    let param = scene.param();
+    let mut trees = vec![brdf];
+    for k in (0..scene.objects.len()).filter(|&k| k != moving) {
+        if let Some((fi, fv)) = scene.occlusion(k, r.point, depth, scratch) {
+            trees.push(tree::<f64>(param, fi, fv.iter().copied())?);
+        }
+    }
+    let refs: Vec<&HaarTree<f64, 3>> = trees.iter().collect();
+    let (fi, fv) = product(&refs)?.sparse_coefficients();
+    Ok(Some(dot_dense(dense, ti, tv, &fi, &fv)))
 }

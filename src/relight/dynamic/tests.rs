@@ -6,11 +6,11 @@ use crate::relight::fields::FieldOptions;
 use crate::relight::shade::{PreparedTransport, ShadeOptions};
 use crate::sphere::param::SphereMap;
 
-fn param() -> Parameterization {
+pub(super) fn param() -> Parameterization {
     Parameterization::new(ParamKind::LatLong, 8).unwrap()
 }
 
-fn options() -> DynamicOptions {
+pub(super) fn options() -> DynamicOptions {
     let mut o = DynamicOptions::new(param());
     o.field = FieldOptions {
         circles: 6,
@@ -22,16 +22,16 @@ fn options() -> DynamicOptions {
     o
 }
 
-fn scene_file(json: &str) -> SceneFile {
+pub(super) fn scene_file(json: &str) -> SceneFile {
     serde_json::from_str(json).unwrap()
 }
 
-fn build(json: &str) -> DynamicScene {
+pub(super) fn build(json: &str) -> DynamicScene {
     DynamicScene::build(&scene_file(json), Path::new("."), &options()).unwrap()
 }
 
 /// A sky with a bright patch, so that shadows matter.
-fn lighting(turn: f64) -> Lighting {
+pub(super) fn lighting(turn: f64) -> Lighting {
     let sky = SphereMap::<f64>::from_fn(param(), 3, |d, out| {
         let sun = (d[0] * turn.cos() + d[2] * turn.sin() + 0.5 * d[1])
             .max(0.0)
@@ -44,12 +44,12 @@ fn lighting(turn: f64) -> Lighting {
     Lighting::from_map(&sky, Selection::All).unwrap()
 }
 
-fn rms(a: &Array2<f64>) -> f64 {
+pub(super) fn rms(a: &Array2<f64>) -> f64 {
     (a.iter().map(|x| x * x).sum::<f64>() / a.len() as f64).sqrt()
 }
 
 /// Largest difference relative to the RMS of `want`.
-fn relative(got: &Array2<f64>, want: &Array2<f64>) -> f64 {
+pub(super) fn relative(got: &Array2<f64>, want: &Array2<f64>) -> f64 {
     assert_eq!(got.dim(), want.dim());
     let worst = got
         .iter()
@@ -59,7 +59,7 @@ fn relative(got: &Array2<f64>, want: &Array2<f64>) -> f64 {
     worst / rms(want)
 }
 
-const THREE: &str = r#"{"objects": [
+pub(super) const THREE: &str = r#"{"objects": [
     {"name": "a", "generator": {"sphere": {"cells": 2}}},
     {"name": "b", "generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.4, 0, 0.5]}},
     {"name": "c", "generator": {"sphere": {"cells": 2}},

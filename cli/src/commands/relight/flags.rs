@@ -60,7 +60,7 @@ pub fn triple(s: &str) -> std::result::Result<[f64; 3], String> {
 
 /// `--brdf`, its syntax checked by the library; a `merl:FILE` is read later
 /// ([`MaterialFlags::brdf`]), so that a bad file is one line naming it, not a usage error.
-fn brdf(s: &str) -> std::result::Result<String, String> {
+pub fn brdf(s: &str) -> std::result::Result<String, String> {
     match s.strip_prefix("merl:") {
         Some(path) if !path.is_empty() => Ok(s.to_owned()),
         _ => s

@@ -5,18 +5,20 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use haarshift::product::Selection;
-use haarshift::relight::Lighting;
 use haarshift::relight::animation::{numbered_path, write_gif};
 use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
 use haarshift::relight::fields::file::FieldStore;
 use haarshift::relight::fields::{FieldOptions, Truncation};
 use haarshift::relight::motion::{MotionPath, play};
 use haarshift::relight::raster::{render_format, to_srgb8, write_render};
+use haarshift::relight::{Brdf, Lighting};
 use haarshift::sphere::{ParamKind, Parameterization};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
 
-use super::flags::{CameraFlags, LightFlags, bytes, ms, refuse_inputs, rotation};
+use super::flags::{
+    CameraFlags, GlossyFlags, LightFlags, brdf, bytes, ms, refuse_inputs, rotation,
+};
 use crate::commands::{choice, names, print, refuse_existing};
 
 const HELP: &str = "\
@@ -30,6 +32,10 @@ looked up where the vertex is (bilinear on the plane, trilinear between shells; 
 outermost shell an object occludes nothing): an n-function product integral on sparse Haar
 coefficients. Objects move by translation, uniform scale and whole-column yaw (the scene
 file's yaw is rounded to a column of the lat-long map); pitch and roll are refused.
+
+A glossy material (\"brdf\": \"phong\" or \"blinn\" with an \"exponent\", or --brdf for every
+object) adds its BRDF, rotated into each vertex's frame toward the camera (--brdf-rotation),
+as one more factor: albedo x the integral of transport x lighting x occlusion x BRDF.
 
 --animate PATH.json plays segments that each move one object or turn the lighting (see the
 library's relight::motion for the file): the fixed factors' product is re-formed when the
@@ -53,6 +59,7 @@ Examples:
   haarshift relight scene testdata/scenes/table_and_chair.json --animate testdata/scenes/chair_path.json -o chair.gif
   haarshift relight scene scene.json --resolution 64 --keep-light 200 --keep-visibility 70 --keep-field 70 -o s.png
   haarshift relight scene scene.json --method reference --vertices truth.npy -o truth.png
+  haarshift relight scene testdata/scenes/table_and_chair.json --brdf phong:40 -o glossy.png
   haarshift relight scene testdata/scenes/bunny.json --param cube --resolution 64 --keep-field 120 --fields-dir fields -o bunny.png
       (the first run builds fields/bunny.hsf; the same command again loads it)";
 
@@ -155,6 +162,14 @@ pub struct Args {
     #[arg(long, value_name = "MS", default_value_t = 100)]
     pub delay: u32,
 
+    /// Every object's BRDF instead of its material's (its albedo stays; the ground plane stays
+    /// Lambertian): lambert, phong:EXP, blinn:EXP, merl:FILE [default: the scene file's]
+    #[arg(long, value_name = "BRDF", value_parser = brdf)]
+    pub brdf: Option<String>,
+
+    #[command(flatten)]
+    pub glossy: GlossyFlags,
+
     #[command(flatten)]
     pub light: LightFlags,
 
@@ -225,6 +240,12 @@ pub fn run(args: Args) -> Result<()> {
     let mut inputs = vec![args.scene.as_path()];
     inputs.extend(args.animate.as_deref());
     inputs.extend(args.light.env.as_deref());
+    inputs.extend(
+        args.brdf
+            .as_deref()
+            .and_then(|b| b.strip_prefix("merl:"))
+            .map(Path::new),
+    );
     refuse_inputs(&inputs, &outputs)?;
     refuse_existing(&outputs, args.force)?;
     let background = args.camera.background()?;
@@ -240,6 +261,30 @@ pub fn run(args: Args) -> Result<()> {
     let build_ms = ms(start);
     let (env, angles) = args.light.load(scene.environment.as_ref())?;
     let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh())?;
+    if let Some(spec) = &args.brdf {
+        let brdf: Brdf = spec.parse()?;
+        for k in 0..scene.object_count() {
+            scene.set_brdf(k, brdf.clone())?;
+        }
+    }
+    // The glossy flags apply to the first glossy material (any other is rotated alike).
+    let glossy = (0..scene.object_count())
+        .map(|k| scene.brdf(k).cloned())
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .find(|b| !b.is_lambert())
+        .unwrap_or(Brdf::Lambert);
+    args.glossy.check(&glossy)?;
+    if args.glossy.fill_cache || args.glossy.rotation_cache.is_some() {
+        return Err(Error::InvalidParameter {
+            name: "rotation-cache",
+            reason: "a dynamic scene rotates every glossy vertex's BRDF in its exact frame: \
+                     --rotation-cache and --fill-cache are for relight render"
+                .into(),
+        });
+    }
+    scene.set_glossy(&args.glossy.options(&glossy))?;
+    scene.set_eye(camera.position())?;
     let param = scene.param();
     let r = *scene.report();
     let files = store.as_ref().map_or(String::new(), |s| {
