@@ -353,6 +353,9 @@ impl<T: Sample, const C: usize> HaarTree<T, C> {
                 }
             }
         }
+        // Sorted once; every later match is a forward merge, not a search (this runs per
+        // vertex and per looked-up map in dynamic scenes).
+        details.sort_unstable_by_key(|d| d.0);
         let keys = with_ancestors(details.iter().map(|d| d.0).collect());
         let mut nodes = vec![
             Node {
@@ -364,36 +367,56 @@ impl<T: Sample, const C: usize> HaarTree<T, C> {
             keys.len()
         ];
         let inv_s = T::one() / T::from_f64(side as f64);
+        let mut at = 0;
         for &(key, band, v) in &details {
-            let at = keys
-                .binary_search(&key)
-                .expect("every detail's node is a key");
+            while keys[at] != key {
+                at += 1;
+            }
             let inv_b = T::from_f64((1u64 << key.level) as f64) * inv_s;
             nodes[at].step[band] = v.map(|x| x * inv_b);
         }
         let signs = wavelet_signs().map(|q| q.map(T::from_f64));
         let mut roots = vec![None; faces];
+        let mut positions = Vec::with_capacity(keys.len());
+        // Parents ascend with their children within a face's level; `p` only jumps back
+        // where a new level or face starts.
+        let mut p = 0;
         for at in 0..keys.len() {
             let key = keys[at];
             match key.parent() {
                 None => {
                     roots[key.face as usize] = Some(at as u32);
                     nodes[at].mean = scaling[key.face as usize].map(|x| x * inv_s);
+                    positions.push(NodePosition {
+                        face: key.face,
+                        level: 0,
+                        row: 0,
+                        col: 0,
+                    });
                 }
                 Some(parent) => {
-                    let p = keys[..at]
-                        .binary_search(&parent)
-                        .expect("a node's parent sorts before it");
+                    if keys[p] > parent {
+                        p = keys[..at].partition_point(|k| *k < parent);
+                    }
+                    while keys[p] < parent {
+                        p += 1;
+                    }
                     let q = (key.morton & 3) as usize;
                     if nodes[p].children == 0 {
                         nodes[p].first_child = at as u32;
                     }
                     nodes[p].children |= 1 << q;
                     nodes[at].mean = nodes[p].quadrant_mean(&signs[q]);
+                    let up: NodePosition = positions[p];
+                    positions.push(NodePosition {
+                        level: key.level,
+                        row: 2 * up.row + (q >> 1) as u32,
+                        col: 2 * up.col + (q & 1) as u32,
+                        ..up
+                    });
                 }
             }
         }
-        let positions = keys.iter().map(NodeKey::position).collect();
         Ok(Self::from_parts(
             faces, n, layout, scaling, roots, nodes, positions,
         ))
@@ -766,19 +789,5 @@ impl NodeKey {
             level: self.level - 1,
             morton: self.morton >> 2,
         })
-    }
-
-    fn position(&self) -> NodePosition {
-        let gather = |shift: u32| {
-            (0..u32::from(self.level)).fold(0u32, |acc, b| {
-                acc | ((((self.morton >> (2 * b + shift)) & 1) as u32) << b)
-            })
-        };
-        NodePosition {
-            face: self.face,
-            level: self.level,
-            row: gather(1),
-            col: gather(0),
-        }
     }
 }

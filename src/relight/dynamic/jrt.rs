@@ -3,6 +3,7 @@
 //! then one sparse dot product per vertex with the varying factor.
 
 use super::*;
+use crate::product::triple::triple_integral;
 
 /// What just-in-time radiance transfer holds fixed and what varies between frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -40,7 +41,8 @@ pub struct JrtReport {
 /// when the kind of change switches.
 ///
 /// A vertex of the moving object sees every other object move: its `F` is the product of
-/// their looked-up maps (one map: a dot product; several: their product tree, then the dot).
+/// their looked-up maps (one map: a dot product; several: the product integral of `T` and the
+/// maps, the triple product for two, without forming their product).
 ///
 /// ```
 /// use haarshift::product::Selection;
@@ -161,8 +163,11 @@ impl<T: Sample> Jrt<T> {
             .par_iter()
             .enumerate()
             .map_init(
-                || (Scratch::new(param), vec![[T::zero(); 3]; param.texels()]),
-                |(scratch, dense), (v, r)| -> Result<[T; 3]> {
+                || {
+                    let dense = vec![[T::zero(); 3]; param.texels()];
+                    (Scratch::new(param), dense, Vec::new())
+                },
+                |(scratch, dense, held), (v, r)| -> Result<[T; 3]> {
                     let (ti, tv) = self.products.row(v);
                     if r.owner != Some(moving) {
                         // The one varying factor: a dot product with the moving object's map;
@@ -186,26 +191,23 @@ impl<T: Sample> Jrt<T> {
                     {
                         return Ok(value);
                     }
-                    // A vertex of the moving object: every other object's map varies; their
-                    // product (a tree of the maps alone) is the varying factor.
-                    let mut trees = Vec::new();
-                    let mut single = None;
+                    // A vertex of the moving object: every other object's map varies. Each
+                    // map found is swapped out of the scratch (no copy) for the product integral.
+                    let mut found = 0;
                     for k in (0..scene.objects.len()).filter(|&k| k != moving) {
-                        if let Some((fi, fv)) = scene.occlusion(k, r.point, depth, scratch) {
-                            single = Some((fi.to_vec(), fv.to_vec()));
-                            trees.push(tree::<f64>(param, fi, fv.iter().copied())?);
+                        if scene.occlusion(k, r.point, depth, scratch).is_some() {
+                            if held.len() == found {
+                                held.push((Vec::new(), Vec::new()));
+                            }
+                            std::mem::swap(&mut held[found], &mut scratch.map);
+                            found += 1;
                         }
                     }
-                    let (fi, fv) = match (trees.len(), single) {
-                        (0, _) => return Ok(dot_one(param, ti, tv)),
-                        (1, Some(map)) => map,
-                        _ => {
-                            let refs: Vec<&HaarTree<f64, 3>> = trees.iter().collect();
-                            let (i, v) = product(&refs)?.sparse_coefficients();
-                            (i, v.into_iter().map(|c| c[0]).collect())
-                        }
-                    };
-                    Ok(dot_dense(dense, ti, tv, &fi, &fv))
+                    Ok(match &held[..found] {
+                        [] => dot_one(param, ti, tv),
+                        [(fi, fv)] => dot_dense(dense, ti, tv, fi, fv),
+                        maps => dot_product(param, ti, tv, maps)?,
+                    })
                 },
             )
             .collect::<Result<_>>()?;
@@ -395,36 +397,32 @@ fn dot_blend<T: Sample>(
     blend: &Blend,
     depth: usize,
 ) -> [T; 3] {
-    for (&i, t) in ti.iter().zip(tv) {
-        dense[i as usize] = *t;
-    }
     let s = field.options().param.face_size();
     let all = depth == s.trailing_zeros() as usize;
-    let mut acc = [0.0f64; 3];
-    for &(sample, w) in blend.samples() {
-        let (fi, fv) = field.map(sample as usize);
-        let mut part = [T::zero(); 3];
-        for (&i, &f) in fi.iter().zip(fv) {
-            if all || within_depth(s, depth, i as usize) {
-                let t = dense[i as usize];
-                let f = T::from_f64(f64::from(f));
-                for c in 0..3 {
-                    part[c] += t[c] * f;
+    with_dense(dense, ti, tv, |dense| {
+        let mut acc = [0.0f64; 3];
+        for &(sample, w) in blend.samples() {
+            let (fi, fv) = field.map(sample as usize);
+            let mut part = [T::zero(); 3];
+            for (&i, &f) in fi.iter().zip(fv) {
+                if all || within_depth(s, depth, i as usize) {
+                    let t = dense[i as usize];
+                    let f = T::from_f64(f64::from(f));
+                    for c in 0..3 {
+                        part[c] += t[c] * f;
+                    }
                 }
             }
+            for c in 0..3 {
+                acc[c] += f64::from(w) * part[c].as_f64();
+            }
         }
-        for c in 0..3 {
-            acc[c] += f64::from(w) * part[c].as_f64();
-        }
-    }
-    for &i in ti {
-        dense[i as usize] = [T::zero(); 3];
-    }
-    acc.map(T::from_f64)
+        acc.map(T::from_f64)
+    })
 }
 
 /// A sparse factor's value: one channel for every colour, or RGB.
-trait Channels: Copy {
+pub(super) trait Channels: Copy {
     fn channel(self, c: usize) -> f64;
 }
 
@@ -442,27 +440,67 @@ impl Channels for [f64; 3] {
 
 /// `<T, F>` for a sparse `T` and a sparse `F` (one channel or RGB), through a dense copy of
 /// `T` (`dense` is all zeros and is left so).
-fn dot_dense<T: Sample, F: Channels>(
+pub(super) fn dot_dense<T: Sample, F: Channels>(
     dense: &mut [[T; 3]],
     ti: &[u32],
     tv: &[[T; 3]],
     fi: &[u32],
     fv: &[F],
 ) -> [T; 3] {
+    with_dense(dense, ti, tv, |dense| {
+        let mut acc = [0.0f64; 3];
+        for (&i, &f) in fi.iter().zip(fv) {
+            let t = dense[i as usize];
+            for c in 0..3 {
+                acc[c] += t[c].as_f64() * f.channel(c);
+            }
+        }
+        acc.map(T::from_f64)
+    })
+}
+
+/// `f` of the sparse `T` scattered into `dense` (all zeros, and left so): a dot with a sparse
+/// map is then one load per map coefficient, not a merge of two index lists.
+fn with_dense<T: Sample, R>(
+    dense: &mut [[T; 3]],
+    ti: &[u32],
+    tv: &[[T; 3]],
+    f: impl FnOnce(&[[T; 3]]) -> R,
+) -> R {
     for (&i, t) in ti.iter().zip(tv) {
         dense[i as usize] = *t;
     }
-    let mut acc = [0.0f64; 3];
-    for (&i, &f) in fi.iter().zip(fv) {
-        let t = dense[i as usize];
-        for c in 0..3 {
-            acc[c] += t[c].as_f64() * f.channel(c);
-        }
-    }
+    let out = f(dense);
     for &i in ti {
         dense[i as usize] = [T::zero(); 3];
     }
-    acc.map(T::from_f64)
+    out
+}
+
+/// `<T, prod_k M_k>` for two or more one-channel sparse maps `M_k`: the product integral of
+/// `T` as the transport (it carries the weight) and the maps, by the triple traversal for two
+/// (seed 002's three cases), the `n`-function one for more. Nothing of the maps' product is
+/// formed: the traversals visit only nodes where two or more functions have nodes.
+pub(super) fn dot_product<T: Sample>(
+    param: Parameterization,
+    ti: &[u32],
+    tv: &[[T; 3]],
+    maps: &[(Vec<u32>, Vec<f64>)],
+) -> Result<[T; 3]> {
+    let own = HaarTree::from_sparse(param.faces(), param.face_size(), layout(param), ti, tv)?;
+    let transport = Transport::from_weighted_tree(own);
+    let trees = maps
+        .iter()
+        .map(|(i, v)| tree::<T>(param, i, v.iter().copied()))
+        .collect::<Result<Vec<_>>>()?;
+    let value = match &trees[..] {
+        [a, b] => triple_integral(&transport, a, b)?.value,
+        _ => {
+            let refs: Vec<&HaarTree<T, 3>> = trees.iter().collect();
+            product_integral(&transport, &refs, IntegralOptions::default())?.value
+        }
+    };
+    Ok(value.map(T::from_f64))
 }
 
 /// A glossy vertex of the moving object: its view moves with it, so its fixed product holds

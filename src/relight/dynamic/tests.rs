@@ -319,3 +319,71 @@ fn a_clone_shares_its_shape_and_shadows_like_the_original() {
     grown.clone_object(1, scene.placement(1)).unwrap();
     assert!(jrt.frame_moved(&grown).is_err());
 }
+
+/// A sphere with three others around it: two within whose fields it lies, and one whose
+/// outermost shell (6 R = 5.4) passes through it once it has moved to `[0.3, 0.1, 0.2]`, so
+/// that its vertices see two maps or three.
+const FOUR: &str = r#"{"objects": [
+    {"name": "middle", "generator": {"sphere": {"cells": 2}}},
+    {"generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.2, 0, 0.3]}},
+    {"generator": {"sphere": {"cells": 2}}, "transform": {"translate": [-0.4, 0.2, 2.1], "scale": 0.8}},
+    {"generator": {"sphere": {"cells": 2}}, "transform": {"translate": [-4.02, 0.1, -3.04], "scale": 0.9}}
+  ], "ground_plane": true}"#;
+
+#[test]
+fn a_moving_objects_product_integral_of_several_maps_equals_their_product_tree_dotted() {
+    let mut scene = build(FOUR);
+    let light = lighting(0.4);
+    let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(0)).unwrap();
+    let mut p = scene.placement(0);
+    p.translate = [0.3, 0.1, 0.2];
+    scene.place(0, p).unwrap();
+    let (param, depth) = (param(), 3);
+    let light_tree = light_tree::<f64>(&light, depth).unwrap();
+    let mut scratch = Scratch::new(param);
+    let mut dense = vec![[0.0f64; 3]; param.texels()];
+    let receivers = scene.receivers();
+    let mut seen = [0usize; 4];
+    let mut effect = 0.0f64;
+    for r in receivers.iter().filter(|r| r.owner == Some(0)) {
+        // A moving vertex's fixed product: its own transport times the lighting.
+        let (i, v) = scene.own_transport(r, depth).unwrap();
+        let own = tree::<f64>(param, &i, v.iter().map(|&x| f64::from(x))).unwrap();
+        let (ti, tv) = product(&[&own, &light_tree]).unwrap().sparse_coefficients();
+        let maps: Vec<(Vec<u32>, Vec<f64>)> = (1..4)
+            .filter_map(|k| {
+                let (i, v) = scene.occlusion(k, r.point, depth, &mut scratch)?;
+                Some((i.to_vec(), v.to_vec()))
+            })
+            .collect();
+        seen[maps.len()] += 1;
+        if maps.len() < 2 {
+            continue;
+        }
+        // The formulation it replaces: the maps' product tree, then one dot with `T`.
+        let trees: Vec<HaarTree<f64, 3>> = maps
+            .iter()
+            .map(|(i, v)| tree(param, i, v.iter().copied()).unwrap())
+            .collect();
+        let refs: Vec<&HaarTree<f64, 3>> = trees.iter().collect();
+        let (pi, pv) = product(&refs).unwrap().sparse_coefficients();
+        let pv: Vec<f64> = pv.iter().map(|c| c[0]).collect();
+        let want = super::jrt::dot_dense(&mut dense, &ti, &tv, &pi, &pv);
+        let got = super::jrt::dot_product(param, &ti, &tv, &maps).unwrap();
+        // Without the last map the value moves (below): every map takes part.
+        let fewer = super::jrt::dot_product(param, &ti, &tv, &maps[..maps.len() - 1]).unwrap();
+        for c in 0..3 {
+            let scale = want[c].abs().max(1e-3);
+            assert!(
+                (got[c] - want[c]).abs() <= 1e-12 * scale,
+                "{got:?} {want:?}"
+            );
+            effect = effect.max((fewer[c] - want[c]).abs() / scale);
+        }
+    }
+    assert!(effect > 0.05, "dropping a map changes at most {effect}");
+    // Both traversals are exercised: two maps (the triple product) and three.
+    assert!(seen[2] >= 10 && seen[3] >= 10, "{seen:?}");
+    let want = scene.shade::<f64>(&light).unwrap();
+    assert!(relative(&jrt.frame_moved(&scene).unwrap(), &want) < 1e-9);
+}
