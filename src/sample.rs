@@ -43,20 +43,6 @@ pub trait Sample:
 
     /// Converts to f64 exactly.
     fn as_f64(self) -> f64;
-
-    /// Truncates toward zero to an `i32`, saturating (as `as i32` does), in the type's own
-    /// precision: an `f32` then converts in vector registers, where a trip through `f64`
-    /// would not.
-    ///
-    /// ```
-    /// use haarshift::Sample;
-    /// assert_eq!((7.9f32.truncate_i32(), (-2.5f64).truncate_i32()), (7, -2));
-    /// assert_eq!((f32::NAN.truncate_i32(), 1e20f64.truncate_i32()), (0, i32::MAX));
-    /// ```
-    #[inline(always)]
-    fn truncate_i32(self) -> i32 {
-        self.as_f64() as i32
-    }
 }
 
 impl Sample for f32 {
@@ -68,10 +54,6 @@ impl Sample for f32 {
     #[inline(always)]
     fn as_f64(self) -> f64 {
         self as f64
-    }
-    #[inline(always)]
-    fn truncate_i32(self) -> i32 {
-        self as i32
     }
 }
 

@@ -386,6 +386,7 @@ fn a_stale_or_damaged_field_file_fails_cleanly_naming_it_until_force_replaces_it
     // A fields directory that is a file.
     a[6] = p(&obj);
     fails_cleanly(&a, &["tetra.obj"]);
+}
 
 /// A box over a plane, alone (no field between objects), with `material` and a camera.
 fn glossy_box(dir: &Path, name: &str, material: &str) -> PathBuf {

@@ -412,8 +412,10 @@ impl<T: Sample> SourceGradient<T> {
     /// The linear interpolation of [`interpolate_zonal`](Self::interpolate_zonal): two taps,
     /// never across a pole (rows `0..=m` hold every `theta` in `[0, pi]`), in `T`. A chunk
     /// of targets at a time: first each target's row and weights, in a loop without lookups
-    /// that vectorises, then the lookups: each reads one span of two neighbouring rows
-    /// ([`ZonalProfile::spans`]) and takes three operations a value.
+    /// (it vectorises but for the saturating float-to-index conversion), then the lookups:
+    /// each reads one span of two neighbouring rows ([`ZonalProfile::spans`]) and takes three
+    /// operations a value. The AVX2 build does both for one channel of `f32` with vector
+    /// conversions and gathers ([`interpolate_f32_avx2`]).
     #[inline(always)]
     fn interpolate_zonal_linear<const CH: usize, A: Sample>(
         &self,
@@ -435,8 +437,7 @@ impl<T: Sample> SourceGradient<T> {
                 // theta is finite (atan2), so is y: the row is in 0..m and exact.
                 let r = y.floor().min(last).max(T::zero());
                 let (fy, alpha) = (y - r, T::from_f64(alpha.as_f64()));
-                // Through i32, which converts in vector registers (u32 does not).
-                *at = (r.truncate_i32() * ch as i32) as u32;
+                *at = r.as_f64() as u32 * ch as u32;
                 *w0 = alpha * (T::one() - fy);
                 *w1 = alpha * fy;
             }
@@ -1346,7 +1347,8 @@ pub fn set_mean_from_energy<T: Sample>(
     coeffs: &mut SphereCoefficients<T>,
     energy: &[f64],
 ) -> Result<()> {
-    set_mean(coeffs, energy, 0.0)
+    let solid = row_solid_angles(coeffs.height());
+    set_mean(coeffs, energy, 0.0, &solid)
 }
 
 /// Sets each channel's constant so that [`sampled_integral`] of the map equals that of
@@ -1364,11 +1366,9 @@ pub fn set_mean_from_sampled_integral<T: Sample>(
     coeffs: &mut SphereCoefficients<T>,
     samples: &LatLongMap<T>,
 ) -> Result<()> {
-    set_mean(
-        coeffs,
-        &sampled_integral(samples),
-        pole_weight(coeffs.height()),
-    )
+    let m = coeffs.height();
+    let target = sampled_integral(samples);
+    set_mean(coeffs, &target, pole_weight(m), &row_solid_angles(m))
 }
 
 /// The integral over the sphere of the function whose values at the texel centres the map
@@ -1416,12 +1416,19 @@ fn pole_weight(m: usize) -> f64 {
     delta * delta / 24.0
 }
 
+/// The solid angle `Omega_i` of a pixel in each row of an `m`-row map.
+fn row_solid_angles(m: usize) -> Vec<f64> {
+    (0..m).map(|i| pixel_solid_angle(m, i)).collect()
+}
+
 /// Sets each channel's constant so that `sum_ij X_ij Omega_i - pole 2 pi (N + S)` (see
-/// [`sampled_integral`]; `pole = 0`: the plain solid-angle integral) equals `target`.
+/// [`sampled_integral`]; `pole = 0`: the plain solid-angle integral) equals `target`, with
+/// `solid` the map's [`row_solid_angles`].
 fn set_mean<T: Sample>(
     coeffs: &mut SphereCoefficients<T>,
     target: &[f64],
     pole: f64,
+    solid: &[f64],
 ) -> Result<()> {
     let (ch, m, n) = coeffs.as_array().dim();
     if target.len() != ch {
@@ -1451,7 +1458,7 @@ fn set_mean<T: Sample>(
         let current: f64 = rows
             .iter()
             .enumerate()
-            .map(|(i, s)| pixel_solid_angle(m, i) * s)
+            .map(|(i, s)| solid[i] * s)
             .sum::<f64>()
             - w * (rows[0] + rows[m - 1]);
         // A constant c adds 4 pi c to the sum and 2 pi c to each pole mean.
@@ -1506,6 +1513,8 @@ pub struct Rotator<T> {
     grad: SourceGradient<T>,
     /// Per channel, what step 6 keeps: the solid-angle integral, or (cubic) the sampled one.
     integral: Vec<f64>,
+    /// [`row_solid_angles`] of the source's rows, which every rotation's step 6 weighs by.
+    solid: Vec<f64>,
 }
 
 impl<T: Sample> Rotator<T> {
@@ -1525,6 +1534,7 @@ impl<T: Sample> Rotator<T> {
                 Scheme::Linear => approx.energy(),
                 Scheme::Cubic => sampled_integral(approx),
             },
+            solid: row_solid_angles(m),
         })
     }
 
@@ -1563,7 +1573,7 @@ impl<T: Sample> Rotator<T> {
             Scheme::Linear => 0.0,
             Scheme::Cubic => pole_weight(self.grad.m),
         };
-        set_mean(&mut coeffs, &self.integral, pole)?;
+        set_mean(&mut coeffs, &self.integral, pole, &self.solid)?;
         Ok(coeffs)
     }
 }
