@@ -83,7 +83,7 @@
 //!   on a hemisphere or more, and so is its profile past some row. A target whose pre-image
 //!   lies there (`cos Theta` beyond a bound with the taps' reach as margin) would read only
 //!   zeros: whole rows (`q_y` swings within `a -+ sqrt(b^2 + c^2)` along a row) and chunks of
-//!   16 targets are written as zeros without their angles (exactly the computed values,
+//!   32 targets are written as zeros without their angles (exactly the computed values,
 //!   tested).
 //! * **Two fields, not three.** `C` is read off `V` and `U` (step 5), so each level filters
 //!   two fields and stores no diagonal one.
@@ -92,11 +92,13 @@
 //! the same taps and weights as the turned map's own fields, at no cost. Measured
 //! (`cargo bench --bench sphere -- lobe_one_channel`, 64 x 128 `f32`, one channel, one run,
 //! `results/sphere/lobe_one_channel.txt`):
-//! a prepared rotation 0.14 ms (`haar`) and 0.35 ms (`haar-cubic`), against 0.44 ms for
-//! writing the analytic lobe; steps 4-6 alone (`pyramid_of_fields`) 15 us, channel by
-//! channel so that the column pairs are `[T; 2]` chunks. The target of 100 us for one
-//! rotation from the finest level is not reached; from the thesis's level 4 (16 x 32
-//! working grid) a rotation costs 12 us.
+//! a prepared rotation 95 us (`haar`; 92 us in a run of that entry alone) and 0.25 ms
+//! (`haar-cubic`), against 0.41 ms for writing the analytic lobe; steps 4-6 alone
+//! (`pyramid_of_fields`) 15 us, channel by channel so that the column pairs are `[T; 2]`
+//! chunks. The Phong lobe is zero on a hemisphere: skipping its zero region took a rotation
+//! from 1.03 M to 0.81 M instructions (cachegrind), the gathered taps to 0.60 M; a lobe with
+//! no zero region pays for every target. From the thesis's level 4 (16 x 32 working grid) a
+//! rotation costs 12 us.
 //!
 //! # Accuracy
 //!
@@ -811,8 +813,8 @@ impl<G: Sample> ZonalRow<G> {
     }
 }
 
-/// Targets of a zonal row computed together: one AVX2 vector of `f32` twice over.
-const ZONAL_CHUNK: usize = 16;
+/// Targets of a zonal row computed together: four AVX2 vectors of `f32` (16 and 64 measured slower).
+const ZONAL_CHUNK: usize = 32;
 
 /// [`SourceGradient::interpolate_zonal`] of one channel of `f32` by the linear scheme, for
 /// one chunk: the rows, weights and two taps of eight targets at a time, the taps gathered

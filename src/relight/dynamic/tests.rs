@@ -168,21 +168,30 @@ fn moving_an_object_beyond_its_field_renders_as_removing_it() {
     assert!(relative(&first(&jrt.frame_moved(&scene).unwrap()), &want) < 1e-12);
 }
 
-#[test]
-fn just_in_time_transfer_equals_the_full_product_integral_with_unpruned_factors() {
-    let mut scene = build(THREE);
-    let light = lighting(0.4);
-    for moving in 0..3 {
-        let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(moving)).unwrap();
+/// Moves each object of `scene` in turn (translated and scaled) after forming JRT for it:
+/// every frame must equal the full product integrals to 1e-9 relative.
+pub(super) fn each_moved_object_is_the_full_product_integral(
+    scene: &mut DynamicScene,
+    light: &Lighting,
+) {
+    for moving in 0..scene.object_count() {
+        let jrt = Jrt::<f64>::form(scene, light, Change::Object(moving)).unwrap();
         let mut p = scene.placement(moving);
         p.translate[0] += 0.35;
         p.translate[2] -= 0.2;
         p.scale *= 1.1;
         scene.place(moving, p).unwrap();
-        let want = scene.shade::<f64>(&light).unwrap();
-        let got = jrt.frame_moved(&scene).unwrap();
-        assert!(relative(&got, &want) < 1e-9, "object {moving}");
+        let want = scene.shade::<f64>(light).unwrap();
+        let err = relative(&jrt.frame_moved(scene).unwrap(), &want);
+        assert!(err < 1e-9, "object {moving}: {err:e}");
     }
+}
+
+#[test]
+fn just_in_time_transfer_equals_the_full_product_integral_with_unpruned_factors() {
+    let mut scene = build(THREE);
+    let light = lighting(0.4);
+    each_moved_object_is_the_full_product_integral(&mut scene, &light);
     let jrt = Jrt::<f64>::form(&scene, &light, Change::Lighting).unwrap();
     let turned = lighting(2.5);
     let want = scene.shade::<f64>(&turned).unwrap();

@@ -1,4 +1,7 @@
-use super::super::tests::{THREE, build, lighting, options, param, relative, scene_file};
+use super::super::tests::{
+    THREE, build, each_moved_object_is_the_full_product_integral, lighting, options, param,
+    relative, scene_file,
+};
 use super::*;
 use crate::relight::glossy::GlossyShader;
 use crate::relight::orient::BrdfRotation;
@@ -152,17 +155,7 @@ fn a_change_of_view_equals_the_full_product_integral() {
 fn moving_objects_and_lighting_hold_the_brdf_in_the_fixed_product() {
     let mut scene = build(&three([PHONG, BLINN, LAMBERT]));
     let light = lighting(0.4);
-    for moving in 0..3 {
-        let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(moving)).unwrap();
-        let mut p = scene.placement(moving);
-        p.translate[0] += 0.35;
-        p.translate[2] -= 0.2;
-        p.scale *= 1.1;
-        scene.place(moving, p).unwrap();
-        let want = scene.shade::<f64>(&light).unwrap();
-        let err = relative(&jrt.frame_moved(&scene).unwrap(), &want);
-        assert!(err < 1e-9, "object {moving}: {err:e}");
-    }
+    each_moved_object_is_the_full_product_integral(&mut scene, &light);
     let jrt = Jrt::<f64>::form(&scene, &light, Change::Lighting).unwrap();
     let turned = lighting(2.5);
     let want = scene.shade::<f64>(&turned).unwrap();
