@@ -832,7 +832,7 @@ fn interpolate_f32_avx2(
     use std::arch::x86_64::*;
     let m = spans.len() / 2;
     // Every row index is in 0..m, so every gathered index (2 row + 0 or 1) is in spans.
-    assert!(m >= 1 && m < 1 << 24, "a profile of {m} rows");
+    assert!((1..1 << 24).contains(&m), "a profile of {m} rows");
     let (last, zero, one) = (
         _mm256_set1_ps((m - 1) as f32),
         _mm256_setzero_ps(),

@@ -11,6 +11,9 @@ use super::*;
 use crate::relight::brdf::MAX_EXPONENT;
 use crate::relight::orient::Frame;
 
+/// Sparse RGB coefficients: ascending indices and their values.
+type SparseRgb = (Vec<u32>, Vec<[f64; 3]>);
+
 impl DynamicScene {
     /// Object `k`'s BRDF (its material's, or what [`set_brdf`](Self::set_brdf) gave it).
     ///
@@ -295,11 +298,7 @@ impl DynamicScene {
     }
 
     /// Receiver `r`'s BRDF factor as sparse RGB coefficients, ascending (`None`: Lambertian).
-    pub(super) fn brdf_sparse(
-        &self,
-        r: &Receiver,
-        depth: usize,
-    ) -> Result<Option<(Vec<u32>, Vec<[f64; 3]>)>> {
+    pub(super) fn brdf_sparse(&self, r: &Receiver, depth: usize) -> Result<Option<SparseRgb>> {
         Ok(self
             .brdf_coefficients(r, depth)?
             .map(|(c, depth)| light_sparse::<f64>(&c, depth)))
