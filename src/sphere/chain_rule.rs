@@ -92,13 +92,11 @@
 //! the same taps and weights as the turned map's own fields, at no cost. Measured
 //! (`cargo bench --bench sphere -- lobe_one_channel`, 64 x 128 `f32`, one channel, one run,
 //! `results/sphere/lobe_one_channel.txt`):
-//! a prepared rotation 95 us (`haar`; 92 us in a run of that entry alone) and 0.25 ms
-//! (`haar-cubic`), against 0.41 ms for writing the analytic lobe; steps 4-6 alone
-//! (`pyramid_of_fields`) 15 us, channel by channel so that the column pairs are `[T; 2]`
-//! chunks. The Phong lobe is zero on a hemisphere: skipping its zero region took a rotation
-//! from 1.03 M to 0.81 M instructions (cachegrind), the gathered taps to 0.60 M; a lobe with
-//! no zero region pays for every target. From the thesis's level 4 (16 x 32 working grid) a
-//! rotation costs 12 us.
+//! a prepared rotation 95 us (`haar`) and 0.25 ms (`haar-cubic`), against 0.41 ms for writing
+//! the analytic lobe; steps 4-6 alone (`pyramid_of_fields`) 15 us, channel by channel so that
+//! the column pairs are `[T; 2]` chunks. The Phong lobe is zero on a hemisphere, whose targets
+//! are skipped; a lobe with no zero region pays for every target. From the thesis's level 4
+//! (16 x 32 working grid) a rotation costs 12 us.
 //!
 //! # Accuracy
 //!
@@ -813,7 +811,7 @@ impl<G: Sample> ZonalRow<G> {
     }
 }
 
-/// Targets of a zonal row computed together: four AVX2 vectors of `f32` (16 and 64 measured slower).
+/// Targets of a zonal row computed together: four AVX2 vectors of `f32`.
 const ZONAL_CHUNK: usize = 32;
 
 /// [`SourceGradient::interpolate_zonal`] of one channel of `f32` by the linear scheme, for
