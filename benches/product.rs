@@ -7,7 +7,9 @@
 //! Groups: `targets` (the speed targets, f32, one channel and RGB) and `scaling`
 //! (N = 3..6 functions; cube S = 32..256 and lat-long H = 64..256; 1 %..100 % kept: tree vs
 //! pixel domain vs pairwise), each benchmark short (10 samples, 0.5 s) so that the whole table
-//! runs in minutes. One core: run with `RAYON_NUM_THREADS=1`; `python3
+//! runs in minutes; and `vertex` (a dynamic scene's per-vertex products, from sparse
+//! coefficients: the quadtree product against the texel product, lat-long 32 to cube 64).
+//! One core: run with `RAYON_NUM_THREADS=1`; `python3
 //! benches/product_table.py --run-cargo` runs it and writes the tables under
 //! `results/product/`.
 
@@ -15,6 +17,8 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use haarshift::product::baseline::{pairwise_integral, pixel_integral, pixel_integral_of_trees};
+use haarshift::product::multiply::product;
+use haarshift::product::texel::TexelProduct;
 use haarshift::product::triple::{
     DenseFaces, DenseTransport, dense_triple_integral, triple_integral,
 };
@@ -272,5 +276,106 @@ fn scaling(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, targets, scaling);
+/// A sparse function's coefficients: the largest `keep` of `pixels` (one channel).
+fn sparse_of(pixels: &Array4<f64>, layout: FaceLayout, keep: usize) -> (Vec<u32>, Vec<f32>) {
+    let tree =
+        HaarTree::<f32, 1>::from_pixels(to32(pixels).view(), layout, Selection::Largest(keep))
+            .expect("tree");
+    let (i, v) = tree.sparse_coefficients();
+    (i, v.into_iter().map(|[x]| x).collect())
+}
+
+/// Per vertex of a dynamic scene (`relight::dynamic::Jrt`), from sparse coefficients: the
+/// fixed product of its transport (70 kept), two occlusion maps (200 each) and the lighting
+/// (200, RGB), and a frame's `<T, O_a O_b>`; by quadtrees (`from_sparse`, `product`,
+/// `triple_integral`) and by texels ([`TexelProduct`]).
+fn vertex(c: &mut Criterion) {
+    let bunny = bunny();
+    for p in [
+        param(ParamKind::LatLong, 32),
+        param(ParamKind::Cube, 32),
+        param(ParamKind::Cube, 64),
+    ] {
+        let (faces, s) = (p.faces(), p.face_size());
+        let layout = match p.kind() {
+            ParamKind::LatLong => FaceLayout::SideBySide,
+            ParamKind::Cube => FaceLayout::Stacked,
+        };
+        let weights = p.solid_angles();
+        let transport = visibility(&bunny, 100, p) * &weights.insert_axis(Axis(3));
+        let own = sparse_of(&transport, layout, 70);
+        let maps = [
+            sparse_of(&visibility(&bunny, 400, p), layout, 200),
+            sparse_of(&visibility(&bunny, 700, p), layout, 200),
+        ];
+        let light = HaarTree::<f32, 3>::from_pixels(
+            to32(&envmap(p, 3)).view(),
+            layout,
+            Selection::Largest(200),
+        )
+        .expect("tree");
+        let (li, lv) = light.sparse_coefficients();
+        let widen = |(i, v): &(Vec<u32>, Vec<f32>)| -> HaarTree<f32, 3> {
+            let v: Vec<[f32; 3]> = v.iter().map(|&x| [x; 3]).collect();
+            HaarTree::from_sparse(faces, s, layout, i, &v).expect("tree")
+        };
+        let mut group = c.benchmark_group(format!("vertex_{}{s}", p.kind()));
+        group.sample_size(20);
+        group.warm_up_time(Duration::from_millis(300));
+        group.measurement_time(Duration::from_secs(1));
+        group.bench_function("fixed_product/tree", |b| {
+            b.iter(|| {
+                let light = HaarTree::from_sparse(faces, s, layout, &li, &lv).expect("tree");
+                let trees = [widen(&own), widen(&maps[0]), widen(&maps[1])];
+                product(&[&trees[0], &trees[1], &trees[2], &light])
+                    .expect("ok")
+                    .sparse_coefficients()
+            })
+        });
+        let mut shared = TexelProduct::<f32>::new(faces, s).expect("faces");
+        shared.multiply(&li, &lv).expect("ok");
+        let mut texels = TexelProduct::<f32>::new(faces, s).expect("faces");
+        let (mut ti, mut tv) = (Vec::new(), Vec::new());
+        let mut fixed = |ti: &mut Vec<u32>, tv: &mut Vec<[f32; 3]>| {
+            texels.reset();
+            for (i, v) in [&own, &maps[0], &maps[1]] {
+                texels.multiply(i, v).expect("ok");
+            }
+            texels.multiply_by(&shared).expect("ok");
+            texels.sparse_coefficients(ti, tv);
+        };
+        group.bench_function("fixed_product/texel", |b| {
+            b.iter(|| fixed(&mut ti, &mut tv))
+        });
+        // The fixed product a frame dots with (the same for both methods).
+        fixed(&mut ti, &mut tv);
+        // The transport of T's own tree (weights folded in: ones), built per vertex as
+        // `Jrt` builds it; the bench builds it once and times `from_sparse` in its stead.
+        let t_pixels = HaarTree::from_sparse(faces, s, layout, &ti, &tv)
+            .expect("tree")
+            .to_pixels()
+            .expect("ok");
+        let ones = ndarray::Array3::<f32>::ones((faces, s, s));
+        let weighted = WeightedPixels::new(t_pixels.view(), ones.view()).expect("ok");
+        let t = Transport::new(&weighted, layout, Selection::All).expect("transport");
+        group.bench_function("moving_dot/tree", |b| {
+            b.iter(|| {
+                black_box(HaarTree::from_sparse(faces, s, layout, &ti, &tv).expect("tree"));
+                triple_integral(&t, &widen(&maps[0]), &widen(&maps[1])).expect("ok")
+            })
+        });
+        group.bench_function("moving_dot/texel", |b| {
+            b.iter(|| {
+                texels.reset();
+                for (i, v) in &maps {
+                    texels.multiply(i, v).expect("ok");
+                }
+                texels.dot(&ti, &tv).expect("ok")
+            })
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, targets, scaling, vertex);
 criterion_main!(benches);

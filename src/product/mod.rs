@@ -14,6 +14,7 @@
 //! | [`tree`] | [`HaarTree`], the flat sparse quadtree with parent sums |
 //! | [`transport`] | [`Transport`], the one factor that carries the weight |
 //! | [`integral`] | [`product_integral`], the `N`-function tree traversal, depth limit |
+//! | [`texel`] | [`TexelProduct`](texel::TexelProduct): the product of sparse factors through texels |
 //! | [`triple`] | the `N = 3` fast paths: sparse on trees, dense `O(M)` |
 //! | [`multiply`] | the product of `N` functions as a tree (reuse of fixed factors) |
 //! | [`baseline`] | pixel domain (from pixel maps, or with inverse transforms) and pairwise products |
@@ -75,6 +76,7 @@ pub mod coefficient;
 pub mod integral;
 pub mod multiply;
 pub mod selection;
+pub mod texel;
 pub mod transport;
 pub mod tree;
 pub mod triple;

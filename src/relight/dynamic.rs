@@ -1036,6 +1036,7 @@ fn radiance<T: Sample>(integrals: &[[T; 3]], reflectance: &Array2<f64>) -> Array
 
 mod glossy;
 mod jrt;
+mod products;
 pub use jrt::{Change, Jrt, JrtReport};
 
 #[cfg(test)]

@@ -135,6 +135,9 @@ enum ApproxTarget<'a, T> {
     Output,
 }
 
+/// A row of the top half of a level's output and its partner in the bottom half.
+type RowPair<'a, T> = (&'a mut [T], &'a mut [T]);
+
 /// Analysis of the `h x w` approximation `cur` (row stride `cur_stride`) into `out` (row
 /// stride `out_stride`): `a`, `b`, `c` into their bands, the approximation into `target`.
 fn analysis_step<T: Sample>(
@@ -148,34 +151,58 @@ fn analysis_step<T: Sample>(
 ) {
     let (hh, hw) = (h / 2, w / 2);
     let (top, bottom) = out[..h * out_stride].split_at_mut(hh * out_stride);
-    let min_len = (MIN_VALUES_PER_TASK / w).max(1);
-    let rows = top
-        .par_chunks_mut(out_stride)
-        .zip(bottom.par_chunks_mut(out_stride))
-        .with_min_len(min_len);
     let pair = move |r: usize| {
         (
             &cur[2 * r * cur_stride..][..w],
             &cur[(2 * r + 1) * cur_stride..][..w],
         )
     };
+    // A level that would be one task anyway runs here: rayon's bridge costs more than a
+    // small level's work (per-vertex products transform thousands of 32 x 32 faces).
+    let serial = h * w <= MIN_VALUES_PER_TASK;
     match target {
         ApproxTarget::Buffer(buf) => {
-            rows.zip(buf[..hh * hw].par_chunks_mut(hw))
-                .enumerate()
-                .for_each(|(r, ((t, b), approx))| {
-                    let (r0, r1) = pair(r);
-                    let (b_row, c_row) = b[..w].split_at_mut(hw);
-                    analyse_rows(r0, r1, approx, &mut t[hw..w], b_row, c_row, f2);
-                });
+            let row = |(r, ((t, b), approx)): (usize, (RowPair<'_, T>, &mut [T]))| {
+                let (r0, r1) = pair(r);
+                let (b_row, c_row) = b[..w].split_at_mut(hw);
+                analyse_rows(r0, r1, approx, &mut t[hw..w], b_row, c_row, f2);
+            };
+            let buf = &mut buf[..hh * hw];
+            if serial {
+                let rows = top
+                    .chunks_mut(out_stride)
+                    .zip(bottom.chunks_mut(out_stride));
+                rows.zip(buf.chunks_mut(hw)).enumerate().for_each(row);
+            } else {
+                let rows = top
+                    .par_chunks_mut(out_stride)
+                    .zip(bottom.par_chunks_mut(out_stride));
+                let min_len = (MIN_VALUES_PER_TASK / w).max(1);
+                rows.zip(buf.par_chunks_mut(hw))
+                    .with_min_len(min_len)
+                    .enumerate()
+                    .for_each(row);
+            }
         }
         ApproxTarget::Output => {
-            rows.enumerate().for_each(|(r, (t, b))| {
+            let row = |(r, (t, b)): (usize, RowPair<'_, T>)| {
                 let (r0, r1) = pair(r);
                 let (approx, a_row) = t[..w].split_at_mut(hw);
                 let (b_row, c_row) = b[..w].split_at_mut(hw);
                 analyse_rows(r0, r1, approx, a_row, b_row, c_row, f2);
-            });
+            };
+            if serial {
+                let rows = top
+                    .chunks_mut(out_stride)
+                    .zip(bottom.chunks_mut(out_stride));
+                rows.enumerate().for_each(row);
+            } else {
+                let rows = top
+                    .par_chunks_mut(out_stride)
+                    .zip(bottom.par_chunks_mut(out_stride));
+                let min_len = (MIN_VALUES_PER_TASK / w).max(1);
+                rows.with_min_len(min_len).enumerate().for_each(row);
+            }
         }
     }
 }
@@ -204,24 +231,30 @@ fn synthesis_step<T: Sample>(
     dst_stride: usize,
     g2: T,
 ) {
-    let min_len = (MIN_VALUES_PER_TASK / (4 * w)).max(1);
-    dst[..2 * h * dst_stride]
-        .par_chunks_mut(2 * dst_stride)
-        .with_min_len(min_len)
-        .enumerate()
-        .for_each(|(r, rows)| {
-            let (r0, r1) = rows.split_at_mut(dst_stride);
-            let (b, c) = coeffs.row(h + r, 0, 2 * w).split_at(w);
-            synthesise_rows(
-                cur.row(r, 0, w),
-                coeffs.row(r, w, w),
-                b,
-                c,
-                &mut r0[..2 * w],
-                &mut r1[..2 * w],
-                g2,
-            );
-        });
+    let row = |(r, rows): (usize, &mut [T])| {
+        let (r0, r1) = rows.split_at_mut(dst_stride);
+        let (b, c) = coeffs.row(h + r, 0, 2 * w).split_at(w);
+        synthesise_rows(
+            cur.row(r, 0, w),
+            coeffs.row(r, w, w),
+            b,
+            c,
+            &mut r0[..2 * w],
+            &mut r1[..2 * w],
+            g2,
+        );
+    };
+    let dst = &mut dst[..2 * h * dst_stride];
+    // As in analysis: a level that would be one task runs here.
+    if 4 * h * w <= MIN_VALUES_PER_TASK {
+        dst.chunks_mut(2 * dst_stride).enumerate().for_each(row);
+    } else {
+        let min_len = (MIN_VALUES_PER_TASK / (4 * w)).max(1);
+        dst.par_chunks_mut(2 * dst_stride)
+            .with_min_len(min_len)
+            .enumerate()
+            .for_each(row);
+    }
 }
 
 /// Splits `work` into the two ping-pong approximation buffers for an `h x w` transform.

@@ -2,8 +2,9 @@
 //! `T` of the factors that stay fixed while one varies, formed once ([`Jrt::form`]); a frame is
 //! then one sparse dot product per vertex with the varying factor.
 
+use super::products::{Method, SharedFactor, Use, VertexProduct};
 use super::*;
-use crate::product::triple::triple_integral;
+use crate::product::texel::FactorValue;
 
 /// What just-in-time radiance transfer holds fixed and what varies between frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -93,33 +94,37 @@ impl<T: Sample> Jrt<T> {
             Change::Lighting | Change::View => None,
         };
         let param = scene.param();
-        let light = light_tree::<T>(lighting, depth)?;
+        let method = Method::for_param(param, Use::Fixed);
+        let (li, lv) = light_sparse::<T>(lighting, depth);
+        let light = SharedFactor::new(param, method, &li, &lv)?;
+        let one = VertexProduct::new(param, method)?;
         let receivers = scene.receivers();
         let keep = scene.options.keep_product;
         let rows: Vec<(Vec<u32>, Vec<[T; 3]>)> = receivers
             .par_iter()
             .map_init(
-                || (Scratch::new(param), Vec::new()),
-                |(scratch, pool), r| -> Result<_> {
+                || (Scratch::new(param), Vec::new(), one.clone()),
+                |(scratch, pool, fixed), r| -> Result<_> {
+                    fixed.reset();
                     let (i, v) = scene.own_transport(r, depth)?;
-                    let mut factors = vec![tree::<T>(param, &i, v.iter().map(|&x| f64::from(x)))?];
+                    fixed.multiply(&i, &v)?;
                     let fixed_occluders = (0..scene.objects.len())
                         .filter(|&k| Some(k) != r.owner && Some(k) != moving)
                         .filter(|_| moving.is_none() || r.owner != moving);
                     for k in fixed_occluders {
                         if let Some((i, v)) = scene.occlusion(k, r.point, depth, scratch) {
-                            factors.push(tree(param, i, v.iter().copied())?);
+                            fixed.multiply(i, v)?;
                         }
                     }
                     // The BRDF is fixed unless the view of it varies.
-                    if change != Change::View && (moving.is_none() || r.owner != moving) {
-                        factors.extend(scene.brdf_tree(r, depth)?);
+                    if change != Change::View
+                        && (moving.is_none() || r.owner != moving)
+                        && let Some((i, v)) = scene.brdf_sparse(r, depth)?
+                    {
+                        fixed.multiply(&i, &v)?;
                     }
-                    let mut refs: Vec<&HaarTree<T, 3>> = factors.iter().collect();
-                    if change != Change::Lighting {
-                        refs.push(&light);
-                    }
-                    let (indices, values) = product(&refs)?.sparse_coefficients();
+                    let shared = (change != Change::Lighting).then_some(&light);
+                    let (indices, values) = fixed.coefficients(shared)?;
                     Ok(prune(param, keep, indices, values, pool))
                 },
             )
@@ -159,15 +164,16 @@ impl<T: Sample> Jrt<T> {
         let depth = scene.options.check()?;
         let param = scene.param();
         let receivers = scene.receivers();
+        let one = VertexProduct::new(param, Method::for_param(param, Use::Frame))?;
         let rows: Vec<[T; 3]> = receivers
             .par_iter()
             .enumerate()
             .map_init(
                 || {
                     let dense = vec![[T::zero(); 3]; param.texels()];
-                    (Scratch::new(param), dense, Vec::new())
+                    (Scratch::new(param), dense, Vec::new(), one.clone())
                 },
-                |(scratch, dense, held), (v, r)| -> Result<[T; 3]> {
+                |(scratch, dense, held, varying), (v, r)| -> Result<[T; 3]> {
                     let (ti, tv) = self.products.row(v);
                     if r.owner != Some(moving) {
                         // The one varying factor: a dot product with the moving object's map;
@@ -186,13 +192,10 @@ impl<T: Sample> Jrt<T> {
                             Some((fi, fv)) => dot_dense(dense, ti, tv, fi, fv),
                         });
                     }
-                    if let Some(value) =
-                        moving_glossy(scene, r, moving, depth, scratch, dense, ti, tv)?
-                    {
-                        return Ok(value);
-                    }
-                    // A vertex of the moving object: every other object's map varies. Each
-                    // map found is swapped out of the scratch (no copy) for the product integral.
+                    // A vertex of the moving object: every other object's map varies, and so
+                    // does a glossy vertex's BRDF (its view moves with it). Each map found is
+                    // swapped out of the scratch (no copy).
+                    let brdf = scene.brdf_sparse(r, depth)?;
                     let mut found = 0;
                     for k in (0..scene.objects.len()).filter(|&k| k != moving) {
                         if scene.occlusion(k, r.point, depth, scratch).is_some() {
@@ -203,10 +206,20 @@ impl<T: Sample> Jrt<T> {
                             found += 1;
                         }
                     }
-                    Ok(match &held[..found] {
-                        [] => dot_one(param, ti, tv),
-                        [(fi, fv)] => dot_dense(dense, ti, tv, fi, fv),
-                        maps => dot_product(param, ti, tv, maps)?,
+                    Ok(match (&held[..found], &brdf) {
+                        ([], None) => dot_one(param, ti, tv),
+                        ([(fi, fv)], None) => dot_dense(dense, ti, tv, fi, fv),
+                        ([], Some((bi, bv))) => dot_dense(dense, ti, tv, bi, bv),
+                        (maps, brdf) => {
+                            varying.reset();
+                            for (fi, fv) in maps {
+                                varying.multiply(fi, fv)?;
+                            }
+                            if let Some((bi, bv)) = brdf {
+                                varying.multiply(bi, bv)?;
+                            }
+                            varying.dot(ti, tv)?
+                        }
                     })
                 },
             )
@@ -421,26 +434,9 @@ fn dot_blend<T: Sample>(
     })
 }
 
-/// A sparse factor's value: one channel for every colour, or RGB.
-pub(super) trait Channels: Copy {
-    fn channel(self, c: usize) -> f64;
-}
-
-impl Channels for f64 {
-    fn channel(self, _: usize) -> f64 {
-        self
-    }
-}
-
-impl Channels for [f64; 3] {
-    fn channel(self, c: usize) -> f64 {
-        self[c]
-    }
-}
-
 /// `<T, F>` for a sparse `T` and a sparse `F` (one channel or RGB), through a dense copy of
 /// `T` (`dense` is all zeros and is left so).
-pub(super) fn dot_dense<T: Sample, F: Channels>(
+pub(super) fn dot_dense<T: Sample, F: FactorValue>(
     dense: &mut [[T; 3]],
     ti: &[u32],
     tv: &[[T; 3]],
@@ -452,7 +448,7 @@ pub(super) fn dot_dense<T: Sample, F: Channels>(
         for (&i, &f) in fi.iter().zip(fv) {
             let t = dense[i as usize];
             for c in 0..3 {
-                acc[c] += t[c].as_f64() * f.channel(c);
+                acc[c] += t[c].as_f64() * f.channel(c % F::CHANNELS);
             }
         }
         acc.map(T::from_f64)
@@ -475,63 +471,4 @@ fn with_dense<T: Sample, R>(
         dense[i as usize] = [T::zero(); 3];
     }
     out
-}
-
-/// `<T, prod_k M_k>` for two or more one-channel sparse maps `M_k`: the product integral of
-/// `T` as the transport (it carries the weight) and the maps, by the triple traversal for two
-/// (seed 002's three cases), the `n`-function one for more. Nothing of the maps' product is
-/// formed: the traversals visit only nodes where two or more functions have nodes.
-pub(super) fn dot_product<T: Sample>(
-    param: Parameterization,
-    ti: &[u32],
-    tv: &[[T; 3]],
-    maps: &[(Vec<u32>, Vec<f64>)],
-) -> Result<[T; 3]> {
-    let own = HaarTree::from_sparse(param.faces(), param.face_size(), layout(param), ti, tv)?;
-    let transport = Transport::from_weighted_tree(own);
-    let trees = maps
-        .iter()
-        .map(|(i, v)| tree::<T>(param, i, v.iter().copied()))
-        .collect::<Result<Vec<_>>>()?;
-    let value = match &trees[..] {
-        [a, b] => triple_integral(&transport, a, b)?.value,
-        _ => {
-            let refs: Vec<&HaarTree<T, 3>> = trees.iter().collect();
-            product_integral(&transport, &refs, IntegralOptions::default())?.value
-        }
-    };
-    Ok(value.map(T::from_f64))
-}
-
-/// A glossy vertex of the moving object: its view moves with it, so its fixed product holds
-/// its transport and the lighting only and the varying factor is every other object's map
-/// times its BRDF re-oriented where it now is: that product's tree, then the dot. `None`: the
-/// vertex is not glossy (or not the moving object's).
-#[allow(clippy::too_many_arguments)]
-fn moving_glossy<T: Sample>(
-    scene: &DynamicScene,
-    r: &Receiver,
-    moving: usize,
-    depth: usize,
-    scratch: &mut Scratch,
-    dense: &mut [[T; 3]],
-    ti: &[u32],
-    tv: &[[T; 3]],
-) -> Result<Option<[T; 3]>> {
-    if r.owner != Some(moving) {
-        return Ok(None);
-    }
-    let Some(brdf) = scene.brdf_tree::<f64>(r, depth)? else {
-        return Ok(None);
-    };
-    let param = scene.param();
-    let mut trees = vec![brdf];
-    for k in (0..scene.objects.len()).filter(|&k| k != moving) {
-        if let Some((fi, fv)) = scene.occlusion(k, r.point, depth, scratch) {
-            trees.push(tree::<f64>(param, fi, fv.iter().copied())?);
-        }
-    }
-    let refs: Vec<&HaarTree<f64, 3>> = trees.iter().collect();
-    let (fi, fv) = product(&refs)?.sparse_coefficients();
-    Ok(Some(dot_dense(dense, ti, tv, &fi, &fv)))
 }

@@ -340,7 +340,8 @@ const FOUR: &str = r#"{"objects": [
   ], "ground_plane": true}"#;
 
 #[test]
-fn a_moving_objects_product_integral_of_several_maps_equals_their_product_tree_dotted() {
+fn both_ways_of_a_vertex_product_give_the_quadtree_product() {
+    use super::products::{Method, SharedFactor, VertexProduct};
     let mut scene = build(FOUR);
     let light = lighting(0.4);
     let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(0)).unwrap();
@@ -348,17 +349,38 @@ fn a_moving_objects_product_integral_of_several_maps_equals_their_product_tree_d
     p.translate = [0.3, 0.1, 0.2];
     scene.place(0, p).unwrap();
     let (param, depth) = (param(), 3);
+    let (li, lv) = light_sparse::<f64>(&light, depth);
     let light_tree = light_tree::<f64>(&light, depth).unwrap();
     let mut scratch = Scratch::new(param);
     let mut dense = vec![[0.0f64; 3]; param.texels()];
-    let receivers = scene.receivers();
+    let methods = [Method::Texels, Method::Trees];
+    let mut products = methods.map(|m| VertexProduct::<f64>::new(param, m).unwrap());
+    let shared = methods.map(|m| SharedFactor::new(param, m, &li, &lv).unwrap());
     let mut seen = [0usize; 4];
     let mut effect = 0.0f64;
-    for r in receivers.iter().filter(|r| r.owner == Some(0)) {
-        // A moving vertex's fixed product: its own transport times the lighting.
+    let close = |got: [f64; 3], want: [f64; 3]| {
+        (0..3).all(|c| (got[c] - want[c]).abs() <= 1e-12 * want[c].abs().max(1e-3))
+    };
+    for r in scene.receivers().iter().filter(|r| r.owner == Some(0)) {
+        // A moving vertex's fixed product: its own transport times the lighting, both ways.
         let (i, v) = scene.own_transport(r, depth).unwrap();
         let own = tree::<f64>(param, &i, v.iter().map(|&x| f64::from(x))).unwrap();
         let (ti, tv) = product(&[&own, &light_tree]).unwrap().sparse_coefficients();
+        let want_t =
+            HaarTree::from_sparse(param.faces(), param.face_size(), layout(param), &ti, &tv)
+                .unwrap()
+                .to_coefficients();
+        for (vp, sh) in products.iter_mut().zip(&shared) {
+            vp.reset();
+            vp.multiply(&i, &v).unwrap();
+            let (gi, gv) = vp.coefficients(Some(sh)).unwrap();
+            let got =
+                HaarTree::from_sparse(param.faces(), param.face_size(), layout(param), &gi, &gv)
+                    .unwrap()
+                    .to_coefficients();
+            let err = (&got - &want_t).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(err < 1e-12, "{err:e}");
+        }
         let maps: Vec<(Vec<u32>, Vec<f64>)> = (1..4)
             .filter_map(|k| {
                 let (i, v) = scene.occlusion(k, r.point, depth, &mut scratch)?;
@@ -369,7 +391,7 @@ fn a_moving_objects_product_integral_of_several_maps_equals_their_product_tree_d
         if maps.len() < 2 {
             continue;
         }
-        // The formulation it replaces: the maps' product tree, then one dot with `T`.
+        // The oracle: the maps' product tree, then one dot with `T`.
         let trees: Vec<HaarTree<f64, 3>> = maps
             .iter()
             .map(|(i, v)| tree(param, i, v.iter().copied()).unwrap())
@@ -378,20 +400,28 @@ fn a_moving_objects_product_integral_of_several_maps_equals_their_product_tree_d
         let (pi, pv) = product(&refs).unwrap().sparse_coefficients();
         let pv: Vec<f64> = pv.iter().map(|c| c[0]).collect();
         let want = super::jrt::dot_dense(&mut dense, &ti, &tv, &pi, &pv);
-        let got = super::jrt::dot_product(param, &ti, &tv, &maps).unwrap();
-        // Without the last map the value moves (below): every map takes part.
-        let fewer = super::jrt::dot_product(param, &ti, &tv, &maps[..maps.len() - 1]).unwrap();
-        for c in 0..3 {
-            let scale = want[c].abs().max(1e-3);
-            assert!(
-                (got[c] - want[c]).abs() <= 1e-12 * scale,
-                "{got:?} {want:?}"
+        for vp in &mut products {
+            let mut dot = |maps: &[(Vec<u32>, Vec<f64>)]| {
+                vp.reset();
+                for (i, v) in maps {
+                    vp.multiply(i, v).unwrap();
+                }
+                vp.dot(&ti, &tv).unwrap()
+            };
+            let got = dot(&maps);
+            assert!(close(got, want), "{got:?} {want:?}");
+            // Without the last map the value moves (below): every map takes part.
+            let fewer = dot(&maps[..maps.len() - 1]);
+            effect = effect.max(
+                (0..3)
+                    .map(|c| (fewer[c] - want[c]).abs() / want[c].abs().max(1e-3))
+                    .fold(0.0, f64::max),
             );
-            effect = effect.max((fewer[c] - want[c]).abs() / scale);
         }
     }
     assert!(effect > 0.05, "dropping a map changes at most {effect}");
-    // Both traversals are exercised: two maps (the triple product) and three.
+    // Both traversals of the quadtree way are exercised: two maps (the triple product) and
+    // three.
     assert!(seen[2] >= 10 && seen[3] >= 10, "{seen:?}");
     let want = scene.shade::<f64>(&light).unwrap();
     assert!(relative(&jrt.frame_moved(&scene).unwrap(), &want) < 1e-9);
