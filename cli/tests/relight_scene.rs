@@ -473,3 +473,61 @@ fn glossy_materials_come_from_the_scene_file_or_brdf_and_agree_with_the_referenc
     args.extend(["--rotation-cache", "4"]);
     fails_cleanly(&args, &["--rotation-cache"]);
 }
+
+#[test]
+fn an_eye_segment_renders_as_the_camera_placed_where_it_orbits_to() {
+    let dir = tempfile::tempdir().unwrap();
+    let phong = r#"{"brdf": "phong", "exponent": 20, "albedo": [0.9, 0.9, 0.9]}"#;
+    let scene = glossy_box(dir.path(), "g.json", phong);
+    let path = dir.path().join("orbit.json");
+    std::fs::write(&path, r#"{"segments": [{"frames": 2, "eye_yaw": 90}]}"#).unwrap();
+    let (stack, one) = (dir.path().join("a.npy"), dir.path().join("one.npy"));
+    let stdout = run_scene(
+        &scene,
+        &dir.path().join("a.gif"),
+        &COARSE,
+        &["--animate", p(&path), "--vertices", p(&stack)],
+    );
+    // The camera at (2, 3, 5) about (0, 0, 0), +Z toward +X: a quarter turn ends at (5, 3, -2).
+    assert!(
+        stdout.contains("frame 2: eye at [5.000, 3.000, -2.000]"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.matches("re-formed in").count(), 1, "{stdout}");
+    run_scene(
+        &scene,
+        &dir.path().join("one.png"),
+        &COARSE,
+        &[
+            "--camera",
+            "5,3,-2",
+            "--look-at",
+            "0,0,0",
+            "--vertices",
+            p(&one),
+        ],
+    );
+    let (frames, still) = (read_npy(&stack), read_npy(&one));
+    let last = frames.index_axis(ndarray::Axis(0), 2);
+    let first = frames.index_axis(ndarray::Axis(0), 0);
+    let scale = still.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+    let differ = |a: &ndarray::ArrayViewD<f32>, b: &ndarray::ArrayViewD<f32>| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max)
+            / scale
+    };
+    // Just-in-time transfer against the full product integrals, in f32.
+    assert!(
+        differ(&last, &still.view()) < 1e-5,
+        "{}",
+        differ(&last, &still.view())
+    );
+    // The glossy radiance moved with the eye.
+    assert!(
+        differ(&first, &still.view()) > 1e-2,
+        "{}",
+        differ(&first, &still.view())
+    );
+}

@@ -1,5 +1,5 @@
 //! Animations of dynamic scenes: a path file of segments, each varying one thing (one object
-//! moving, or the lighting turning), played with just-in-time radiance transfer re-formed
+//! moving, the lighting turning, or the eye orbiting), played with just-in-time radiance transfer re-formed
 //! whenever the kind of change switches (seed 001 section 3.5.3).
 //!
 //! **Path file** (JSON, unknown keys refused):
@@ -8,14 +8,17 @@
 //! { "segments": [
 //!     { "frames": 24, "object": "ball", "to": { "translate": [1.5, 0, 0.5] } },
 //!     { "frames": 24, "light_yaw": 90 },
-//!     { "frames": 12, "object": "chair", "to": { "translate": [0, 0, 1], "yaw": 45 } }
+//!     { "frames": 12, "object": "chair", "to": { "translate": [0, 0, 1], "yaw": 45 } },
+//!     { "frames": 12, "eye_yaw": 30 }
 //! ] }
 //! ```
 //!
 //! Frame 0 is the scene as its file places it. A segment of `F` frames adds frames
 //! `1..=F`: an object segment moves the named object linearly (translation, scale and yaw)
 //! from where it is to `to`; a lighting segment turns the lighting about +Y by `light_yaw`
-//! degrees in all, in equal steps. Each segment re-forms the transfer for its change; a
+//! degrees in all, in equal steps; an eye segment turns the eye by `eye_yaw` degrees about the
+//! vertical through the point the scene's camera looks at (right-handed about +Y: +Z toward
+//! +X), so that glossy vertices are seen from elsewhere ([`Change::View`]). Each segment re-forms the transfer for its change; a
 //! segment that turns an object re-forms at every frame whose turn (in whole columns)
 //! differs from the last (the object's own transport turns with it).
 
@@ -52,6 +55,9 @@ pub struct Segment {
     /// Degrees the lighting turns about +Y over the segment.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub light_yaw: Option<f64>,
+    /// Degrees the eye turns about the vertical through the camera's point of interest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eye_yaw: Option<f64>,
 }
 
 /// A path file's content; see the [module docs](self).
@@ -81,6 +87,8 @@ pub struct FrameState {
     pub placement: Option<Placement>,
     /// The lighting's yaw added to the scene's, degrees.
     pub light_yaw: f64,
+    /// Where the eye is (`None`: the scene has none).
+    pub eye: Option<[f64; 3]>,
 }
 
 /// What playing one frame did.
@@ -123,13 +131,15 @@ impl MotionPath {
             .map(|k| scene.placement(k))
             .collect();
         let mut light = 0.0;
+        let mut eye = scene.eye();
         let mut out = Vec::with_capacity(self.frame_count());
         for (k, seg) in self.segments.iter().enumerate() {
             if seg.frames == 0 {
                 return Err(bad(k, "frames must be at least 1".into()));
             }
-            let change = match (&seg.object, &seg.to, seg.light_yaw) {
-                (Some(name), Some(to), None) => {
+            let finite = |yaw: f64| yaw.is_finite() && yaw.abs() <= 1e6;
+            let change = match (&seg.object, &seg.to, seg.light_yaw, seg.eye_yaw) {
+                (Some(name), Some(to), None, None) => {
                     let object = scene
                         .object_index(name)
                         .ok_or_else(|| bad(k, format!("no object is named {name:?}")))?;
@@ -141,13 +151,28 @@ impl MotionPath {
                         target,
                     }
                 }
-                (None, None, Some(yaw)) if yaw.is_finite() && yaw.abs() <= 1e6 => {
-                    Move::Lighting { yaw }
+                (None, None, Some(yaw), None) if finite(yaw) => Move::Lighting { yaw },
+                (None, None, None, Some(yaw)) if finite(yaw) => {
+                    let (Some(from), Some(camera)) = (eye, &scene.camera) else {
+                        return Err(bad(
+                            k,
+                            "an eye segment turns the camera about the point it looks at: the \
+                             scene needs a camera"
+                                .into(),
+                        ));
+                    };
+                    Move::View {
+                        from,
+                        pivot: camera.look_at,
+                        yaw,
+                    }
                 }
                 _ => {
                     return Err(bad(
                         k,
-                        "give either \"object\" and \"to\", or a finite \"light_yaw\"".into(),
+                        "give either \"object\" and \"to\", a finite \"light_yaw\" or a \
+                         finite \"eye_yaw\""
+                            .into(),
                     ));
                 }
             };
@@ -158,6 +183,7 @@ impl MotionPath {
                     change: change.kind(),
                     placement: change.start(),
                     light_yaw: 0.0,
+                    eye,
                 });
             }
             let start_light = light;
@@ -176,12 +202,17 @@ impl MotionPath {
                         light = start_light + t * yaw;
                         None
                     }
+                    Move::View { from, pivot, yaw } => {
+                        eye = Some(orbit(from, pivot, t * yaw));
+                        None
+                    }
                 };
                 out.push(FrameState {
                     segment: k,
                     change: change.kind(),
                     placement,
                     light_yaw: light,
+                    eye,
                 });
             }
         }
@@ -190,7 +221,8 @@ impl MotionPath {
 }
 
 /// What one path segment changes: an object's placement (from where the segment finds it to
-/// `target`), or the lighting's yaw (by `yaw` degrees).
+/// `target`), the lighting's yaw (by `yaw` degrees), or the eye (from `from`, by `yaw` degrees
+/// about the vertical through `pivot`).
 #[derive(Clone, Copy)]
 enum Move {
     Object {
@@ -201,6 +233,11 @@ enum Move {
     Lighting {
         yaw: f64,
     },
+    View {
+        from: [f64; 3],
+        pivot: [f64; 3],
+        yaw: f64,
+    },
 }
 
 impl Move {
@@ -209,6 +246,7 @@ impl Move {
         match *self {
             Move::Object { object, .. } => Change::Object(object),
             Move::Lighting { .. } => Change::Lighting,
+            Move::View { .. } => Change::View,
         }
     }
 
@@ -216,9 +254,20 @@ impl Move {
     fn start(&self) -> Option<Placement> {
         match *self {
             Move::Object { from, .. } => Some(from),
-            Move::Lighting { .. } => None,
+            Move::Lighting { .. } | Move::View { .. } => None,
         }
     }
+}
+
+/// `p` turned by `degrees` about the vertical through `pivot` (+Z toward +X).
+fn orbit(p: [f64; 3], pivot: [f64; 3], degrees: f64) -> [f64; 3] {
+    let (sin, cos) = degrees.to_radians().sin_cos();
+    let (x, z) = (p[0] - pivot[0], p[2] - pivot[2]);
+    [
+        pivot[0] + x * cos + z * sin,
+        p[1],
+        pivot[2] - x * sin + z * cos,
+    ]
 }
 
 /// The placement a fraction `t` of the way from `a` to `b`; the turn takes the shorter way
@@ -290,6 +339,9 @@ pub fn play(
         // The moving object where this frame has it, once: a re-formation needs its turn.
         if let (Change::Object(k), Some(p)) = (state.change, state.placement) {
             scene.place(k, p)?;
+        }
+        if let (Change::View, Some(eye)) = (state.change, state.eye) {
+            scene.set_eye(eye)?;
         }
         // Re-form for a new segment, or when the moving object turns.
         let stale = match (&jrt, state.change) {

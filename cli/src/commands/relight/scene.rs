@@ -6,12 +6,12 @@ use std::time::Instant;
 
 use haarshift::product::Selection;
 use haarshift::relight::animation::{numbered_path, write_gif};
-use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene};
 use haarshift::relight::fields::file::FieldStore;
 use haarshift::relight::fields::{FieldOptions, Truncation};
 use haarshift::relight::motion::{MotionPath, play};
-use haarshift::relight::raster::{render_format, to_srgb8, write_render};
-use haarshift::relight::{Brdf, Lighting};
+use haarshift::relight::raster::{Camera, render_format, to_srgb8, write_render};
+use haarshift::relight::{Brdf, CameraSpec, Lighting};
 use haarshift::sphere::{ParamKind, Parameterization};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
@@ -37,8 +37,9 @@ A glossy material (\"brdf\": \"phong\" or \"blinn\" with an \"exponent\", or --b
 object) adds its BRDF, rotated into each vertex's frame toward the camera (--brdf-rotation),
 as one more factor: albedo x the integral of transport x lighting x occlusion x BRDF.
 
---animate PATH.json plays segments that each move one object or turn the lighting (see the
-library's relight::motion for the file): the fixed factors' product is re-formed when the
+--animate PATH.json plays segments that each move one object, turn the lighting or turn the
+eye about the camera's look-at point (\"eye_yaw\": glossy vertices are seen from elsewhere; see
+the library's relight::motion for the file): the fixed factors' product is re-formed when the
 kind of change switches, and each frame is one sparse dot product per vertex with the varying
 factor (just-in-time radiance transfer). Every frame's times are printed: re-forming, shading,
 rasterisation. The output is a looping GIF or numbered PNGs (a pattern with %d).
@@ -285,6 +286,12 @@ pub fn run(args: Args) -> Result<()> {
     }
     scene.set_glossy(&args.glossy.options(&glossy))?;
     scene.set_eye(camera.position())?;
+    // The camera as resolved from the flags and the file: eye segments orbit its look-at point.
+    scene.camera = Some(CameraSpec {
+        position: camera.position(),
+        look_at: camera.look_at(),
+        fov: camera.fov(),
+    });
     let param = scene.param();
     let r = *scene.report();
     let files = store.as_ref().map_or(String::new(), |s| {
@@ -318,6 +325,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut all_radiance: Vec<Array2<f32>> = Vec::new();
     let mut gif_frames = Vec::new();
     let mut draw = |scene: &DynamicScene,
+                    camera: &Camera,
                     radiance: &Array2<f32>,
                     turn: &haarshift::sphere::SphereRotation,
                     index: usize,
@@ -326,7 +334,7 @@ pub fn run(args: Args) -> Result<()> {
      -> Result<()> {
         let start = Instant::now();
         let image = args.camera.draw(
-            &camera,
+            camera,
             &scene.mesh(),
             radiance.view(),
             &background,
@@ -364,7 +372,7 @@ pub fn run(args: Args) -> Result<()> {
                 Method::Reference => (reference(&scene, &turn)?, "ray-cast reference"),
             };
             let what = format!("{}: {what} {:.1} ms", args.output.display(), ms(start));
-            draw(&scene, &radiance, &turn, 0, &mut text, what)?;
+            draw(&scene, &camera, &radiance, &turn, 0, &mut text, what)?;
         }
         Some(path) => {
             play(
@@ -404,10 +412,27 @@ pub fn run(args: Args) -> Result<()> {
                             p.scale,
                             p.yaw_degrees(param)
                         ),
+                        None if report.state.change == Change::View => {
+                            format!("eye at {:.3?}", scene.eye().unwrap_or(camera.position()))
+                        }
                         None => format!("lighting yaw {:+.2}", report.state.light_yaw),
                     };
                     let what = format!("frame {}: {state}: {reformed}{shade}", report.index);
-                    draw(scene, &radiance, turn, report.index, &mut text, what)
+                    let seen_from = match scene.eye() {
+                        Some(eye) if eye != camera.position() => {
+                            Camera::new(eye, camera.look_at(), camera.fov())?
+                        }
+                        _ => camera,
+                    };
+                    draw(
+                        scene,
+                        &seen_from,
+                        &radiance,
+                        turn,
+                        report.index,
+                        &mut text,
+                        what,
+                    )
                 },
             )?;
         }
