@@ -471,7 +471,7 @@ fn glossy_materials_come_from_the_scene_file_or_brdf_and_agree_with_the_referenc
     args.extend(SMALL);
     args.extend(COARSE);
     args.extend(["--rotation-cache", "4"]);
-    fails_cleanly(&args, &["--rotation-cache"]);
+    fails_cleanly(&args, &["rotation cache", "exact frame"]);
 }
 
 #[test]

@@ -88,6 +88,46 @@ pub struct GlossyOptions {
     pub elevations: usize,
 }
 
+impl GlossyOptions {
+    /// Refuses what maps of `param` cannot hold: more kept coefficients than a map has
+    /// details, more levels than its faces have, a cache bin count outside `1..=1024`.
+    ///
+    /// ```
+    /// use haarshift::relight::glossy::GlossyOptions;
+    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap(); // 2 x 8^2 texels
+    /// assert!(GlossyOptions::default().check(param).is_ok());
+    /// let levels = GlossyOptions { brdf_levels: Some(4), ..Default::default() };
+    /// assert!(levels.check(param).unwrap_err().to_string().contains("3 detail levels"));
+    /// ```
+    pub fn check(&self, param: Parameterization) -> Result<()> {
+        if let Some(k) = self.keep_brdf {
+            Selection::Largest(k).limit(param.texels() - param.faces())?;
+        }
+        let levels = param.face_size().trailing_zeros() as usize;
+        if let Some(l) = self.brdf_levels
+            && l > levels
+        {
+            return Err(Error::parameter(
+                "brdf levels",
+                format!(
+                    "{l}: faces {} texels wide have {levels} detail levels (L from 0 to {levels})",
+                    param.face_size()
+                ),
+            ));
+        }
+        if let Some(n) = self.cache_bins
+            && !(1..=MAX_CACHE_BINS).contains(&n)
+        {
+            return Err(Error::parameter(
+                "rotation cache",
+                format!("{n} bins per axis: expected 1 to {MAX_CACHE_BINS}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Default for GlossyOptions {
     fn default() -> Self {
         GlossyOptions {
@@ -207,29 +247,8 @@ impl<T: Sample> GlossyShader<T> {
             options.level,
             options.elevations,
         )?;
-        if let Some(k) = options.keep_brdf {
-            Selection::Largest(k).limit(param.texels() - param.faces())?;
-        }
+        options.check(param)?;
         let levels = param.face_size().trailing_zeros() as usize;
-        if let Some(l) = options.brdf_levels
-            && l > levels
-        {
-            return Err(Error::parameter(
-                "brdf levels",
-                format!(
-                    "{l}: faces {} texels wide have {levels} detail levels (L from 0 to {levels})",
-                    param.face_size()
-                ),
-            ));
-        }
-        if let Some(n) = options.cache_bins
-            && !(1..=MAX_CACHE_BINS).contains(&n)
-        {
-            return Err(Error::parameter(
-                "rotation cache",
-                format!("{n} bins per axis: expected 1 to {MAX_CACHE_BINS}"),
-            ));
-        }
         let rows = |a: ArrayView2<'_, f64>| -> Vec<[f64; 3]> {
             a.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect()
         };

@@ -184,21 +184,7 @@ impl DynamicScene {
                 "a dynamic scene rotates every glossy vertex's BRDF in its exact frame: no cache",
             ));
         }
-        if let Some(k) = g.keep_brdf {
-            Selection::Largest(k).limit(param.texels() - param.faces())?;
-        }
-        let levels = param.face_size().trailing_zeros() as usize;
-        if let Some(l) = g.brdf_levels
-            && l > levels
-        {
-            return Err(Error::parameter(
-                "brdf levels",
-                format!(
-                    "{l}: faces {} texels wide have {levels} detail levels",
-                    param.face_size()
-                ),
-            ));
-        }
+        g.check(param)?;
         for (k, o) in self.objects.iter().enumerate() {
             if let Brdf::Phong { exponent } | Brdf::BlinnPhong { exponent } = o.brdf
                 && !(0.0..=MAX_EXPONENT).contains(&exponent)

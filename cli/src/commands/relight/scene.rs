@@ -276,14 +276,6 @@ pub fn run(args: Args) -> Result<()> {
         .find(|b| !b.is_lambert())
         .unwrap_or(Brdf::Lambert);
     args.glossy.check(&glossy)?;
-    if args.glossy.fill_cache || args.glossy.rotation_cache.is_some() {
-        return Err(Error::InvalidParameter {
-            name: "rotation-cache",
-            reason: "a dynamic scene rotates every glossy vertex's BRDF in its exact frame: \
-                     --rotation-cache and --fill-cache are for relight render"
-                .into(),
-        });
-    }
     scene.set_glossy(&args.glossy.options(&glossy))?;
     scene.set_eye(camera.position())?;
     // The camera as resolved from the flags and the file: eye segments orbit its look-at point.
