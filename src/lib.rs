@@ -53,7 +53,7 @@ pub mod transform;
 pub use boundary::BoundaryMode;
 pub use error::{Error, Result};
 pub use planar_image::{Channels, PlanarImage, SampleDepth};
-pub use sample::{Sample, ensure_finite};
+pub use sample::{Sample, ensure_finite, round_to_code};
 
 /// The README's Rust examples, compiled and run as doctests so that they stay true.
 #[doc = include_str!("../README.md")]

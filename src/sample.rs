@@ -71,13 +71,30 @@ impl Sample for f64 {
 
 /// `x` rounded to the nearest integer (ties away from zero) and clamped to `0..=max`, for an
 /// integer code range (`max` below 2^32): exactly `x.round().clamp(0, max)`, without the libm
-/// call `round` is on baseline x86-64, which dominated writing 8- and 16-bit images.
+/// call `round` is on baseline x86-64, which dominated writing 8- and 16-bit images. This is
+/// how a float result becomes an 8- or 16-bit sample everywhere in haarshift.
+///
+/// ```
+/// use haarshift::round_to_code;
+/// assert_eq!(round_to_code(2.5f32, 255.0), 3.0);
+/// assert_eq!(round_to_code(-0.7f64, 255.0), 0.0);
+/// assert_eq!(round_to_code(300.2f64, 255.0), 255.0);
+/// ```
 #[inline]
-pub(crate) fn round_to_code<T: Sample>(x: T, max: f64) -> T {
+pub fn round_to_code<T: Sample>(x: T, max: f64) -> T {
     let x = x.as_f64().clamp(0.0, max);
     // Truncation is exact here and so is the fraction `x - whole` (both below 2^32).
     let whole = x as u32 as f64;
     T::from_f64(if x - whole >= 0.5 { whole + 1.0 } else { whole })
+}
+
+/// Whether every value is finite: in chunks without an early exit inside, so that each
+/// vectorises.
+#[inline]
+pub(crate) fn all_finite<T: Sample>(values: &[T]) -> bool {
+    values
+        .chunks(256)
+        .all(|c| c.iter().fold(true, |ok, v| ok & v.is_finite()))
 }
 
 /// Returns an error naming the first NaN or infinity in `array`, if any.
@@ -92,14 +109,11 @@ pub fn ensure_finite<T: Sample, S: Data<Elem = T>, D: Dimension>(
     array: &ArrayBase<S, D>,
 ) -> Result<()> {
     // The common case, all finite, in one fast pass; the index only when something is not.
-    // Over contiguous memory, chunks without an early exit inside, so that each vectorises.
-    let all_finite = match array.as_slice_memory_order() {
-        Some(values) => values
-            .chunks(256)
-            .all(|c| c.iter().fold(true, |ok, v| ok & v.is_finite())),
+    let finite = match array.as_slice_memory_order() {
+        Some(values) => all_finite(values),
         None => array.iter().all(|v| v.is_finite()),
     };
-    if all_finite {
+    if finite {
         return Ok(());
     }
     match array.indexed_iter().find(|(_, v)| !v.is_finite()) {

@@ -323,6 +323,47 @@ impl Default for KernelOptions {
     }
 }
 
+impl KernelOptions {
+    /// The options of `method` from optional parameters (`None`: the default), refusing a
+    /// parameter that `method` does not take, so that none is silently ignored.
+    ///
+    /// ```
+    /// use haarshift::kernels::{KernelOptions, ShiftMethod};
+    /// let o = KernelOptions::for_method(ShiftMethod::Haar, Some(2), true, None).unwrap();
+    /// assert_eq!((o.precision, o.retain, o.keys_a), (2, true, -0.5));
+    /// let e = KernelOptions::for_method(ShiftMethod::Keys, Some(2), false, None).unwrap_err();
+    /// assert_eq!(e.to_string(), "invalid precision: precision applies to method haar only, not keys");
+    /// ```
+    pub fn for_method(
+        method: ShiftMethod,
+        precision: Option<u32>,
+        retain: bool,
+        keys_a: Option<f64>,
+    ) -> Result<KernelOptions> {
+        let misplaced = |name: &'static str, owner: ShiftMethod| Error::InvalidParameter {
+            name,
+            reason: format!("{name} applies to method {owner} only, not {method}"),
+        };
+        if method != ShiftMethod::Haar {
+            if precision.is_some() {
+                return Err(misplaced("precision", ShiftMethod::Haar));
+            }
+            if retain {
+                return Err(misplaced("retain", ShiftMethod::Haar));
+            }
+        }
+        if method != ShiftMethod::Keys && keys_a.is_some() {
+            return Err(misplaced("keys_a", ShiftMethod::Keys));
+        }
+        let defaults = KernelOptions::default();
+        Ok(KernelOptions {
+            precision: precision.unwrap_or(defaults.precision),
+            retain,
+            keys_a: keys_a.unwrap_or(defaults.keys_a),
+        })
+    }
+}
+
 impl ShiftMethod {
     /// The kernel with its default parameters.
     ///

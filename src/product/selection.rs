@@ -113,6 +113,42 @@ impl Selection {
             Selection::Threshold(_) => Ok(None),
         }
     }
+
+    /// The selections of the command line's `--keep K[,K...]` (one count for every map, or one
+    /// per map), `--threshold T` and `--per-face`: empty (keep everything) when none is given.
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// assert_eq!(Selection::from_counts(&[200, 70], None, false).unwrap(),
+    ///            [Selection::Largest(200), Selection::Largest(70)]);
+    /// assert_eq!(Selection::from_counts(&[], Some(0.5), false).unwrap(), [Selection::Threshold(0.5)]);
+    /// assert!(Selection::from_counts(&[], None, false).unwrap().is_empty());
+    /// assert!(Selection::from_counts(&[10], Some(0.5), false).is_err());
+    /// assert!(Selection::from_counts(&[], None, true).is_err());
+    /// ```
+    pub fn from_counts(
+        keep: &[usize],
+        threshold: Option<f64>,
+        per_face: bool,
+    ) -> Result<Vec<Self>> {
+        match (threshold, per_face) {
+            (Some(_), _) if !keep.is_empty() => Err(Error::parameter(
+                "threshold",
+                "keep counts and a threshold are two different selections: give one",
+            )),
+            (Some(_), true) => Err(Error::parameter(
+                "per_face",
+                "per-face selection counts coefficients: it needs keep, not a threshold",
+            )),
+            (Some(t), false) => Ok(vec![Selection::Threshold(t)]),
+            (None, true) if keep.is_empty() => Err(Error::parameter(
+                "per_face",
+                "per-face selection needs keep counts",
+            )),
+            (None, true) => Ok(keep.iter().map(|&k| Selection::LargestPerFace(k)).collect()),
+            (None, false) => Ok(keep.iter().map(|&k| Selection::Largest(k)).collect()),
+        }
+    }
 }
 
 /// A detail coefficient competing for a place: its squared magnitude and tie-break index.

@@ -127,12 +127,14 @@
 pub mod dense;
 mod grid;
 pub mod oracle;
+mod plane;
 mod random_access;
 mod retained;
 pub mod separable;
 
 pub use dense::ShiftWorkspace;
 pub use grid::{GridShift, MAX_PRECISION};
+pub use plane::PlaneShift;
 pub use random_access::{PyramidIndex, ShiftQuery1d, ShiftQuery2d};
 pub use retained::{DEFAULT_MEMORY_BUDGET, RetainedImage, RetainedSignal};
 

@@ -27,7 +27,7 @@
 
 use std::ops::Range;
 
-use ndarray::{Array2, ArrayView2, s};
+use ndarray::{Array2, ArrayView2, ArrayViewMut2, s};
 use serde::{Deserialize, Serialize};
 
 use crate::named::named_enum;
@@ -196,6 +196,94 @@ pub struct TransformInfo {
     pub original_shape: [usize; 2],
 }
 
+impl TransformInfo {
+    /// Checks that coefficients of `shape` can be what this transform made: power-of-two sides,
+    /// the original size padded to them, and levels that fit.
+    ///
+    /// ```
+    /// use haarshift::transform::TransformSpec;
+    /// let c = TransformSpec::default().forward(ndarray::Array2::<f64>::zeros((3, 5)).view()).unwrap();
+    /// assert!(c.info().check_shape((4, 8)).is_ok());
+    /// assert!(c.info().check_shape((8, 8)).is_err());
+    /// ```
+    pub fn check_shape(&self, shape: (usize, usize)) -> Result<()> {
+        let (h, w) = shape;
+        let [rows, cols] = self.original_shape;
+        let fits = h.is_power_of_two()
+            && w.is_power_of_two()
+            && rows <= h
+            && cols <= w
+            && h == rows.max(1).next_power_of_two()
+            && w == cols.max(1).next_power_of_two();
+        if !fits {
+            return Err(Error::shape(
+                &[h, w],
+                format!("coefficients do not match an original image of {rows}x{cols}"),
+            ));
+        }
+        let max = [h.trailing_zeros() as usize, w.trailing_zeros() as usize];
+        let levels_ok = match self.layout {
+            Layout::Pyramid => {
+                self.levels[0] == self.levels[1] && self.levels[0] <= max[0].min(max[1])
+            }
+            Layout::Separable => self.levels[0] <= max[0] && self.levels[1] <= max[1],
+        };
+        if !levels_ok {
+            return Err(Error::parameter(
+                "levels",
+                format!(
+                    "{:?} do not fit a {h}x{w} {} transform",
+                    self.levels, self.layout
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The image whose coefficients (made as `info` says) are `coefficients`, cropped to
+/// `info.original_shape` and written into `out` (of that size, any strides; a contiguous
+/// row-major `out` of the coefficients' size is written directly).
+///
+/// ```
+/// use haarshift::transform::{TransformSpec, inverse_into};
+/// use ndarray::{Array2, array};
+/// let image = array![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
+/// let c = TransformSpec::default().forward(image.view()).unwrap();
+/// let mut out = Array2::zeros((2, 3));
+/// inverse_into(c.as_array(), c.info(), out.view_mut()).unwrap();
+/// assert_eq!(out, image);
+/// ```
+pub fn inverse_into<T: Sample>(
+    coefficients: ArrayView2<'_, T>,
+    info: &TransformInfo,
+    mut out: ArrayViewMut2<'_, T>,
+) -> Result<()> {
+    info.check_shape(coefficients.dim())?;
+    let [rows, cols] = info.original_shape;
+    if out.dim() != (rows, cols) {
+        return Err(Error::shape(
+            &[out.nrows(), out.ncols()],
+            format!("the image is {rows}x{cols}"),
+        ));
+    }
+    ensure_finite(&coefficients)?;
+    let norm = info.normalization;
+    let full = match info.layout {
+        Layout::Pyramid if out.dim() == coefficients.dim() && out.is_standard_layout() => {
+            return pyramid::inverse_into(coefficients, info.levels[0], norm, out, &mut Vec::new());
+        }
+        Layout::Pyramid => pyramid::inverse(coefficients, info.levels[0], norm)?,
+        Layout::Separable => {
+            let mut data = coefficients.to_owned();
+            separable::inverse_in_place(data.view_mut(), &info.levels, norm)?;
+            data
+        }
+    };
+    out.assign(&full.slice(s![..rows, ..cols]));
+    Ok(())
+}
+
 /// A recipe for a 2D Haar transform of an image of any size.
 ///
 /// ```
@@ -223,27 +311,117 @@ pub struct TransformSpec {
 impl TransformSpec {
     /// Transforms `image` (any non-empty size, finite values).
     pub fn forward<T: Sample>(&self, image: ArrayView2<'_, T>) -> Result<Coefficients<T>> {
-        ensure_finite(&image)?;
+        let mut data = Array2::zeros(self.padded_shape(image.nrows(), image.ncols())?);
+        let info = self.forward_into(image, data.view_mut(), &mut Vec::new())?;
+        Ok(Coefficients { data, info })
+    }
+
+    /// The size of the coefficients of a `rows x cols` image: each side rounded up to a power of
+    /// two. Errors on an empty image, or when the levels asked for do not fit.
+    ///
+    /// ```
+    /// use haarshift::transform::{Levels, TransformSpec};
+    /// assert_eq!(TransformSpec::default().padded_shape(3, 5).unwrap(), (4, 8));
+    /// let deep = TransformSpec { levels: Levels::Count(3), ..Default::default() };
+    /// assert!(deep.padded_shape(4, 8).is_err()); // a 4 x 8 pyramid has 2 levels
+    /// ```
+    pub fn padded_shape(&self, rows: usize, cols: usize) -> Result<(usize, usize)> {
+        if rows == 0 || cols == 0 {
+            return Err(Error::shape(&[rows, cols], "image is empty"));
+        }
+        let too_large = || Error::shape(&[rows, cols], "too large to pad to a power of two");
+        let h = rows.checked_next_power_of_two().ok_or_else(too_large)?;
+        let w = cols.checked_next_power_of_two().ok_or_else(too_large)?;
+        self.resolve_levels(h, w)?;
+        Ok((h, w))
+    }
+
+    /// [`forward`](Self::forward) into `out`, of [`padded_shape`](Self::padded_shape) and any
+    /// strides (a contiguous row-major `out` is written directly, with no intermediate copy),
+    /// with `work` as scratch that repeated calls reuse (as [`pyramid::forward_into`]).
+    /// Returns what was done, for [`inverse_into`].
+    ///
+    /// ```
+    /// use haarshift::transform::TransformSpec;
+    /// use ndarray::{Array2, array};
+    /// let spec = TransformSpec::default();
+    /// let mut out = Array2::zeros((2, 2));
+    /// let image = array![[1.0, 3.0], [5.0, 7.0]];
+    /// let info = spec.forward_into(image.view(), out.view_mut(), &mut Vec::new()).unwrap();
+    /// assert_eq!(out, array![[4.0, -1.0], [-2.0, 0.0]]);
+    /// assert_eq!(info.original_shape, [2, 2]);
+    /// ```
+    pub fn forward_into<T: Sample>(
+        &self,
+        image: ArrayView2<'_, T>,
+        mut out: ArrayViewMut2<'_, T>,
+        work: &mut Vec<T>,
+    ) -> Result<TransformInfo> {
         let (rows, cols) = image.dim();
+        let (h, w) = self.padded_shape(rows, cols)?;
+        if out.dim() != (h, w) {
+            return Err(Error::shape(
+                &[out.nrows(), out.ncols()],
+                format!("the coefficients of a {rows}x{cols} image are {h}x{w}"),
+            ));
+        }
         let padded = pad_to_power_of_two(image, self.padding)?;
-        let (h, w) = padded.dim();
         let levels = self.resolve_levels(h, w)?;
-        let data = match self.layout {
-            Layout::Pyramid => pyramid::forward(padded.view(), levels[0], self.normalization)?,
-            Layout::Separable => {
-                let mut data = padded.into_owned();
-                separable::forward_in_place(data.view_mut(), &levels, self.normalization)?;
-                data
+        let norm = self.normalization;
+        // The pyramid checks finiteness during its pass; padding puts no NaN or infinity
+        // before the first one of the image in row-major order, so its error names the
+        // image's index.
+        match self.layout {
+            Layout::Pyramid if out.is_standard_layout() => {
+                pyramid::forward_into(padded.view(), levels[0], norm, out, work)?
             }
-        };
-        let info = TransformInfo {
+            Layout::Pyramid => out.assign(&pyramid::forward(padded.view(), levels[0], norm)?),
+            Layout::Separable => {
+                ensure_finite(&image)?;
+                out.assign(&padded);
+                separable::forward_in_place(out, &levels, norm)?;
+            }
+        }
+        Ok(TransformInfo {
             layout: self.layout,
             normalization: self.normalization,
             levels,
             padding: self.padding,
             original_shape: [rows, cols],
+        })
+    }
+
+    /// What this transform does to an image of `original` size whose coefficients are
+    /// `coefficients` in size: the [`TransformInfo`] [`inverse_into`] needs, checked against
+    /// both sizes.
+    ///
+    /// ```
+    /// use haarshift::transform::TransformSpec;
+    /// let info = TransformSpec::default().info_for((4, 8), (3, 5)).unwrap();
+    /// assert_eq!((info.levels, info.original_shape), ([2, 2], [3, 5]));
+    /// assert!(TransformSpec::default().info_for((4, 8), (3, 3)).is_err()); // 3 pads to 4
+    /// ```
+    pub fn info_for(
+        &self,
+        coefficients: (usize, usize),
+        original: (usize, usize),
+    ) -> Result<TransformInfo> {
+        let (h, w) = coefficients;
+        if !(h.is_power_of_two() && w.is_power_of_two()) {
+            return Err(Error::shape(
+                &[h, w],
+                "coefficients have power-of-two sides",
+            ));
+        }
+        let info = TransformInfo {
+            layout: self.layout,
+            normalization: self.normalization,
+            levels: self.resolve_levels(h, w)?,
+            padding: self.padding,
+            original_shape: [original.0, original.1],
         };
-        Ok(Coefficients { data, info })
+        info.check_shape(coefficients)?;
+        Ok(info)
     }
 
     /// Steps per axis for a padded `h x w` array.
@@ -275,36 +453,7 @@ pub struct Coefficients<T> {
 impl<T: Sample> Coefficients<T> {
     /// Wraps a coefficient array (read from a file, say), checking it against `info`.
     pub fn from_parts(data: Array2<T>, info: TransformInfo) -> Result<Self> {
-        let (h, w) = data.dim();
-        let [rows, cols] = info.original_shape;
-        let fits = h.is_power_of_two()
-            && w.is_power_of_two()
-            && rows <= h
-            && cols <= w
-            && h == rows.max(1).next_power_of_two()
-            && w == cols.max(1).next_power_of_two();
-        if !fits {
-            return Err(Error::shape(
-                &[h, w],
-                format!("coefficients do not match an original image of {rows}x{cols}"),
-            ));
-        }
-        let max = [h.trailing_zeros() as usize, w.trailing_zeros() as usize];
-        let levels_ok = match info.layout {
-            Layout::Pyramid => {
-                info.levels[0] == info.levels[1] && info.levels[0] <= max[0].min(max[1])
-            }
-            Layout::Separable => info.levels[0] <= max[0] && info.levels[1] <= max[1],
-        };
-        if !levels_ok {
-            return Err(Error::parameter(
-                "levels",
-                format!(
-                    "{:?} do not fit a {h}x{w} {} transform",
-                    info.levels, info.layout
-                ),
-            ));
-        }
+        info.check_shape(data.dim())?;
         ensure_finite(&data)?;
         Ok(Coefficients { data, info })
     }
@@ -337,20 +486,10 @@ impl<T: Sample> Coefficients<T> {
 
     /// The image these coefficients came from, cropped back to its original size.
     pub fn inverse(&self) -> Result<Array2<T>> {
-        let norm = self.info.normalization;
-        let full = match self.info.layout {
-            Layout::Pyramid => pyramid::inverse(self.data.view(), self.info.levels[0], norm)?,
-            Layout::Separable => {
-                let mut data = self.data.clone();
-                separable::inverse_in_place(data.view_mut(), &self.info.levels, norm)?;
-                data
-            }
-        };
         let [rows, cols] = self.info.original_shape;
-        if full.dim() == (rows, cols) {
-            return Ok(full);
-        }
-        Ok(full.slice(s![..rows, ..cols]).to_owned())
+        let mut out = Array2::zeros((rows, cols));
+        inverse_into(self.data.view(), &self.info, out.view_mut())?;
+        Ok(out)
     }
 
     /// A view of one pyramid band at detail `level` (0 coarsest). [`Band::Scaling`] is stored

@@ -13,7 +13,8 @@ use ndarray::{Array2, ArrayView2, ArrayViewMut2};
 use rayon::prelude::*;
 
 use super::{Band, Normalization};
-use crate::{Error, Result, Sample};
+use crate::sample::all_finite;
+use crate::{Error, Result, Sample, ensure_finite};
 
 /// Below this many output values per task, rayon's overhead outweighs the work.
 const MIN_VALUES_PER_TASK: usize = 1 << 14;
@@ -77,7 +78,10 @@ pub(crate) fn band_ranges(
     })
 }
 
-/// One analysis step on a row pair: 2x2 blocks to (A, a, b, c). `f2` is the per-level factor.
+/// One analysis step on a row pair: 2x2 blocks to (A, a, b, c). `f2` is the per-level factor,
+/// a power of two (1/4 or 1/2), applied to the four values first: the results are the same
+/// bits as scaling the sums (a power of two commutes with rounding), but in the average
+/// normalisation no intermediate can overflow, since each is at most the largest input.
 #[inline]
 pub(crate) fn analyse_rows<T: Sample>(
     r0: &[T],
@@ -93,12 +97,13 @@ pub(crate) fn analyse_rows<T: Sample>(
     let (a, b, c) = (&mut a[..n], &mut b[..n], &mut c[..n]);
     for j in 0..n {
         let ([p, q], [r, s]) = (top[j], bottom[j]);
+        let (p, q, r, s) = (f2 * p, f2 * q, f2 * r, f2 * s);
         let (sum_top, sum_bottom) = (p + q, r + s);
         let (dif_top, dif_bottom) = (p - q, r - s);
-        approx[j] = f2 * (sum_top + sum_bottom);
-        a[j] = f2 * (dif_top + dif_bottom);
-        b[j] = f2 * (sum_top - sum_bottom);
-        c[j] = f2 * (dif_top - dif_bottom);
+        approx[j] = sum_top + sum_bottom;
+        a[j] = dif_top + dif_bottom;
+        b[j] = sum_top - sum_bottom;
+        c[j] = dif_top - dif_bottom;
     }
 }
 
@@ -140,6 +145,10 @@ type RowPair<'a, T> = (&'a mut [T], &'a mut [T]);
 
 /// Analysis of the `h x w` approximation `cur` (row stride `cur_stride`) into `out` (row
 /// stride `out_stride`): `a`, `b`, `c` into their bands, the approximation into `target`.
+/// Returns whether the values written are finite, checked on each row pair while it is in
+/// cache: the approximations always (a NaN or infinity in `cur` reaches the approximation of
+/// its block), the details too with `check_details` (where they can overflow).
+#[allow(clippy::too_many_arguments)] // one level's geometry, target and arithmetic
 fn analysis_step<T: Sample>(
     cur: &[T],
     cur_stride: usize,
@@ -148,7 +157,8 @@ fn analysis_step<T: Sample>(
     out_stride: usize,
     target: ApproxTarget<'_, T>,
     f2: T,
-) {
+    check_details: bool,
+) -> bool {
     let (hh, hw) = (h / 2, w / 2);
     let (top, bottom) = out[..h * out_stride].split_at_mut(hh * out_stride);
     let pair = move |r: usize| {
@@ -157,51 +167,60 @@ fn analysis_step<T: Sample>(
             &cur[(2 * r + 1) * cur_stride..][..w],
         )
     };
+    let analyse = |r: usize, approx: &mut [T], a: &mut [T], b: &mut [T], c: &mut [T]| {
+        let (r0, r1) = pair(r);
+        analyse_rows(r0, r1, approx, a, b, c, f2);
+        all_finite(approx) & (!check_details || all_finite(a) & all_finite(b) & all_finite(c))
+    };
     // A level that would be one task anyway runs here: rayon's bridge costs more than a
     // small level's work (per-vertex products transform thousands of 32 x 32 faces).
     let serial = h * w <= MIN_VALUES_PER_TASK;
+    let min_len = (MIN_VALUES_PER_TASK / w).max(1);
     match target {
         ApproxTarget::Buffer(buf) => {
             let row = |(r, ((t, b), approx)): (usize, (RowPair<'_, T>, &mut [T]))| {
-                let (r0, r1) = pair(r);
                 let (b_row, c_row) = b[..w].split_at_mut(hw);
-                analyse_rows(r0, r1, approx, &mut t[hw..w], b_row, c_row, f2);
+                analyse(r, approx, &mut t[hw..w], b_row, c_row)
             };
             let buf = &mut buf[..hh * hw];
             if serial {
                 let rows = top
                     .chunks_mut(out_stride)
                     .zip(bottom.chunks_mut(out_stride));
-                rows.zip(buf.chunks_mut(hw)).enumerate().for_each(row);
+                rows.zip(buf.chunks_mut(hw))
+                    .enumerate()
+                    .map(row)
+                    .fold(true, |x, y| x & y)
             } else {
                 let rows = top
                     .par_chunks_mut(out_stride)
                     .zip(bottom.par_chunks_mut(out_stride));
-                let min_len = (MIN_VALUES_PER_TASK / w).max(1);
                 rows.zip(buf.par_chunks_mut(hw))
                     .with_min_len(min_len)
                     .enumerate()
-                    .for_each(row);
+                    .map(row)
+                    .reduce(|| true, |x, y| x & y)
             }
         }
         ApproxTarget::Output => {
             let row = |(r, (t, b)): (usize, RowPair<'_, T>)| {
-                let (r0, r1) = pair(r);
                 let (approx, a_row) = t[..w].split_at_mut(hw);
                 let (b_row, c_row) = b[..w].split_at_mut(hw);
-                analyse_rows(r0, r1, approx, a_row, b_row, c_row, f2);
+                analyse(r, approx, a_row, b_row, c_row)
             };
             if serial {
                 let rows = top
                     .chunks_mut(out_stride)
                     .zip(bottom.chunks_mut(out_stride));
-                rows.enumerate().for_each(row);
+                rows.enumerate().map(row).fold(true, |x, y| x & y)
             } else {
                 let rows = top
                     .par_chunks_mut(out_stride)
                     .zip(bottom.par_chunks_mut(out_stride));
-                let min_len = (MIN_VALUES_PER_TASK / w).max(1);
-                rows.with_min_len(min_len).enumerate().for_each(row);
+                rows.with_min_len(min_len)
+                    .enumerate()
+                    .map(row)
+                    .reduce(|| true, |x, y| x & y)
             }
         }
     }
@@ -269,7 +288,10 @@ fn ping_pong<T: Sample>(work: &mut Vec<T>, h: usize, w: usize) -> (&mut [T], &mu
 }
 
 /// Forward pyramid transform of `image` into `out` (same shape, standard layout), reusing
-/// `work` as scratch so that repeated calls allocate nothing.
+/// `work` as scratch so that repeated calls allocate nothing. Errors name a NaN or infinity
+/// in `image`, or orthonormal coefficients that overflow `T`; the check rides on the
+/// transform's own pass (each row pair's outputs while they are in cache), not a pass of its
+/// own.
 ///
 /// ```
 /// use haarshift::transform::{Normalization, pyramid};
@@ -301,12 +323,16 @@ pub fn forward_into<T: Sample>(
     let image = image.as_slice().expect("standard layout is contiguous");
     if levels == 0 {
         out.copy_from_slice(image);
-        return Ok(());
+        return ensure_finite(&rows_view(out, w));
     }
     let f2 = norm.forward_factor_2d::<T>();
+    // Average coefficients are means and half-differences of values in range: only the
+    // orthonormal ones, which grow by 2 a level, can overflow.
+    let check_details = norm == Normalization::Orthonormal;
     let (x, y) = ping_pong(work, h, w);
     // Step s writes its approximation to x when s is even, y when odd; the last to `out`.
     let (mut dst, mut spare) = (x, y);
+    let mut finite = true;
     for step in 0..levels {
         let size = (h >> step, w >> step);
         let last = step + 1 == levels;
@@ -320,10 +346,23 @@ pub fn forward_into<T: Sample>(
         } else {
             ApproxTarget::Buffer(&mut *dst)
         };
-        analysis_step(cur, stride, size, out, w, target, f2);
+        finite &= analysis_step(cur, stride, size, out, w, target, f2, check_details);
         std::mem::swap(&mut dst, &mut spare);
     }
-    Ok(())
+    if finite {
+        return Ok(());
+    }
+    // Name the input's first NaN or infinity; with none, the sums overflowed.
+    ensure_finite(&rows_view(image, w))?;
+    Err(Error::parameter(
+        "image",
+        format!("values too large: the transform overflows {}", T::NAME),
+    ))
+}
+
+/// A row-major `h x w` slice as an array view, for error messages naming an index.
+fn rows_view<T>(values: &[T], w: usize) -> ArrayView2<'_, T> {
+    ArrayView2::from_shape((values.len() / w, w), values).expect("whole rows")
 }
 
 /// Forward pyramid transform with `levels` steps, returning the coefficients.

@@ -332,3 +332,55 @@ proptest! {
         prop_assert!(back.iter().zip(x.iter()).all(|(a, b)| (a - b).abs() < 1e-12));
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+    /// The pyramid's finiteness check rides on its own pass: a NaN or an infinity anywhere, at
+    /// any size (padded or not), any depth and in either precision, is refused with the
+    /// image's own index, exactly as a separate pass over the input would name it.
+    #[test]
+    fn a_non_finite_value_anywhere_is_named(
+        rows in 1usize..40,
+        cols in 1usize..40,
+        at in 0usize..1600,
+        which in 0usize..3,
+        levels in 0usize..6,
+        padding in 0usize..4,
+    ) {
+        let bad = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY][which];
+        let (r, c) = ((at / 40) % rows, at % cols);
+        let mut x = test_image(rows, cols, at as u64);
+        x[[r, c]] = bad;
+        let spec = TransformSpec {
+            levels: Levels::Count(levels.min(pyramid::max_levels(
+                rows.next_power_of_two(),
+                cols.next_power_of_two(),
+            ))),
+            padding: BoundaryMode::ALL[padding],
+            ..Default::default()
+        };
+        let want = ensure_finite(&x).unwrap_err().to_string();
+        prop_assert_eq!(spec.forward(x.view()).unwrap_err().to_string(), want.clone());
+        let single = x.mapv(|v| v as f32);
+        prop_assert_eq!(spec.forward(single.view()).unwrap_err().to_string(), want);
+    }
+}
+
+#[test]
+fn orthonormal_coefficients_that_overflow_are_refused_and_average_ones_cannot_overflow() {
+    // Every value is finite and near the largest f32: left minus right of the block is not.
+    let x = ndarray::array![[3e38f32, -3e38], [3e38, -3e38]];
+    let orthonormal = TransformSpec {
+        normalization: Normalization::Orthonormal,
+        ..Default::default()
+    };
+    let err = orthonormal.forward(x.view()).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "invalid image: values too large: the transform overflows f32"
+    );
+    // The average normalisation scales first: the half-difference is 3e38 itself.
+    let c = TransformSpec::default().forward(x.view()).unwrap();
+    assert_eq!(c.as_array(), ndarray::array![[0.0f32, 3e38], [0.0, 0.0]]);
+    assert_eq!(c.inverse().unwrap(), x);
+}

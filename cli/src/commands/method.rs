@@ -1,8 +1,8 @@
 //! The `--method` flags shared by `rotate` and `shift`: which 1D shift kernel, and its
 //! parameters.
 
+use haarshift::Result;
 use haarshift::kernels::{KernelOptions, ShiftMethod};
-use haarshift::{Error, Result};
 
 use super::{choice, names};
 
@@ -35,29 +35,7 @@ impl MethodFlags {
     /// the method does not have, so that a flag is never silently ignored.
     pub fn resolve(&self, default: ShiftMethod) -> Result<(ShiftMethod, KernelOptions)> {
         let method = self.method.unwrap_or(default);
-        let misplaced = |name: &'static str, owner: ShiftMethod| Error::InvalidParameter {
-            name,
-            reason: format!("--{name} applies to --method {owner} only, not {method}"),
-        };
-        if method != ShiftMethod::Haar {
-            if self.precision.is_some() {
-                return Err(misplaced("precision", ShiftMethod::Haar));
-            }
-            if self.retain {
-                return Err(misplaced("retain", ShiftMethod::Haar));
-            }
-        }
-        if method != ShiftMethod::Keys && self.keys_a.is_some() {
-            return Err(misplaced("keys-a", ShiftMethod::Keys));
-        }
-        let defaults = KernelOptions::default();
-        Ok((
-            method,
-            KernelOptions {
-                precision: self.precision.unwrap_or(defaults.precision),
-                retain: self.retain,
-                keys_a: self.keys_a.unwrap_or(defaults.keys_a),
-            },
-        ))
+        let options = KernelOptions::for_method(method, self.precision, self.retain, self.keys_a)?;
+        Ok((method, options))
     }
 }

@@ -4,11 +4,9 @@
 use std::path::PathBuf;
 
 use haarshift::io::read_image;
-use haarshift::kernels::{KernelOptions, Outside, ShiftMethod, shift_plane};
-use haarshift::shift::{RetainedImage, shift_image};
-use haarshift::transform::{TransformSpec, pyramid};
-use haarshift::{BoundaryMode, Error, Result, Sample};
-use ndarray::{Array2, ArrayView2, s};
+use haarshift::kernels::ShiftMethod;
+use haarshift::shift::PlaneShift;
+use haarshift::{BoundaryMode, Result, Sample};
 
 use super::method::MethodFlags;
 use super::{Compute, ComputeFlag, ImageOutput, choice, names, number};
@@ -87,22 +85,10 @@ pub fn run(args: Args) -> Result<()> {
 /// Reads, shifts and writes in `T`.
 fn shift<T: Sample>(args: &Args) -> Result<()> {
     let (method, options) = args.method.resolve(ShiftMethod::Haar)?;
-    let boundary = args.boundary.unwrap_or(BoundaryMode::Wrap);
+    let shift = PlaneShift::new(method, options, args.boundary.unwrap_or(BoundaryMode::Wrap))?;
     let (dx, dy) = (args.dx, args.dy);
     let image = read_image::<T>(&args.input)?;
-    let shifted = if method == ShiftMethod::Haar {
-        if boundary != BoundaryMode::Wrap {
-            return Err(Error::InvalidParameter {
-                name: "boundary",
-                reason: format!("the Haar shift is periodic (wrap), not {boundary}"),
-            });
-        }
-        image.map_planes(|p| haar_shift(p, dx, dy, &options))?
-    } else {
-        let kernel = method.kernel_with::<T>(&options)?;
-        let outside = Outside::Boundary(boundary);
-        image.map_planes(|p| shift_plane(p, dx, dy, kernel.as_ref(), outside))?
-    };
+    let shifted = image.map_planes(|p| shift.apply(p, dx, dy))?;
     drop(image);
     let what = format!(
         ", shifted by ({}, {}) with {method} in {}",
@@ -111,33 +97,4 @@ fn shift<T: Sample>(args: &Args) -> Result<()> {
         T::NAME
     );
     args.output.write(&shifted, None, &what)
-}
-
-/// One plane shifted in the Haar domain: compact (same size), or the retained `2^h`-finer
-/// image.
-fn haar_shift<T: Sample>(
-    plane: ArrayView2<'_, T>,
-    dx: f64,
-    dy: f64,
-    options: &KernelOptions,
-) -> Result<Array2<T>> {
-    let spec = TransformSpec {
-        padding: BoundaryMode::Wrap,
-        ..Default::default()
-    };
-    let coeffs = spec.forward(plane)?;
-    let h = options.precision;
-    if !options.retain {
-        return shift_image(&coeffs, dx, dy, h)?.inverse();
-    }
-    let mut retained = RetainedImage::new(&coeffs, h)?;
-    retained.shift(dx, dy)?;
-    let info = coeffs.info();
-    let fine = pyramid::inverse(
-        retained.fine(),
-        info.levels[0] + h as usize,
-        info.normalization,
-    )?;
-    let [rows, cols] = info.original_shape;
-    Ok(fine.slice(s![..rows << h, ..cols << h]).to_owned())
 }

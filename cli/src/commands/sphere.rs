@@ -231,16 +231,8 @@ pub struct MapFlags {
 
 impl MapFlags {
     /// The selection of each map (one for all when one is given).
-    fn selections(&self) -> Vec<Selection> {
-        match (self.threshold, self.per_face) {
-            (Some(t), _) => vec![Selection::Threshold(t)],
-            (None, true) => self
-                .keep
-                .iter()
-                .map(|&k| Selection::LargestPerFace(k))
-                .collect(),
-            (None, false) => self.keep.iter().map(|&k| Selection::Largest(k)).collect(),
-        }
+    fn selections(&self) -> Result<Vec<Selection>> {
+        Selection::from_counts(&self.keep, self.threshold, self.per_face)
     }
 
     /// The float type given, or f64 when any map holds f64 samples and f32 otherwise.
@@ -357,7 +349,7 @@ fn integrate_as<T: Sample>(args: &IntegrateArgs) -> Result<()> {
     let options = IntegrateOptions {
         param: flags.param,
         resolution: flags.resolution,
-        selections: flags.selections(),
+        selections: flags.selections()?,
         depth: args.depth,
         method: args.method,
     };
@@ -484,7 +476,7 @@ fn product_as<T: Sample>(
     let options = ProductOptions {
         param: flags.param,
         resolution: flags.resolution,
-        selections: flags.selections(),
+        selections: flags.selections()?,
     };
     bar.set_message("multiplying");
     let result = multiply(&maps, &options);

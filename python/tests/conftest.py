@@ -1,0 +1,41 @@
+"""Shared fixtures: test images made here or read from the repository's testdata/, and the
+command-line binary that `cargo test --workspace --release` builds."""
+import pathlib
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="session")
+def camera():
+    """The 512 x 512 8-bit camera photograph (testdata/camera.png) as uint8."""
+    import haarshift
+
+    return haarshift.read_image(ROOT / "testdata" / "camera.png")
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(20081122)
+
+
+@pytest.fixture(scope="session")
+def cli():
+    """Runs the haarshift binary; skips when it has not been built (CI builds it first)."""
+    binary = ROOT / "target" / "release" / "haarshift"
+    if not binary.exists():
+        found = shutil.which("haarshift")
+        if found is None:
+            pytest.skip("target/release/haarshift not built: run cargo build --release")
+        binary = pathlib.Path(found)
+
+    def run(*args):
+        result = subprocess.run([str(binary), *map(str, args)], capture_output=True, text=True)
+        assert result.returncode == 0, result.stderr
+        return result
+
+    return run
