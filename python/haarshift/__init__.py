@@ -13,7 +13,7 @@ budget), each with the library's one-line message.
 >>> bool((haarshift.inverse(c) == x).all())
 True
 """
-from . import sphere
+from . import relight, sphere
 from ._native import (
     Rotator,
     __version__,
@@ -30,6 +30,7 @@ __all__ = [
     "__version__",
     "inverse",
     "read_image",
+    "relight",
     "rotate",
     "shift",
     "sphere",

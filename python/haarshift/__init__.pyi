@@ -4,6 +4,7 @@ from typing import Literal, Optional, Tuple, Union
 import numpy as np
 import numpy.typing as npt
 
+from . import relight as relight
 from . import sphere as sphere
 
 __version__: str

@@ -8,6 +8,7 @@ mod arrays;
 mod errors;
 mod io;
 mod options;
+mod relight;
 mod rotate;
 mod scratch;
 mod shift;
@@ -28,5 +29,6 @@ fn _native(py: Python<'_>, m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(io::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(io::write_image, m)?)?;
     m.add_submodule(&sphere::module(py)?)?;
+    m.add_submodule(&relight::module(py)?)?;
     Ok(())
 }

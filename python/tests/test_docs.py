@@ -6,8 +6,9 @@ import pytest
 
 import haarshift
 
-PUBLIC = [getattr(haarshift, name) for name in haarshift.__all__ if name not in ("__version__", "sphere")]
+PUBLIC = [getattr(haarshift, name) for name in haarshift.__all__ if name not in ("__version__", "relight", "sphere")]
 PUBLIC += [haarshift.sphere.rotate, haarshift.sphere.integrate, haarshift.sphere.product]
+PUBLIC += [haarshift.relight.scene]
 
 
 @pytest.mark.parametrize("obj", PUBLIC, ids=lambda o: o.__name__)
