@@ -79,16 +79,26 @@ fn rotate<'py>(
     };
     let map = ArrayArg::image(map, "map")?;
     let flat = map.shape().len() == 2;
-    let run = |data| rotated(py, data, &rotation, &options);
+    let (rotation, options) = (&rotation, &options);
     Ok(match &map {
-        ArrayArg::F32(a) => map_out(py, run(a.as_array().to_owned())?, flat),
-        ArrayArg::F64(a) => map_out(
+        ArrayArg::F32(a) => map_out(
             py,
-            rotated(py, a.as_array().to_owned(), &rotation, &options)?,
+            rotated(py, a.as_array().to_owned(), rotation, options)?,
             flat,
         ),
-        ArrayArg::U8(_) => map_out(py, to_codes::<u8>(run(map.to_float())?), flat),
-        ArrayArg::U16(_) => map_out(py, to_codes::<u16>(run(map.to_float())?), flat),
+        ArrayArg::F64(a) => map_out(
+            py,
+            rotated(py, a.as_array().to_owned(), rotation, options)?,
+            flat,
+        ),
+        ArrayArg::U8(_) => {
+            let floats = rotated::<f32>(py, map.to_float(), rotation, options)?;
+            map_out(py, to_codes::<u8>(floats), flat)
+        }
+        ArrayArg::U16(_) => {
+            let floats = rotated::<f32>(py, map.to_float(), rotation, options)?;
+            map_out(py, to_codes::<u16>(floats), flat)
+        }
     })
 }
 

@@ -66,7 +66,7 @@ def test_integer_images_round_to_codes(camera):
     got = haarshift.rotate(camera, 30)
     assert got.dtype == np.uint8
     want = haarshift.rotate(camera.astype(np.float32), 30)
-    assert np.array_equal(got, np.clip(np.floor(want + 0.5), 0, 255).astype(np.uint8))
+    assert np.array_equal(got, np.clip(np.floor(want.astype(np.float64) + 0.5), 0, 255).astype(np.uint8))
 
 
 def test_agrees_with_the_command_line(cli, tmp_path, rng):

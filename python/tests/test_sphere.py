@@ -65,3 +65,13 @@ def test_product_equals_the_pixelwise_product(rng):
     np.testing.assert_allclose(got, a[..., None] * b, rtol=0, atol=1e-12)
     cube = haarshift.sphere.product([a, b], param="cube")
     assert cube.shape == (6, 4, 4, 3)
+
+
+def test_integer_maps_round_back_to_codes(rng):
+    m = rng.integers(0, 256, size=(8, 16, 3), dtype=np.uint8)
+    rolled = haarshift.sphere.rotate(m, yaw=45.0)  # two of 16 columns: exact
+    assert rolled.dtype == np.uint8 and np.array_equal(rolled, np.roll(m, -2, axis=1))
+    tilted = haarshift.sphere.rotate(m, pitch=20.0, method="bilinear")
+    want = haarshift.sphere.rotate(m.astype(np.float32), pitch=20.0, method="bilinear")
+    assert tilted.dtype == np.uint8
+    assert np.array_equal(tilted, np.clip(np.floor(want.astype(np.float64) + 0.5), 0, 255).astype(np.uint8))
