@@ -326,12 +326,7 @@ impl TransformSpec {
     /// assert!(deep.padded_shape(4, 8).is_err()); // a 4 x 8 pyramid has 2 levels
     /// ```
     pub fn padded_shape(&self, rows: usize, cols: usize) -> Result<(usize, usize)> {
-        if rows == 0 || cols == 0 {
-            return Err(Error::shape(&[rows, cols], "image is empty"));
-        }
-        let too_large = || Error::shape(&[rows, cols], "too large to pad to a power of two");
-        let h = rows.checked_next_power_of_two().ok_or_else(too_large)?;
-        let w = cols.checked_next_power_of_two().ok_or_else(too_large)?;
+        let (h, w) = padding::padded_size(rows, cols)?;
         self.resolve_levels(h, w)?;
         Ok((h, w))
     }

@@ -20,16 +20,13 @@ pub fn pad_to_power_of_two<T: Sample>(
     mode: BoundaryMode,
 ) -> Result<CowArray<'_, T, Ix2>> {
     let (rows, cols) = image.dim();
-    if rows == 0 || cols == 0 {
-        return Err(Error::shape(&[rows, cols], "image is empty"));
-    }
-    let too_large = || Error::shape(&[rows, cols], "too large to pad to a power of two");
-    let h = rows.checked_next_power_of_two().ok_or_else(too_large)?;
-    let w = cols.checked_next_power_of_two().ok_or_else(too_large)?;
+    let (h, w) = padded_size(rows, cols)?;
     if (h, w) == (rows, cols) {
         return Ok(CowArray::from(image));
     }
-    let elements = h.checked_mul(w).ok_or_else(too_large)?;
+    let elements = h
+        .checked_mul(w)
+        .ok_or_else(|| Error::shape(&[rows, cols], "too large to pad to a power of two"))?;
     let mut data: Vec<T> = Vec::new();
     data.try_reserve_exact(elements)
         .map_err(|_| Error::MemoryBudget {
@@ -51,4 +48,15 @@ pub fn pad_to_power_of_two<T: Sample>(
     }
     let padded = Array2::from_shape_vec((h, w), data).expect("length is h * w");
     Ok(CowArray::from(padded))
+}
+
+/// The sides of a non-empty `rows x cols` array rounded up to powers of two.
+pub(crate) fn padded_size(rows: usize, cols: usize) -> Result<(usize, usize)> {
+    if rows == 0 || cols == 0 {
+        return Err(Error::shape(&[rows, cols], "image is empty"));
+    }
+    let too_large = || Error::shape(&[rows, cols], "too large to pad to a power of two");
+    let h = rows.checked_next_power_of_two().ok_or_else(too_large)?;
+    let w = cols.checked_next_power_of_two().ok_or_else(too_large)?;
+    Ok((h, w))
 }
