@@ -24,12 +24,12 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::sync::OnceLock;
 
 use haarshift::product::Selection;
-use haarshift::relight::environment::{Environment, SphereMapping, downsample_solid_angle};
-use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV, Mesh, render};
+use haarshift::relight::light::environment::{Environment, SphereMapping, downsample_solid_angle};
 use haarshift::relight::{
     Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,
     VisibilityOptions, shade_sh, vertex_major,
 };
+use haarshift::render::raster::{Background, Camera, DEFAULT_FOV, Mesh, render};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::sphere::latlong::direction;
 use haarshift::sphere::param::SphereMap;

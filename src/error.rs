@@ -83,7 +83,7 @@ pub enum Error {
         path: PathBuf,
         /// What is wrong with it.
         #[source]
-        source: crate::relight::brdf::merl::MerlError,
+        source: crate::relight::material::merl::MerlError,
     },
     /// The output file exists and the caller did not ask to replace it.
     #[error("{}: already exists (use --force to replace it)", path.display())]

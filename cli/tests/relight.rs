@@ -321,7 +321,7 @@ fn render_writes_the_image_and_vertices_and_times_each_stage() {
         &["--env", p(&env), "--keep-light", "20"],
     ));
     let linear = haarshift::io::read_image::<f32>(&exr).unwrap();
-    let srgb = haarshift::relight::raster::to_srgb8(&linear, 0.0).unwrap();
+    let srgb = haarshift::render::raster::to_srgb8(&linear, 0.0).unwrap();
     assert_eq!(srgb.planes(), image.planes());
 }
 
@@ -681,7 +681,7 @@ fn reference_refuses_bad_inputs_before_any_work() {
 
 #[test]
 fn reference_takes_glossy_and_measured_brdfs() {
-    use haarshift::relight::brdf::merl::MerlBrdf;
+    use haarshift::relight::material::merl::MerlBrdf;
     let dir = tempfile::tempdir().unwrap();
     let scene = sphere_on_plane(dir.path());
     let env = env32();

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use haarshift::product::Selection;
 use haarshift::relight::Lighting;
 use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
-use haarshift::relight::environment::Environment;
+use haarshift::relight::light::environment::Environment;
 use haarshift::sphere::{LatLongMap, ParamKind, Parameterization, SphereRotation};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;

@@ -23,9 +23,9 @@ use serde::Serialize;
 
 use crate::metrics::RelativeError;
 use crate::product::Selection;
+use crate::relight::dynamic::fields::{FieldOptions, Truncation};
 use crate::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
-use crate::relight::environment::Environment;
-use crate::relight::fields::{FieldOptions, Truncation};
+use crate::relight::light::environment::Environment;
 use crate::relight::{
     Lighting, PreparedTransport, SceneBvh, SceneFile, ShadeOptions, Transform, VisibilityOptions,
     vertex_major,

@@ -46,16 +46,16 @@ use serde::Serialize;
 use crate::experiments::plot::labelled_colour_tiles;
 use crate::metrics::{RelativeError, rms};
 use crate::product::Selection;
-use crate::relight::environment::Environment;
 use crate::relight::glossy::{GlossyOptions, GlossyShader};
-use crate::relight::orient::{BrdfRotation, mirror_directions};
-use crate::relight::raster::{
-    Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
-};
+use crate::relight::light::environment::Environment;
+use crate::relight::material::orient::{BrdfRotation, mirror_directions};
 use crate::relight::reference::ReferenceVisibility;
 use crate::relight::{
     Brdf, Lighting, PhongSh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, ShTransfer,
     ShadeOptions, TransportSet, VisibilityOptions, shade_sh, vertex_major,
+};
+use crate::render::raster::{
+    Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
 };
 use crate::sphere::harmonics::SphericalHarmonics;
 use crate::sphere::{ParamKind, Parameterization, SphereRotation};
@@ -705,7 +705,7 @@ impl<'a> Bench<'a> {
             spatial_difference: None,
             precompute_seconds: shaded.precompute_seconds,
             relight_seconds: shaded.relight_seconds,
-            peak_mib: crate::relight::memory::peak_resident_bytes().unwrap_or(0) as f64
+            peak_mib: crate::memory::peak_resident_bytes().unwrap_or(0) as f64
                 / (1u64 << 20) as f64,
         })
     }

@@ -23,16 +23,18 @@ use std::path::{Path, PathBuf};
 
 use ndarray::{Array2, Array3, Axis, concatenate};
 
-use super::environment::Environment;
-use super::precompute::{PrecomputeOptions, precompute};
-use super::raster::{Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8};
-use super::{
-    Lighting, Mesh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, SceneCache, ShadeOptions,
-    VisibilityOptions, reference, shade_sh,
-};
 use crate::io::{WriteOptions, write_image};
 use crate::metrics::relative_rms_error;
 use crate::product::Selection;
+use crate::relight::light::environment::Environment;
+use crate::relight::precompute::{PrecomputeOptions, precompute};
+use crate::relight::{
+    Lighting, Mesh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, SceneCache, ShadeOptions,
+    VisibilityOptions, reference, shade_sh,
+};
+use crate::render::raster::{
+    Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
+};
 use crate::sphere::harmonics::SphericalHarmonics;
 use crate::sphere::{ParamKind, Parameterization, SphereRotation};
 use crate::{Channels, Error, PlanarImage, Result, SampleDepth};
@@ -338,5 +340,5 @@ fn turntable(
             )
         })
         .collect::<Result<Vec<_>>>()?;
-    super::animation::write_gif(&frames, path, 100, options.force)
+    crate::render::animation::write_gif(&frames, path, 100, options.force)
 }

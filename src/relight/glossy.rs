@@ -5,11 +5,11 @@
 //! camera at `e` (`w_o = (e - p_v) / |e - p_v|`),
 //! `B_v = a_v x integral of T_v(w) L(w) rho_v(w) dw`, with `T_v` the transport (visibility x
 //! cosine x solid angle), `L` the lighting and `rho_v` the BRDF in the vertex's global frame
-//! ([`orient`](super::orient)). Each factor is truncated as the options say: the transport to
+//! ([`orient`](crate::relight::material::orient)). Each factor is truncated as the options say: the transport to
 //! `--keep-visibility`, the lighting to `--keep-light`, the BRDF to `--keep-brdf` (the `K`
 //! largest orthonormal details by RGB magnitude plus each face's scaling coefficient, the rule
 //! of [`crate::product::selection`]), and all three to the detail levels `0..depth`. Vertices
-//! from `object_vertices` on (the ground plane) stay Lambertian ([`fn@super::shade`]).
+//! from `object_vertices` on (the ground plane) stay Lambertian ([`fn@crate::relight::shade`]).
 //!
 //! **How.** The triple product of the three truncated functions is the integral of the
 //! product of their reconstructions, so `B_v = a_v <T_v, Q>` with `Q` the orthonormal Haar
@@ -29,7 +29,7 @@
 //!   nearest bins (four dot products; the triple product is linear in the BRDF), so the
 //!   quantisation error is second order in the bin size;
 //! * view-dependent BRDFs: the nearest normal bin, with the viewer's elevation and azimuth
-//!   quantised as [`orient`](super::orient) does anyway (the key is the triple).
+//!   quantised as [`orient`](crate::relight::material::orient) does anyway (the key is the triple).
 //!
 //! A cache starts empty and fills with the bins views ask for;
 //! [`GlossyShader::fill_cache`] rotates every Phong bin ahead, so that any later view rotates
@@ -45,13 +45,13 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use super::Mesh;
-use super::brdf::Brdf;
-use super::lighting::Lighting;
-use super::orient::{BrdfRotation, Frame, Orientation, to_pole, unit};
-use super::shade::{PreparedTransport, ShadeOptions, select_kept, within_depth};
-use super::transport::TransportSet;
 use crate::product::Selection;
+use crate::relight::Mesh;
+use crate::relight::light::lighting::Lighting;
+use crate::relight::material::brdf::Brdf;
+use crate::relight::material::orient::{BrdfRotation, Frame, Orientation, to_pole, unit};
+use crate::relight::precompute::transport::TransportSet;
+use crate::relight::shade::{PreparedTransport, ShadeOptions, select_kept, within_depth};
 use crate::sphere::latlong::{angles, direction};
 use crate::sphere::param::Parameterization;
 use crate::transform::{Normalization, pyramid};
@@ -64,7 +64,7 @@ pub const MAX_CACHE_BINS: usize = 1024;
 ///
 /// ```
 /// use haarshift::relight::glossy::GlossyOptions;
-/// use haarshift::relight::orient::BrdfRotation;
+/// use haarshift::relight::material::orient::BrdfRotation;
 /// let o = GlossyOptions::default();
 /// assert_eq!((o.rotation, o.level, o.keep_brdf, o.cache_bins), (BrdfRotation::Haar, None, None, None));
 /// ```
@@ -137,7 +137,7 @@ impl Default for GlossyOptions {
             keep_brdf: None,
             brdf_levels: None,
             cache_bins: None,
-            elevations: super::brdf::DEFAULT_ELEVATIONS,
+            elevations: crate::relight::material::brdf::DEFAULT_ELEVATIONS,
         }
     }
 }
@@ -176,7 +176,7 @@ pub struct GlossyReport {
 /// use haarshift::product::Selection;
 /// use haarshift::relight::{Brdf, Lighting, Mesh, ShadeOptions, TransportSet};
 /// use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
-/// use haarshift::relight::orient::BrdfRotation;
+/// use haarshift::relight::material::orient::BrdfRotation;
 /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
 /// use ndarray::{Array2, Axis, array};
 /// // An upward triangle whose vertices see the whole sky: transport = cosine x solid angle.

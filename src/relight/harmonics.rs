@@ -8,9 +8,9 @@
 //! of the precomputation's [`Parameterization`]. The texel solid angle enters here once (the
 //! transfer is the factor that carries it, as the Haar transport does); the basis values
 //! `Y_i(w_t) dOmega_t` are tabulated once per texel, not per vertex. The precomputation
-//! ([`vertex_major`](super::vertex_major), [`direction_major`](super::direction_major)) makes it
-//! when [`VisibilityOptions::sh_bands`](super::VisibilityOptions::sh_bands) asks, and the
-//! [`TransportSet`](super::TransportSet) carries it beside the Haar coefficients.
+//! ([`vertex_major`](crate::relight::vertex_major), [`direction_major`](crate::relight::direction_major)) makes it
+//! when [`VisibilityOptions::sh_bands`](crate::relight::VisibilityOptions::sh_bands) asks, and the
+//! [`TransportSet`](crate::relight::TransportSet) carries it beside the Haar coefficients.
 //!
 //! **Shading.** The lighting's coefficients are its own projection,
 //! `l_i = sum_t L(w_t) Y_i(w_t) dOmega_t` ([`SphericalHarmonics::project`], which weights by

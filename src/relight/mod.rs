@@ -1,32 +1,22 @@
-//! All-frequency relighting: meshes and scenes, ray casting, per-vertex visibility and
-//! transport precomputation, the scene cache, the lighting, and images of the result.
+//! All-frequency relighting, in the order the data flows: a scene is read and checked
+//! ([`scene`]), its per-vertex transport precomputed ([`precompute`]), the lighting encoded
+//! ([`light`]), a material brought into each vertex's frame ([`material`]), the outgoing
+//! radiance computed ([`shade`](mod@shade), [`glossy`], [`harmonics`], [`mod@reference`]), and
+//! scenes whose objects move relit by just-in-time radiance transfer ([`dynamic`]). Images of
+//! the result are [`crate::render`]'s.
 //!
-//! | file | idea |
+//! | module | idea |
 //! |---|---|
 //! | [`error`] | [`SceneError`]: what can be wrong with a mesh, a scene file or a cache |
-//! | [`mesh`] | [`Mesh`]: OBJ and PLY in, vertex normals |
-//! | [`scene`] | the ground plane, procedural generators, the JSON scene file ([`Scene`]) |
-//! | [`raycast`] | [`Occlusion`], the any-hit query, answered by [`SceneBvh`] |
-//! | [`shadowmap`] | [`ShadowMap`], seed 003's orthographic depth buffer along one direction |
-//! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
-//! | [`sparse`] | [`SparseRows`](sparse::SparseRows): many sparse Haar functions in flat arrays |
-//! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
-//! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
-//! | [`fields`] | [`OcclusionField`](fields::OcclusionField): an object's occlusion seen from sample points around it (seed 001); on disk, the `.hsf` file ([`fields::file`]) |
-//! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other; [`Jrt`](dynamic::Jrt), just-in-time radiance transfer |
-//! | [`motion`] | [`MotionPath`](motion::MotionPath): animations of dynamic scenes, played with re-formed transfer |
-//! | [`mod@reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
-//! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file (its framing, `framed`, is shared with the `.hsf` field file) |
-//! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
-//! | [`lighting`] | [`Lighting`]: the environment's kept Haar coefficients, RGB, in Mallat order |
-//! | [`brdf`] | [`Brdf`]: Lambert, Phong, Blinn-Phong; local copies of a BRDF |
+//! | [`scene`] | the ground plane, procedural generators, the JSON scene file ([`Scene`]); [`scene::mesh`] ([`Mesh`]: OBJ and PLY in, vertex normals); [`scene::cache`] ([`SceneCache`]: the versioned, checksummed `.hsr` file) |
+//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order: [`precompute::raycast`] ([`Occlusion`], answered by [`SceneBvh`]), [`precompute::shadowmap`] ([`ShadowMap`], the PRT patent's depth buffer), [`precompute::visibility`] ([`vertex_major`], [`direction_major`]), [`precompute::transport`] ([`TransportSet`]), [`precompute::sparse`] (many sparse Haar functions in flat arrays) |
+//! | [`light`] | [`light::environment`]: the lighting loaded, downsampled by solid-angle-weighted means, rotated; [`light::lighting`] ([`Lighting`]): its kept Haar coefficients, RGB, in Mallat order |
+//! | [`material`] | [`material::brdf`] ([`Brdf`]: Lambert, Phong, Blinn-Phong, local copies), [`material::merl`] (measured BRDFs), [`material::orient`] (a BRDF into a vertex's frame: Haar, spatial, reference or direct) |
 //! | [`shade`](mod@shade) | per-vertex outgoing radiance: [`PreparedTransport`], one sparse dot per vertex |
-//! | [`orient`] | bringing a BRDF into a vertex's frame: Haar, spatial, reference or direct |
 //! | [`glossy`] | glossy shading: the triple product with the rotated BRDF, the rotation cache |
-//! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
-//! | [`animation`] | frames into an animated GIF |
-//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
-//! | [`memory`] | the process's peak resident memory, for reports |
+//! | [`harmonics`] | [`ShTransfer`]: the PRT patent's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
+//! | [`mod@reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
+//! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other (Sun 2006); [`dynamic::fields`] (occlusion fields, the `.hsf` file), [`dynamic::motion`] (animations played with re-formed transfer) |
 //! | [`gallery`] | the committed diffuse renders: Haar, SH and the reference under several maps |
 //!
 //! Conventions are the sphere module's: world Y up, right-handed, directions as in
@@ -34,51 +24,67 @@
 //! `R = Rz(roll) Ry(yaw) Rx(pitch)`.
 //! The transport is the one factor of a product integral that carries the texel solid angle
 //! ([`crate::product::Transport`]).
-pub mod animation;
-pub mod brdf;
-pub mod cache;
 pub mod dynamic;
-pub mod environment;
 pub mod error;
-pub mod fields;
-mod framed;
 pub mod gallery;
 pub mod glossy;
 pub mod harmonics;
-pub mod lighting;
-pub mod memory;
-pub mod mesh;
-pub mod motion;
-pub mod orient;
+pub mod light;
+pub mod material;
 pub mod precompute;
-pub mod raster;
-pub mod raycast;
 pub mod reference;
 pub mod scene;
 pub mod shade;
-pub mod shadowmap;
-pub mod sparse;
-pub mod transport;
-pub mod visibility;
 
-pub use brdf::Brdf;
-pub use cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
 pub use error::SceneError;
 pub use harmonics::{PhongSh, ShTransfer, non_zonal_material, shade_sh, shade_sh_glossy};
-pub use lighting::Lighting;
-pub use mesh::{Bounds, Mesh};
-pub use raycast::{Occlusion, SceneBvh};
+pub use light::lighting::Lighting;
+pub use material::brdf::Brdf;
+pub use precompute::raycast::{Occlusion, SceneBvh};
+pub use precompute::shadowmap::ShadowMap;
+pub use precompute::transport::TransportSet;
+pub use precompute::visibility::{
+    PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major,
+};
 pub use reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
+pub use scene::cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
+pub use scene::mesh::{Bounds, Mesh};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,
 };
 pub use shade::{PreparedTransport, ShadeOptions, shade};
-pub use shadowmap::ShadowMap;
-pub use transport::TransportSet;
-pub use visibility::{
-    PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major,
-};
+
+/// The paths of the modules before they were grouped by pipeline stage, kept for one release
+/// (CHANGELOG.md lists them).
+macro_rules! moved {
+    ($($old:ident => $($new:ident)::+, $note:literal;)*) => {$(
+        #[doc(hidden)]
+        #[deprecated(note = $note)]
+        pub mod $old {
+            pub use crate::$($new)::+::*;
+        }
+    )*};
+}
+
+moved! {
+    animation => render::animation, "moved to `haarshift::render::animation`";
+    brdf => relight::material::brdf, "moved to `haarshift::relight::material::brdf`";
+    cache => relight::scene::cache, "moved to `haarshift::relight::scene::cache`";
+    environment => relight::light::environment, "moved to `haarshift::relight::light::environment`";
+    fields => relight::dynamic::fields, "moved to `haarshift::relight::dynamic::fields`";
+    lighting => relight::light::lighting, "moved to `haarshift::relight::light::lighting`";
+    memory => memory, "moved to `haarshift::memory`";
+    mesh => relight::scene::mesh, "moved to `haarshift::relight::scene::mesh`";
+    motion => relight::dynamic::motion, "moved to `haarshift::relight::dynamic::motion`";
+    orient => relight::material::orient, "moved to `haarshift::relight::material::orient`";
+    raster => render::raster, "moved to `haarshift::render::raster`";
+    raycast => relight::precompute::raycast, "moved to `haarshift::relight::precompute::raycast`";
+    shadowmap => relight::precompute::shadowmap, "moved to `haarshift::relight::precompute::shadowmap`";
+    sparse => relight::precompute::sparse, "moved to `haarshift::relight::precompute::sparse`";
+    transport => relight::precompute::transport, "moved to `haarshift::relight::precompute::transport`";
+    visibility => relight::precompute::visibility, "moved to `haarshift::relight::precompute::visibility`";
+}
 
 /// The [`SceneError`] of a refusal that names the file `path`; panics on anything else.
 #[cfg(test)]

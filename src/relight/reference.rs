@@ -15,11 +15,11 @@
 //! leaves the sum as `a_v / pi x sum_t L(t) V(v, t) max(0, n_v . w_t) dOmega_t`, which is
 //! what is computed (the eye is not needed). [`ReferenceOptions::object_vertices`] gives the
 //! BRDF to the scene's objects only, the ground plane after them staying Lambertian
-//! ([`Scene::object_vertices`](super::Scene::object_vertices)).
+//! ([`Scene::object_vertices`](crate::relight::Scene::object_vertices)).
 //!
 //! This is issue 11's contract for checking: `L` is the environment brought
 //! to `N x 2N` by solid-angle-weighted means and rotated
-//! ([`Environment::lat_long`](super::environment::Environment::lat_long)); `N` need not be a
+//! ([`Environment::lat_long`](crate::relight::light::environment::Environment::lat_long)); `N` need not be a
 //! power of two. Nothing here touches the transport, the Haar transform or a product integral,
 //! so the Haar path at full coefficients can be checked against it (the two cast the same rays
 //! in the same `f32` arithmetic, so their visibility agrees bit for bit).
@@ -32,10 +32,10 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2, Axis};
 use rayon::prelude::*;
 
-use super::mesh::dot;
-use super::raycast::Occlusion;
-use super::visibility::{f32x3, origin_and_normal, progress_bar, ray_offset};
-use super::{Brdf, Mesh};
+use crate::relight::precompute::raycast::Occlusion;
+use crate::relight::precompute::visibility::{f32x3, origin_and_normal, progress_bar, ray_offset};
+use crate::relight::scene::mesh::dot;
+use crate::relight::{Brdf, Mesh};
 use crate::sphere::LatLongMap;
 use crate::sphere::latlong::{direction, pixel_centre, pixel_solid_angle};
 use crate::{Error, Result};

@@ -38,12 +38,12 @@
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use super::brdf::check_albedo;
-use super::lighting::Lighting;
-use super::transport::TransportSet;
 use crate::product::Selection;
 use crate::product::selection::{Candidate, keep_largest};
 use crate::product::tree::mallat_detail;
+use crate::relight::light::lighting::Lighting;
+use crate::relight::material::brdf::check_albedo;
+use crate::relight::precompute::transport::TransportSet;
 use crate::sphere::Parameterization;
 use crate::sphere::integrate::layout;
 use crate::{Error, Result, Sample};

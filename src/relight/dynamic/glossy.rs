@@ -8,8 +8,8 @@
 //! integral.
 
 use super::*;
-use crate::relight::brdf::MAX_EXPONENT;
-use crate::relight::orient::Frame;
+use crate::relight::material::brdf::MAX_EXPONENT;
+use crate::relight::material::orient::Frame;
 
 /// Sparse RGB coefficients: ascending indices and their values.
 type SparseRgb = (Vec<u32>, Vec<[f64; 3]>);
@@ -79,14 +79,14 @@ impl DynamicScene {
     }
 
     /// Sets how glossy BRDFs are brought into vertex frames and truncated: `rotation`, `level`,
-    /// `elevations`, `keep_brdf` and `brdf_levels` as [`GlossyShader`](super::super::glossy::GlossyShader)
+    /// `elevations`, `keep_brdf` and `brdf_levels` as [`GlossyShader`](crate::relight::glossy::GlossyShader)
     /// reads them. Its `brdf` is not read (each object has its own, [`set_brdf`](Self::set_brdf)),
     /// and a rotation cache is refused: every vertex's lobe is rotated in its exact frame.
     ///
     /// ```
     /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// use haarshift::relight::glossy::GlossyOptions;
-    /// use haarshift::relight::orient::BrdfRotation;
+    /// use haarshift::relight::material::orient::BrdfRotation;
     /// use haarshift::relight::SceneFile;
     /// use haarshift::sphere::{ParamKind, Parameterization};
     /// let file: SceneFile = serde_json::from_str(
@@ -292,4 +292,5 @@ impl DynamicScene {
 }
 
 #[cfg(test)]
+#[path = "glossy_tests.rs"]
 mod tests;

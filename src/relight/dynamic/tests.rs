@@ -2,7 +2,7 @@ use ndarray::{Array3, Axis};
 
 use super::*;
 use crate::relight::Occlusion;
-use crate::relight::fields::FieldOptions;
+use crate::relight::dynamic::fields::FieldOptions;
 use crate::relight::shade::{PreparedTransport, ShadeOptions};
 use crate::sphere::param::SphereMap;
 

@@ -384,7 +384,7 @@ fn a_merl_table_of_phong_agrees_with_phong_to_its_quantisation() {
     // 20 tan(alpha) per radian in relative terms, about 9 % per degree at its half maximum
     // (alpha = 15 degrees): the table is exact at its grid points (the MERL module's tests)
     // and its integrals are a few percent off, more for sharper lobes.
-    use crate::relight::brdf::merl::tests::{phong_table, phong_table_at_centres};
+    use crate::relight::material::merl::tests::{phong_table, phong_table_at_centres};
     use std::sync::Arc;
     let mesh = Generator::PlaneUnderBox { height: 1.0 }.mesh().unwrap();
     let albedo = Array2::from_elem((mesh.vertex_count(), 3), 0.7f32);

@@ -1,7 +1,7 @@
 use std::path::Path;
 
 use super::*;
-use crate::relight::mesh::sub;
+use crate::relight::scene::mesh::sub;
 
 /// Every triangle of a closed convex mesh faces away from `centre`.
 fn assert_outward(mesh: &Mesh, centre: [f64; 3]) {

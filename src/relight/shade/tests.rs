@@ -5,7 +5,7 @@ use ndarray::{Array2, Array3, Array4, Axis};
 use super::*;
 use crate::metrics::relative_rms_error;
 use crate::product::{HaarTree, IntegralOptions, product_integral, triple::triple_integral};
-use crate::relight::environment::{Environment, downsample_solid_angle};
+use crate::relight::light::environment::{Environment, downsample_solid_angle};
 use crate::relight::{
     Generator, Mesh, Occlusion, SceneBvh, VisibilityOptions, ray_offset, vertex_major,
 };

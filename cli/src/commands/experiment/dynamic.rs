@@ -8,7 +8,7 @@ use haarshift::experiments::pareto::frontier;
 use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
 use haarshift::experiments::table::{Table, significant};
 use haarshift::relight::Transform;
-use haarshift::relight::environment::Environment;
+use haarshift::relight::light::environment::Environment;
 use haarshift::{Error, Result};
 
 use super::{OutputFlags, progress_bar, wrote};

@@ -5,15 +5,15 @@ use std::path::{Path, PathBuf};
 
 use haarshift::PlanarImage;
 use haarshift::product::Selection;
-use haarshift::relight::brdf::DEFAULT_ELEVATIONS;
-use haarshift::relight::environment::Environment;
 use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
-use haarshift::relight::orient::BrdfRotation;
-use haarshift::relight::raster::{Background, Camera, DEFAULT_FOV};
-use haarshift::relight::raster::{Mesh as RasterMesh, render};
+use haarshift::relight::light::environment::Environment;
+use haarshift::relight::material::brdf::DEFAULT_ELEVATIONS;
+use haarshift::relight::material::orient::BrdfRotation;
 use haarshift::relight::scene::GROUND_VERTICES;
 use haarshift::relight::{Brdf, PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
+use haarshift::render::raster::{Background, Camera, DEFAULT_FOV};
+use haarshift::render::raster::{Mesh as RasterMesh, render};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift::{Error, Result};
 

@@ -3,9 +3,9 @@
 use std::path::PathBuf;
 
 use haarshift::Result;
+use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
 use haarshift::relight::VisibilityOptions;
-use haarshift::relight::memory::peak_resident_bytes;
 use haarshift::relight::precompute::{DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute};
 use haarshift::sphere::{ParamKind, Parameterization};
 

@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::relight::raster::{render_format, write_render};
 use haarshift::relight::{ReferenceOptions, SceneBvh, reference};
+use haarshift::render::raster::{render_format, write_render};
 use haarshift::{Result, SampleDepth};
 
 use super::flags::{

@@ -5,13 +5,13 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use haarshift::product::Selection;
-use haarshift::relight::animation::{numbered_path, write_gif};
+use haarshift::relight::dynamic::fields::file::FieldStore;
+use haarshift::relight::dynamic::fields::{FieldOptions, Truncation};
+use haarshift::relight::dynamic::motion::{MotionPath, play};
 use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene};
-use haarshift::relight::fields::file::FieldStore;
-use haarshift::relight::fields::{FieldOptions, Truncation};
-use haarshift::relight::motion::{MotionPath, play};
-use haarshift::relight::raster::{Camera, render_format, to_srgb8, write_render};
 use haarshift::relight::{Brdf, CameraSpec, Lighting};
+use haarshift::render::animation::{numbered_path, write_gif};
+use haarshift::render::raster::{Camera, render_format, to_srgb8, write_render};
 use haarshift::sphere::{ParamKind, Parameterization};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
@@ -39,7 +39,7 @@ as one more factor: albedo x the integral of transport x lighting x occlusion x 
 
 --animate PATH.json plays segments that each move one object, turn the lighting or turn the
 eye about the camera's look-at point (\"eye_yaw\": glossy vertices are seen from elsewhere; see
-the library's relight::motion for the file): the fixed factors' product is re-formed when the
+the library's relight::dynamic::motion for the file): the fixed factors' product is re-formed when the
 kind of change switches, and each frame is one sparse dot product per vertex with the varying
 factor (just-in-time radiance transfer). Every frame's times are printed: re-forming, shading,
 rasterisation. The output is a looping GIF or numbered PNGs (a pattern with %d).

@@ -1,0 +1,362 @@
+//! Precomputing every vertex's transport: visibility x cosine x solid angle at the texel
+//! directions of a [`Parameterization`], Haar-transformed and truncated ([`TransportSet`]).
+//!
+//! **What is computed.** For vertex `v` (position `p`, unit normal `n`) and texel `t` (centre
+//! direction `w_t`, solid angle `dOmega_t`), `T_v(t) = V(v, t) max(0, n . w_t) dOmega_t`. Rays
+//! start at `p + eps n`, `eps = 1e-4 x` the scene's bounding-box diagonal ([`ray_offset`]); a
+//! ray that hits any triangle is blocked. Texels whose centre is below the horizon
+//! (`n . w_t <= 0`) are 0 and cast no ray. With `samples = S > 1`, `V(v, t)` is the fraction of
+//! `S x S` stratified rays through the texel that escape (sub-cell `(a, b)` of the texel's
+//! parameter square, jittered uniformly inside it by a hash of the seed, vertex, texel and
+//! sample, so the result does not depend on the thread schedule); a jittered ray below the
+//! horizon counts as blocked. `S = 1` is one ray through the texel centre. The cosine is the
+//! centre's.
+//!
+//! **Two loop orders.**
+//! * [`vertex_major`]: vertices outer (rayon), directions inner, rays through a BVH
+//!   ([`Occlusion`]); each vertex is encoded as soon as it is done, so the working memory is one
+//!   `(faces, S, S)` array per thread.
+//! * [`direction_major`]: seed 003's order: directions outer, vertices inner, a software shadow
+//!   buffer per direction ([`ShadowMap`]) instead of rays. Visibility of all (vertex, direction)
+//!   pairs is held as bits, one column of `V` bits per direction (`V x D / 8` bytes: 352 MB for
+//!   85,860 vertices x 32,768 directions, against 11 GB as f32), then each vertex is encoded.
+//!   Texel centres only (`samples = 1`).
+//!
+//! With [`VisibilityOptions::sh_bands`], both also project every vertex's values onto spherical
+//! harmonics ([`harmonics`](crate::relight::harmonics): `t_i = sum_t V cos Y_i(w_t) dOmega_t`, the
+//! basis tabulated once per texel and shared by all threads); the returned set carries the
+//! transfer ([`TransportSet::sh`]).
+//!
+//! Both report what they did in a [`PrecomputeReport`]: rays cast, wall time, the working
+//! memory the method holds beyond its inputs and outputs.
+
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use ndarray::Array3;
+use rayon::prelude::*;
+
+use crate::product::Selection;
+use crate::relight::Mesh;
+use crate::relight::harmonics::check_bands;
+use crate::relight::precompute::raycast::Occlusion;
+use crate::relight::precompute::shadowmap::ShadowMap;
+use crate::relight::precompute::transport::{Encoded, Encoder, TransportSet};
+use crate::relight::scene::mesh::dot;
+use crate::sphere::Parameterization;
+use crate::{Error, Result};
+
+/// How to precompute; see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::VisibilityOptions;
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// let o = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 16).unwrap());
+/// assert_eq!((o.samples, o.seed, o.sh_bands, o.progress), (1, 0, None, false));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisibilityOptions {
+    /// The directions: texel centres of this parameterisation.
+    pub param: Parameterization,
+    /// `S`: `S x S` stratified rays per texel (1: the centre).
+    pub samples: usize,
+    /// Which coefficients of each vertex's transport to keep.
+    pub keep: Selection,
+    /// Seed of the stratified jitter.
+    pub seed: u64,
+    /// Also project every vertex's transport onto this many bands of spherical harmonics
+    /// (`--sh-bands B`: degrees `0..B`, `B^2` coefficients, 1 to
+    /// [`MAX_SH_BANDS`](crate::relight::harmonics::MAX_SH_BANDS)); the set then carries an
+    /// [`ShTransfer`](crate::relight::harmonics::ShTransfer).
+    pub sh_bands: Option<usize>,
+    /// Show a progress bar on standard error (hidden when it is not a terminal).
+    pub progress: bool,
+}
+
+impl VisibilityOptions {
+    /// One ray per texel centre, every coefficient kept, seed 0, no progress bar.
+    pub fn new(param: Parameterization) -> Self {
+        VisibilityOptions {
+            param,
+            samples: 1,
+            keep: Selection::All,
+            seed: 0,
+            sh_bands: None,
+            progress: false,
+        }
+    }
+
+    fn check(&self) -> Result<()> {
+        if !(1..=64).contains(&self.samples) {
+            return Err(Error::parameter(
+                "visibility samples",
+                format!("{}: must be 1 to 64 (S x S rays per texel)", self.samples),
+            ));
+        }
+        if let Some(b) = self.sh_bands {
+            check_bands(b)?;
+        }
+        let p = self.param;
+        self.keep.limit(p.texels() - p.faces())?;
+        Ok(())
+    }
+}
+
+/// What a precomputation did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrecomputeReport {
+    /// Rays cast (0 for the shadow-buffer order).
+    pub rays: u64,
+    /// Wall-clock seconds, encoding included.
+    pub seconds: f64,
+    /// Bytes of working memory the method held at its peak beyond the mesh and the output
+    /// (visibility bits and depth buffers, or per-thread texel arrays, and the shared tables:
+    /// solid angles and spherical harmonics).
+    pub working_bytes: usize,
+}
+
+/// The distance rays start off their surface: `1e-4 x` the bounding-box diagonal.
+///
+/// ```
+/// use haarshift::relight::{Mesh, ray_offset};
+/// use ndarray::array;
+/// let m = Mesh::new(array![[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+///                   vec![[0, 1, 2]], None).unwrap();
+/// assert!((ray_offset(&m) - 5e-4).abs() < 1e-15);
+/// ```
+pub fn ray_offset(mesh: &Mesh) -> f64 {
+    1e-4 * mesh.bounds().diagonal()
+}
+
+/// Texel centre directions in Mallat/texel index order `(face, row, col)`.
+pub(crate) fn texel_directions(param: Parameterization) -> Vec<[f64; 3]> {
+    let s = param.face_size();
+    (0..param.texels())
+        .map(|t| param.texel_direction(t / (s * s), (t / s) % s, t % s))
+        .collect()
+}
+
+pub(crate) fn progress_bar(show: bool, len: usize, what: &str) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len as u64).with_message(what.to_string());
+    if let Ok(style) =
+        ProgressStyle::with_template("{msg} {wide_bar} {pos}/{len} vertices, eta {eta}")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// SplitMix64: a well-mixed hash of a 64-bit key.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Two uniform numbers in `[0, 1)` for one (seed, vertex, texel, sample).
+fn jitter(seed: u64, vertex: usize, texel: usize, sample: usize) -> (f64, f64) {
+    let h = mix(seed ^ mix((vertex as u64) << 32 ^ texel as u64) ^ mix(sample as u64 + 1));
+    let unit = |x: u64| (x >> 11) as f64 / (1u64 << 53) as f64;
+    (unit(h), unit(mix(h)))
+}
+
+/// The ray origin of vertex `v` and its normal.
+pub(crate) fn origin_and_normal(mesh: &Mesh, v: usize, eps: f64) -> ([f64; 3], [f64; 3]) {
+    let (p, n) = (mesh.positions(), mesh.normals());
+    let n = [n[[v, 0]], n[[v, 1]], n[[v, 2]]];
+    (std::array::from_fn(|k| p[[v, k]] + eps * n[k]), n)
+}
+
+pub(crate) fn f32x3(a: [f64; 3]) -> [f32; 3] {
+    a.map(|x| x as f32)
+}
+
+/// Vertex-major precomputation by ray casting; see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::{Mesh, SceneBvh, VisibilityOptions, vertex_major};
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use ndarray::array;
+/// // One upward triangle: nothing occludes it, so each vertex sees the upper hemisphere.
+/// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+///                   vec![[0, 1, 2]], None).unwrap();
+/// let options = VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 16).unwrap());
+/// let (set, report) = vertex_major(&m, &SceneBvh::new(&m), &options).unwrap();
+/// let total: f32 = set.transport(0).unwrap().tree().to_pixels().unwrap().sum();
+/// assert!((total - std::f32::consts::PI).abs() < 0.02); // the integral of cos over a hemisphere
+/// assert_eq!(report.rays, 3 * 16 * 16); // the upper half of 16 x 32 texels, per vertex
+/// ```
+pub fn vertex_major(
+    mesh: &Mesh,
+    occlusion: &impl Occlusion,
+    options: &VisibilityOptions,
+) -> Result<(TransportSet, PrecomputeReport)> {
+    options.check()?;
+    let start = Instant::now();
+    let param = options.param;
+    let directions = texel_directions(param);
+    let eps = ray_offset(mesh);
+    let s = param.face_size();
+    let samples = options.samples;
+    let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
+    let mut set = encoder.empty_set()?;
+    let bar = progress_bar(options.progress, mesh.vertex_count(), "visibility (rays)");
+    let encoded: Vec<Result<(Encoded, u64)>> = (0..mesh.vertex_count())
+        .into_par_iter()
+        .map_init(
+            || Array3::<f32>::zeros((param.faces(), s, s)),
+            |values, v| {
+                let (origin, n) = origin_and_normal(mesh, v, eps);
+                let o = f32x3(origin);
+                let flat = values.as_slice_mut().expect("fresh array is contiguous");
+                let mut rays = 0u64;
+                for (t, (value, &w)) in flat.iter_mut().zip(&directions).enumerate() {
+                    let cos = dot(n, w);
+                    *value = 0.0;
+                    if cos <= 0.0 {
+                        continue;
+                    }
+                    let visible = if samples == 1 {
+                        rays += 1;
+                        u32::from(!occlusion.occluded(o, f32x3(w), f32::INFINITY))
+                    } else {
+                        let (face, row, col) = (t / (s * s), (t / s) % s, t % s);
+                        let mut escaped = 0;
+                        for k in 0..samples * samples {
+                            let (ju, jv) = jitter(options.seed, v, t, k);
+                            let r = row as f64 + ((k / samples) as f64 + ju) / samples as f64;
+                            let c = col as f64 + ((k % samples) as f64 + jv) / samples as f64;
+                            let d = param.point(face, r, c);
+                            if dot(n, d) > 0.0 {
+                                rays += 1;
+                                escaped +=
+                                    u32::from(!occlusion.occluded(o, f32x3(d), f32::INFINITY));
+                            }
+                        }
+                        escaped
+                    };
+                    *value = (visible as f64 / (samples * samples) as f64 * cos) as f32;
+                }
+                let vertex = encoder.encode(values.view())?;
+                bar.inc(1);
+                Ok((vertex, rays))
+            },
+        )
+        .collect();
+    bar.finish_and_clear();
+    let mut rays = 0;
+    for vertex in encoded {
+        let (vertex, r) = vertex?;
+        set.extend(&vertex);
+        rays += r;
+    }
+    let report = PrecomputeReport {
+        rays,
+        seconds: start.elapsed().as_secs_f64(),
+        working_bytes: rayon::current_num_threads() * param.texels() * 4 + encoder.bytes(),
+    };
+    Ok((set, report))
+}
+
+/// Direction-major precomputation with a shadow buffer of `map_size x map_size` texels per
+/// direction (seed 003); see the [module docs](self).
+///
+/// ```
+/// use haarshift::relight::{Mesh, SceneBvh, VisibilityOptions, direction_major, vertex_major};
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use ndarray::array;
+/// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+///                   vec![[0, 1, 2]], None).unwrap();
+/// let options = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap());
+/// let (by_maps, _) = direction_major(&m, &options, 256).unwrap();
+/// let (by_rays, _) = vertex_major(&m, &SceneBvh::new(&m), &options).unwrap();
+/// assert_eq!(by_maps, by_rays); // nothing occludes: both are the cosine lobe
+/// ```
+pub fn direction_major(
+    mesh: &Mesh,
+    options: &VisibilityOptions,
+    map_size: usize,
+) -> Result<(TransportSet, PrecomputeReport)> {
+    options.check()?;
+    if options.samples != 1 {
+        return Err(Error::parameter(
+            "visibility samples",
+            "the direction-major order samples texel centres only: use 1",
+        ));
+    }
+    if !(1..=16384).contains(&map_size) {
+        return Err(Error::parameter(
+            "shadow map size",
+            format!("{map_size}: must be 1 to 16384"),
+        ));
+    }
+    let start = Instant::now();
+    let param = options.param;
+    let directions = texel_directions(param);
+    let eps = ray_offset(mesh);
+    let vertices = mesh.vertex_count();
+    let words = vertices.div_ceil(64);
+    let origins: Vec<([f64; 3], [f64; 3])> = (0..vertices)
+        .map(|v| origin_and_normal(mesh, v, eps))
+        .collect();
+    // One column of V bits per direction: bit v set when vertex v sees the direction.
+    let columns: Vec<Vec<u64>> = directions
+        .par_iter()
+        .map(|&w| {
+            let mut column = vec![0u64; words];
+            if origins.iter().all(|(_, n)| dot(*n, w) <= 0.0) {
+                return column;
+            }
+            let map = ShadowMap::render(mesh, w, map_size);
+            for (v, (o, n)) in origins.iter().enumerate() {
+                let cos = dot(*n, w);
+                if cos > 0.0 && map.lit(*o, cos) {
+                    column[v / 64] |= 1 << (v % 64);
+                }
+            }
+            column
+        })
+        .collect();
+    let bits_bytes = directions.len() * words * 8;
+    let maps_bytes = rayon::current_num_threads() * map_size * map_size * 4;
+    let s = param.face_size();
+    let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
+    let bar = progress_bar(options.progress, vertices, "transport (shadow maps)");
+    let encoded: Vec<Result<Encoded>> = (0..vertices)
+        .into_par_iter()
+        .map(|v| {
+            let n = origins[v].1;
+            let values = Array3::from_shape_fn((param.faces(), s, s), |(f, r, c)| {
+                let t = (f * s + r) * s + c;
+                let lit = columns[t][v / 64] >> (v % 64) & 1 == 1;
+                if lit {
+                    dot(n, directions[t]) as f32
+                } else {
+                    0.0
+                }
+            });
+            let out = encoder.encode(values.view());
+            bar.inc(1);
+            out
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut set = encoder.empty_set()?;
+    for vertex in encoded {
+        set.extend(&vertex?);
+    }
+    let report = PrecomputeReport {
+        rays: 0,
+        seconds: start.elapsed().as_secs_f64(),
+        working_bytes: bits_bytes + maps_bytes + encoder.bytes(),
+    };
+    Ok((set, report))
+}
+
+#[cfg(test)]
+#[path = "visibility_tests.rs"]
+mod tests;
