@@ -16,6 +16,7 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use haarshift::faces::{ParamKind, Parameterization, SphereMap};
 use haarshift::product::baseline::{pairwise_integral, pixel_integral, pixel_integral_of_trees};
 use haarshift::product::multiply::product;
 use haarshift::product::texel::TexelProduct;
@@ -26,8 +27,8 @@ use haarshift::product::{
     FaceLayout, HaarTree, IntegralOptions, Selection, Transport, WeightedPixels, product_integral,
 };
 use haarshift::relight::{Mesh, Occlusion, SceneBvh, ray_offset};
+use haarshift::sphere::LatLongMap;
 use haarshift::sphere::latlong::angles;
-use haarshift::sphere::{LatLongMap, ParamKind, Parameterization, SphereMap};
 use ndarray::{Array3, Array4, Axis};
 use std::time::Duration;
 

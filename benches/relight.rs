@@ -23,6 +23,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::sync::OnceLock;
 
+use haarshift::faces::param::SphereMap;
+use haarshift::faces::param::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::light::environment::{Environment, SphereMapping, downsample_solid_angle};
 use haarshift::relight::{
@@ -32,8 +34,6 @@ use haarshift::relight::{
 use haarshift::render::raster::{Background, Camera, DEFAULT_FOV, Mesh, render};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::sphere::latlong::direction;
-use haarshift::sphere::param::SphereMap;
-use haarshift::sphere::param::{ParamKind, Parameterization};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use ndarray::{Array2, Array3};
 

@@ -19,11 +19,11 @@
 use std::path::Path;
 use std::time::Instant;
 
+use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::{
     Generator, Mesh, SceneBvh, VisibilityOptions, add_ground_plane, direction_major, vertex_major,
 };
-use haarshift::sphere::{ParamKind, Parameterization};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -36,6 +36,7 @@ mod test_support;
 mod boundary;
 mod error;
 pub mod experiments;
+pub mod faces;
 pub mod io;
 pub mod kernels;
 pub mod memory;

@@ -11,9 +11,10 @@ use common::maps::{planes, pruned, write_map};
 use common::{fails_cleanly, p, succeeds, text};
 
 use haarshift::SampleDepth;
+use haarshift::faces::convert::{convert, default_samples};
+use haarshift::faces::{ParamKind, Parameterization, SphereMap};
 use haarshift::io::read_image;
-use haarshift::sphere::convert::{convert, default_samples};
-use haarshift::sphere::{LatLongMap, ParamKind, Parameterization, SphereMap};
+use haarshift::sphere::LatLongMap;
 use haarshift::transform::{Normalization, pyramid};
 use ndarray::{Array3, Array4, Axis, s};
 

@@ -3,11 +3,12 @@
 
 use std::path::PathBuf;
 
+use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::Lighting;
 use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
 use haarshift::relight::light::environment::Environment;
-use haarshift::sphere::{LatLongMap, ParamKind, Parameterization, SphereRotation};
+use haarshift::sphere::{LatLongMap, SphereRotation};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 

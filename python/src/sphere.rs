@@ -1,10 +1,11 @@
 //! `haarshift.sphere`: lat-long maps rotated, integrated and multiplied through their Haar
 //! coefficients.
 
+use haarshift::faces::ParamKind;
+use haarshift::faces::integrate::{IntegralMethod, IntegrateOptions, integrate as integrate_maps};
+use haarshift::faces::product::{ProductOptions, multiply};
 use haarshift::product::Selection;
-use haarshift::sphere::integrate::{IntegralMethod, IntegrateOptions, integrate as integrate_maps};
-use haarshift::sphere::product::{ProductOptions, multiply};
-use haarshift::sphere::{LatLongMap, Method, ParamKind, SphereOptions, SphereRotation, rotate_map};
+use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
 use haarshift::{Sample, round_to_code};
 use ndarray::{Array3, ArrayD, Axis, Ix2, Ix3};
 use numpy::{Element, IntoPyArray, PyArray1};

@@ -21,6 +21,7 @@ use std::time::Instant;
 use ndarray::Array2;
 use serde::Serialize;
 
+use crate::faces::param::{ParamKind, Parameterization};
 use crate::metrics::RelativeError;
 use crate::product::Selection;
 use crate::relight::dynamic::fields::{FieldOptions, Truncation};
@@ -31,7 +32,6 @@ use crate::relight::{
     vertex_major,
 };
 use crate::sphere::SphereRotation;
-use crate::sphere::param::{ParamKind, Parameterization};
 use crate::{Error, Result};
 
 /// A kept-coefficient budget: lighting, each vertex's own transport, each occlusion map

@@ -44,6 +44,7 @@ use ndarray::{Array2, Array3, Axis, s};
 use serde::Serialize;
 
 use crate::experiments::plot::labelled_colour_tiles;
+use crate::faces::{ParamKind, Parameterization};
 use crate::metrics::{RelativeError, rms};
 use crate::product::Selection;
 use crate::relight::glossy::{GlossyOptions, GlossyShader};
@@ -57,8 +58,8 @@ use crate::relight::{
 use crate::render::raster::{
     Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
 };
+use crate::sphere::SphereRotation;
 use crate::sphere::harmonics::SphericalHarmonics;
-use crate::sphere::{ParamKind, Parameterization, SphereRotation};
 use crate::{Error, PlanarImage, Result};
 
 /// How far the second camera orbits the first about the vertical, degrees.

@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 
 use ndarray::{Array2, Array3, Axis, concatenate};
 
+use crate::faces::{ParamKind, Parameterization};
 use crate::io::{WriteOptions, write_image};
 use crate::metrics::relative_rms_error;
 use crate::product::Selection;
@@ -35,8 +36,8 @@ use crate::relight::{
 use crate::render::raster::{
     Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
 };
+use crate::sphere::SphereRotation;
 use crate::sphere::harmonics::SphericalHarmonics;
-use crate::sphere::{ParamKind, Parameterization, SphereRotation};
 use crate::{Channels, Error, PlanarImage, Result, SampleDepth};
 
 /// What to make; see the [module docs](self).

@@ -45,6 +45,7 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
+use crate::faces::param::Parameterization;
 use crate::product::Selection;
 use crate::relight::Mesh;
 use crate::relight::light::lighting::Lighting;
@@ -53,7 +54,6 @@ use crate::relight::material::orient::{BrdfRotation, Frame, Orientation, to_pole
 use crate::relight::precompute::transport::TransportSet;
 use crate::relight::shade::{PreparedTransport, ShadeOptions, select_kept, within_depth};
 use crate::sphere::latlong::{angles, direction};
-use crate::sphere::param::Parameterization;
 use crate::transform::{Normalization, pyramid};
 use crate::{Error, Result, Sample};
 
@@ -94,7 +94,7 @@ impl GlossyOptions {
     ///
     /// ```
     /// use haarshift::relight::glossy::GlossyOptions;
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap(); // 2 x 8^2 texels
     /// assert!(GlossyOptions::default().check(param).is_ok());
     /// let levels = GlossyOptions { brdf_levels: Some(4), ..Default::default() };
@@ -177,7 +177,7 @@ pub struct GlossyReport {
 /// use haarshift::relight::{Brdf, Lighting, Mesh, ShadeOptions, TransportSet};
 /// use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
 /// use haarshift::relight::material::orient::BrdfRotation;
-/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// use ndarray::{Array2, Axis, array};
 /// // An upward triangle whose vertices see the whole sky: transport = cosine x solid angle.
 /// let mesh = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
@@ -358,7 +358,7 @@ impl<T: Sample> GlossyShader<T> {
     /// # use haarshift::product::Selection;
     /// # use haarshift::relight::{Brdf, Mesh, ShadeOptions, TransportSet};
     /// # use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
-    /// # use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// # use haarshift::faces::param::{ParamKind, Parameterization};
     /// # use ndarray::{Array2, Array3, array};
     /// # let mesh = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
     /// #                      vec![[0, 1, 2]], None).unwrap();

@@ -51,7 +51,7 @@ use std::f64::consts::PI;
 use ndarray::{Array2, ArrayView1, ArrayView2, Axis, Zip};
 use rayon::prelude::*;
 
-use crate::sphere::Parameterization;
+use crate::faces::Parameterization;
 use crate::sphere::gaunt::Gaunt;
 use crate::sphere::harmonics::{SphericalHarmonics, phong_factors};
 use crate::{Error, Result};

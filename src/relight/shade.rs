@@ -38,14 +38,14 @@
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
+use crate::faces::Parameterization;
+use crate::faces::integrate::layout;
 use crate::product::Selection;
 use crate::product::selection::{Candidate, keep_largest};
 use crate::product::tree::mallat_detail;
 use crate::relight::light::lighting::Lighting;
 use crate::relight::material::brdf::check_albedo;
 use crate::relight::precompute::transport::TransportSet;
-use crate::sphere::Parameterization;
-use crate::sphere::integrate::layout;
 use crate::{Error, Result, Sample};
 
 /// Coefficients summed in the working precision before the sum is added in f64.
@@ -76,7 +76,7 @@ pub struct ShadeOptions {
 /// ```
 /// use haarshift::product::Selection;
 /// use haarshift::relight::{Lighting, PreparedTransport, ShadeOptions, TransportSet};
-/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// use ndarray::{Array2, Array3};
 /// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
 /// // One vertex that sees the whole sphere with cosine 1: its transport is the solid angle.
@@ -285,7 +285,7 @@ fn dot<T: Sample>(indices: &[u32], values: &[T], light: &[[T; 3]]) -> [f64; 3] {
 /// ```
 /// use haarshift::product::Selection;
 /// use haarshift::relight::{Lighting, ShadeOptions, TransportSet, shade};
-/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// use ndarray::{Array2, Array3};
 /// let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
 /// let mut set = TransportSet::new(param, Selection::All);

@@ -67,7 +67,7 @@
 use ndarray::{Array2, Array3, ArrayView2, Axis};
 use rayon::prelude::*;
 
-use super::param::{Parameterization, SphereMap};
+use crate::faces::param::{Parameterization, SphereMap};
 use crate::{Error, Result, Sample};
 
 /// The most bands accepted (degrees 0 to 63).
@@ -202,7 +202,7 @@ impl SphericalHarmonics {
     ///
     /// ```
     /// use haarshift::sphere::harmonics::SphericalHarmonics;
-    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
     /// let p = Parameterization::new(ParamKind::Cube, 32).unwrap();
     /// let f = SphereMap::<f64>::from_fn(p, 1, |d, o| o[0] = 1.0 + d[1]).unwrap();
     /// let c = SphericalHarmonics::new(2).unwrap().project(&f);
@@ -245,7 +245,7 @@ impl SphericalHarmonics {
     ///
     /// ```
     /// use haarshift::sphere::harmonics::SphericalHarmonics;
-    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// use ndarray::array;
     /// let sh = SphericalHarmonics::new(1).unwrap();
     /// let p = Parameterization::new(ParamKind::LatLong, 4).unwrap();
@@ -401,7 +401,7 @@ pub fn lambert_factor(l: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sphere::param::ParamKind;
+    use crate::faces::param::ParamKind;
     use std::f64::consts::PI;
 
     fn param(kind: ParamKind, size: usize) -> Parameterization {

@@ -38,27 +38,17 @@
 //! [`coefficients`] (how a 2:1 map maps onto two square Haar pyramids side by side).
 //! Measurements: [`experiment`].
 //!
-//! **Square faces.** Product integrals work on functions stored as sets of square faces:
-//! [`param`] (one [`Parameterization`] over lat-long, two `H x H` faces, and the cube map,
-//! six; texel directions, exact texel solid angles, [`SphereMap`]), [`cube`] (the cube map's
-//! faces, orientation and exact spherical-quadrilateral solid angles), [`convert`] (between
-//! parameterisations by solid-angle integration over each target texel), [`integrate`] (the
-//! integral over the sphere of a product of maps, on their Haar trees), [`product`] (the
-//! product of maps as a map, through their Haar trees), [`harmonics`] (real spherical
-//! harmonics: evaluation, projection, reconstruction, the Lambertian convolution).
+//! **Spherical harmonics.** [`harmonics`] (real spherical harmonics: evaluation, projection,
+//! reconstruction, the Lambertian convolution) and [`gaunt`] (their triple products). Maps
+//! stored as square faces, for product integrals, are [`crate::faces`]'s.
 
 pub mod chain_rule;
 pub mod coefficients;
-pub mod convert;
-pub mod cube;
 pub mod experiment;
 pub mod gaunt;
 pub mod harmonics;
-pub mod integrate;
 pub mod latlong;
 pub mod lobes;
-pub mod param;
-pub mod product;
 pub mod reference;
 pub mod resample;
 pub mod rotation;
@@ -66,8 +56,27 @@ pub mod yaw;
 
 pub use coefficients::SphereCoefficients;
 pub use latlong::LatLongMap;
-pub use param::{ParamKind, Parameterization, SphereMap};
 pub use rotation::SphereRotation;
+
+/// The face-map modules before they moved to [`crate::faces`], kept for one release
+/// (CHANGELOG.md lists them).
+macro_rules! moved {
+    ($($old:ident, $note:literal;)*) => {$(
+        #[doc(hidden)]
+        #[deprecated(note = $note)]
+        pub mod $old {
+            pub use crate::faces::$old::*;
+        }
+    )*};
+}
+
+moved! {
+    convert, "moved to `haarshift::faces::convert`";
+    cube, "moved to `haarshift::faces::cube`";
+    integrate, "moved to `haarshift::faces::integrate`";
+    param, "moved to `haarshift::faces::param`";
+    product, "moved to `haarshift::faces::product`";
+}
 
 use crate::named::named_enum;
 use crate::{Error, Result, Sample};

@@ -3,11 +3,12 @@
 use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
+use haarshift::faces::ParamKind;
+use haarshift::faces::integrate::{IntegralMethod, IntegrateOptions, check_size};
+use haarshift::faces::product::{ProductOptions, multiply};
 use haarshift::io::{CoefficientFile, FileFormat, WriteOptions, read_image};
 use haarshift::product::Selection;
-use haarshift::sphere::integrate::{IntegralMethod, IntegrateOptions, check_size};
-use haarshift::sphere::product::{ProductOptions, multiply};
-use haarshift::sphere::{LatLongMap, Method, ParamKind, SphereOptions, SphereRotation, rotate_map};
+use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
 use haarshift::{Error, PlanarImage, Result, Sample, SampleDepth};
 use indicatif::ProgressBar;
 
@@ -354,7 +355,7 @@ fn integrate_as<T: Sample>(args: &IntegrateArgs) -> Result<()> {
         method: args.method,
     };
     bar.set_message("integrating");
-    let result = haarshift::sphere::integrate::integrate(&maps, &options);
+    let result = haarshift::faces::integrate::integrate(&maps, &options);
     bar.finish_and_clear();
     let result = result?;
     let kept: Vec<String> = result.kept.iter().map(|k| k.to_string()).collect();

@@ -20,7 +20,7 @@ impl DynamicScene {
     /// ```
     /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// use haarshift::relight::{Brdf, SceneFile};
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let file: SceneFile = serde_json::from_str(r#"{"objects": [{"generator": {"sphere": {"cells": 2}},
     ///     "material": {"brdf": "phong", "exponent": 20, "albedo": [1, 1, 1]}}],
     ///     "camera": {"position": [0, 1, 5], "look_at": [0, 0, 0]}}"#).unwrap();
@@ -42,7 +42,7 @@ impl DynamicScene {
     /// ```
     /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// use haarshift::relight::{Brdf, SceneFile};
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let file: SceneFile = serde_json::from_str(
     ///     r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
     /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
@@ -88,7 +88,7 @@ impl DynamicScene {
     /// use haarshift::relight::glossy::GlossyOptions;
     /// use haarshift::relight::material::orient::BrdfRotation;
     /// use haarshift::relight::SceneFile;
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let file: SceneFile = serde_json::from_str(
     ///     r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
     /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());

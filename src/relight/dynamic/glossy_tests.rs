@@ -1,4 +1,5 @@
 use super::*;
+use crate::faces::param::SphereMap;
 use crate::relight::dynamic::tests::{
     THREE, build, each_moved_object_is_the_full_product_integral, lighting, options, param,
     relative, scene_file,
@@ -6,7 +7,6 @@ use crate::relight::dynamic::tests::{
 use crate::relight::glossy::GlossyShader;
 use crate::relight::material::orient::BrdfRotation;
 use crate::relight::shade::ShadeOptions;
-use crate::sphere::param::SphereMap;
 
 const CAMERA: &str = r#""camera": {"position": [1.5, 2.5, 4.0], "look_at": [0, 0, 0]}"#;
 

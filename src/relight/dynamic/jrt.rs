@@ -49,7 +49,7 @@ pub struct JrtReport {
 /// use haarshift::product::Selection;
 /// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
 /// use haarshift::relight::{Lighting, SceneFile};
-/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
 ///     {"generator": {"sphere": {"cells": 2}}},
 ///     {"generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.5, 0, 0]}}
@@ -263,7 +263,7 @@ impl<T: Sample> Jrt<T> {
     /// use haarshift::product::Selection;
     /// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt};
     /// use haarshift::relight::{Lighting, SceneFile};
-    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
     /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
     ///     {"generator": {"sphere": {"cells": 2}},
     ///      "material": {"brdf": "phong", "exponent": 10, "albedo": [0.9, 0.9, 0.9]}},

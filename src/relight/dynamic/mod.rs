@@ -48,6 +48,8 @@ use ndarray::Array2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::faces::integrate::layout;
+use crate::faces::param::{ParamKind, Parameterization};
 use crate::product::multiply::product;
 use crate::product::selection::Candidate;
 use crate::product::{HaarTree, IntegralOptions, Selection, Transport, product_integral};
@@ -67,8 +69,6 @@ use crate::relight::scene::{
 };
 use crate::relight::shade::{select_kept, within_depth};
 use crate::relight::{Mesh, ReferenceOptions, SceneBvh, SceneError};
-use crate::sphere::integrate::layout;
-use crate::sphere::param::{ParamKind, Parameterization};
 use crate::sphere::{LatLongMap, SphereRotation};
 use crate::{Error, Result, Sample};
 
@@ -76,7 +76,7 @@ use crate::{Error, Result, Sample};
 ///
 /// ```
 /// use haarshift::relight::dynamic::DynamicOptions;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let o = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 32).unwrap());
 /// assert_eq!(o.field.samples(), 29_720); // seed 001's fields
 /// ```
@@ -143,7 +143,7 @@ impl DynamicOptions {
 /// ```
 /// use haarshift::relight::dynamic::Placement;
 /// use haarshift::relight::Transform;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let param = Parameterization::new(ParamKind::LatLong, 32).unwrap(); // 64 columns
 /// let t = Transform { yaw: 92.0, translate: [1.0, 0.0, 0.0], ..Transform::default() };
 /// let p = Placement::from_transform(&t, param).unwrap();
@@ -293,7 +293,7 @@ pub struct BuildReport {
 /// ```
 /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
 /// use haarshift::relight::SceneFile;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
 ///     {"name": "a", "generator": {"sphere": {"cells": 2}}},
 ///     {"name": "b", "generator": {"sphere": {"cells": 2}}, "transform": {"translate": [3, 0, 0]}}
@@ -337,7 +337,7 @@ impl DynamicScene {
     /// ```
     /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// use haarshift::relight::dynamic::fields::file::FieldStore;
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let dir = tempfile::tempdir().unwrap();
     /// let scene = dir.path().join("ball.json");
     /// std::fs::write(&scene, r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
@@ -370,7 +370,7 @@ impl DynamicScene {
     /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// use haarshift::relight::dynamic::fields::file::FieldStore;
     /// use haarshift::relight::SceneFile;
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let file: SceneFile = serde_json::from_str(
     ///     r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
     /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());

@@ -297,7 +297,7 @@ fn interpolate(a: &Placement, b: &Placement, t: f64, w: usize) -> Placement {
 /// use haarshift::relight::dynamic::motion::{MotionPath, play};
 /// use haarshift::relight::SceneFile;
 /// use haarshift::sphere::LatLongMap;
-/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// use haarshift::faces::param::{ParamKind, Parameterization};
 /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
 ///     {"generator": {"sphere": {"cells": 2}}},
 ///     {"name": "ball", "generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.5, 0, 0]}}

@@ -1,11 +1,11 @@
 use std::path::Path;
 
 use super::*;
+use crate::faces::param::{ParamKind, Parameterization};
 use crate::relight::SceneFile;
 use crate::relight::dynamic::DynamicOptions;
 use crate::relight::dynamic::fields::FieldOptions;
 use crate::sphere::LatLongMap;
-use crate::sphere::param::{ParamKind, Parameterization};
 
 fn scene() -> DynamicScene {
     scene_of(

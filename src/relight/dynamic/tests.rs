@@ -1,10 +1,10 @@
 use ndarray::{Array3, Axis};
 
 use super::*;
+use crate::faces::param::SphereMap;
 use crate::relight::Occlusion;
 use crate::relight::dynamic::fields::FieldOptions;
 use crate::relight::shade::{PreparedTransport, ShadeOptions};
-use crate::sphere::param::SphereMap;
 
 pub(super) fn param() -> Parameterization {
     Parameterization::new(ParamKind::LatLong, 8).unwrap()

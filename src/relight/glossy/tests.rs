@@ -1,11 +1,11 @@
 use ndarray::{Array2, Array3, Axis};
 
 use super::*;
+use crate::faces::integrate::layout;
+use crate::faces::param::{ParamKind, SphereMap};
 use crate::product::triple::triple_integral;
 use crate::product::{HaarTree, Selection, Transport, WeightedPixels};
 use crate::relight::TransportSet;
-use crate::sphere::integrate::layout;
-use crate::sphere::param::{ParamKind, SphereMap};
 
 /// A strip of `n` vertices along X, normals varied, facing up and a little sideways.
 fn strip(n: usize) -> Mesh {

@@ -1,7 +1,7 @@
 use std::f64::consts::PI;
 
 use super::*;
-use crate::sphere::ParamKind;
+use crate::faces::ParamKind;
 
 #[test]
 fn the_projector_matches_the_sphere_modules_projection() {
@@ -9,7 +9,7 @@ fn the_projector_matches_the_sphere_modules_projection() {
     let bands = 4;
     for (kind, size) in [(ParamKind::LatLong, 8), (ParamKind::Cube, 4)] {
         let param = Parameterization::new(kind, size).unwrap();
-        let values = crate::sphere::param::SphereMap::<f64>::from_fn(param, 1, |d, o| {
+        let values = crate::faces::param::SphereMap::<f64>::from_fn(param, 1, |d, o| {
             o[0] = (d[0] + 0.5 * d[1] * d[2]).max(0.0)
         })
         .unwrap();
@@ -134,7 +134,7 @@ fn sh_render(
         (transfer.bands(), transfer.vertex_count()),
         (bands, mesh.vertex_count())
     );
-    let map = crate::sphere::param::SphereMap::from_lat_long(lighting).unwrap();
+    let map = crate::faces::param::SphereMap::from_lat_long(lighting).unwrap();
     let l = SphericalHarmonics::new(bands).unwrap().project(&map);
     shade_sh(transfer, albedo(mesh.vertex_count()).view(), l.view()).unwrap()
 }

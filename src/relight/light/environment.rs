@@ -36,7 +36,7 @@
 //!
 //! For a cube of face side `S`, the map is first downsampled to the lat-long height
 //! `min(2 S, H')`, `H'` the largest power of two at most `H`, and then converted by
-//! [`convert`](crate::sphere::convert) (solid-angle integration over each cube texel, with its
+//! [`convert`](crate::faces::convert) (solid-angle integration over each cube texel, with its
 //! [`default_samples`]).
 
 use std::path::Path;
@@ -44,9 +44,9 @@ use std::path::Path;
 use ndarray::{Array2, Array3, Axis, s};
 use rayon::prelude::*;
 
+use crate::faces::convert::{Conversion, default_samples};
+use crate::faces::param::{ParamKind, Parameterization, SphereMap};
 use crate::io::read_image;
-use crate::sphere::convert::{Conversion, default_samples};
-use crate::sphere::param::{ParamKind, Parameterization, SphereMap};
 use crate::sphere::{LatLongMap, SphereRotation};
 use crate::{Error, Result, Sample};
 
@@ -146,7 +146,7 @@ impl Environment {
     ///
     /// ```
     /// use haarshift::relight::light::environment::Environment;
-    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// use haarshift::sphere::{LatLongMap, SphereRotation};
     /// let env = Environment::new(LatLongMap::<f64>::from_fn(64, 3, |_, o| o.fill(0.5)).unwrap());
     /// let cube = Parameterization::new(ParamKind::Cube, 8).unwrap();
@@ -169,7 +169,7 @@ impl Environment {
 ///
 /// ```
 /// use haarshift::relight::light::environment::{Environment, SphereMapping};
-/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// use haarshift::faces::param::{ParamKind, Parameterization};
 /// use haarshift::sphere::{LatLongMap, SphereRotation};
 /// let env = Environment::new(LatLongMap::<f64>::from_fn(64, 1, |d, o| o[0] = 1.0 + d[0]).unwrap());
 /// let cube = Parameterization::new(ParamKind::Cube, 8).unwrap();

@@ -27,11 +27,11 @@
 
 use ndarray::{Array2, Array4, ArrayView2};
 
+use crate::faces::integrate::layout;
+use crate::faces::param::{Parameterization, SphereMap};
 use crate::product::{HaarTree, Selection};
 use crate::relight::light::environment::{Environment, SphereMapping};
 use crate::sphere::SphereRotation;
-use crate::sphere::integrate::layout;
-use crate::sphere::param::{Parameterization, SphereMap};
 use crate::{Error, Result, Sample};
 
 /// The environment's kept Haar coefficients, RGB; see the [module docs](self).
@@ -40,7 +40,7 @@ use crate::{Error, Result, Sample};
 /// use haarshift::product::Selection;
 /// use haarshift::relight::Lighting;
 /// use haarshift::relight::light::environment::Environment;
-/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// use haarshift::faces::param::{ParamKind, Parameterization};
 /// use haarshift::sphere::{LatLongMap, SphereRotation};
 /// let sky = LatLongMap::<f64>::from_fn(32, 3, |d, out| out.fill(1.0 + d[1].max(0.0))).unwrap();
 /// let param = Parameterization::new(ParamKind::Cube, 8).unwrap();
@@ -84,7 +84,7 @@ impl Lighting {
     /// use haarshift::product::Selection;
     /// use haarshift::relight::Lighting;
     /// use haarshift::relight::light::environment::{Environment, SphereMapping};
-    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// use haarshift::sphere::{LatLongMap, SphereRotation};
     /// let env = Environment::new(LatLongMap::<f64>::from_fn(32, 3, |d, o| o.fill(1.0 + d[2])).unwrap());
     /// let cube = Parameterization::new(ParamKind::Cube, 8).unwrap();
@@ -110,7 +110,7 @@ impl Lighting {
     /// ```
     /// use haarshift::product::Selection;
     /// use haarshift::relight::Lighting;
-    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
     /// let p = Parameterization::new(ParamKind::LatLong, 4).unwrap();
     /// let grey = SphereMap::<f64>::from_fn(p, 1, |_, out| out[0] = 2.0).unwrap();
     /// let light = Lighting::from_map(&grey, Selection::All).unwrap();

@@ -43,12 +43,12 @@
 
 use ndarray::Array2;
 
+use crate::faces::param::{ParamKind, Parameterization, SphereMap};
 use crate::named::named_enum;
 use crate::relight::Mesh;
 use crate::relight::material::brdf::{Brdf, LocalTable, mirror};
 use crate::sphere::chain_rule::Rotator;
 use crate::sphere::latlong::{angles, direction};
-use crate::sphere::param::{ParamKind, Parameterization, SphereMap};
 use crate::sphere::{Method, SphereOptions, SphereRotation, rotate_map};
 use crate::{Error, Result};
 
@@ -189,7 +189,7 @@ pub fn to_pole(a: [f64; 3]) -> SphereRotation {
 /// ```
 /// use haarshift::relight::Brdf;
 /// use haarshift::relight::material::orient::{BrdfRotation, Frame, Orientation};
-/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// use haarshift::faces::param::{ParamKind, Parameterization};
 /// let param = Parameterization::new(ParamKind::LatLong, 32).unwrap();
 /// let phong = Brdf::Phong { exponent: 10.0 };
 /// let frame = Frame::new([0.0, 1.0, 0.0], [0.0, 0.8, 0.6]).unwrap();

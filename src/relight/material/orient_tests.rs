@@ -1,6 +1,6 @@
 use super::*;
+use crate::faces::param::SphereMap;
 use crate::sphere::latlong::direction;
-use crate::sphere::param::SphereMap;
 use crate::sphere::{LatLongMap, SphereCoefficients, yaw::yaw_coefficients};
 
 fn latlong(h: usize) -> Parameterization {

@@ -45,7 +45,7 @@ pub const DEFAULT_MAP_SIZE: usize = 2048;
 /// ```
 /// use haarshift::relight::precompute::{Order, PrecomputeOptions};
 /// use haarshift::relight::VisibilityOptions;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let o = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 8).unwrap()));
 /// assert_eq!((o.order, o.map_size), (Order::Vertex, 2048));
 /// ```
@@ -94,7 +94,7 @@ impl PrecomputeOptions {
 /// ```
 /// use haarshift::relight::precompute::{PrecomputeOptions, precompute};
 /// use haarshift::relight::{Generator, Scene, VisibilityOptions};
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true);
 /// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
 /// let (cache, report) = precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(param))).unwrap();

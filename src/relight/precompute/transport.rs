@@ -17,11 +17,11 @@
 
 use ndarray::{Array3, Array4, ArrayView3, Axis};
 
+use crate::faces::Parameterization;
+use crate::faces::integrate::layout;
 use crate::product::{HaarTree, Selection, Transport, WeightedPixels};
 use crate::relight::harmonics::{ShProjector, ShTransfer};
 use crate::relight::precompute::sparse::SparseRows;
-use crate::sphere::Parameterization;
-use crate::sphere::integrate::layout;
 use crate::{Error, Result};
 
 /// The sparse transport of every vertex; see the [module docs](self).
@@ -29,7 +29,7 @@ use crate::{Error, Result};
 /// ```
 /// use haarshift::product::Selection;
 /// use haarshift::relight::TransportSet;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// use ndarray::Array3;
 /// let param = Parameterization::new(ParamKind::LatLong, 4).unwrap();
 /// let mut set = TransportSet::new(param, Selection::Largest(3));
@@ -64,7 +64,7 @@ impl TransportSet {
     /// ```
     /// use haarshift::product::Selection;
     /// use haarshift::relight::TransportSet;
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// use ndarray::Array3;
     /// let param = Parameterization::new(ParamKind::LatLong, 32).unwrap();
     /// let mut set = TransportSet::with_sh(param, Selection::All, 2).unwrap();

@@ -36,6 +36,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ndarray::Array3;
 use rayon::prelude::*;
 
+use crate::faces::Parameterization;
 use crate::product::Selection;
 use crate::relight::Mesh;
 use crate::relight::harmonics::check_bands;
@@ -43,14 +44,13 @@ use crate::relight::precompute::raycast::Occlusion;
 use crate::relight::precompute::shadowmap::ShadowMap;
 use crate::relight::precompute::transport::{Encoded, Encoder, TransportSet};
 use crate::relight::scene::mesh::dot;
-use crate::sphere::Parameterization;
 use crate::{Error, Result};
 
 /// How to precompute; see the [module docs](self).
 ///
 /// ```
 /// use haarshift::relight::VisibilityOptions;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let o = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 16).unwrap());
 /// assert_eq!((o.samples, o.seed, o.sh_bands, o.progress), (1, 0, None, false));
 /// ```
@@ -179,7 +179,7 @@ pub(crate) fn f32x3(a: [f64; 3]) -> [f32; 3] {
 ///
 /// ```
 /// use haarshift::relight::{Mesh, SceneBvh, VisibilityOptions, vertex_major};
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// use ndarray::array;
 /// // One upward triangle: nothing occludes it, so each vertex sees the upper hemisphere.
 /// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
@@ -267,7 +267,7 @@ pub fn vertex_major(
 ///
 /// ```
 /// use haarshift::relight::{Mesh, SceneBvh, VisibilityOptions, direction_major, vertex_major};
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// use ndarray::array;
 /// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
 ///                   vec![[0, 1, 2]], None).unwrap();

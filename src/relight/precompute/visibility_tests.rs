@@ -1,8 +1,8 @@
 use std::f64::consts::PI;
 
 use super::*;
+use crate::faces::ParamKind;
 use crate::relight::{Generator, SceneBvh, add_ground_plane};
-use crate::sphere::ParamKind;
 use crate::test_support::corner_form_factor;
 
 fn latlong(n: usize) -> Parameterization {

@@ -3,8 +3,8 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use ndarray::{Array3, array};
 
 use super::*;
+use crate::faces::{ParamKind, Parameterization};
 use crate::relight::{Generator, SceneBvh, VisibilityOptions, add_ground_plane, vertex_major};
-use crate::sphere::{ParamKind, Parameterization};
 
 fn constant(n: usize, value: f64) -> LatLongMap<f64> {
     LatLongMap::from_fn(n, 1, |_, o| o[0] = value).unwrap()

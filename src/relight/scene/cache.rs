@@ -28,13 +28,13 @@ use std::path::Path;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
+use crate::faces::{ParamKind, Parameterization};
 use crate::product::Selection;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::precompute::transport::TransportSet;
 use crate::relight::scene::framed::{Format, put_all};
 use crate::relight::scene::{CameraSpec, EnvironmentSpec};
 use crate::relight::{Mesh, SceneError};
-use crate::sphere::{ParamKind, Parameterization};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
@@ -133,7 +133,7 @@ pub struct CacheHeader {
 /// ```
 /// use haarshift::relight::{CacheParams, KeepRecord, Scene, SceneBvh, SceneCache,
 ///                          VisibilityOptions, Generator, vertex_major};
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false);
 /// let options = VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();

@@ -3,14 +3,14 @@ use std::f64::consts::PI;
 use ndarray::{Array2, Array3, Array4, Axis};
 
 use super::*;
+use crate::faces::integrate::layout;
+use crate::faces::param::{ParamKind, SphereMap};
 use crate::metrics::relative_rms_error;
 use crate::product::{HaarTree, IntegralOptions, product_integral, triple::triple_integral};
 use crate::relight::light::environment::{Environment, downsample_solid_angle};
 use crate::relight::{
     Generator, Mesh, Occlusion, SceneBvh, VisibilityOptions, ray_offset, vertex_major,
 };
-use crate::sphere::integrate::layout;
-use crate::sphere::param::{ParamKind, SphereMap};
 use crate::sphere::{LatLongMap, SphereRotation};
 use crate::test_support::corner_form_factor;
 

@@ -3,11 +3,11 @@
 use std::path::PathBuf;
 
 use haarshift::Result;
+use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
 use haarshift::relight::VisibilityOptions;
 use haarshift::relight::precompute::{DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute};
-use haarshift::sphere::{ParamKind, Parameterization};
 
 use super::flags::{SceneFlags, bytes};
 use crate::commands::{choice, names, print, refuse_existing, refuse_overwriting_input};

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::dynamic::fields::file::FieldStore;
 use haarshift::relight::dynamic::fields::{FieldOptions, Truncation};
@@ -12,7 +13,6 @@ use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene};
 use haarshift::relight::{Brdf, CameraSpec, Lighting};
 use haarshift::render::animation::{numbered_path, write_gif};
 use haarshift::render::raster::{Camera, render_format, to_srgb8, write_render};
-use haarshift::sphere::{ParamKind, Parameterization};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
 

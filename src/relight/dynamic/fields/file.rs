@@ -36,12 +36,12 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use crate::faces::{ParamKind, Parameterization};
 use crate::relight::dynamic::fields::{FieldFrame, FieldOptions, FieldReport, OcclusionField};
 use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::scene::cache::KeepRecord;
 use crate::relight::scene::framed::{Format, put_all};
 use crate::relight::{Generator, Mesh, SceneError, scene_hash};
-use crate::sphere::{ParamKind, Parameterization};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
@@ -59,7 +59,7 @@ const FORMAT: Format = Format {
 ///
 /// ```
 /// use haarshift::relight::dynamic::fields::{FieldOptions, file::FieldRecord};
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let options = FieldOptions::new(Parameterization::new(ParamKind::Cube, 64).unwrap());
 /// let record = FieldRecord::of(&options);
 /// assert_eq!((record.param.as_str(), record.resolution, record.circles), ("cube", 64, 100));
@@ -186,7 +186,7 @@ impl OcclusionField {
     ///
     /// ```
     /// use haarshift::relight::{Generator, fields::{FieldOptions, OcclusionField}};
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let ball = Generator::Sphere { cells: 2 }.mesh().unwrap();
     /// let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
     /// (options.circles, options.circle_points, options.shells, options.shell_grid) = (3, 6, 2, 2);
@@ -384,7 +384,7 @@ pub enum FieldOrigin {
 ///
 /// ```
 /// use haarshift::relight::{Generator, fields::{FieldOptions, file::{FieldOrigin, FieldStore}}};
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let generator = Generator::Sphere { cells: 2 };
 /// let ball = generator.mesh().unwrap();
 /// let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());

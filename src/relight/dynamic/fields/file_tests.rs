@@ -1,11 +1,11 @@
 use std::path::Path;
 
 use super::*;
+use crate::faces::param::SphereMap;
 use crate::product::Selection;
 use crate::relight::dynamic::fields::Truncation;
 use crate::relight::dynamic::{DynamicOptions, DynamicScene};
 use crate::relight::{Lighting, SceneFile, refusal_in};
-use crate::sphere::param::SphereMap;
 
 fn latlong(n: usize) -> Parameterization {
     Parameterization::new(ParamKind::LatLong, n).unwrap()

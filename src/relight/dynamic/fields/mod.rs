@@ -20,7 +20,7 @@
 //! * the **spherical field**: `shells` concentric spheres about `c`, radii `shell_radii.0 x R`
 //!   to `shell_radii.1 x R` (001: 20 shells, 0.2 R to 6 R), each sampled at a
 //!   `shell_grid x shell_grid` grid on each of the six cube faces (001: 6 x 9 x 9), the grid
-//!   uniform in the face coordinates `a, b` of [`crate::sphere::cube`] (edge points are on two
+//!   uniform in the face coordinates `a, b` of [`crate::faces::cube`] (edge points are on two
 //!   faces, as in 001).
 //!
 //! Neighbouring circles (shells) are spaced in proportion to their radius, as 001 asks ("the
@@ -54,6 +54,8 @@ use ndarray::{Array2, Array3, Axis, s};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::faces::cube::{face_direction, face_point};
+use crate::faces::param::{ParamKind, Parameterization};
 use crate::product::Selection;
 use crate::product::selection::Candidate;
 use crate::relight::Mesh;
@@ -61,9 +63,7 @@ use crate::relight::precompute::raycast::{Occlusion, SceneBvh};
 use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::transport::encode;
 use crate::relight::precompute::visibility::{f32x3, progress_bar, ray_offset, texel_directions};
-use crate::sphere::cube::{face_direction, face_point};
 use crate::sphere::latlong::atan2;
-use crate::sphere::param::{ParamKind, Parameterization};
 use crate::transform::{Normalization, pyramid};
 use crate::{Error, Result};
 
@@ -91,7 +91,7 @@ pub enum Truncation {
 ///
 /// ```
 /// use haarshift::relight::dynamic::fields::FieldOptions;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let o = FieldOptions::new(Parameterization::new(ParamKind::Cube, 64).unwrap());
 /// assert_eq!(o.samples(), 100 * 200 + 20 * 6 * 9 * 9);
 /// assert_eq!(o.samples() * o.param.texels(), 730_398_720); // 001's rays at 6 x 64^2
@@ -264,7 +264,7 @@ impl Blend {
 ///
 /// ```
 /// use haarshift::relight::{Generator, fields::{FieldOptions, OcclusionField}};
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let ball = Generator::Sphere { cells: 4 }.mesh().unwrap();
 /// let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
 /// (options.circles, options.circle_points, options.shells, options.shell_grid) = (4, 8, 3, 3);
@@ -646,7 +646,7 @@ fn sample_points(o: &FieldOptions, f: &FieldFrame, lift: f64) -> Vec<[f64; 3]> {
 /// ```
 /// use haarshift::product::Selection;
 /// use haarshift::relight::dynamic::fields::yaw_sparse;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let param = Parameterization::new(ParamKind::LatLong, 4).unwrap();
 /// // Face 0's scaling coefficient: 1 on columns 0..4 (scaling = pixel sum / S = 4).
 /// let (i, v) = yaw_sparse(param, &[0], &[4.0], 4, Selection::All).unwrap();

@@ -2,9 +2,9 @@ use ndarray::{Array3, Axis};
 use proptest::prelude::*;
 
 use super::*;
+use crate::faces::integrate::layout;
 use crate::product::{FaceLayout, HaarTree};
 use crate::relight::Generator;
-use crate::sphere::integrate::layout;
 
 fn small(param: Parameterization) -> FieldOptions {
     FieldOptions {

@@ -19,7 +19,7 @@
 //! | 4 `+Z` | `+Z` | `+X` | `-Y` |
 //! | 5 `-Z` | `-Z` | `-X` | `-Y` |
 //!
-//! Directions live in the world frame of [`latlong`](super::latlong): right-handed, Y up,
+//! Directions live in the world frame of [`latlong`](crate::sphere::latlong): right-handed, Y up,
 //! `phi = 0` at `+Z` and `phi = 90` degrees at `+X`. The four side faces are laid out the
 //! way the lat-long map is: their columns run with increasing `phi` (from `+Z` over `+X`,
 //! `-Z` and `-X` back to `+Z`) and their rows downwards (`v = -Y`), so the row of side faces
@@ -38,7 +38,7 @@
 /// One face of the cube map, in the order of the face index (see the [module docs](self)).
 ///
 /// ```
-/// use haarshift::sphere::cube::CubeFace;
+/// use haarshift::faces::cube::CubeFace;
 /// assert_eq!(CubeFace::ALL[4], CubeFace::PosZ);
 /// assert_eq!(CubeFace::PosZ.axes(), [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]);
 /// ```
@@ -87,7 +87,7 @@ impl CubeFace {
 /// `n + a u + b v`, normalised.
 ///
 /// ```
-/// use haarshift::sphere::cube::face_direction;
+/// use haarshift::faces::cube::face_direction;
 /// assert_eq!(face_direction(4, 0.0, 0.0), [0.0, 0.0, 1.0]); // the centre of +Z
 /// let d = face_direction(2, 0.0, 1.0); // the edge of +Y shared with +Z
 /// assert!((d[1] - d[2]).abs() < 1e-15 && d[0] == 0.0);
@@ -109,7 +109,7 @@ pub fn face_direction(face: usize, a: f64, b: f64) -> [f64; 3] {
 /// candidates wins.
 ///
 /// ```
-/// use haarshift::sphere::cube::{face_direction, face_point};
+/// use haarshift::faces::cube::{face_direction, face_point};
 /// let (face, a, b) = face_point(face_direction(3, 0.25, -0.5));
 /// assert_eq!(face, 3);
 /// assert!((a - 0.25).abs() < 1e-15 && (b + 0.5).abs() < 1e-15);
@@ -137,7 +137,7 @@ pub fn face_point(d: [f64; 3]) -> (usize, f64, f64) {
 /// The texel `(face, row, col)` of an `size x size` cube map that direction `d` falls in.
 ///
 /// ```
-/// use haarshift::sphere::cube::{texel_direction, texel_of};
+/// use haarshift::faces::cube::{texel_direction, texel_of};
 /// assert_eq!(texel_of(8, texel_direction(8, 5, 2, 7)), (5, 2, 7));
 /// assert_eq!(texel_of(8, [0.0, 1.0, 0.0]).0, 2); // straight up: the +Y face
 /// ```
@@ -157,7 +157,7 @@ pub(crate) fn edge(size: usize, k: f64) -> f64 {
 /// The centre direction of texel `(row, col)` of face `face` of a `size x size` cube map.
 ///
 /// ```
-/// use haarshift::sphere::cube::texel_direction;
+/// use haarshift::faces::cube::texel_direction;
 /// // The top-left texel of the +Z face: a = b = -1/2, so -X (u = +X) and up (v = -Y).
 /// let d = texel_direction(2, 4, 0, 0);
 /// let s = (1.5f64).sqrt();
@@ -177,7 +177,7 @@ pub fn texel_direction(size: usize, face: usize, row: usize, col: usize) -> [f64
 /// [module docs](self).
 ///
 /// ```
-/// use haarshift::sphere::cube::rectangle_solid_angle;
+/// use haarshift::faces::cube::rectangle_solid_angle;
 /// let face = rectangle_solid_angle(-1.0, 1.0, -1.0, 1.0);
 /// assert!((face - 4.0 * std::f64::consts::PI / 6.0).abs() < 1e-15);
 /// ```
@@ -191,7 +191,7 @@ pub fn rectangle_solid_angle(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
 /// face). The `6 size^2` texels sum to `4 pi` to rounding.
 ///
 /// ```
-/// use haarshift::sphere::cube::texel_solid_angle;
+/// use haarshift::faces::cube::texel_solid_angle;
 /// let total: f64 = (0..4).flat_map(|r| (0..4).map(move |c| texel_solid_angle(4, r, c))).sum();
 /// assert!((6.0 * total - 4.0 * std::f64::consts::PI).abs() < 1e-14);
 /// ```

@@ -19,7 +19,6 @@ use std::time::Instant;
 use ndarray::{Array3, Array4};
 use rayon::prelude::*;
 
-use super::LatLongMap;
 use super::convert::{Conversion, default_samples};
 use super::param::{ParamKind, Parameterization, SphereMap};
 use crate::named::named_enum;
@@ -28,6 +27,7 @@ use crate::product::triple::triple_integral;
 use crate::product::{
     FaceLayout, HaarTree, IntegralOptions, Selection, Transport, WeightedPixels, product_integral,
 };
+use crate::sphere::LatLongMap;
 use crate::{Error, Result, Sample};
 
 named_enum! {
@@ -49,7 +49,7 @@ named_enum! {
 /// What [`integrate`] does.
 ///
 /// ```
-/// use haarshift::sphere::integrate::IntegrateOptions;
+/// use haarshift::faces::integrate::IntegrateOptions;
 /// let o = IntegrateOptions::default();
 /// assert!(o.resolution.is_none() && o.depth.is_none() && o.selections.is_empty());
 /// ```
@@ -86,7 +86,7 @@ pub struct SphereIntegral {
 ///
 /// ```
 /// use haarshift::sphere::LatLongMap;
-/// use haarshift::sphere::integrate::{IntegrateOptions, integrate};
+/// use haarshift::faces::integrate::{IntegrateOptions, integrate};
 /// use haarshift::sphere::latlong::pixel_solid_angle;
 /// let f = LatLongMap::<f64>::from_fn(8, 1, |d, out| out[0] = 1.0 + d[1]).unwrap();
 /// let g = LatLongMap::<f64>::from_fn(8, 3, |d, out| out.fill(2.0 + d[0])).unwrap();
@@ -199,7 +199,7 @@ fn check_maps<T: Sample>(maps: &[LatLongMap<T>]) -> Result<usize> {
 ///
 /// ```
 /// use haarshift::sphere::LatLongMap;
-/// use haarshift::sphere::integrate::check_size;
+/// use haarshift::faces::integrate::check_size;
 /// let m = LatLongMap::<f32>::from_fn(8, 1, |_, o| o[0] = 1.0).unwrap();
 /// assert!(check_size(8, &m).is_ok());
 /// assert!(check_size(16, &m).unwrap_err().to_string().contains("different sizes"));

@@ -5,11 +5,11 @@
 //!
 //! | [`ParamKind`] | faces | texel `(face, row, col)` | solid angle |
 //! |---|---|---|---|
-//! | [`ParamKind::LatLong`] | 2 of `H x H` | lat-long pixel `(row, face H + col)` of the `H x 2H` map: face 0 is `phi in [0, pi)`, face 1 `[pi, 2 pi)` ([`latlong`](super::latlong)) | `(2 pi / W)(cos theta_row - cos theta_row+1)` |
+//! | [`ParamKind::LatLong`] | 2 of `H x H` | lat-long pixel `(row, face H + col)` of the `H x 2H` map: face 0 is `phi in [0, pi)`, face 1 `[pi, 2 pi)` ([`latlong`](crate::sphere::latlong)) | `(2 pi / W)(cos theta_row - cos theta_row+1)` |
 //! | [`ParamKind::Cube`] | 6 of `S x S` | texel `(row, col)` of cube face `face` ([`cube`]) | the spherical quadrilateral's, exact |
 //!
 //! The lat-long faces are the halves of the map, the same two square pyramids that
-//! [`SphereCoefficients`](super::SphereCoefficients) holds side by side. A [`SphereMap`]
+//! [`SphereCoefficients`](crate::sphere::SphereCoefficients) holds side by side. A [`SphereMap`]
 //! stores a function as one `(faces, S, S, C)` array: the face array of the product module
 //! (`crate::product`). Its integral over the sphere is the sum over texels of value x solid
 //! angle ([`SphereMap::energy`]); [`Parameterization::solid_angles`] is that per-texel weight
@@ -17,10 +17,10 @@
 
 use ndarray::{Array3, Array4, ArrayView4};
 
-use super::LatLongMap;
 use super::cube;
-use super::latlong::{angles, direction, fill_grid, pixel_centre, pixel_solid_angle};
 use crate::named::named_enum;
+use crate::sphere::LatLongMap;
+use crate::sphere::latlong::{angles, direction, fill_grid, pixel_centre, pixel_solid_angle};
 use crate::{Channels, Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
 named_enum! {
@@ -42,7 +42,7 @@ const MAX_FACE_SIZE: usize = 1 << 15;
 /// two; for lat-long `S = H`, the map's height).
 ///
 /// ```
-/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// use haarshift::faces::param::{ParamKind, Parameterization};
 /// let p = Parameterization::new(ParamKind::Cube, 16).unwrap();
 /// assert_eq!((p.faces(), p.face_size(), p.texels()), (6, 16, 1536));
 /// let total: f64 = p.solid_angles().sum();
@@ -97,7 +97,7 @@ impl Parameterization {
     /// The centre direction of texel `(face, row, col)`.
     ///
     /// ```
-    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// let p = Parameterization::new(ParamKind::LatLong, 4).unwrap();
     /// // face 1, column 0 is lat-long column 4: phi just past pi, towards -Z
     /// let d = p.texel_direction(1, 2, 0);
@@ -116,7 +116,7 @@ impl Parameterization {
     /// The exact solid angle of texel `(face, row, col)` (the same on every face).
     ///
     /// ```
-    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// let p = Parameterization::new(ParamKind::LatLong, 8).unwrap();
     /// let step = std::f64::consts::PI / 8.0;
     /// let want = step * (1.0 - step.cos()); // (2 pi / W)(cos 0 - cos step)
@@ -132,7 +132,7 @@ impl Parameterization {
     /// The texel `(face, row, col)` that the direction `d` (unit length) falls in.
     ///
     /// ```
-    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// for kind in [ParamKind::LatLong, ParamKind::Cube] {
     ///     let p = Parameterization::new(kind, 8).unwrap();
     ///     assert_eq!(p.texel_of(p.texel_direction(1, 3, 6)), (1, 3, 6));
@@ -188,7 +188,7 @@ impl Parameterization {
     /// to `4 pi` to rounding.
     ///
     /// ```
-    /// use haarshift::sphere::param::{ParamKind, Parameterization};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// let w = Parameterization::new(ParamKind::LatLong, 4).unwrap().solid_angles();
     /// assert_eq!(w.dim(), (2, 4, 4));
     /// assert!((w.sum() - 4.0 * std::f64::consts::PI).abs() < 1e-13);
@@ -205,7 +205,7 @@ impl Parameterization {
 /// texel `(face, row, col)` as the parameterisation places it, `C` channels per texel.
 ///
 /// ```
-/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// let p = Parameterization::new(ParamKind::Cube, 8).unwrap();
 /// let m = SphereMap::<f64>::from_fn(p, 1, |d, out| out[0] = d[1] * d[1]).unwrap();
 /// // the integral of y^2 over the sphere is 4 pi / 3
@@ -222,7 +222,7 @@ impl<T: Sample> SphereMap<T> {
     /// values).
     ///
     /// ```
-    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
     /// use ndarray::Array4;
     /// let p = Parameterization::new(ParamKind::Cube, 2).unwrap();
     /// assert!(SphereMap::new(p, Array4::<f32>::zeros((6, 2, 2, 3))).is_ok());
@@ -286,7 +286,7 @@ impl<T: Sample> SphereMap<T> {
     ///
     /// ```
     /// use haarshift::sphere::LatLongMap;
-    /// use haarshift::sphere::param::SphereMap;
+    /// use haarshift::faces::param::SphereMap;
     /// let m = LatLongMap::<f64>::from_fn(4, 2, |d, out| out.copy_from_slice(&d[..2])).unwrap();
     /// let s = SphereMap::from_lat_long(&m).unwrap();
     /// assert_eq!(s.as_array()[[1, 2, 3, 1]], m.as_array()[[2, 7, 1]]);
@@ -327,7 +327,7 @@ impl<T: Sample> SphereMap<T> {
     /// in face order `+X, -X, +Y, -Y, +Z, -Z` (an `S` wide, `6 S` high strip).
     ///
     /// ```
-    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
     /// use haarshift::SampleDepth;
     /// let p = Parameterization::new(ParamKind::Cube, 4).unwrap();
     /// let data = ndarray::Array4::from_shape_fn((6, 4, 4, 1), |(f, r, c, _)| (100 * f + 10 * r + c) as f32);
@@ -374,7 +374,7 @@ impl<T: Sample> SphereMap<T> {
     /// The integral over the sphere of each channel: `sum over texels of value x solid angle`.
     ///
     /// ```
-    /// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+    /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
     /// let p = Parameterization::new(ParamKind::Cube, 4).unwrap();
     /// let one = SphereMap::<f32>::from_fn(p, 1, |_, out| out[0] = 1.0).unwrap();
     /// assert!((one.energy()[0] - 4.0 * std::f64::consts::PI).abs() < 1e-12);

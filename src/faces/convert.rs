@@ -25,7 +25,7 @@
 //! by iterative proportional fitting, was tried: the sampled sparsity pattern often admits no
 //! such balance and the fitting stalls at a few percent.)
 //!
-//! Compared with [`reference`](super::reference), which integrates the *bilinear* interpolant
+//! Compared with [`reference`](crate::sphere::reference), which integrates the *bilinear* interpolant
 //! of a lat-long map for rotation ground truth, this integrates the piecewise-constant
 //! function that the product integrals fed by it integrate.
 
@@ -39,8 +39,8 @@ use crate::{Error, Result, Sample};
 /// 4 and at most 16.
 ///
 /// ```
-/// use haarshift::sphere::convert::default_samples;
-/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// use haarshift::faces::convert::default_samples;
+/// use haarshift::faces::param::{ParamKind, Parameterization};
 /// let ll = Parameterization::new(ParamKind::LatLong, 128).unwrap();
 /// let cube = Parameterization::new(ParamKind::Cube, 64).unwrap();
 /// assert_eq!(default_samples(ll, cube), 6); // 4 x (2 / 64) / (pi / 128), rounded up
@@ -66,8 +66,8 @@ fn texel_angle(p: Parameterization) -> f64 {
 /// maps, built once and applied to any number of maps (see the [module docs](self)).
 ///
 /// ```
-/// use haarshift::sphere::convert::Conversion;
-/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use haarshift::faces::convert::Conversion;
+/// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// let ll = Parameterization::new(ParamKind::LatLong, 32).unwrap();
 /// let cube = Parameterization::new(ParamKind::Cube, 16).unwrap();
 /// let to_cube = Conversion::new(ll, cube, 8).unwrap();
@@ -169,8 +169,8 @@ impl Conversion {
 /// samples)` applied to `map`.
 ///
 /// ```
-/// use haarshift::sphere::convert::convert;
-/// use haarshift::sphere::param::{ParamKind, Parameterization, SphereMap};
+/// use haarshift::faces::convert::convert;
+/// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// let cube = Parameterization::new(ParamKind::Cube, 8).unwrap();
 /// let f = SphereMap::<f32>::from_fn(cube, 3, |_, out| out.fill(2.5)).unwrap();
 /// let ll = Parameterization::new(ParamKind::LatLong, 16).unwrap();
@@ -231,9 +231,9 @@ fn sampled_overlaps(
 
 #[cfg(test)]
 mod tests {
-    use super::super::LatLongMap;
     use super::super::param::ParamKind;
     use super::*;
+    use crate::sphere::LatLongMap;
     use ndarray::Array3;
     use std::f64::consts::PI;
 

@@ -25,17 +25,17 @@ use std::time::Instant;
 
 use ndarray::Array4;
 
-use super::LatLongMap;
 use super::integrate::{layout, plain_trees, working_faces};
 use super::param::{ParamKind, SphereMap};
 use crate::product::Selection;
 use crate::product::multiply::product;
+use crate::sphere::LatLongMap;
 use crate::{Result, Sample};
 
 /// What [`multiply`] does.
 ///
 /// ```
-/// use haarshift::sphere::product::ProductOptions;
+/// use haarshift::faces::product::ProductOptions;
 /// let o = ProductOptions::default();
 /// assert!(o.resolution.is_none() && o.selections.is_empty());
 /// ```
@@ -70,7 +70,7 @@ pub struct SphereProduct<T> {
 ///
 /// ```
 /// use haarshift::sphere::LatLongMap;
-/// use haarshift::sphere::product::{ProductOptions, multiply};
+/// use haarshift::faces::product::{ProductOptions, multiply};
 /// let f = LatLongMap::<f64>::from_fn(8, 1, |d, out| out[0] = 1.0 + d[1]).unwrap();
 /// let g = LatLongMap::<f64>::from_fn(8, 3, |d, out| out.fill(2.0 + d[0])).unwrap();
 /// let fg = multiply(&[f.clone(), g.clone()], &ProductOptions::default()).unwrap();
@@ -111,9 +111,9 @@ pub fn multiply<T: Sample>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::faces::convert::{convert, default_samples};
+    use crate::faces::param::Parameterization;
     use crate::product::{FaceLayout, HaarTree};
-    use crate::sphere::convert::{convert, default_samples};
-    use crate::sphere::param::Parameterization;
     use crate::transform::{Normalization, pyramid};
     use ndarray::{Array3, Axis};
 
