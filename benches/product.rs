@@ -286,7 +286,7 @@ fn sparse_of(pixels: &Array4<f64>, layout: FaceLayout, keep: usize) -> (Vec<u32>
     (i, v.into_iter().map(|[x]| x).collect())
 }
 
-/// Per vertex of a dynamic scene (`relight::dynamic::Jrt`), from sparse coefficients: the
+/// Per vertex of a dynamic scene (`relight::dynamic::JustInTimeTransfer`), from sparse coefficients: the
 /// fixed product of its transport (70 kept), two occlusion maps (200 each) and the lighting
 /// (200, RGB), and a frame's `<T, O_a O_b>`; by quadtrees (`from_sparse`, `product`,
 /// `triple_integral`) and by texels ([`TexelProduct`]).
@@ -351,7 +351,7 @@ fn vertex(c: &mut Criterion) {
         // The fixed product a frame dots with (the same for both methods).
         fixed(&mut ti, &mut tv);
         // The transport of T's own tree (weights folded in: ones), built per vertex as
-        // `Jrt` builds it; the bench builds it once and times `from_sparse` in its stead.
+        // `JustInTimeTransfer` builds it; the bench builds it once and times `from_sparse` in its stead.
         let t_pixels = HaarTree::from_sparse(faces, s, layout, &ti, &tv)
             .expect("tree")
             .to_pixels()

@@ -31,7 +31,7 @@ use haarshift::relight::{
     Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,
     VisibilityOptions, shade_sh, vertex_major,
 };
-use haarshift::render::raster::{Background, Camera, DEFAULT_FOV, Mesh, render};
+use haarshift::render::raster::{Background, Camera, DEFAULT_FOV, LitMesh, render};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::sphere::latlong::direction;
 use haarshift::sphere::{LatLongMap, SphereRotation};
@@ -77,7 +77,7 @@ fn map_512() -> LatLongMap<f64> {
 
 fn bench(c: &mut Criterion) {
     let (positions, triangles, radiance) = sphere(158);
-    let mesh = Mesh {
+    let mesh = LitMesh {
         positions: positions.view(),
         triangles: &triangles,
         radiance: radiance.view(),

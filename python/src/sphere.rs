@@ -3,7 +3,7 @@
 
 use haarshift::faces::ParamKind;
 use haarshift::faces::integrate::{IntegralMethod, IntegrateOptions, integrate as integrate_maps};
-use haarshift::faces::product::{ProductOptions, multiply};
+use haarshift::faces::product::{ProductOptions, map_product};
 use haarshift::product::Selection;
 use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
 use haarshift::{Sample, round_to_code};
@@ -270,7 +270,7 @@ fn product_as<'py, T: Sample + Element>(
     cube: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let maps = lat_longs::<T>(maps).or_raise()?;
-    let result = py.detach(|| multiply(&maps, options)).or_raise()?;
+    let result = py.detach(|| map_product(&maps, options)).or_raise()?;
     if cube {
         return Ok(result.map.into_array().into_pyarray(py).into_any());
     }

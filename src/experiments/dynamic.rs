@@ -25,7 +25,9 @@ use crate::faces::param::{ParamKind, Parameterization};
 use crate::metrics::RelativeError;
 use crate::product::Selection;
 use crate::relight::dynamic::fields::{FieldOptions, Truncation};
-use crate::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
+use crate::relight::dynamic::{
+    Change, DynamicOptions, DynamicScene, JustInTimeTransfer, Placement,
+};
 use crate::relight::light::environment::Environment;
 use crate::relight::{
     Lighting, PreparedTransport, SceneBvh, SceneFile, ShadeOptions, Transform, VisibilityOptions,
@@ -391,7 +393,7 @@ impl Built {
         let lighting = self.lighting(env, rotation, budget)?;
         let mut scene = self.scene.clone();
         let start = Instant::now();
-        let jrt = Jrt::<f32>::form(&scene, &lighting, Change::Object(self.moving))?;
+        let jrt = JustInTimeTransfer::<f32>::form(&scene, &lighting, Change::Object(self.moving))?;
         let reform = start.elapsed().as_secs_f64();
         scene.place(self.moving, self.target)?;
         let start = Instant::now();
@@ -452,7 +454,7 @@ impl Built {
         scene.place(self.moving, self.target)?;
         let lighting = self.lighting(env, rotation, budget)?;
         let start = Instant::now();
-        let jrt = Jrt::<f32>::form(&scene, &lighting, Change::Lighting)?;
+        let jrt = JustInTimeTransfer::<f32>::form(&scene, &lighting, Change::Lighting)?;
         let reform = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let lighting = self.lighting(env, rotation, budget)?;

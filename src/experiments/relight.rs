@@ -55,9 +55,7 @@ use crate::relight::{
     Brdf, Lighting, PhongSh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, ShTransfer,
     ShadeOptions, TransportSet, VisibilityOptions, shade_sh, vertex_major,
 };
-use crate::render::raster::{
-    Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
-};
+use crate::render::raster::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
 use crate::sphere::SphereRotation;
 use crate::sphere::harmonics::SphericalHarmonics;
 use crate::{Error, PlanarImage, Result};
@@ -1110,7 +1108,7 @@ fn draw(
     background: Background<'_>,
 ) -> Result<PlanarImage<f32>> {
     let radiance = radiance.mapv(|v| v as f32);
-    let mesh = RasterMesh {
+    let mesh = LitMesh {
         positions: scene.mesh.positions(),
         triangles: scene.mesh.triangles(),
         radiance: radiance.view(),

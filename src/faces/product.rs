@@ -2,7 +2,7 @@
 //! maps' trees multiplied by [`product::multiply::product`](crate::product::multiply::product)
 //! (seed 001 section 3.4.4), not pixel by pixel.
 //!
-//! [`multiply`] takes the maps as [`integrate`](super::integrate::integrate) does (one size,
+//! [`map_product`] takes the maps as [`integrate`](super::integrate::integrate) does (one size,
 //! `H` a power of two, one-channel maps broadcast over the channels of the others; lat-long at
 //! the maps' own height or a cube map, at any working resolution), builds each map's tree with
 //! its [`Selection`] and returns the product as a [`SphereMap`] and as its Haar coefficients.
@@ -32,7 +32,7 @@ use crate::product::multiply::product;
 use crate::sphere::LatLongMap;
 use crate::{Result, Sample};
 
-/// What [`multiply`] does.
+/// What [`map_product`] does.
 ///
 /// ```
 /// use haarshift::faces::product::ProductOptions;
@@ -50,7 +50,7 @@ pub struct ProductOptions {
     pub selections: Vec<Selection>,
 }
 
-/// The result of [`multiply`].
+/// The result of [`map_product`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SphereProduct<T> {
     /// The product map, in the working parameterisation.
@@ -70,15 +70,15 @@ pub struct SphereProduct<T> {
 ///
 /// ```
 /// use haarshift::sphere::LatLongMap;
-/// use haarshift::faces::product::{ProductOptions, multiply};
+/// use haarshift::faces::product::{ProductOptions, map_product};
 /// let f = LatLongMap::<f64>::from_fn(8, 1, |d, out| out[0] = 1.0 + d[1]).unwrap();
 /// let g = LatLongMap::<f64>::from_fn(8, 3, |d, out| out.fill(2.0 + d[0])).unwrap();
-/// let fg = multiply(&[f.clone(), g.clone()], &ProductOptions::default()).unwrap();
+/// let fg = map_product(&[f.clone(), g.clone()], &ProductOptions::default()).unwrap();
 /// let got = fg.map.to_lat_long().unwrap();
 /// let want = &f.as_array() * &g.as_array();
 /// assert!(got.as_array().iter().zip(want.iter()).all(|(a, b)| (a - b).abs() < 1e-12));
 /// ```
-pub fn multiply<T: Sample>(
+pub fn map_product<T: Sample>(
     maps: &[LatLongMap<T>],
     options: &ProductOptions,
 ) -> Result<SphereProduct<T>> {
@@ -106,6 +106,15 @@ pub fn multiply<T: Sample>(
         3 => channels!(3),
         _ => channels!(4),
     })
+}
+
+/// The old name of [`map_product`], kept for one release.
+#[deprecated(note = "renamed `haarshift::faces::product::map_product`")]
+pub fn multiply<T: Sample>(
+    maps: &[LatLongMap<T>],
+    options: &ProductOptions,
+) -> Result<SphereProduct<T>> {
+    map_product(maps, options)
 }
 
 #[cfg(test)]
@@ -148,7 +157,7 @@ mod tests {
         .collect();
         /// The product's lat-long pixels, in f64.
         fn pixels<T: Sample>(maps: &[LatLongMap<T>]) -> Vec<f64> {
-            let got = multiply(maps, &ProductOptions::default()).unwrap();
+            let got = map_product(maps, &ProductOptions::default()).unwrap();
             assert_eq!(got.kept, vec![16 * 32 - 2; 3]);
             let map = got.map.to_lat_long().unwrap();
             map.as_array().iter().map(|v| v.as_f64()).collect()
@@ -165,7 +174,7 @@ mod tests {
     #[test]
     fn coefficients_are_the_orthonormal_pyramids_of_the_product_faces() {
         let maps = [map::<f64>(8, 1, 4), map(8, 1, 5)];
-        let got = multiply(&maps, &ProductOptions::default()).unwrap();
+        let got = map_product(&maps, &ProductOptions::default()).unwrap();
         let faces = got.map.as_array();
         for f in 0..2 {
             let plane = faces
@@ -211,7 +220,7 @@ mod tests {
             selections: vec![Selection::Largest(k)],
             ..Default::default()
         };
-        let got = multiply(&maps, &o).unwrap();
+        let got = map_product(&maps, &o).unwrap();
         assert_eq!(got.kept, vec![k, k]);
         let err = got
             .map
@@ -221,7 +230,7 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         assert!(err < 1e-12, "{err}");
-        let full = multiply(&maps, &ProductOptions::default()).unwrap();
+        let full = map_product(&maps, &ProductOptions::default()).unwrap();
         assert!(
             max_relative(
                 &got.map.as_array().iter().copied().collect::<Vec<_>>(),
@@ -237,7 +246,7 @@ mod tests {
             param: ParamKind::Cube,
             ..Default::default()
         };
-        let got = multiply(&maps, &o).unwrap();
+        let got = map_product(&maps, &o).unwrap();
         let (ll, cube) = (
             Parameterization::new(ParamKind::LatLong, 16).unwrap(),
             Parameterization::new(ParamKind::Cube, 8).unwrap(),
@@ -268,12 +277,12 @@ mod tests {
         let (a, b) = (map::<f64>(16, 1, 10), map::<f64>(8, 1, 11));
         let d = ProductOptions::default();
         assert_err!(
-            multiply(&[a.clone(), b], &d),
+            map_product(&[a.clone(), b], &d),
             InvalidShape { .. },
             "maps of different sizes"
         );
         assert_err!(
-            multiply::<f64>(&[], &d),
+            map_product::<f64>(&[], &d),
             InvalidParameter { name: "maps", .. },
             "no map given"
         );
@@ -282,13 +291,13 @@ mod tests {
             ..Default::default()
         };
         assert_err!(
-            multiply(&[a.clone(), a.clone()], &many),
+            map_product(&[a.clone(), a.clone()], &many),
             InvalidParameter { name: "keep", .. },
             "only 510 details"
         );
         let odd = LatLongMap::<f64>::from_fn(6, 1, |_, o| o[0] = 1.0).unwrap();
         assert_err!(
-            multiply(&[odd.clone(), odd], &d),
+            map_product(&[odd.clone(), odd], &d),
             InvalidShape { .. },
             "not a power of two"
         );

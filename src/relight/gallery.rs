@@ -33,9 +33,7 @@ use crate::relight::{
     Lighting, Mesh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, SceneCache, ShadeOptions,
     VisibilityOptions, reference, shade_sh,
 };
-use crate::render::raster::{
-    Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
-};
+use crate::render::raster::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
 use crate::sphere::SphereRotation;
 use crate::sphere::harmonics::SphericalHarmonics;
 use crate::{Channels, Error, PlanarImage, Result, SampleDepth};
@@ -212,7 +210,7 @@ pub fn gallery(
             .iter()
             .map(|radiance| {
                 let radiance = radiance.mapv(|v| v as f32);
-                let mesh = RasterMesh {
+                let mesh = LitMesh {
                     positions: cache.mesh.positions(),
                     triangles: cache.mesh.triangles(),
                     radiance: radiance.view(),
@@ -324,7 +322,7 @@ fn turntable(
                 Lighting::new(env, param, &turn, Selection::Largest(options.keep_light))?;
             let radiance = prepared.shade(&lighting)?;
             let backdrop = env.lat_long(env.map().height().min(512), &turn)?;
-            let mesh = RasterMesh {
+            let mesh = LitMesh {
                 positions: cache.mesh.positions(),
                 triangles: cache.mesh.triangles(),
                 radiance: radiance.view(),

@@ -242,7 +242,7 @@ pub enum Background<'a> {
 /// A mesh to draw: `positions` `(V, 3)`, triangles indexing them, and the linear RGB radiance
 /// leaving each vertex, `(V, 3)`.
 #[derive(Clone, Copy, Debug)]
-pub struct Mesh<'a> {
+pub struct LitMesh<'a> {
     /// Vertex positions, world space.
     pub positions: ArrayView2<'a, f64>,
     /// Triangles as vertex indices.
@@ -251,7 +251,11 @@ pub struct Mesh<'a> {
     pub radiance: ArrayView2<'a, f32>,
 }
 
-impl Mesh<'_> {
+/// The old name of [`LitMesh`], kept for one release.
+#[deprecated(note = "renamed `haarshift::render::raster::LitMesh`")]
+pub type Mesh<'a> = LitMesh<'a>;
+
+impl LitMesh<'_> {
     /// Checks shapes, indices and values.
     fn check(&self) -> Result<()> {
         let (v, c) = self.positions.dim();
@@ -282,11 +286,11 @@ impl Mesh<'_> {
 /// depth [`SampleDepth::F32`]); see the [module docs](self).
 ///
 /// ```
-/// use haarshift::render::raster::{Background, Camera, Mesh, render};
+/// use haarshift::render::raster::{Background, Camera, LitMesh, render};
 /// use ndarray::array;
 /// let positions = array![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
 /// let radiance = array![[1.0f32, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-/// let mesh = Mesh { positions: positions.view(), triangles: &[[0, 1, 2]], radiance: radiance.view() };
+/// let mesh = LitMesh { positions: positions.view(), triangles: &[[0, 1, 2]], radiance: radiance.view() };
 /// let camera = Camera::new([0.0, 0.0, 4.0], [0.0; 3], 40.0).unwrap();
 /// let image = render(&camera, 32, 32, &mesh, Background::Colour([0.5; 3])).unwrap();
 /// let centre: f32 = (0..3).map(|c| image.plane(c)[[16, 16]]).sum();
@@ -297,7 +301,7 @@ pub fn render(
     camera: &Camera,
     width: usize,
     height: usize,
-    mesh: &Mesh<'_>,
+    mesh: &LitMesh<'_>,
     background: Background<'_>,
 ) -> Result<PlanarImage<f32>> {
     if width == 0 || height == 0 || width > 1 << 15 || height > 1 << 15 {
@@ -404,7 +408,7 @@ struct Setup {
 type ClipVertex = [f64; 6];
 
 /// Every triangle of `mesh` clipped, projected, snapped and set up, in the mesh's order.
-fn setup_triangles(camera: &Camera, width: usize, height: usize, mesh: &Mesh<'_>) -> Vec<Setup> {
+fn setup_triangles(camera: &Camera, width: usize, height: usize, mesh: &LitMesh<'_>) -> Vec<Setup> {
     let near = NEAR_FRACTION * norm(sub(camera.look_at, camera.position));
     let f = camera.focal(height);
     let (cx, cy) = (0.5 * width as f64, 0.5 * height as f64);
@@ -733,7 +737,7 @@ mod tests {
         tris: &[[u32; 3]],
     ) -> Vec<Setup> {
         let radiance = Array2::<f32>::zeros((positions.nrows(), 3));
-        let mesh = Mesh {
+        let mesh = LitMesh {
             positions: positions.view(),
             triangles: tris,
             radiance: radiance.view(),
@@ -869,7 +873,7 @@ mod tests {
         radiance.slice_mut(ndarray::s![..3, 0]).fill(1.0); // far: red
         radiance.slice_mut(ndarray::s![3.., 2]).fill(1.0); // near: blue
         for tris in [[[0, 1, 2], [3, 4, 5]], [[3, 4, 5], [0, 1, 2]]] {
-            let mesh = Mesh {
+            let mesh = LitMesh {
                 positions: positions.view(),
                 triangles: &tris,
                 radiance: radiance.view(),
@@ -899,7 +903,7 @@ mod tests {
         let radiance = Array2::from_shape_fn((3, 3), |(k, c)| {
             f([0, 1, 2].map(|i| positions[[k, i]]))[c] as f32
         });
-        let mesh = Mesh {
+        let mesh = LitMesh {
             positions: positions.view(),
             triangles: &[[0, 1, 2]],
             radiance: radiance.view(),
@@ -962,7 +966,7 @@ mod tests {
         let camera = Camera::new([1.0, 2.0, 3.0], [0.0, 0.5, 0.0], 75.0).unwrap();
         let positions = Array2::<f64>::zeros((0, 3));
         let radiance = Array2::<f32>::zeros((0, 3));
-        let mesh = Mesh {
+        let mesh = LitMesh {
             positions: positions.view(),
             triangles: &[],
             radiance: radiance.view(),
@@ -1035,7 +1039,7 @@ mod tests {
         let camera = front_camera();
         let positions = array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, f64::NAN, 0.0]];
         let radiance = Array2::<f32>::zeros((3, 3));
-        let mesh = Mesh {
+        let mesh = LitMesh {
             positions: positions.view(),
             triangles: &[[0, 1, 2]],
             radiance: radiance.view(),
@@ -1046,7 +1050,7 @@ mod tests {
             "NaN"
         );
         let positions = Array2::<f64>::zeros((3, 3));
-        let mesh = Mesh {
+        let mesh = LitMesh {
             positions: positions.view(),
             triangles: &[[0, 1, 3]],
             radiance: radiance.view(),
@@ -1054,7 +1058,7 @@ mod tests {
         let err = render(&camera, 8, 8, &mesh, Background::Colour([0.0; 3])).unwrap_err();
         assert!(err.to_string().contains("triangle 0"), "{err}");
         let short = Array2::<f32>::zeros((2, 3));
-        let mesh = Mesh {
+        let mesh = LitMesh {
             positions: positions.view(),
             triangles: &[],
             radiance: short.view(),
@@ -1064,7 +1068,7 @@ mod tests {
             InvalidShape { .. },
             "positions (V, 3) and radiance (V, 3)"
         );
-        let mesh = Mesh {
+        let mesh = LitMesh {
             positions: positions.view(),
             triangles: &[],
             radiance: radiance.view(),

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use clap::Subcommand;
 use haarshift::faces::ParamKind;
 use haarshift::faces::integrate::{IntegralMethod, IntegrateOptions, check_size};
-use haarshift::faces::product::{ProductOptions, multiply};
+use haarshift::faces::product::{ProductOptions, map_product};
 use haarshift::io::{CoefficientFile, FileFormat, WriteOptions, read_image};
 use haarshift::product::Selection;
 use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
@@ -480,7 +480,7 @@ fn product_as<T: Sample>(
         selections: flags.selections()?,
     };
     bar.set_message("multiplying");
-    let result = multiply(&maps, &options);
+    let result = map_product(&maps, &options);
     bar.finish_and_clear();
     let result = result?;
     let kept: Vec<String> = result.kept.iter().map(|k| k.to_string()).collect();

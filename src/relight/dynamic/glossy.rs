@@ -36,7 +36,7 @@ impl DynamicScene {
         Ok(&self.objects[k].brdf)
     }
 
-    /// Gives object `k` the BRDF `brdf` (its albedo stays). A [`Jrt`] formed before holds the
+    /// Gives object `k` the BRDF `brdf` (its albedo stays). A [`JustInTimeTransfer`] formed before holds the
     /// old BRDF in its fixed products: re-form it.
     ///
     /// ```

@@ -124,7 +124,7 @@ fn phong_zero_is_lambert_with_albedo_one() {
 fn a_change_of_view_equals_the_full_product_integral() {
     let light = lighting(0.4);
     let mut scene = build(&three([PHONG, BLINN, LAMBERT]));
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::View).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::View).unwrap();
     let mut frames = Vec::new();
     for eye in [[1.5, 2.5, 4.0], [-4.0, 1.0, 2.0], [0.5, 6.0, -3.0]] {
         scene.set_eye(eye).unwrap();
@@ -156,7 +156,7 @@ fn moving_objects_and_lighting_hold_the_brdf_in_the_fixed_product() {
     let mut scene = build(&three([PHONG, BLINN, LAMBERT]));
     let light = lighting(0.4);
     each_moved_object_is_the_full_product_integral(&mut scene, &light);
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::Lighting).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Lighting).unwrap();
     let turned = lighting(2.5);
     let want = scene.shade::<f64>(&turned).unwrap();
     let err = relative(&jrt.frame_lit(&scene, &turned).unwrap(), &want);

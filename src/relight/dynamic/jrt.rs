@@ -1,5 +1,5 @@
 //! Just-in-time radiance transfer (seed 001 sections 3.2.2 and 3.5.3): per vertex the product
-//! `T` of the factors that stay fixed while one varies, formed once ([`Jrt::form`]); a frame is
+//! `T` of the factors that stay fixed while one varies, formed once ([`JustInTimeTransfer::form`]); a frame is
 //! then one sparse dot product per vertex with the varying factor.
 
 use super::products::{Method, SharedFactor, Use, VertexProduct};
@@ -24,9 +24,9 @@ pub enum Change {
     View,
 }
 
-/// What forming or using a [`Jrt`] cost.
+/// What forming or using a [`JustInTimeTransfer`] cost.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct JrtReport {
+pub struct TransferReport {
     /// Wall-clock seconds.
     pub seconds: f64,
     /// Coefficients of the fixed products, all vertices.
@@ -47,7 +47,7 @@ pub struct JrtReport {
 ///
 /// ```
 /// use haarshift::product::Selection;
-/// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt, Placement};
+/// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, JustInTimeTransfer, Placement};
 /// use haarshift::relight::{Lighting, SceneFile};
 /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
@@ -61,7 +61,7 @@ pub struct JrtReport {
 /// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
 /// let sky = SphereMap::<f64>::from_fn(param, 3, |d, o| o.fill(0.2 + d[1].max(0.0))).unwrap();
 /// let light = Lighting::from_map(&sky, Selection::All).unwrap();
-/// let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
+/// let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
 /// // Move object 1; a frame is one dot product per vertex with its looked-up map.
 /// let moved = Placement { translate: [1.5, 0.0, 1.0], ..scene.placement(1) };
 /// scene.place(1, moved).unwrap();
@@ -70,17 +70,17 @@ pub struct JrtReport {
 /// assert!(fast.iter().zip(&full).all(|(a, b)| (a - b).abs() < 1e-9));
 /// ```
 #[derive(Clone, Debug)]
-pub struct Jrt<T> {
+pub struct JustInTimeTransfer<T> {
     change: Change,
     /// Every object's turn at formation (a vertex's own transport turns with its object).
     turns: Vec<usize>,
     /// Every placement at formation (a change of view holds them all).
     placements: Vec<Placement>,
     products: SparseRows<[T; 3]>,
-    report: JrtReport,
+    report: TransferReport,
 }
 
-impl<T: Sample> Jrt<T> {
+impl<T: Sample> JustInTimeTransfer<T> {
     /// Forms every vertex's fixed product for `change` in `scene`'s present placement under
     /// `lighting` (which a [`Change::Lighting`] will replace).
     pub fn form(scene: &DynamicScene, lighting: &Lighting, change: Change) -> Result<Self> {
@@ -130,12 +130,12 @@ impl<T: Sample> Jrt<T> {
             )
             .collect::<Result<_>>()?;
         let products: SparseRows<[T; 3]> = rows.iter().map(|(i, v)| (i, v)).collect();
-        let report = JrtReport {
+        let report = TransferReport {
             seconds: start.elapsed().as_secs_f64(),
             coefficients: products.coefficient_count(),
             bytes: products.bytes(),
         };
-        Ok(Jrt {
+        Ok(JustInTimeTransfer {
             change,
             turns: scene.objects.iter().map(|o| o.placement.turn).collect(),
             placements: scene.objects.iter().map(|o| o.placement).collect(),
@@ -150,7 +150,7 @@ impl<T: Sample> Jrt<T> {
     }
 
     /// What forming it cost.
-    pub fn report(&self) -> &JrtReport {
+    pub fn report(&self) -> &TransferReport {
         &self.report
     }
 
@@ -261,7 +261,7 @@ impl<T: Sample> Jrt<T> {
     ///
     /// ```
     /// use haarshift::product::Selection;
-    /// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, Jrt};
+    /// use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene, JustInTimeTransfer};
     /// use haarshift::relight::{Lighting, SceneFile};
     /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
     /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
@@ -276,7 +276,7 @@ impl<T: Sample> Jrt<T> {
     /// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
     /// let sky = SphereMap::<f64>::from_fn(param, 3, |d, o| o.fill(0.2 + d[1].max(0.0))).unwrap();
     /// let light = Lighting::from_map(&sky, Selection::All).unwrap();
-    /// let jrt = Jrt::<f64>::form(&scene, &light, Change::View).unwrap();
+    /// let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::View).unwrap();
     /// scene.set_eye([5.0, 1.0, 1.0]).unwrap(); // the camera moves
     /// let fast = jrt.frame_view(&scene).unwrap();
     /// let full = scene.shade::<f64>(&light).unwrap();

@@ -1,7 +1,7 @@
 //! Dynamic scenes (seed 001 chapter 3): rigid objects that move, scale, turn about the
 //! vertical and are cloned at run time, each shadowing the others through its
 //! [occlusion field](crate::relight::dynamic::fields), shaded by n-function product integrals and by
-//! just-in-time radiance transfer ([`Jrt`]).
+//! just-in-time radiance transfer ([`JustInTimeTransfer`]).
 //!
 //! **What is computed.** A Lambertian vertex `v` of albedo `a` reflects
 //! `B_v = a / pi x integral of T_v x L x prod_(k != own) O_k`, seed 001 eq. 3.1-3.3 with the
@@ -838,7 +838,7 @@ impl DynamicScene {
 
     /// Every vertex's outgoing radiance `(V, 3)` by the n-function product integral of its
     /// own transport, the lighting and every other object's occlusion (issue 7's traversal),
-    /// with no reuse between frames: the oracle of [`Jrt`] and the cost it saves.
+    /// with no reuse between frames: the oracle of [`JustInTimeTransfer`] and the cost it saves.
     pub fn shade<T: Sample>(&self, lighting: &Lighting) -> Result<Array2<T>> {
         let depth = self.check_lighting(lighting)?;
         let param = self.param();
@@ -1045,7 +1045,15 @@ mod glossy;
 mod jrt;
 pub mod motion;
 mod products;
-pub use jrt::{Change, Jrt, JrtReport};
+pub use jrt::{Change, JustInTimeTransfer, TransferReport};
+
+/// The old name of [`JustInTimeTransfer`], kept for one release.
+#[deprecated(note = "renamed `haarshift::relight::dynamic::JustInTimeTransfer`")]
+pub type Jrt<T> = JustInTimeTransfer<T>;
+
+/// The old name of [`TransferReport`], kept for one release.
+#[deprecated(note = "renamed `haarshift::relight::dynamic::TransferReport`")]
+pub type JrtReport = TransferReport;
 
 #[cfg(test)]
 mod tests;

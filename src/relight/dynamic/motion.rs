@@ -30,7 +30,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::product::Selection;
 use crate::relight::SceneError;
-use crate::relight::dynamic::{Change, DynamicScene, Jrt, JrtReport, Placement};
+use crate::relight::dynamic::{
+    Change, DynamicScene, JustInTimeTransfer, Placement, TransferReport,
+};
 use crate::relight::light::environment::{Environment, SphereMapping};
 use crate::relight::light::lighting::Lighting;
 use crate::relight::scene::Transform;
@@ -99,7 +101,7 @@ pub struct FrameReport {
     /// The frame's state.
     pub state: FrameState,
     /// What re-forming the transfer before this frame cost, when it was re-formed.
-    pub reformed: Option<JrtReport>,
+    pub reformed: Option<TransferReport>,
     /// Seconds encoding the varying factor and shading (the per-frame cost).
     pub shade_seconds: f64,
 }
@@ -332,7 +334,7 @@ pub fn play(
     let mapping = SphereMapping::new(env.map().height(), scene.param())?;
     let rotation = |yaw: f64| SphereRotation::from_degrees(angles[0] + yaw, angles[1], angles[2]);
     let mut lighting = Lighting::encode(env, &mapping, &rotation(0.0)?, keep_light)?;
-    let mut jrt: Option<(usize, Jrt<f32>, usize)> = None;
+    let mut jrt: Option<(usize, JustInTimeTransfer<f32>, usize)> = None;
     for (index, state) in states.iter().enumerate() {
         let turn = |k: usize, scene: &DynamicScene| scene.placement(k).turn;
         let mut reformed = None;
@@ -352,7 +354,7 @@ pub fn play(
             (Some((segment, ..)), Change::Lighting | Change::View) => *segment != state.segment,
         };
         if stale {
-            let formed = Jrt::form(scene, &lighting, state.change)?;
+            let formed = JustInTimeTransfer::form(scene, &lighting, state.change)?;
             let t = match state.change {
                 Change::Object(k) => turn(k, scene),
                 Change::Lighting | Change::View => 0,

@@ -82,7 +82,7 @@ fn one_object_alone_is_shaded_as_the_static_path_shades_it() {
     // The box shadows the plane: the comparison is not of unshadowed vertices only.
     assert!(want.column(0).iter().fold(f64::INFINITY, |a, &b| a.min(b)) < 0.5 * rms(&want));
     assert!(relative(&scene.shade::<f64>(&light).unwrap(), &want) < 1e-12);
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::Lighting).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Lighting).unwrap();
     let turned = lighting(1.9);
     let want = prepared.shade(&turned).unwrap();
     assert!(relative(&jrt.frame_lit(&scene, &turned).unwrap(), &want) < 1e-12);
@@ -152,7 +152,7 @@ fn moving_an_object_beyond_its_field_renders_as_removing_it() {
     let mut scene = build(two);
     let alone = build(r#"{"objects": [{"generator": {"plane_under_box": {"height": 0.4}}}]}"#);
     let light = lighting(0.7);
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
     let with = scene.shade::<f64>(&light).unwrap();
     let far = Placement {
         translate: [1000.0, 0.0, 0.0],
@@ -175,7 +175,7 @@ pub(super) fn each_moved_object_is_the_full_product_integral(
     light: &Lighting,
 ) {
     for moving in 0..scene.object_count() {
-        let jrt = Jrt::<f64>::form(scene, light, Change::Object(moving)).unwrap();
+        let jrt = JustInTimeTransfer::<f64>::form(scene, light, Change::Object(moving)).unwrap();
         let mut p = scene.placement(moving);
         p.translate[0] += 0.35;
         p.translate[2] -= 0.2;
@@ -192,13 +192,13 @@ fn just_in_time_transfer_equals_the_full_product_integral_with_unpruned_factors(
     let mut scene = build(THREE);
     let light = lighting(0.4);
     each_moved_object_is_the_full_product_integral(&mut scene, &light);
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::Lighting).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Lighting).unwrap();
     let turned = lighting(2.5);
     let want = scene.shade::<f64>(&turned).unwrap();
     assert!(relative(&jrt.frame_lit(&scene, &turned).unwrap(), &want) < 1e-9);
     // The wrong frame for the change is refused, and so is a turn since formation.
     assert!(jrt.frame_moved(&scene).is_err());
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
     let turned = Placement {
         turn: 3,
         ..scene.placement(1)
@@ -212,13 +212,13 @@ fn just_in_time_transfer_equals_the_full_product_integral_with_unpruned_factors(
 fn pruning_the_fixed_product_trades_coefficients_for_error() {
     let scene = build(THREE);
     let light = lighting(0.4);
-    let full = Jrt::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
+    let full = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
     let want = full.frame_moved(&scene).unwrap();
     let mut errors = Vec::new();
     for k in [8, 32] {
         let mut pruned = scene.clone();
         pruned.options.keep_product = Selection::Largest(k);
-        let jrt = Jrt::<f64>::form(&pruned, &light, Change::Object(1)).unwrap();
+        let jrt = JustInTimeTransfer::<f64>::form(&pruned, &light, Change::Object(1)).unwrap();
         assert!(jrt.report().coefficients < full.report().coefficients);
         errors.push(relative(&jrt.frame_moved(&pruned).unwrap(), &want));
     }
@@ -316,7 +316,7 @@ fn a_clone_shares_its_shape_and_shadows_like_the_original() {
     let k = scene.clone_object(0, p).unwrap();
     assert_eq!((k, scene.shape_count()), (3, 1));
     assert_eq!(scene.vertex_count(), before + 54);
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(k)).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Object(k)).unwrap();
     assert!(
         relative(
             &jrt.frame_moved(&scene).unwrap(),
@@ -344,7 +344,7 @@ fn both_ways_of_a_vertex_product_give_the_quadtree_product() {
     use super::products::{Method, SharedFactor, VertexProduct};
     let mut scene = build(FOUR);
     let light = lighting(0.4);
-    let jrt = Jrt::<f64>::form(&scene, &light, Change::Object(0)).unwrap();
+    let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Object(0)).unwrap();
     let mut p = scene.placement(0);
     p.translate = [0.3, 0.1, 0.2];
     scene.place(0, p).unwrap();

@@ -458,7 +458,7 @@ pub struct Transform {
     #[serde(default)]
     pub translate: [f64; 3],
     /// Uniform scale, applied first.
-    #[serde(default = "one")]
+    #[serde(default = "unit_scale")]
     pub scale: f64,
     /// Degrees about Y.
     #[serde(default)]
@@ -471,7 +471,8 @@ pub struct Transform {
     pub roll: f64,
 }
 
-fn one() -> f64 {
+/// A transform's default scale.
+fn unit_scale() -> f64 {
     1.0
 }
 

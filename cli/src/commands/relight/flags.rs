@@ -13,7 +13,7 @@ use haarshift::relight::scene::GROUND_VERTICES;
 use haarshift::relight::{Brdf, PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
 use haarshift::render::raster::{Background, Camera, DEFAULT_FOV};
-use haarshift::render::raster::{Mesh as RasterMesh, render};
+use haarshift::render::raster::{LitMesh, render};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift::{Error, Result};
 
@@ -361,7 +361,7 @@ impl CameraFlags {
             }
             BackgroundChoice::Colour(c) => Background::Colour(c),
         };
-        let drawn = RasterMesh {
+        let drawn = LitMesh {
             positions: mesh.positions(),
             triangles: mesh.triangles(),
             radiance,
