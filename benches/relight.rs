@@ -31,7 +31,7 @@ use haarshift::relight::{
     Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,
     VisibilityOptions, shade_sh, vertex_major,
 };
-use haarshift::render::raster::{Background, Camera, DEFAULT_FOV, LitMesh, render};
+use haarshift::render::{Background, Camera, DEFAULT_FOV, LitMesh, render};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::sphere::latlong::direction;
 use haarshift::sphere::{LatLongMap, SphereRotation};

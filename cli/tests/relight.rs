@@ -321,7 +321,7 @@ fn render_writes_the_image_and_vertices_and_times_each_stage() {
         &["--env", p(&env), "--keep-light", "20"],
     ));
     let linear = haarshift::io::read_image::<f32>(&exr).unwrap();
-    let srgb = haarshift::render::raster::to_srgb8(&linear, 0.0).unwrap();
+    let srgb = haarshift::render::to_srgb8(&linear, 0.0).unwrap();
     assert_eq!(srgb.planes(), image.planes());
 }
 

@@ -55,7 +55,7 @@ use crate::relight::{
     Brdf, Lighting, PhongSh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, ShTransfer,
     ShadeOptions, TransportSet, VisibilityOptions, shade_sh, vertex_major,
 };
-use crate::render::raster::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
+use crate::render::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
 use crate::sphere::SphereRotation;
 use crate::sphere::harmonics::SphericalHarmonics;
 use crate::{Error, PlanarImage, Result};

@@ -33,7 +33,7 @@ use crate::relight::{
     Lighting, Mesh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, SceneCache, ShadeOptions,
     VisibilityOptions, reference, shade_sh,
 };
-use crate::render::raster::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
+use crate::render::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
 use crate::sphere::SphereRotation;
 use crate::sphere::harmonics::SphericalHarmonics;
 use crate::{Channels, Error, PlanarImage, Result, SampleDepth};

@@ -67,6 +67,15 @@ macro_rules! moved {
     )*};
 }
 
+/// The rasteriser's old path: its camera, drawing and files are [`crate::render`]'s.
+#[doc(hidden)]
+#[deprecated(note = "moved to `haarshift::render`")]
+pub mod raster {
+    #[allow(deprecated)]
+    pub use crate::render::raster::Mesh;
+    pub use crate::render::*;
+}
+
 moved! {
     animation => render::animation, "moved to `haarshift::render::animation`";
     brdf => relight::material::brdf, "moved to `haarshift::relight::material::brdf`";
@@ -78,7 +87,6 @@ moved! {
     mesh => relight::scene::mesh, "moved to `haarshift::relight::scene::mesh`";
     motion => relight::dynamic::motion, "moved to `haarshift::relight::dynamic::motion`";
     orient => relight::material::orient, "moved to `haarshift::relight::material::orient`";
-    raster => render::raster, "moved to `haarshift::render::raster`";
     raycast => relight::precompute::raycast, "moved to `haarshift::relight::precompute::raycast`";
     shadowmap => relight::precompute::shadowmap, "moved to `haarshift::relight::precompute::shadowmap`";
     sparse => relight::precompute::sparse, "moved to `haarshift::relight::precompute::sparse`";

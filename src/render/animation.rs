@@ -18,7 +18,7 @@ use crate::{Error, PlanarImage, Result, SampleDepth};
 /// The NeuQuant sampling speed used for every frame's palette.
 pub const QUANTIZER_SPEED: i32 = 10;
 
-/// Writes `frames` (8-bit sRGB codes, as [`to_srgb8`](crate::render::raster::to_srgb8) gives them:
+/// Writes `frames` (8-bit sRGB codes, as [`to_srgb8`](crate::render::to_srgb8) gives them:
 /// RGB or gray of depth [`SampleDepth::U8`], all the same size) to `path` as a looping
 /// animated GIF, `delay_ms` per frame (10 ms to 655 s); atomically, replacing an existing file
 /// only with `force`. See the [module docs](self) for the palette.

@@ -1,5 +1,12 @@
-//! Images of per-vertex radiance: the camera, the software rasteriser (z-buffer,
-//! perspective-correct interpolation, sRGB) ([`raster`]), and animated GIFs ([`animation`]).
+//! Images of per-vertex radiance: a perspective [`camera`], the software rasteriser
+//! ([`raster`]: z-buffer, perspective-correct interpolation, the environment behind), exposure,
+//! sRGB and files ([`output`]), and animated GIFs ([`animation`]).
 
 pub mod animation;
+pub mod camera;
+pub mod output;
 pub mod raster;
+
+pub use camera::{Camera, DEFAULT_FOV};
+pub use output::{render_format, srgb_encode, to_srgb8, write_render};
+pub use raster::{Background, LitMesh, render};

@@ -2,17 +2,7 @@
 //! perspective-correct Gouraud interpolation, the environment (or a colour) as background,
 //! exposure and sRGB for 8-bit PNG, linear f32 for OpenEXR.
 //!
-//! # Camera
-//!
-//! [`Camera`]: a `position`, a point to `look_at`, the world's +Y as up, and a vertical field
-//! of view in degrees. The image's right is `forward x Y`, its up `right x forward`; looking
-//! straight up or down (no horizontal component), the image's up is `-Z` (looking down) or
-//! `+Z` (looking up). A point at camera coordinates `(x, y, z)` (`z` the depth along
-//! `forward`) lands at pixel coordinates `(W / 2 + f x / z, H / 2 - f y / z)` with
-//! `f = (H / 2) / tan(fov / 2)`; pixel `(row i, column j)` has its centre at `(j + 0.5, i + 0.5)`.
-//! [`Camera::framing`] is the default: it looks at a bounding box's centre from 20 degrees above
-//! the horizon on the +Z side, far enough that the box's bounding sphere fits the vertical field
-//! of view (the narrower one of an image at least as wide as high).
+//! The camera is [`camera`](super::camera)'s; files are written by [`output`](super::output).
 //!
 //! # Rasterisation
 //!
@@ -32,26 +22,16 @@
 //! depend on the thread count). Pixels no triangle covers show the [`Background`]: a colour,
 //! or the environment seen along the pixel centre's ray (bilinear lookup in the lat-long map,
 //! the sphere module's direction convention).
-//!
-//! # Output
-//!
-//! [`render`] returns linear radiance as an f32 RGB [`PlanarImage`]. [`write_render`] writes
-//! `.exr` as it is (linear f32) and `.png` as 8-bit sRGB after an exposure of `2^stops`
-//! ([`to_srgb8`], [`srgb_encode`]), atomically, through [`crate::io`].
 
 use std::ops::Range;
-use std::path::Path;
 
 use ndarray::{Array3, ArrayView2, Axis};
 use rayon::prelude::*;
 
-use crate::io::{FileFormat, WriteOptions, write_image};
+use super::camera::Camera;
 use crate::sphere::LatLongMap;
 use crate::sphere::latlong::angles;
 use crate::{Channels, Error, PlanarImage, Result, SampleDepth};
-
-/// The default vertical field of view, degrees.
-pub const DEFAULT_FOV: f64 = 40.0;
 
 /// The near plane's distance as a fraction of the camera's distance to the point looked at.
 const NEAR_FRACTION: f64 = 1e-3;
@@ -65,170 +45,6 @@ const GUARD: f64 = (1u64 << 21) as f64;
 
 /// Rows per band of parallel work.
 const BAND_ROWS: usize = 16;
-
-/// A perspective camera (see the [module docs](self) for its conventions).
-///
-/// ```
-/// use haarshift::render::raster::Camera;
-/// let c = Camera::new([0.0, 0.0, 5.0], [0.0, 0.0, 0.0], 90.0).unwrap();
-/// // 100 x 100 pixels: f = 50, so (1, 0.5, 0) at depth 5 lands 10 right and 5 up of the centre
-/// let [x, y, depth] = c.project([1.0, 0.5, 0.0], 100, 100).unwrap();
-/// assert!((x - 60.0).abs() < 1e-12 && (y - 45.0).abs() < 1e-12 && (depth - 5.0).abs() < 1e-12);
-/// assert!(Camera::new([0.0; 3], [0.0; 3], 40.0).is_err());
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    position: [f64; 3],
-    look_at: [f64; 3],
-    fov: f64,
-    right: [f64; 3],
-    up: [f64; 3],
-    forward: [f64; 3],
-}
-
-impl Camera {
-    /// A camera at `position` looking at `look_at` (a different point), +Y up, with a vertical
-    /// field of view of `fov_degrees` (above 0 and below 180).
-    pub fn new(position: [f64; 3], look_at: [f64; 3], fov_degrees: f64) -> Result<Self> {
-        if position.iter().chain(&look_at).any(|v| !v.is_finite()) {
-            return Err(Error::parameter(
-                "camera",
-                "the position and the point looked at must be finite",
-            ));
-        }
-        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
-            return Err(Error::parameter(
-                "fov",
-                format!("{fov_degrees} degrees (expected more than 0 and less than 180)"),
-            ));
-        }
-        let forward = normalize(sub(look_at, position)).ok_or_else(|| {
-            Error::parameter("camera", "the camera cannot look at its own position")
-        })?;
-        let level = cross(forward, [0.0, 1.0, 0.0]);
-        // Straight up or down: the image's up is -Z looking down, +Z looking up.
-        let side = if norm(level) > 1e-9 {
-            level
-        } else {
-            cross(forward, [0.0, 0.0, forward[1].signum()])
-        };
-        let right = normalize(side).expect("not parallel to the forward axis");
-        let up = cross(right, forward);
-        Ok(Camera {
-            position,
-            look_at,
-            fov: fov_degrees,
-            right,
-            up,
-            forward,
-        })
-    }
-
-    /// The default camera for the box `[min, max]` (see the [module docs](self)), with a vertical
-    /// field of view of `fov_degrees`.
-    ///
-    /// ```
-    /// use haarshift::render::raster::{Camera, DEFAULT_FOV};
-    /// let c = Camera::framing([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0], DEFAULT_FOV).unwrap();
-    /// assert_eq!(c.look_at(), [0.0, 1.0, 0.0]);
-    /// // every corner of the box projects inside a square image
-    /// for k in 0..8 {
-    ///     let p = [[-1.0, 1.0][k & 1], [0.0, 2.0][(k >> 1) & 1], [-1.0, 1.0][k >> 2]];
-    ///     let [x, y, _] = c.project(p, 64, 64).unwrap();
-    ///     assert!((0.0..64.0).contains(&x) && (0.0..64.0).contains(&y));
-    /// }
-    /// ```
-    pub fn framing(min: [f64; 3], max: [f64; 3], fov_degrees: f64) -> Result<Self> {
-        let centre = [0, 1, 2].map(|k| 0.5 * (min[k] + max[k]));
-        let radius = 0.5 * norm(sub(max, min));
-        let radius = if radius > 0.0 { radius } else { 1.0 };
-        let half = 0.5 * fov_degrees.to_radians();
-        let distance = radius / half.sin();
-        let (s, c) = 20f64.to_radians().sin_cos();
-        let position = [
-            centre[0],
-            centre[1] + distance * s,
-            centre[2] + distance * c,
-        ];
-        Camera::new(position, centre, fov_degrees)
-    }
-
-    /// The camera moved `degrees` about the vertical axis through the point it looks at (a
-    /// turntable seen from a circling viewer; positive turns go from +Z toward +X, the
-    /// direction of increasing azimuth).
-    ///
-    /// ```
-    /// use haarshift::render::raster::Camera;
-    /// let c = Camera::new([0.0, 1.0, 5.0], [0.0, 1.0, 0.0], 40.0).unwrap();
-    /// let p = c.orbited(90.0).unwrap().position();
-    /// assert!((p[0] - 5.0).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12 && p[2].abs() < 1e-12);
-    /// assert_eq!(c.orbited(0.0).unwrap().position(), c.position());
-    /// ```
-    pub fn orbited(&self, degrees: f64) -> Result<Camera> {
-        if !degrees.is_finite() {
-            return Err(Error::parameter(
-                "orbit",
-                format!("{degrees} degrees is not an angle"),
-            ));
-        }
-        let (s, c) = degrees.to_radians().sin_cos();
-        let d = sub(self.position, self.look_at);
-        let turned = [
-            self.look_at[0] + c * d[0] + s * d[2],
-            self.position[1],
-            self.look_at[2] - s * d[0] + c * d[2],
-        ];
-        Camera::new(turned, self.look_at, self.fov)
-    }
-
-    /// The camera's position.
-    pub fn position(&self) -> [f64; 3] {
-        self.position
-    }
-
-    /// The point looked at.
-    pub fn look_at(&self) -> [f64; 3] {
-        self.look_at
-    }
-
-    /// The vertical field of view, degrees.
-    pub fn fov(&self) -> f64 {
-        self.fov
-    }
-
-    /// The focal length in pixels of an image `height` pixels high.
-    fn focal(&self, height: usize) -> f64 {
-        0.5 * height as f64 / (0.5 * self.fov.to_radians()).tan()
-    }
-
-    /// Camera coordinates `(x, y, depth)` of a world point.
-    fn camera_coordinates(&self, p: [f64; 3]) -> [f64; 3] {
-        let d = sub(p, self.position);
-        [dot(d, self.right), dot(d, self.up), dot(d, self.forward)]
-    }
-
-    /// The pixel coordinates `(x, y)` and depth of a world point in a `width x height` image,
-    /// or `None` when it is not in front of the camera.
-    pub fn project(&self, p: [f64; 3], width: usize, height: usize) -> Option<[f64; 3]> {
-        let [x, y, z] = self.camera_coordinates(p);
-        (z > 0.0).then(|| {
-            let f = self.focal(height);
-            [
-                0.5 * width as f64 + f * x / z,
-                0.5 * height as f64 - f * y / z,
-                z,
-            ]
-        })
-    }
-
-    /// The unit direction (world) of the ray through pixel coordinates `(x, y)`.
-    pub fn ray(&self, x: f64, y: f64, width: usize, height: usize) -> [f64; 3] {
-        let f = self.focal(height);
-        let (a, b) = ((x - 0.5 * width as f64) / f, (0.5 * height as f64 - y) / f);
-        let d = [0, 1, 2].map(|k| self.forward[k] + a * self.right[k] + b * self.up[k]);
-        normalize(d).expect("the forward axis has unit length")
-    }
-}
 
 /// What pixels that no triangle covers show.
 #[derive(Clone, Copy, Debug)]
@@ -409,7 +225,7 @@ type ClipVertex = [f64; 6];
 
 /// Every triangle of `mesh` clipped, projected, snapped and set up, in the mesh's order.
 fn setup_triangles(camera: &Camera, width: usize, height: usize, mesh: &LitMesh<'_>) -> Vec<Setup> {
-    let near = NEAR_FRACTION * norm(sub(camera.look_at, camera.position));
+    let near = camera.near(NEAR_FRACTION);
     let f = camera.focal(height);
     let (cx, cy) = (0.5 * width as f64, 0.5 * height as f64);
     let vertex = |i: u32| -> ClipVertex {
@@ -593,135 +409,11 @@ fn rasterize(
     }
 }
 
-/// The sRGB encoding (IEC 61966-2-1) of a linear value, clamped to `[0, 1]` first:
-/// `12.92 v` up to `0.0031308`, `1.055 v^(1/2.4) - 0.055` above.
-///
-/// ```
-/// use haarshift::render::raster::srgb_encode;
-/// assert_eq!(srgb_encode(0.0), 0.0);
-/// assert!((srgb_encode(1.0) - 1.0).abs() < 1e-15);
-/// assert_eq!(srgb_encode(-1.0), 0.0);
-/// ```
-pub fn srgb_encode(linear: f64) -> f64 {
-    let v = linear.clamp(0.0, 1.0);
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// `image` (linear) times `2^exposure` (stops), sRGB-encoded, as 8-bit codes (depth
-/// [`SampleDepth::U8`], values `0..=255`, rounded to nearest).
-///
-/// ```
-/// use haarshift::render::raster::to_srgb8;
-/// use haarshift::{PlanarImage, SampleDepth};
-/// use ndarray::Array2;
-/// let half = PlanarImage::from_gray(Array2::from_elem((1, 1), 0.5f32), SampleDepth::F32).unwrap();
-/// assert_eq!(to_srgb8(&half, 1.0).unwrap().plane(0)[[0, 0]], 255.0); // 0.5 x 2 = 1
-/// assert_eq!(to_srgb8(&half, 0.0).unwrap().plane(0)[[0, 0]], 188.0); // 0.7354 x 255
-/// ```
-pub fn to_srgb8(image: &PlanarImage<f32>, exposure: f64) -> Result<PlanarImage<f32>> {
-    if !exposure.is_finite() || exposure.abs() > 64.0 {
-        return Err(Error::parameter(
-            "exposure",
-            format!("{exposure} stops (expected a finite number from -64 to 64)"),
-        ));
-    }
-    let scale = exposure.exp2();
-    let planes = image
-        .planes()
-        .mapv(|v| (srgb_encode(v as f64 * scale) * 255.0).round() as f32);
-    PlanarImage::new(planes, image.channels(), SampleDepth::U8)
-}
-
-/// Writes a linear render: `.exr` as linear f32, `.png` as 8-bit sRGB after `exposure` stops
-/// ([`to_srgb8`]); atomically, replacing an existing file only with `force`. Other extensions
-/// are refused.
-///
-/// ```
-/// use haarshift::render::raster::write_render;
-/// use haarshift::{PlanarImage, SampleDepth};
-/// use ndarray::Array3;
-/// let dir = tempfile::tempdir().unwrap();
-/// let image = PlanarImage::new(Array3::from_elem((3, 2, 2), 0.25f32), haarshift::Channels::Rgb, SampleDepth::F32).unwrap();
-/// write_render(&image, &dir.path().join("a.exr"), 0.0, false).unwrap();
-/// let back = haarshift::io::read_image::<f32>(dir.path().join("a.exr")).unwrap();
-/// assert_eq!(back.planes(), image.planes());
-/// assert!(write_render(&image, &dir.path().join("a.jpg"), 0.0, false).is_err());
-/// ```
-pub fn write_render(
-    image: &PlanarImage<f32>,
-    path: &Path,
-    exposure: f64,
-    force: bool,
-) -> Result<()> {
-    let options = WriteOptions {
-        force,
-        ..Default::default()
-    };
-    match render_format(path)? {
-        FileFormat::Exr => {
-            let linear = PlanarImage::new(
-                image.planes().to_owned(),
-                image.channels(),
-                SampleDepth::F32,
-            )?;
-            write_image(&linear, path, options)
-        }
-        _ => write_image(&to_srgb8(image, exposure)?, path, options),
-    }
-}
-
-/// The format [`write_render`] writes to `path`: PNG or OpenEXR by the extension, anything else
-/// refused (so a caller can check an output before rendering).
-///
-/// ```
-/// use haarshift::io::FileFormat;
-/// use haarshift::render::raster::render_format;
-/// assert_eq!(render_format("a.PNG".as_ref()).unwrap(), FileFormat::Png);
-/// assert!(render_format("a.tif".as_ref()).unwrap_err().to_string().contains("a.tif"));
-/// ```
-pub fn render_format(path: &Path) -> Result<FileFormat> {
-    match FileFormat::from_extension(path) {
-        Some(format @ (FileFormat::Exr | FileFormat::Png)) => Ok(format),
-        _ => Err(Error::Format {
-            path: path.to_path_buf(),
-            reason: "a render is written as .png (8-bit sRGB) or .exr (linear f32)".into(),
-        }),
-    }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// `a / |a|`, or `None` for a zero vector.
-fn normalize(a: [f64; 3]) -> Option<[f64; 3]> {
-    let n = norm(a);
-    (n > 0.0).then(|| [a[0] / n, a[1] / n, a[2] / n])
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::{srgb_encode, write_render};
+    use glam::DVec3;
     use ndarray::{Array2, array};
 
     fn front_camera() -> Camera {
@@ -910,11 +602,9 @@ mod tests {
         };
         let (w, h) = (80, 60);
         let image = render(&camera, w, h, &mesh, Background::Colour([-1.0; 3])).unwrap();
-        let p0 = [0, 1, 2].map(|c| positions[[0, c]]);
-        let normal = cross(
-            sub([0, 1, 2].map(|c| positions[[1, c]]), p0),
-            sub([0, 1, 2].map(|c| positions[[2, c]]), p0),
-        );
+        let corner = |k: usize| DVec3::new(positions[[k, 0]], positions[[k, 1]], positions[[k, 2]]);
+        let p0 = corner(0);
+        let normal = (corner(1) - p0).cross(corner(2) - p0);
         let mut checked = 0;
         for i in 0..h {
             for j in 0..w {
@@ -922,7 +612,8 @@ mod tests {
                     continue;
                 }
                 let d = camera.ray(j as f64 + 0.5, i as f64 + 0.5, w, h);
-                let t = dot(sub(p0, camera.position()), normal) / dot(d, normal);
+                let t =
+                    (p0 - DVec3::from(camera.position())).dot(normal) / DVec3::from(d).dot(normal);
                 let hit = [0, 1, 2].map(|k| camera.position()[k] + t * d[k]);
                 for (c, want) in f(hit).iter().enumerate() {
                     let got = image.plane(c)[[i, j]] as f64;

@@ -6,7 +6,7 @@ use std::time::Instant;
 use haarshift::relight::light::environment::SphereMapping;
 use haarshift::relight::{Lighting, SceneCache};
 use haarshift::render::animation::{numbered_path, write_gif};
-use haarshift::render::raster::{to_srgb8, write_render};
+use haarshift::render::{to_srgb8, write_render};
 use haarshift::{Error, Result};
 
 use haarshift::relight::PreparedTransport;
@@ -110,7 +110,7 @@ pub fn run(args: Args) -> Result<()> {
             .collect::<Result<_>>()?
     };
     if let Some(first) = frame_paths.first() {
-        haarshift::render::raster::render_format(first)?;
+        haarshift::render::render_format(first)?;
     }
     let outputs = if gif {
         vec![args.output.clone()]

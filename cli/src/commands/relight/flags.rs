@@ -12,8 +12,8 @@ use haarshift::relight::material::orient::BrdfRotation;
 use haarshift::relight::scene::GROUND_VERTICES;
 use haarshift::relight::{Brdf, PreparedTransport, SceneCache, ShadeOptions};
 use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
-use haarshift::render::raster::{Background, Camera, DEFAULT_FOV};
-use haarshift::render::raster::{LitMesh, render};
+use haarshift::render::{Background, Camera, DEFAULT_FOV};
+use haarshift::render::{LitMesh, render};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift::{Error, Result};
 

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use haarshift::relight::{ReferenceOptions, SceneBvh, reference};
-use haarshift::render::raster::{render_format, write_render};
+use haarshift::render::{render_format, write_render};
 use haarshift::{Result, SampleDepth};
 
 use super::flags::{

@@ -7,7 +7,7 @@ use std::time::Instant;
 use haarshift::relight::harmonics::{PhongSh, non_zonal_material};
 use haarshift::relight::material::orient::mirror_directions;
 use haarshift::relight::{Brdf, Lighting, SceneCache, shade_sh};
-use haarshift::render::raster::{render_format, write_render};
+use haarshift::render::{render_format, write_render};
 use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::Array2;

@@ -12,7 +12,7 @@ use haarshift::relight::dynamic::motion::{MotionPath, play};
 use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene};
 use haarshift::relight::{Brdf, CameraSpec, Lighting};
 use haarshift::render::animation::{numbered_path, write_gif};
-use haarshift::render::raster::{Camera, render_format, to_srgb8, write_render};
+use haarshift::render::{Camera, render_format, to_srgb8, write_render};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
 
