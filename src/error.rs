@@ -86,7 +86,7 @@ pub enum Error {
         source: crate::relight::material::merl::MerlError,
     },
     /// The output file exists and the caller did not ask to replace it.
-    #[error("{}: already exists (use --force to replace it)", path.display())]
+    #[error("{}: already exists", path.display())]
     OutputExists {
         /// The existing file.
         path: PathBuf,

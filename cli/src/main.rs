@@ -66,6 +66,11 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The library's message serves every caller; the flag that replaces a file is ours.
+        Err(error @ haarshift::Error::OutputExists { .. }) => {
+            eprintln!("haarshift: {error} (use --force to replace it)");
+            ExitCode::FAILURE
+        }
         Err(error) => {
             eprintln!("haarshift: {error}");
             ExitCode::FAILURE

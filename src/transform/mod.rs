@@ -554,3 +554,6 @@ fn band1d_range(n: usize, levels: usize, band: Band1d) -> Result<Range<usize>> {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod pywavelets_tests;

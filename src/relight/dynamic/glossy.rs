@@ -65,7 +65,7 @@ impl DynamicScene {
     /// ```
     /// # use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// # use haarshift::relight::SceneFile;
-    /// # use haarshift::sphere::{ParamKind, Parameterization};
+    /// # use haarshift::faces::{ParamKind, Parameterization};
     /// # let file: SceneFile = serde_json::from_str(
     /// #     r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
     /// # let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
@@ -114,7 +114,7 @@ impl DynamicScene {
     /// ```
     /// # use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// # use haarshift::relight::SceneFile;
-    /// # use haarshift::sphere::{ParamKind, Parameterization};
+    /// # use haarshift::faces::{ParamKind, Parameterization};
     /// let file: SceneFile = serde_json::from_str(r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}],
     ///     "camera": {"position": [0, 1, 5], "look_at": [0, 0, 0]}}"#).unwrap();
     /// # let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
@@ -135,7 +135,7 @@ impl DynamicScene {
     /// ```
     /// # use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
     /// # use haarshift::relight::SceneFile;
-    /// # use haarshift::sphere::{ParamKind, Parameterization};
+    /// # use haarshift::faces::{ParamKind, Parameterization};
     /// # let file: SceneFile = serde_json::from_str(
     /// #     r#"{"objects": [{"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
     /// # let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());

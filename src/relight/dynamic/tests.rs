@@ -2,6 +2,7 @@ use ndarray::{Array3, Axis};
 
 use super::*;
 use crate::faces::param::SphereMap;
+use crate::metrics;
 use crate::relight::Occlusion;
 use crate::relight::dynamic::fields::FieldOptions;
 use crate::relight::shade::{PreparedTransport, ShadeOptions};
@@ -44,10 +45,6 @@ pub(super) fn lighting(turn: f64) -> Lighting {
     Lighting::from_map(&sky, Selection::All).unwrap()
 }
 
-pub(super) fn rms(a: &Array2<f64>) -> f64 {
-    (a.iter().map(|x| x * x).sum::<f64>() / a.len() as f64).sqrt()
-}
-
 /// Largest difference relative to the RMS of `want`.
 pub(super) fn relative(got: &Array2<f64>, want: &Array2<f64>) -> f64 {
     assert_eq!(got.dim(), want.dim());
@@ -56,7 +53,7 @@ pub(super) fn relative(got: &Array2<f64>, want: &Array2<f64>) -> f64 {
         .zip(want)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    worst / rms(want)
+    worst / metrics::rms(want.view())
 }
 
 pub(super) const THREE: &str = r#"{"objects": [
@@ -80,7 +77,10 @@ fn one_object_alone_is_shaded_as_the_static_path_shades_it() {
     let light = lighting(0.3);
     let want = prepared.shade(&light).unwrap();
     // The box shadows the plane: the comparison is not of unshadowed vertices only.
-    assert!(want.column(0).iter().fold(f64::INFINITY, |a, &b| a.min(b)) < 0.5 * rms(&want));
+    assert!(
+        want.column(0).iter().fold(f64::INFINITY, |a, &b| a.min(b))
+            < 0.5 * metrics::rms(want.view())
+    );
     assert!(relative(&scene.shade::<f64>(&light).unwrap(), &want) < 1e-12);
     let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Lighting).unwrap();
     let turned = lighting(1.9);

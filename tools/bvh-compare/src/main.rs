@@ -8,7 +8,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use haarshift::relight::{Generator, Mesh, Occlusion, SceneBvh, add_ground_plane, ray_offset};
-use haarshift::sphere::{ParamKind, Parameterization};
+use haarshift::faces::{ParamKind, Parameterization};
 use rayon::prelude::*;
 
 /// One vertex's rays: origin and the directions above its horizon.

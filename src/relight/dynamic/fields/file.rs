@@ -226,7 +226,7 @@ impl OcclusionField {
     ///
     /// ```
     /// # use haarshift::relight::{Generator, fields::{FieldOptions, OcclusionField}};
-    /// # use haarshift::sphere::{ParamKind, Parameterization};
+    /// # use haarshift::faces::{ParamKind, Parameterization};
     /// # let ball = Generator::Sphere { cells: 2 }.mesh().unwrap();
     /// # let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
     /// # (options.circles, options.circle_points, options.shells, options.shell_grid) = (3, 6, 2, 2);
@@ -252,7 +252,7 @@ impl OcclusionField {
     ///
     /// ```
     /// # use haarshift::relight::{Generator, fields::{FieldOptions, OcclusionField}};
-    /// # use haarshift::sphere::{ParamKind, Parameterization};
+    /// # use haarshift::faces::{ParamKind, Parameterization};
     /// # let ball = Generator::Sphere { cells: 2 }.mesh().unwrap();
     /// # let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
     /// # (options.circles, options.circle_points, options.shells, options.shell_grid) = (3, 6, 2, 2);

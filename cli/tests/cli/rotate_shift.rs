@@ -2,11 +2,9 @@
 //! shifts, the pixel-domain meaning of the Haar shift (bilinear at 1/2^h, and the retained
 //! finer image), round trips, sizes, channels and depths, and one clean line per error.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{fails_cleanly, p, succeeds, testdata};
+use crate::common::{fails_cleanly, p, succeeds, testdata};
 
 use haarshift::Channels::{Gray, Rgb};
 use haarshift::SampleDepth::{F64, U8, U16};

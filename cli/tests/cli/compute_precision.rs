@@ -2,11 +2,9 @@
 //! bit the library's f32 result; f64 for float64 `.npy` files or with `--compute f64`;
 //! float16 `.npy` input; and echoed numbers in a readable form.
 
-mod common;
-
 use std::path::Path;
 
-use common::{p, succeeds_with_stdout};
+use crate::common::{p, succeeds_with_stdout};
 
 use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::kernels::{Outside, ShiftMethod, shift_plane};

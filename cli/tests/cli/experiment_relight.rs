@@ -1,9 +1,7 @@
 //! `haarshift experiment relight` checks its inputs and outputs before the work (the numbers
 //! are the library's, tested in `experiments::relight`).
 
-mod common;
-
-use common::{fails_cleanly, p, succeeds_with_stdout, testdata, usage_error};
+use crate::common::{fails_cleanly, p, succeeds_with_stdout, testdata, usage_error};
 
 #[test]
 fn it_refuses_stale_reports_and_bad_inputs_before_any_work() {

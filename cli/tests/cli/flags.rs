@@ -3,11 +3,9 @@
 //! `--depth u16` and `--depth f16`; and images with alpha (RGBA shifts, gray+alpha
 //! rotations).
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{p, succeeds};
+use crate::common::{p, succeeds};
 
 use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::{Channels, PlanarImage, SampleDepth};

@@ -8,8 +8,8 @@
 
 use std::path::PathBuf;
 
-use haarshift::BoundaryMode;
-use haarshift::transform::{
+use crate::BoundaryMode;
+use crate::transform::{
     Band, Coefficients, Layout, Levels, Normalization, TransformInfo, TransformSpec,
 };
 use ndarray::Array2;

@@ -1,11 +1,9 @@
 //! The `haarshift` binary end to end: exact round trips on the testdata photographs for every
 //! layout, normalisation and padding, and one clean line of error for every kind of bad input.
 
-mod common;
-
 use std::path::Path;
 
-use common::{fails_cleanly, p, succeeds, testdata, text, usage_error};
+use crate::common::{fails_cleanly, p, succeeds, testdata, text, usage_error};
 
 use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::transform::{Layout, Normalization};

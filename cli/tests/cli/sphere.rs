@@ -1,11 +1,11 @@
 //! `haarshift sphere rotate` and `haarshift experiment sphere` end to end on the test map: the
 //! binary must give exactly what the library gives, write what it says, and fail in one line.
 
-mod common;
-
 use std::path::Path;
 
-use common::{fails_cleanly, fails_cleanly_in, p, succeeds, text, usage_error, usage_error_in};
+use crate::common::{
+    fails_cleanly, fails_cleanly_in, p, succeeds, text, usage_error, usage_error_in,
+};
 
 use haarshift::io::{CoefficientFile, WriteOptions, read_image, write_image};
 use haarshift::sphere::experiment::{self, STANDARD_ROTATIONS};

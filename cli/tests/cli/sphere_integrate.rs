@@ -2,12 +2,10 @@
 //! contract computed here independently, `--keep` equals the same sum over the pruned maps,
 //! and every bad request fails in one line.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::maps::{planes, pruned, write_map};
-use common::{fails_cleanly, p, succeeds_with_stdout};
+use crate::common::maps::{planes, pruned, write_map};
+use crate::common::{fails_cleanly, p, succeeds_with_stdout};
 
 use haarshift::SampleDepth;
 use ndarray::Array3;

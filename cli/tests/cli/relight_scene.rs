@@ -2,11 +2,9 @@
 //! Haar frame agrees with the ray-cast reference, animations write every frame and time it,
 //! and bad scene and path files fail cleanly with one line naming the file.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{fails_cleanly, p, succeeds_with_stdout, testdata};
+use crate::common::{fails_cleanly, p, succeeds_with_stdout, testdata};
 
 /// Two spheres on the ground plane, one named `ball`, under the 32 x 16 test map.
 fn two_spheres(dir: &Path) -> PathBuf {

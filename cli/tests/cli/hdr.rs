@@ -3,9 +3,7 @@
 //! file's generator recorded (`rooitou_park_32x16_values.npy`, computed from the RGBE bytes,
 //! not decoded from the file).
 
-mod common;
-
-use common::{p, succeeds, testdata};
+use crate::common::{p, succeeds, testdata};
 
 use haarshift::SampleDepth;
 use haarshift::io::read_image;

@@ -1,6 +1,8 @@
-//! The README's opening commands work out of the box: each `haarshift` command of its first
-//! code block runs, as written, in a copy of the repository's files (with `results/` as
-//! committed), twice, succeeds both times, prints its table and leaves `results/` alone.
+//! The README's commands work out of the box: each `haarshift` command of its first code block
+//! runs, as written, in a copy of the repository's files (with `results/` as committed), twice,
+//! succeeds both times, prints its table and leaves `results/` alone; and every `haarshift`
+//! line of its other `sh` blocks runs in order from the root of a copy and succeeds (the few
+//! that take minutes as written at the smaller sizes of [`SMALLER`]).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -122,4 +124,108 @@ fn the_readme_opening_commands_succeed_on_a_fresh_copy_and_when_run_again() {
         committed,
         "the README's commands changed the committed results/"
     );
+}
+
+/// Flags whose README values make a command take minutes, and the value the test runs instead:
+/// the same command on a coarser map, fewer frames or sparser occlusion fields.
+const SMALLER: &[(&str, &str)] = &[
+    ("--resolution", "16"),
+    ("--frames", "2"),
+    ("--rotation-cache", "8"),
+];
+
+/// Flags the test adds to `relight scene` (its occlusion fields' sampling, 29,720 points a shape
+/// by default), so that each scene command takes seconds.
+const SPARSER_FIELDS: &[&str] = &["--circles", "10", "--circle-points", "20", "--shells", "4"];
+
+/// The arguments of every `haarshift` line in the README's `sh` blocks after the first, in
+/// order, without trailing `# comments`.
+fn later_commands(readme: &str) -> Vec<Vec<String>> {
+    readme
+        .split("```")
+        .skip(1)
+        .step_by(2)
+        .skip(1)
+        .filter_map(|block| block.strip_prefix("sh\n"))
+        .flat_map(str::lines)
+        .filter_map(|line| line.trim().strip_prefix("haarshift "))
+        .map(|line| {
+            let command = line.split(" #").next().unwrap_or(line);
+            command.split_whitespace().map(str::to_owned).collect()
+        })
+        .collect()
+}
+
+/// `args` as the test runs them: the values of [`SMALLER`] in place of the README's, and
+/// [`SPARSER_FIELDS`] for `relight scene`.
+fn smaller(args: &[String]) -> Vec<String> {
+    let mut out: Vec<String> = args.to_vec();
+    for i in 1..out.len() {
+        if let Some((_, value)) = SMALLER.iter().find(|(flag, _)| out[i - 1] == *flag) {
+            out[i] = (*value).to_owned();
+        }
+    }
+    if out.len() > 1 && out[0] == "relight" && out[1] == "scene" {
+        out.extend(SPARSER_FIELDS.iter().map(|s| (*s).to_owned()));
+    }
+    out
+}
+
+#[test]
+fn later_blocks_parse_into_haarshift_commands_at_smaller_sizes() {
+    let readme = "```sh\ncargo run --release -p haarshift-cli -- first\n```\n\
+                  ```text\nhaarshift not-a-command\n```\n\
+                  ```sh\nhaarshift rotate a.png -o b.png   # a comment\n\
+                  haarshift relight scene s.json --resolution 64 -o s.png\n```\n";
+    let commands = later_commands(readme);
+    assert_eq!(
+        commands,
+        vec![
+            vec!["rotate", "a.png", "-o", "b.png"],
+            vec![
+                "relight",
+                "scene",
+                "s.json",
+                "--resolution",
+                "64",
+                "-o",
+                "s.png"
+            ],
+        ]
+    );
+    assert_eq!(smaller(&commands[0]), commands[0]);
+    let mut expected: Vec<&str> = vec!["relight", "scene", "s.json", "--resolution", "16"];
+    expected.extend(["-o", "s.png"]);
+    expected.extend(SPARSER_FIELDS);
+    assert_eq!(smaller(&commands[1]), expected);
+}
+
+#[test]
+fn every_later_readme_command_runs_from_the_root_of_a_fresh_copy() {
+    let readme = std::fs::read_to_string(repository().join("README.md")).unwrap();
+    let commands = later_commands(&readme);
+    assert!(
+        commands.len() >= 20,
+        "the README's sh blocks hold {} haarshift commands",
+        commands.len()
+    );
+    let work = tempfile::tempdir().unwrap();
+    let clone = work.path().join("haarshift");
+    for dir in ["testdata", "results"] {
+        copy_tree(&repository().join(dir), &clone.join(dir));
+    }
+    for args in commands.iter().map(|args| smaller(args)) {
+        let out = Command::new(env!("CARGO_BIN_EXE_haarshift"))
+            .args(&args)
+            .current_dir(&clone)
+            .env("TMPDIR", work.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "`haarshift {}` failed: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
 }

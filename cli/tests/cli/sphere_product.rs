@@ -3,12 +3,10 @@
 //! coefficients are the product's orthonormal pyramids, and bad requests fail cleanly before
 //! anything is computed or written.
 
-mod common;
-
 use std::path::Path;
 
-use common::maps::{planes, pruned, write_map};
-use common::{fails_cleanly, p, succeeds, text};
+use crate::common::maps::{planes, pruned, write_map};
+use crate::common::{fails_cleanly, p, succeeds, text};
 
 use haarshift::SampleDepth;
 use haarshift::faces::convert::{convert, default_samples};

@@ -2,11 +2,9 @@
 //! `--force` (exit code 1, one line naming the file, the file untouched) and replaces it with
 //! `--force`.
 
-mod common;
-
 use std::path::Path;
 
-use common::{fails_cleanly, p, succeeds, testdata};
+use crate::common::{fails_cleanly, p, succeeds, testdata};
 
 use haarshift::io::{WriteOptions, write_image};
 use haarshift::{PlanarImage, SampleDepth};

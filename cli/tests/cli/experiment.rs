@@ -1,10 +1,8 @@
 //! `haarshift experiment`: the command's figures against a computation made directly here.
 
-mod common;
-
 use std::path::Path;
 
-use common::{fails_cleanly, haarshift, succeeds, text, usage_error};
+use crate::common::{fails_cleanly, haarshift, succeeds, text, usage_error};
 
 use haarshift::io::{WriteOptions, write_image};
 use haarshift::kernels::ShiftMethod;

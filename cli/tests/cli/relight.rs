@@ -3,11 +3,11 @@
 //! and every bad input of the relighting issue fails cleanly with one line naming its file (or
 //! works, and the test says how).
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, text, usage_error};
+use crate::common::{
+    fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, text, usage_error,
+};
 
 /// A scene file in `dir`: a coarse sphere resting on the ground plane (a shadow to get right).
 fn sphere_on_plane(dir: &Path) -> PathBuf {

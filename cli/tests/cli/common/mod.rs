@@ -1,7 +1,5 @@
 //! Helpers shared by the CLI integration tests: running the built binary, requiring success or
 //! a clean failure, and naming files.
-// Each test crate compiles this module and uses only some of it.
-#![allow(dead_code)]
 
 pub mod maps;
 
