@@ -102,7 +102,7 @@ impl LitMesh<'_> {
 /// depth [`SampleDepth::F32`]); see the [module docs](self).
 ///
 /// ```
-/// use haarshift::render::raster::{Background, Camera, LitMesh, render};
+/// use haarshift::render::{Background, Camera, LitMesh, render};
 /// use ndarray::array;
 /// let positions = array![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
 /// let radiance = array![[1.0f32, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
