@@ -59,6 +59,7 @@ pub mod shade;
 pub mod shadowmap;
 pub mod sparse;
 pub mod transport;
+pub mod validate;
 pub mod visibility;
 
 pub use brdf::Brdf;

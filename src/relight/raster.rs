@@ -90,10 +90,15 @@ impl Camera {
     /// A camera at `position` looking at `look_at` (a different point), +Y up, with a vertical
     /// field of view of `fov_degrees` (above 0 and below 180).
     pub fn new(position: [f64; 3], look_at: [f64; 3], fov_degrees: f64) -> Result<Self> {
-        if position.iter().chain(&look_at).any(|v| !v.is_finite()) {
+        // In range (relight::validate): the forward axis is then a difference whose square
+        // cannot overflow, so it normalises.
+        let limit = super::validate::MAX_COORDINATE;
+        if position.iter().chain(&look_at).any(|v| !(v.abs() <= limit)) {
             return Err(Error::parameter(
                 "camera",
-                "the position and the point looked at must be finite",
+                format!(
+                    "the position and the point looked at must be finite and within {limit:e} of the origin"
+                ),
             ));
         }
         if !(fov_degrees > 0.0 && fov_degrees < 180.0) {

@@ -108,7 +108,7 @@ fn the_ground_plane_follows_its_definition() {
     let bunny = Mesh::load(&path).unwrap();
     let b = bunny.bounds();
     let mut with = bunny.clone();
-    add_ground_plane(&mut with);
+    add_ground_plane(&mut with).unwrap();
     let v = bunny.vertex_count();
     assert_eq!(with.vertex_count(), v + 33 * 33);
     assert_eq!(
