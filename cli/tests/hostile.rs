@@ -175,12 +175,18 @@ fn transforms_and_cameras_far_from_the_origin_are_refused() {
     let render = |name: &'static str| {
         let mut args = vec!["relight", "scene", name, "-o", "x.png", "--force"];
         args.extend(small);
+        args.extend(["--circles", "12", "--circle-points", "24"]);
+        args.extend(["--shells", "6", "--shell-grid", "4"]);
         args
     };
     file(d, "far.json", scene("[-1e30, 0, 0]", "[0, 1e30, 0]", false));
     refused(d, &render("far.json"), &["far.json", "1e15"]);
     file(d, "eye.json", scene("[0, 0, 0]", "[0, 1e308, 0]", false));
-    refused(d, &render("eye.json"), &["camera", "1e15"]);
+    refused(
+        d,
+        &render("eye.json"),
+        &["eye.json", "camera's look_at", "1e15"],
+    );
     let chair = r#"{"objects": [{"generator": {"chair": {"cells": 2}},
         "transform": {"translate": [-1e30, 0, 0]}}], "ground_plane": true}"#;
     file(d, "chair.json", chair);
@@ -242,6 +248,8 @@ fn counts_that_would_wrap_are_refused_before_allocating() {
         let mut args = vec!["relight", "scene", "s.json", "-o", "a.gif", "--force"];
         args.extend(["--animate", "p.json", "--env", p(&env)]);
         args.extend(["--resolution", "8", "--width", "8", "--height", "8"]);
+        args.extend(["--circles", "12", "--circle-points", "24"]);
+        args.extend(["--shells", "6", "--shell-grid", "4"]);
         refused(d, &args, &["p.json", "frames"]);
     }
 }

@@ -430,6 +430,19 @@ impl DynamicScene {
             })?;
             placed.push((shape, placement, object.material.albedo()?, brdf));
         }
+        // Validated before any field is built (relight::validate).
+        if let Some(camera) = &file.camera {
+            camera.check()?;
+        }
+        let meshes = placed
+            .iter()
+            .map(|(shape, p, _, _)| place_mesh(&shapes[*shape], p, param))
+            .collect::<Result<Vec<Mesh>>>()?;
+        let objects_mesh = merge(meshes.iter().cloned());
+        let ground = file
+            .ground_plane
+            .then(|| ground_plane_under(&objects_mesh.bounds()))
+            .transpose()?;
         let mut fields = Vec::with_capacity(shapes.len());
         for (mesh, (path, generator)) in shapes.iter().zip(&sources) {
             let (field, origin) = match store.as_deref_mut() {
@@ -464,15 +477,6 @@ impl DynamicScene {
             report.field_bytes += field.stored_bytes();
             fields.push(Arc::new(field));
         }
-        let meshes = placed
-            .iter()
-            .map(|(shape, p, _, _)| place_mesh(&shapes[*shape], p, param))
-            .collect::<Result<Vec<Mesh>>>()?;
-        let objects_mesh = merge(meshes.iter().cloned());
-        let ground = file
-            .ground_plane
-            .then(|| ground_plane_under(&objects_mesh.bounds()))
-            .transpose()?;
         let visibility = VisibilityOptions {
             keep: options.keep_visibility,
             progress: options.progress,

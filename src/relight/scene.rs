@@ -671,6 +671,21 @@ pub struct CameraSpec {
     pub fov: f64,
 }
 
+impl CameraSpec {
+    /// Checks the position and the point looked at against
+    /// [`MAX_COORDINATE`](super::validate::MAX_COORDINATE), as a scene file is read.
+    ///
+    /// ```
+    /// use haarshift::relight::CameraSpec;
+    /// let far = CameraSpec { position: [0.0, 2.0, 5.0], look_at: [0.0, 1e308, 0.0], fov: 40.0 };
+    /// assert!(matches!(far.check(), Err(haarshift::Error::Scene { .. })));
+    /// ```
+    pub fn check(&self) -> Result<()> {
+        super::validate::check_point("the camera's position", self.position)?;
+        super::validate::check_point("the camera's look_at", self.look_at)
+    }
+}
+
 fn default_fov() -> f64 {
     45.0
 }
@@ -822,6 +837,9 @@ impl SceneFile {
     pub fn build(&self, dir: &Path) -> Result<Scene> {
         if self.objects.is_empty() {
             return Err(SceneError::SceneFile("a scene needs at least one object".into()).into());
+        }
+        if let Some(camera) = &self.camera {
+            camera.check()?;
         }
         let mut mesh: Option<Mesh> = None;
         let mut albedo = Array2::<f32>::zeros((0, 3));

@@ -80,7 +80,7 @@ fn closed_shapes_face_outward_and_spheres_have_radial_normals() {
         assert!((dot(p, p) - 1.0).abs() < 1e-12 && (dot(p, n) - 1.0).abs() < 1e-12);
     }
     assert_outward(
-        &cuboid([0.0, 1.0, 2.0], [1.0, 3.0, 2.5], 3),
+        &cuboid([0.0, 1.0, 2.0], [1.0, 3.0, 2.5], 3).unwrap(),
         [0.5, 2.0, 2.25],
     );
     assert_outward(&cylinder([1.0, 0.0, 1.0], 0.5, 3.0, 12, 4), [1.0, 1.5, 1.0]);
