@@ -35,7 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "bunny" => {
             let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/meshes/bunny.ply");
             let mut m = Mesh::load(&path)?;
-            add_ground_plane(&mut m);
+            add_ground_plane(&mut m)?;
             m
         }
         "cubes" => Generator::Cubes {

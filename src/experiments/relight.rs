@@ -80,7 +80,7 @@ impl Subject {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
         if is_mesh {
-            scene.add_ground_plane();
+            scene.add_ground_plane().map_err(|e| e.in_file(path))?;
         }
         Ok(Subject {
             name: stem(path),

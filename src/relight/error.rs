@@ -39,6 +39,27 @@ pub enum SceneError {
         /// The offending component.
         value: f64,
     },
+    /// A coordinate is not finite or farther from the origin than
+    /// [`MAX_COORDINATE`](super::validate::MAX_COORDINATE) (what the BVH's f32 boxes can hold).
+    #[error(
+        "{what} has a coordinate {value:e}: coordinates must be finite and within 1e15 of the origin"
+    )]
+    OutOfRange {
+        /// The vertex, camera or point with the coordinate.
+        what: String,
+        /// The coordinate.
+        value: f64,
+    },
+    /// A ground plane was asked for under a mesh too narrow for one.
+    #[error(
+        "a ground plane needs a mesh with a width or depth (here {extent:e}) of at least 1e-6 of its largest coordinate ({largest:e})"
+    )]
+    NoGroundExtent {
+        /// The larger of the mesh's width (x) and depth (z).
+        extent: f64,
+        /// Its largest coordinate in magnitude.
+        largest: f64,
+    },
     /// The file cannot be parsed: truncated, corrupt, or a layout that is not a triangle mesh.
     #[error("not a readable mesh: {0}")]
     Corrupt(String),

@@ -149,7 +149,7 @@ pub fn gallery(
         .map(|m| Environment::load(m))
         .collect::<Result<Vec<_>>>()?;
     let param = Parameterization::new(ParamKind::LatLong, options.resolution)?;
-    let scene = Scene::from_mesh(Mesh::load(mesh)?, true);
+    let scene = Scene::from_mesh(Mesh::load(mesh)?, true).map_err(|e| e.in_file(mesh))?;
     let mut visibility = VisibilityOptions::new(param);
     visibility.progress = true;
     visibility.sh_bands = Some(options.sh_bands);

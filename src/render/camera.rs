@@ -10,19 +10,17 @@
 //! the horizon on the +Z side, far enough that the box's bounding sphere fits the vertical field
 //! of view (the narrower one of an image at least as wide as high).
 //!
-//! Positions and points looked at are refused beyond [`MAX_COORDINATE`] of the origin, where
-//! the squared distances of the camera's geometry would overflow.
+//! Positions and points looked at are refused beyond [`MAX_COORDINATE`] of the origin (the
+//! bound on every scene coordinate), where the squared distances of the camera's geometry
+//! cannot overflow.
 
 use glam::DVec3;
 
+use crate::relight::scene::validate::MAX_COORDINATE;
 use crate::{Error, Result};
 
 /// The default vertical field of view, degrees.
 pub const DEFAULT_FOV: f64 = 40.0;
-
-/// The largest coordinate a camera's position or target may have (`1e15`): far beyond any scene
-/// and far from where `|look_at - position|^2` overflows.
-pub const MAX_COORDINATE: f64 = 1e15;
 
 /// A perspective camera (see the [module docs](self) for its conventions).
 ///

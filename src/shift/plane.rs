@@ -4,7 +4,7 @@
 use ndarray::{Array2, ArrayView2, s};
 
 use crate::kernels::{KernelOptions, Outside, ShiftMethod, shift_plane};
-use crate::shift::{RetainedImage, shift_image};
+use crate::shift::{GridShift, RetainedImage, shift_image};
 use crate::transform::{TransformSpec, pyramid};
 use crate::{BoundaryMode, Error, Result, Sample};
 
@@ -14,7 +14,10 @@ use crate::{BoundaryMode, Error, Result, Sample};
 /// With [`ShiftMethod::Haar`] the plane is transformed (pyramid, average normalisation, full
 /// depth, periodic padding to powers of two), shifted on its coefficients ([`shift_image`])
 /// and transformed back: periodic over the padded size, each shift rounded to
-/// `1 / 2^precision`. With `retain` the result is the `2^precision`-finer image that the
+/// `1 / 2^precision`. A shift that rounds to whole pixels is the permutation it is: the
+/// periodically padded plane rolled and cropped, with no arithmetic, so it is exact in every
+/// precision (through the transform, 8-bit codes divided by 255 in f32 would come back a few
+/// units in the last place off). With `retain` the result is the `2^precision`-finer image that the
 /// retained levels describe ([`RetainedImage`]). Other methods shift rows, then columns, in the
 /// pixel domain ([`shift_plane`]) with `boundary` outside.
 ///
@@ -29,6 +32,8 @@ use crate::{BoundaryMode, Error, Result, Sample};
 /// assert_eq!(haar.apply(x.view(), 0.5, 0.0).unwrap(), array![[3.0, 1.0, 3.0, 5.0]]);
 /// let fine = PlaneShift::new(ShiftMethod::Haar, KernelOptions { retain: true, ..opts }, BoundaryMode::Wrap).unwrap();
 /// assert_eq!(fine.shape(1, 4).unwrap(), (2, 8));
+/// let whole = haar.apply(x.view(), -1.0, 0.0).unwrap();
+/// assert_eq!(whole, array![[2.0, 4.0, 6.0, 0.0]]);
 /// let reflect = PlaneShift::new(ShiftMethod::Haar, opts, BoundaryMode::Reflect);
 /// assert!(matches!(reflect, Err(haarshift::Error::InvalidParameter { name: "boundary", .. })));
 /// ```
@@ -98,11 +103,16 @@ impl PlaneShift {
             padding: BoundaryMode::Wrap,
             ..Default::default()
         };
-        let coeffs = spec.forward(plane)?;
         let h = self.options.precision;
         if !self.options.retain {
-            return shift_image(&coeffs, dx, dy, h)?.inverse();
+            let (sx, sy) = (GridShift::new(dx, h)?, GridShift::new(dy, h)?);
+            if let (Some(sx), Some(sy)) = (sx.whole_multiple_of(0), sy.whole_multiple_of(0)) {
+                let padded = spec.padded_shape(plane.nrows(), plane.ncols())?;
+                return periodic_roll(plane, padded, sx, sy);
+            }
+            return shift_image(&spec.forward(plane)?, dx, dy, h)?.inverse();
         }
+        let coeffs = spec.forward(plane)?;
         let mut retained = RetainedImage::new(&coeffs, h)?;
         retained.shift(dx, dy)?;
         let info = coeffs.info();
@@ -114,4 +124,25 @@ impl PlaneShift {
         let [rows, cols] = info.original_shape;
         Ok(fine.slice(s![..rows << h, ..cols << h]).to_owned())
     }
+}
+
+/// `plane` padded periodically to `padded` (as the transform pads it), rolled by whole
+/// shifts `sx` (columns) and `sy` (rows) over that period and cropped back to its size:
+/// `out[r][c] = plane[((r - sy) mod R) mod rows][((c - sx) mod C) mod cols]`, exactly what the
+/// Haar shift computes for a whole shift, as the permutation it is.
+fn periodic_roll<T: Sample>(
+    plane: ArrayView2<'_, T>,
+    (period_rows, period_cols): (usize, usize),
+    sx: GridShift,
+    sy: GridShift,
+) -> Result<Array2<T>> {
+    let (qx, _) = sx.split(period_cols)?;
+    let (qy, _) = sy.split(period_rows)?;
+    let (rows, cols) = plane.dim();
+    let source_col: Vec<usize> = (0..cols)
+        .map(|c| (c + period_cols - qx) % period_cols % cols)
+        .collect();
+    Ok(Array2::from_shape_fn((rows, cols), |(r, c)| {
+        plane[[(r + period_rows - qy) % period_rows % rows, source_col[c]]]
+    }))
 }

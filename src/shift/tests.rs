@@ -911,3 +911,55 @@ proptest! {
         prop_assert!(max_diff(chain.fine(), once.fine()) < RANDOM_SIZE_BOUND);
     }
 }
+
+#[test]
+fn plane_whole_shifts_are_the_transform_path_as_a_permutation_and_exact_in_f32() {
+    // On 8-bit codes in f64 the transform path is exact (module docs), so it is the oracle for
+    // the permutation, non-power-of-two sizes (periodic padding wrapping into view) included.
+    let haar = PlaneShift::new(
+        crate::kernels::ShiftMethod::Haar,
+        Default::default(),
+        crate::BoundaryMode::Wrap,
+    )
+    .unwrap();
+    let spec = TransformSpec {
+        padding: crate::BoundaryMode::Wrap,
+        ..Default::default()
+    };
+    for (h, w) in [(8, 8), (5, 7), (12, 3), (1, 6)] {
+        let x = bytes_image(h, w);
+        for (dx, dy) in [(5, -3), (-1000, 77), (0, 1), (9, 0)] {
+            let via_transform =
+                shift_image(&spec.forward(x.view()).unwrap(), dx as f64, dy as f64, 0)
+                    .unwrap()
+                    .inverse()
+                    .unwrap();
+            let rolled = haar.apply(x.view(), dx as f64, dy as f64).unwrap();
+            assert_eq!(rolled, via_transform, "{h}x{w} by ({dx}, {dy})");
+        }
+    }
+    // Codes divided by 255 in f32: the transform path rounds, the permutation does not.
+    let x = bytes_image(16, 16).mapv(|v| (v / 255.0) as f32);
+    let rolled = haar.apply(x.view(), 5.0, -3.0).unwrap();
+    let exact = roll_2d(x.mapv(f64::from).view(), 5, -3).mapv(|v| v as f32);
+    assert_eq!(rolled, exact);
+    let via_transform = shift_image(&spec.forward(x.view()).unwrap(), 5.0, -3.0, 0)
+        .unwrap()
+        .inverse()
+        .unwrap();
+    assert!(
+        via_transform != exact,
+        "the f32 transform path is exact here: no test"
+    );
+    // A shift that rounds to whole pixels at the precision asked is whole too.
+    let coarse = PlaneShift::new(
+        crate::kernels::ShiftMethod::Haar,
+        crate::kernels::KernelOptions {
+            precision: 1,
+            ..Default::default()
+        },
+        crate::BoundaryMode::Wrap,
+    )
+    .unwrap();
+    assert_eq!(coarse.apply(x.view(), 5.1, -2.9).unwrap(), exact);
+}

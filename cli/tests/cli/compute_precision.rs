@@ -261,3 +261,57 @@ fn echoed_numbers_are_short() {
     ]);
     assert!(said.contains("shifted by (0.333333, 4)"), "{said}");
 }
+
+/// `image` rolled as `numpy.roll(image, (dy, dx), axis=(1, 2))` over its (power-of-two) size:
+/// `out[r][c] = in[r - dy][c - dx]`.
+fn rolled<T: Sample>(image: &PlanarImage<T>, dx: i64, dy: i64) -> Array3<T> {
+    let planes = image.planes();
+    let (_, h, w) = planes.dim();
+    Array3::from_shape_fn(planes.dim(), |(k, r, c)| {
+        planes[[
+            k,
+            (r as i64 - dy).rem_euclid(h as i64) as usize,
+            (c as i64 - dx).rem_euclid(w as i64) as usize,
+        ]]
+    })
+}
+
+/// `haarshift shift INPUT -o out.npy --dx DX --dy DY --compute PRECISION` read back in `T`.
+fn whole_shift_through_the_cli<T: Sample>(input: &Path, dx: i64, dy: i64) -> PlanarImage<T> {
+    let out = input.with_extension(format!("{dx}_{dy}_{}.npy", T::NAME));
+    let (dx, dy) = (dx.to_string(), dy.to_string());
+    let args = ["shift", p(input), "-o", p(&out), "--dx", &dx, "--dy", &dy];
+    let mut args = args.to_vec();
+    args.extend(["--compute", T::NAME]);
+    succeeds_with_stdout(&args);
+    read_image::<T>(&out).unwrap()
+}
+
+#[test]
+fn whole_haar_shifts_are_numpy_roll_bit_for_bit_in_f32_and_f64() {
+    let dir = tempfile::tempdir().unwrap();
+    let sixteen = save(
+        dir.path(),
+        "sixteen.png",
+        &image::<f32>(Channels::Gray, 64, 128, SampleDepth::U16),
+    );
+    let camera = dir.path().join("camera.png");
+    std::fs::copy(crate::common::testdata("camera.png"), &camera).unwrap();
+    for input in [&camera, &sixteen] {
+        for (dx, dy) in [(5, -3), (-1000, 77)] {
+            let name = format!("{} by ({dx}, {dy})", input.display());
+            let f32_out = whole_shift_through_the_cli::<f32>(input, dx, dy);
+            assert_eq!(
+                f32_out.planes(),
+                rolled(&read_image::<f32>(input).unwrap(), dx, dy),
+                "{name} in f32"
+            );
+            let f64_out = whole_shift_through_the_cli::<f64>(input, dx, dy);
+            assert_eq!(
+                f64_out.planes(),
+                rolled(&read_image::<f64>(input).unwrap(), dx, dy),
+                "{name} in f64"
+            );
+        }
+    }
+}

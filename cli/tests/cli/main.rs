@@ -8,6 +8,7 @@ mod experiment;
 mod experiment_relight;
 mod flags;
 mod hdr;
+mod hostile;
 mod readme;
 mod relight;
 mod relight_scene;

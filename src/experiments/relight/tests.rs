@@ -9,7 +9,8 @@ fn setup() -> (Subject, Light, RelightProtocol) {
         scene: Scene::from_mesh(
             Generator::PlaneUnderBox { height: 0.5 }.mesh().unwrap(),
             false,
-        ),
+        )
+        .unwrap(),
     };
     let sky = LatLongMap::<f64>::from_fn(32, 3, |d, o| {
         let sun = (30.0 * (d[0] * 0.5 + d[1] * 0.8 + d[2] * 0.33 - 1.0)).exp();

@@ -359,8 +359,26 @@ fn sparse_coefficients_out_of_range_or_not_finite_are_refused() {
     let ok = HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[3], &[[1.0]]);
     assert!(ok.is_ok());
     for (i, v) in [(32u32, 1.0), (3, f64::NAN)] {
-        assert!(HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[i], &[[v]]).is_err());
+        assert_err!(
+            HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[i], &[[v]]),
+            InvalidParameter {
+                name: "coefficients",
+                ..
+            },
+            "one finite value per index below 32"
+        );
     }
-    assert!(HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[1, 2], &[[1.0]]).is_err());
-    assert!(HaarTree::<f64, 1>::from_sparse(2, 6, FaceLayout::Stacked, &[], &[]).is_err());
+    assert_err!(
+        HaarTree::<f64, 1>::from_sparse(2, 4, FaceLayout::Stacked, &[1, 2], &[[1.0]]),
+        InvalidParameter {
+            name: "coefficients",
+            ..
+        },
+        "2 indices and 1 values"
+    );
+    assert_err!(
+        HaarTree::<f64, 1>::from_sparse(2, 6, FaceLayout::Stacked, &[], &[]),
+        InvalidShape { .. },
+        "S a power of two"
+    );
 }

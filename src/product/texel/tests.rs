@@ -182,16 +182,67 @@ fn a_depth_limit_carries_over_exactly() {
 
 #[test]
 fn bad_factors_and_faces_are_refused() {
-    assert!(TexelProduct::<f64>::new(0, 4).is_err());
-    assert!(TexelProduct::<f64>::new(2, 6).is_err());
-    assert!(TexelProduct::<f64>::new(2, 0).is_err());
+    assert_err!(
+        TexelProduct::<f64>::new(0, 4),
+        InvalidShape { .. },
+        "[0, 4, 4, 1]"
+    );
+    assert_err!(
+        TexelProduct::<f64>::new(2, 6),
+        InvalidShape { .. },
+        "[2, 6, 6, 1]"
+    );
+    assert_err!(
+        TexelProduct::<f64>::new(2, 0),
+        InvalidShape { .. },
+        "[2, 0, 0, 1]"
+    );
     let mut p = TexelProduct::<f64>::new(2, 4).unwrap();
-    assert!(p.multiply(&[32], &[1.0]).is_err());
-    assert!(p.multiply(&[1, 2], &[1.0]).is_err());
-    assert!(p.multiply(&[1], &[f64::NAN]).is_err());
-    assert!(p.multiply(&[1], &[[1.0, f64::INFINITY, 0.0]]).is_err());
-    assert!(p.dot(&[40], &[1.0]).is_err());
-    assert!(p.multiply_by(&TexelProduct::new(6, 4).unwrap()).is_err());
+    assert_err!(
+        p.multiply(&[32], &[1.0]),
+        InvalidParameter {
+            name: "coefficients",
+            ..
+        },
+        "below 32"
+    );
+    assert_err!(
+        p.multiply(&[1, 2], &[1.0]),
+        InvalidParameter {
+            name: "coefficients",
+            ..
+        },
+        "2 indices and 1 values"
+    );
+    assert_err!(
+        p.multiply(&[1], &[f64::NAN]),
+        InvalidParameter {
+            name: "coefficients",
+            ..
+        },
+        "finite"
+    );
+    assert_err!(
+        p.multiply(&[1], &[[1.0, f64::INFINITY, 0.0]]),
+        InvalidParameter {
+            name: "coefficients",
+            ..
+        },
+        "finite"
+    );
+    assert_err!(
+        p.dot(&[40], &[1.0]),
+        InvalidParameter {
+            name: "coefficients",
+            ..
+        },
+        "below 32"
+    );
+    assert_err!(
+        p.multiply_by(&TexelProduct::new(6, 4).unwrap()),
+        InvalidShape { .. },
+        "different faces"
+    );
     // A refused factor left the product as it was.
     assert_eq!(p.dot(&[0], &[1.0]).unwrap(), [4.0; 3]);
 }

@@ -143,7 +143,11 @@ fn a_change_of_view_equals_the_full_product_integral() {
     assert!(relative(&part(&frames[1], glossy), &part(&frames[0], glossy)) > 0.05);
     assert!(relative(&part(&frames[1], rest), &part(&frames[0], rest)) < 1e-12);
     // Another kind of frame is refused, and so is a frame after a move.
-    assert!(jrt.frame_lit(&scene, &light).is_err());
+    assert_err!(
+        jrt.frame_lit(&scene, &light),
+        InvalidParameter { name: "change", .. },
+        "use frame_view"
+    );
     let mut p = scene.placement(1);
     p.translate[0] += 0.1;
     scene.place(1, p).unwrap();

@@ -434,6 +434,19 @@ impl DynamicScene {
             })?;
             placed.push((shape, placement, object.material.albedo()?, brdf));
         }
+        // Validated before any field is built (relight::validate).
+        if let Some(camera) = &file.camera {
+            camera.check()?;
+        }
+        let meshes = placed
+            .iter()
+            .map(|(shape, p, _, _)| place_mesh(&shapes[*shape], p, param))
+            .collect::<Result<Vec<Mesh>>>()?;
+        let objects_mesh = merge(meshes.iter().cloned());
+        let ground = file
+            .ground_plane
+            .then(|| ground_plane_under(&objects_mesh.bounds()))
+            .transpose()?;
         let mut fields = Vec::with_capacity(shapes.len());
         for (mesh, (path, generator)) in shapes.iter().zip(&sources) {
             let (field, origin) = match store.as_deref_mut() {
@@ -468,14 +481,6 @@ impl DynamicScene {
             report.field_bytes += field.stored_bytes();
             fields.push(Arc::new(field));
         }
-        let meshes: Vec<Mesh> = placed
-            .iter()
-            .map(|(shape, p, _, _)| place_mesh(&shapes[*shape], p, param))
-            .collect();
-        let objects_mesh = merge(meshes.iter().cloned());
-        let ground = file
-            .ground_plane
-            .then(|| ground_plane_under(&objects_mesh.bounds()));
         let visibility = VisibilityOptions {
             keep: options.keep_visibility,
             progress: options.progress,
@@ -651,6 +656,17 @@ impl DynamicScene {
                 ),
             ));
         }
+        // Every placed vertex stays in range, as a scene file's are: a rotation keeps lengths,
+        // so `|R(s q) + t|_k <= s |q| + |t_k|`.
+        let b = self.shapes[self.objects[k].shape].bounds();
+        let radius = (0..3)
+            .map(|c| b.min[c].abs().max(b.max[c].abs()).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let reach = placement
+            .translate
+            .map(|t| t.abs() + placement.scale * radius);
+        crate::relight::scene::validate::check_point("the placed object", reach)?;
         let o = &mut self.objects[k];
         if placement.turn != o.placement.turn {
             o.field = turned(&self.fields[o.shape], placement.turn)?;
@@ -707,7 +723,10 @@ impl DynamicScene {
         merge(
             self.objects
                 .iter()
-                .map(|o| place_mesh(&self.shapes[o.shape], &o.placement, param))
+                .map(|o| {
+                    place_mesh(&self.shapes[o.shape], &o.placement, param)
+                        .expect("placements are checked in range when made")
+                })
                 .chain(self.ground.iter().map(|g| g.0.clone())),
         )
     }
@@ -966,7 +985,7 @@ fn turned(field: &Arc<OcclusionField>, turn: usize) -> Result<Arc<OcclusionField
     })
 }
 
-fn place_mesh(mesh: &Mesh, p: &Placement, param: Parameterization) -> Mesh {
+fn place_mesh(mesh: &Mesh, p: &Placement, param: Parameterization) -> Result<Mesh> {
     let rot = p.rotation(param);
     mesh.mapped(|q| p.to_world(q, param), |n| rot.apply(n))
 }

@@ -112,9 +112,13 @@ impl MotionPath {
         crate::relight::scene::read_json(path)
     }
 
-    /// Frames in all, frame 0 included.
+    /// Frames in all, frame 0 included (`usize::MAX` when the sum does not fit: checked, so
+    /// that no count wraps around [`MAX_FRAMES`]).
     pub fn frame_count(&self) -> usize {
-        1 + self.segments.iter().map(|s| s.frames).sum::<usize>()
+        self.segments
+            .iter()
+            .try_fold(1usize, |n, s| n.checked_add(s.frames))
+            .unwrap_or(usize::MAX)
     }
 
     /// Every frame's state in `scene` (checked: names, placements, counts).

@@ -197,7 +197,11 @@ fn just_in_time_transfer_equals_the_full_product_integral_with_unpruned_factors(
     let want = scene.shade::<f64>(&turned).unwrap();
     assert!(relative(&jrt.frame_lit(&scene, &turned).unwrap(), &want) < 1e-9);
     // The wrong frame for the change is refused, and so is a turn since formation.
-    assert!(jrt.frame_moved(&scene).is_err());
+    assert_err!(
+        jrt.frame_moved(&scene),
+        InvalidParameter { name: "change", .. },
+        "use frame_lit"
+    );
     let jrt = JustInTimeTransfer::<f64>::form(&scene, &light, Change::Object(1)).unwrap();
     let turned = Placement {
         turn: 3,
@@ -296,12 +300,28 @@ fn bad_scene_files_are_refused_with_a_reason() {
     let refused = DynamicScene::load(&path, &cube);
     assert!(refused.unwrap_err().to_string().contains("latlong"));
     let mut scene = build(THREE);
-    assert!(scene.place(7, scene.placement(0)).is_err());
+    assert_err!(
+        scene.place(7, scene.placement(0)),
+        InvalidParameter { name: "object", .. },
+        "the scene has 3 objects"
+    );
     let bad = Placement {
         scale: f64::NAN,
         ..scene.placement(0)
     };
-    assert!(scene.place(0, bad).is_err());
+    assert_err!(
+        scene.place(0, bad),
+        InvalidParameter {
+            name: "placement",
+            ..
+        },
+        "scale must be positive"
+    );
+    let far = Placement {
+        translate: [-1e30, 0.0, 0.0],
+        ..scene.placement(0)
+    };
+    assert_err!(scene.place(0, far), Scene { .. }, "placed object", "1e15");
 }
 
 #[test]
@@ -326,7 +346,11 @@ fn a_clone_shares_its_shape_and_shadows_like_the_original() {
     // A transfer formed before the clone is refused after it.
     let mut grown = scene.clone();
     grown.clone_object(1, scene.placement(1)).unwrap();
-    assert!(jrt.frame_moved(&grown).is_err());
+    assert_err!(
+        jrt.frame_moved(&grown),
+        InvalidParameter { name: "scene", .. },
+        "re-form it after cloning"
+    );
 }
 
 /// A sphere with three others around it: two within whose fields it lies, and one whose

@@ -415,7 +415,7 @@ fn full_coefficients_and_direct_evaluation_equal_the_reference() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
     let mut mesh = Mesh::load(path.as_ref()).unwrap();
     let objects = mesh.vertex_count();
-    add_ground_plane(&mut mesh);
+    add_ground_plane(&mut mesh).unwrap();
     let n = 16;
     let sky = LatLongMap::<f64>::from_fn(n, 3, |d, o| {
         let sun = (8.0 * (d[0] * 0.6 + d[1] * 0.8 - 1.0)).exp();

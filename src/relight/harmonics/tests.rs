@@ -191,7 +191,7 @@ fn on_an_occluded_scene_more_bands_come_closer_to_the_reference() {
     let mut mesh = crate::relight::Generator::Sphere { cells: 4 }
         .mesh()
         .unwrap();
-    crate::relight::add_ground_plane(&mut mesh);
+    crate::relight::add_ground_plane(&mut mesh).unwrap();
     let bvh = crate::relight::SceneBvh::new(&mesh);
     // A smooth sky: a broad lobe towards the upper +X +Z and a dim floor.
     let lighting = crate::sphere::LatLongMap::<f64>::from_fn(64, 1, |d, o| {

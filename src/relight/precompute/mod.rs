@@ -95,13 +95,13 @@ impl PrecomputeOptions {
 /// use haarshift::relight::precompute::{PrecomputeOptions, precompute};
 /// use haarshift::relight::{Generator, Scene, VisibilityOptions};
 /// use haarshift::faces::{ParamKind, Parameterization};
-/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true);
+/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true).unwrap();
 /// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
 /// let (cache, report) = precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(param))).unwrap();
 /// assert_eq!(cache.transport.vertex_count(), 54 + 1089);
 /// assert!(cache.params.ground_plane && report.rays > 0);
 /// let huge = Parameterization::new(ParamKind::LatLong, 4096).unwrap();
-/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false);
+/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
 /// assert!(precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(huge))).is_err());
 /// ```
 pub fn precompute(

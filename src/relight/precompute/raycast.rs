@@ -15,9 +15,16 @@
 //! on the bunny with its ground plane and on the 85,860-vertex cubes scene and prints rays per
 //! second: `cd tools/bvh-compare && cargo run --release`.
 //!
-//! Rays are f32 (the BVH's precision). Zero-area triangles are left out of the BVH (no ray can
-//! hit one). A ray hits a triangle when the Moller-Trumbore test finds `0 <= t <= t_max`
+//! Rays are f32 (the BVH's precision). What the BVH is given is cleaned in f32, after the
+//! conversion: triangles of zero area there are left out (no ray can hit one) and repeated
+//! triangles (the same three corners in any order) are kept once, since they answer every
+//! query alike and many copies of one box make PLOC's merging quadratic. The mesh itself is not
+//! touched: cleaning feeds only the BVH. Positions reach it within
+//! [`MAX_COORDINATE`](super::validate::MAX_COORDINATE) (a [`Mesh`] holds no other), so every
+//! box it builds is finite. A ray hits a triangle when the Moller-Trumbore test finds `0 <= t <= t_max`
 //! ([`obvhs::rt_triangle::RtTriangle::intersect`]); the caller offsets origins off surfaces.
+
+use std::collections::HashSet;
 
 use glam::Vec3A;
 use obvhs::BvhBuildParams;
@@ -55,27 +62,30 @@ pub struct SceneBvh {
 }
 
 impl SceneBvh {
-    /// Builds the BVH of `mesh`'s triangles of non-zero area.
+    /// Builds the BVH of `mesh`'s distinct triangles of non-zero area in f32 (see the
+    /// [module docs](self)).
     pub fn new(mesh: &Mesh) -> Self {
         let p = mesh.positions();
         let point = |i: u32| {
             let r = p.row(i as usize);
-            [r[0], r[1], r[2]]
+            [r[0] as f32, r[1] as f32, r[2] as f32]
         };
-        let vec = |a: [f64; 3]| Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32);
+        let mut seen = HashSet::with_capacity(mesh.triangles().len());
         let triangles: Vec<Triangle> = mesh
             .triangles()
             .iter()
             .filter_map(|t| {
-                let (a, b, c) = (point(t[0]), point(t[1]), point(t[2]));
-                let n = cross(sub(b, a), sub(c, a));
-                (n != [0.0; 3]).then(|| Triangle {
-                    v0: vec(a),
-                    v1: vec(b),
-                    v2: vec(c),
+                let corners = t.map(point);
+                let [a, b, c] = corners.map(|v| v.map(f64::from));
+                let mut key = corners.map(|v| v.map(f32::to_bits));
+                key.sort_unstable();
+                (cross(sub(b, a), sub(c, a)) != [0.0; 3] && seen.insert(key)).then(|| {
+                    let [v0, v1, v2] = corners.map(Vec3A::from_array);
+                    Triangle { v0, v1, v2 }
                 })
             })
             .collect();
+        drop(seen);
         if triangles.is_empty() {
             return SceneBvh {
                 bvh: None,

@@ -7,7 +7,7 @@ use crate::relight::{Scene, add_ground_plane};
 fn bunny_on_ground() -> Mesh {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
     let mut mesh = Mesh::load(path.as_ref()).unwrap();
-    add_ground_plane(&mut mesh);
+    add_ground_plane(&mut mesh).unwrap();
     mesh
 }
 
@@ -63,6 +63,28 @@ fn degenerate_triangles_never_occlude() {
     assert!(bvh.triangles.is_empty());
     assert!(!bvh.occluded([0.5, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
     // A scene built the usual way is unaffected by such triangles.
-    let scene = Scene::from_mesh(mesh, true);
+    let scene = Scene::from_mesh(mesh, true).unwrap();
     assert!(SceneBvh::new(&scene.mesh).occluded([0.5, 2.0, 0.0], [0.0, -1.0, 0.0], 10.0));
+}
+
+#[test]
+fn repeated_and_f32_degenerate_triangles_are_kept_once_and_dropped() {
+    // One roof triangle, the same triangle twice more (rotated corners, reversed winding), one
+    // of zero area in f32 only (its corners differ by 1e-9 near 1) and one of zero area.
+    let positions = ndarray::array![
+        [-1.0, 1.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, -1.0],
+        [1.0, 1.0, 1.0],
+        [1.0 + 1e-9, 1.0, 1.0],
+        [1.0, 1.0 + 1e-9, 1.0],
+    ];
+    let triangles = vec![[0, 1, 2], [1, 2, 0], [0, 2, 1], [3, 4, 5], [0, 0, 1]];
+    let mesh = Mesh::new(positions, triangles.clone(), None).unwrap();
+    let bvh = SceneBvh::new(&mesh);
+    assert_eq!(bvh.triangles.len(), 1);
+    assert!(bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
+    assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, -1.0, 0.0], f32::INFINITY));
+    // The mesh keeps every triangle as read: cleaning feeds only the BVH.
+    assert_eq!(mesh.triangles(), &triangles[..]);
 }

@@ -36,7 +36,7 @@ fn rms_difference(a: &TransportSet, b: &TransportSet) -> (f64, f64) {
 fn bunny_on_ground() -> Mesh {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
     let mut mesh = Mesh::load(path.as_ref()).unwrap();
-    add_ground_plane(&mut mesh);
+    add_ground_plane(&mut mesh).unwrap();
     mesh
 }
 
@@ -115,7 +115,7 @@ fn a_point_under_a_floating_box_sees_one_minus_the_form_factor() {
 #[test]
 fn stratified_samples_are_seeded_and_converge_to_the_centre_rays() {
     let mut mesh = Generator::Sphere { cells: 4 }.mesh().unwrap();
-    add_ground_plane(&mut mesh);
+    add_ground_plane(&mut mesh).unwrap();
     let bvh = SceneBvh::new(&mesh);
     let mut options = VisibilityOptions::new(latlong(8));
     let (centre, _) = vertex_major(&mesh, &bvh, &options).unwrap();

@@ -125,7 +125,7 @@ fn an_upward_vertex_under_a_polar_cap_matches_the_closed_form() {
 fn the_haar_transport_at_full_coefficients_agrees() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
     let mut mesh = Mesh::load(path.as_ref()).unwrap();
-    add_ground_plane(&mut mesh);
+    add_ground_plane(&mut mesh).unwrap();
     let n = 16;
     let lighting = LatLongMap::<f64>::from_fn(n, 3, |d, o| {
         let sun = (8.0 * (d[0] * 0.6 + d[1] * 0.8 - 1.0)).exp();

@@ -134,7 +134,7 @@ pub struct CacheHeader {
 /// use haarshift::relight::{CacheParams, KeepRecord, Scene, SceneBvh, SceneCache,
 ///                          VisibilityOptions, Generator, vertex_major};
 /// use haarshift::faces::{ParamKind, Parameterization};
-/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false);
+/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
 /// let options = VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,

@@ -8,7 +8,7 @@ fn made(cells: usize) -> SceneCache {
 }
 
 fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
-    let scene = Scene::from_mesh(Generator::Sphere { cells }.mesh().unwrap(), true);
+    let scene = Scene::from_mesh(Generator::Sphere { cells }.mesh().unwrap(), true).unwrap();
     let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
     let mut options = VisibilityOptions::new(param);
     options.keep = Selection::Largest(10);

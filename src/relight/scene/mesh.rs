@@ -108,6 +108,7 @@ impl Mesh {
             }
         }
         check_finite(positions.view(), "position")?;
+        super::validate::check_positions(positions.view())?;
         let computed = area_weighted_normals(positions.view(), &triangles);
         let normals = match normals {
             None => computed,
@@ -221,12 +222,13 @@ impl Mesh {
     }
 
     /// The mesh with every position mapped by `position` and every normal by `normal` (then
-    /// normalised): the caller passes a transform and its inverse transpose.
+    /// normalised): the caller passes a transform and its inverse transpose. Errors when a
+    /// mapped position leaves the range of [`check_positions`](super::validate::check_positions).
     pub(crate) fn mapped(
         &self,
         position: impl Fn([f64; 3]) -> [f64; 3],
         normal: impl Fn([f64; 3]) -> [f64; 3],
-    ) -> Mesh {
+    ) -> Result<Mesh> {
         let map = |a: &Array2<f64>, f: &dyn Fn([f64; 3]) -> [f64; 3], unit: bool| {
             let mut out = a.clone();
             for mut row in out.outer_iter_mut() {
@@ -239,11 +241,13 @@ impl Mesh {
             }
             out
         };
-        Mesh {
-            positions: map(&self.positions, &position, false),
+        let positions = map(&self.positions, &position, false);
+        super::validate::check_positions(positions.view())?;
+        Ok(Mesh {
+            positions,
             normals: map(&self.normals, &normal, true),
             triangles: self.triangles.clone(),
-        }
+        })
     }
 }
 
@@ -323,7 +327,9 @@ fn read_obj(path: &Path) -> Result<Mesh> {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_obj(&String::from_utf8_lossy(&text))
+    // A UTF-8 byte-order mark would otherwise hide the first statement.
+    let text = text.strip_prefix("\u{feff}".as_bytes()).unwrap_or(&text);
+    parse_obj(&String::from_utf8_lossy(text))
 }
 
 /// Parses OBJ text: `v x y z [w]`, `vn x y z`, `f` with `a`, `a/t`, `a/t/n` or `a//n` corners
@@ -362,10 +368,11 @@ fn parse_obj(text: &str) -> Result<Mesh> {
                     let index = |part: Option<&str>| -> Result<Option<i64>> {
                         match part {
                             None | Some("") => Ok(None),
-                            Some(p) => p
-                                .parse::<i64>()
-                                .map(|i| Some(if i < 0 { v + i } else { i - 1 }))
-                                .map_err(|_| bad("a face index is not an integer")),
+                            Some(p) => match p.parse::<i64>() {
+                                Ok(0) => Err(bad("face index 0 (OBJ counts vertices from 1)")),
+                                Ok(i) => Ok(Some(if i < 0 { v + i } else { i - 1 })),
+                                Err(_) => Err(bad("a face index is not an integer")),
+                            },
                         }
                     };
                     let position = index(parts.next())?.ok_or_else(|| bad("empty face corner"))?;

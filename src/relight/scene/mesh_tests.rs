@@ -258,3 +258,36 @@ fn errors_print_as_one_line_with_the_file() {
     assert!(line.contains("broken.obj: ") && line.ends_with("the mesh has no triangles"));
     assert!(!line.contains('\n'));
 }
+
+#[test]
+fn a_byte_order_mark_keeps_the_first_vertex_and_index_0_is_named() {
+    let mesh = load_bytes(
+        "bom.obj",
+        "\u{feff}v 9 9 9\nv 0 0 0\nv 1 0 0\nf 1 2 3\n".as_bytes(),
+    );
+    let mesh = mesh.unwrap();
+    assert_eq!(mesh.vertex_count(), 3);
+    assert_eq!(mesh.positions().row(0).to_vec(), vec![9.0, 9.0, 9.0]);
+    let zero = scene_error(load_in("z.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"));
+    assert_eq!(
+        zero,
+        SceneError::Corrupt("line 4: face index 0 (OBJ counts vertices from 1)".into())
+    );
+}
+
+#[test]
+fn positions_beyond_the_range_are_refused_by_vertex() {
+    let far = scene_error(load_in(
+        "far.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1e308 0\nf 1 2 3\n",
+    ));
+    assert_eq!(
+        far,
+        SceneError::OutOfRange {
+            what: "vertex 2".into(),
+            value: 1e308
+        }
+    );
+    let edge = load_bytes("edge.obj", b"v 0 0 0\nv 1 0 0\nv 0 -1e15 0\nf 1 2 3\n");
+    assert_eq!(edge.unwrap().bounds().min[1], -1e15);
+}

@@ -53,6 +53,7 @@
 pub mod cache;
 pub(crate) mod framed;
 pub mod mesh;
+pub mod validate;
 
 use std::path::{Path, PathBuf};
 
@@ -60,6 +61,7 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use crate::relight::scene::mesh::{cross, dot};
+use crate::relight::scene::validate::grid_vertices;
 use crate::relight::{Brdf, Mesh, SceneError};
 use crate::sphere::SphereRotation;
 use crate::{Error, Result};
@@ -75,7 +77,7 @@ pub const GROUND_ALBEDO: [f32; 3] = [0.8, 0.8, 0.8];
 
 /// A grid of `nu x nv` cells on the parallelogram `origin + s u + t v`, `s, t in [0, 1]`;
 /// normal `u x v` (normalised), vertices `(nu + 1)(nv + 1)`, `s` fastest.
-fn grid(origin: [f64; 3], u: [f64; 3], v: [f64; 3], nu: usize, nv: usize) -> Mesh {
+fn grid(origin: [f64; 3], u: [f64; 3], v: [f64; 3], nu: usize, nv: usize) -> Result<Mesh> {
     let n = cross(u, v);
     let len = dot(n, n).sqrt();
     let normal = n.map(|x| x / len);
@@ -99,11 +101,11 @@ fn grid(origin: [f64; 3], u: [f64; 3], v: [f64; 3], nu: usize, nv: usize) -> Mes
             triangles.push([a, c, d]);
         }
     }
-    Mesh::new(positions, triangles, Some(normals)).expect("a grid is a valid mesh")
+    Mesh::new(positions, triangles, Some(normals))
 }
 
 /// A horizontal grid facing `+Y` over `[x0, x0 + side] x [z0 - side, z0]` at height `y`.
-fn ground(x0: f64, z0: f64, y: f64, side: f64, cells: usize) -> Mesh {
+fn ground(x0: f64, z0: f64, y: f64, side: f64, cells: usize) -> Result<Mesh> {
     grid(
         [x0, y, z0],
         [side, 0.0, 0.0],
@@ -115,7 +117,7 @@ fn ground(x0: f64, z0: f64, y: f64, side: f64, cells: usize) -> Mesh {
 
 /// The six outward faces of the box `[min, max]`, `cells x cells` each, in the order +X, -X,
 /// +Y, -Y, +Z, -Z.
-fn cuboid(min: [f64; 3], max: [f64; 3], cells: usize) -> Mesh {
+fn cuboid(min: [f64; 3], max: [f64; 3], cells: usize) -> Result<Mesh> {
     let [x0, y0, z0] = min;
     let [x1, y1, z1] = max;
     let (dx, dy, dz) = (x1 - x0, y1 - y0, z1 - z0);
@@ -127,31 +129,31 @@ fn cuboid(min: [f64; 3], max: [f64; 3], cells: usize) -> Mesh {
         ([x0, y0, z1], [dx, 0.0, 0.0], [0.0, dy, 0.0]),
         ([x1, y0, z0], [-dx, 0.0, 0.0], [0.0, dy, 0.0]),
     ];
-    merge(faces.iter().map(|&(o, u, v)| grid(o, u, v, cells, cells)))
+    let faces = faces.iter().map(|&(o, u, v)| grid(o, u, v, cells, cells));
+    Ok(merge(faces.collect::<Result<Vec<_>>>()?))
 }
 
 /// A sphere of `radius` at `centre`: the faces of a cube projected onto it, normals radial.
-fn cube_sphere(centre: [f64; 3], radius: f64, cells: usize) -> Mesh {
-    let cube = cuboid([-1.0; 3], [1.0; 3], cells);
+fn cube_sphere(centre: [f64; 3], radius: f64, cells: usize) -> Result<Mesh> {
+    let cube = cuboid([-1.0; 3], [1.0; 3], cells)?;
     cube.mapped(
         |p| {
             let len = dot(p, p).sqrt();
             std::array::from_fn(|k| centre[k] + radius * p[k] / len)
         },
         |_| [0.0; 3],
-    )
+    )?
     .with_radial_normals(centre)
 }
 
 impl Mesh {
     /// This mesh with every normal pointing from `centre` to its vertex.
-    fn with_radial_normals(self, centre: [f64; 3]) -> Mesh {
+    fn with_radial_normals(self, centre: [f64; 3]) -> Result<Mesh> {
         let normals = Array2::from_shape_fn((self.vertex_count(), 3), |(v, k)| {
             self.positions()[[v, k]] - centre[k]
         });
         let triangles = self.triangles().to_vec();
         Mesh::new(self.positions().to_owned(), triangles, Some(normals))
-            .expect("a sphere is a valid mesh")
     }
 }
 
@@ -256,8 +258,11 @@ impl Generator {
 /// let b = m.bounds();
 /// assert_eq!((b.min[1], b.max[0]), (-1.0, 4.0)); // at the lowest y, side 4 x 2
 /// ```
-pub fn add_ground_plane(mesh: &mut Mesh) {
-    mesh.append(&ground_plane_under(&mesh.bounds()));
+///
+/// Errors as [`ground_plane_under`] does.
+pub fn add_ground_plane(mesh: &mut Mesh) -> Result<()> {
+    mesh.append(&ground_plane_under(&mesh.bounds())?);
+    Ok(())
 }
 
 /// The ground plane [`add_ground_plane`] puts under a scene of bounding box `b`, on its own.
@@ -265,19 +270,22 @@ pub fn add_ground_plane(mesh: &mut Mesh) {
 /// ```
 /// use haarshift::relight::{Generator, scene::ground_plane_under};
 /// let ball = Generator::Sphere { cells: 4 }.mesh().unwrap();
-/// let ground = ground_plane_under(&ball.bounds());
+/// let ground = ground_plane_under(&ball.bounds()).unwrap();
 /// assert_eq!((ground.vertex_count(), ground.bounds().min[1]), (33 * 33, -1.0));
 /// ```
-pub fn ground_plane_under(b: &crate::relight::Bounds) -> Mesh {
+///
+/// Errors when the box has no horizontal extent to size the plane by
+/// ([`check_ground_extent`](crate::relight::scene::validate::check_ground_extent)), or when the plane would
+/// reach beyond [`MAX_COORDINATE`](crate::relight::scene::validate::MAX_COORDINATE).
+pub fn ground_plane_under(b: &crate::relight::Bounds) -> Result<Mesh> {
+    crate::relight::scene::validate::check_ground_extent(b)?;
     let side = 4.0 * (b.max[0] - b.min[0]).max(b.max[2] - b.min[2]);
     let c = b.centre();
-    ground(
-        c[0] - 0.5 * side,
-        c[2] + 0.5 * side,
-        b.min[1],
-        side,
-        GROUND_CELLS,
-    )
+    let (x0, z0) = (c[0] - 0.5 * side, c[2] + 0.5 * side);
+    for corner in [[x0, b.min[1], z0], [x0 + side, b.min[1], z0 - side]] {
+        validate::check_point("the ground plane's corner", corner)?;
+    }
+    ground(x0, z0, b.min[1], side, GROUND_CELLS)
 }
 
 /// A procedural mesh; see the [module docs](self) for each one's geometry and size.
@@ -378,15 +386,15 @@ impl Generator {
         };
         Ok(match *self {
             Generator::CylinderAndBump { cells } => {
-                cells_ok("cells", cells, (cells + 1).saturating_mul(cells + 1))?;
-                let mut g = ground(-4.0, 4.0, 0.0, 8.0, cells);
+                cells_ok("cells", cells, grid_vertices(cells).unwrap_or(usize::MAX))?;
+                let mut g = ground(-4.0, 4.0, 0.0, 8.0, cells)?;
                 g = g.mapped(
                     |[x, y, z]| {
                         let r2 = (x - 1.5).powi(2) + (z - 1.0).powi(2);
                         [x, y + (-r2 / (2.0 * 0.6 * 0.6)).exp(), z]
                     },
                     |n| n,
-                );
+                )?;
                 let triangles = g.triangles().to_vec();
                 let g = Mesh::new(g.positions().to_owned(), triangles, None)?;
                 merge([g, cylinder([-1.5, 0.0, -1.0], 0.5, 3.0, 48, 24)])
@@ -399,7 +407,7 @@ impl Generator {
                 positive("distance", distance)?;
                 let vertices = 6usize
                     .saturating_mul(count.saturating_mul(count))
-                    .saturating_mul((cells + 1).saturating_mul(cells + 1));
+                    .saturating_mul(grid_vertices(cells).unwrap_or(usize::MAX));
                 cells_ok("cubes per row", count, vertices)?;
                 cells_ok("cells", cells, vertices)?;
                 let wall = grid(
@@ -408,7 +416,7 @@ impl Generator {
                     [0.0, 10.1, 0.0],
                     129,
                     101,
-                );
+                )?;
                 let (h, c) = (0.3, count as f64);
                 let cubes = (0..count * count).map(|k| {
                     let x = 1.2 * ((k % count) as f64 - 0.5 * (c - 1.0));
@@ -419,31 +427,36 @@ impl Generator {
                         cells,
                     )
                 });
-                merge(std::iter::once(wall).chain(cubes))
+                merge(
+                    std::iter::once(Ok(wall))
+                        .chain(cubes)
+                        .collect::<Result<Vec<_>>>()?,
+                )
             }
             Generator::PlaneWithSphere {} => merge([
-                ground(-3.0, 3.0, 0.0, 6.0, 64),
-                cube_sphere([0.0, 1.0, 0.0], 1.0, 16),
+                ground(-3.0, 3.0, 0.0, 6.0, 64)?,
+                cube_sphere([0.0, 1.0, 0.0], 1.0, 16)?,
             ]),
             Generator::Sphere { cells } => {
                 cells_ok(
                     "cells",
                     cells,
-                    6usize.saturating_mul((cells + 1).saturating_mul(cells + 1)),
+                    6usize.saturating_mul(grid_vertices(cells).unwrap_or(usize::MAX)),
                 )?;
-                cube_sphere([0.0; 3], 1.0, cells)
+                cube_sphere([0.0; 3], 1.0, cells)?
             }
             Generator::Table { cells } | Generator::Chair { cells } => {
                 let boxes = self.boxes();
-                let per_box = 6usize.saturating_mul((cells + 1).saturating_mul(cells + 1));
+                let per_box = 6usize.saturating_mul(grid_vertices(cells).unwrap_or(usize::MAX));
                 cells_ok("cells", cells, per_box.saturating_mul(boxes.len()))?;
-                merge(boxes.into_iter().map(|(lo, hi)| cuboid(lo, hi, cells)))
+                let boxes = boxes.into_iter().map(|(lo, hi)| cuboid(lo, hi, cells));
+                merge(boxes.collect::<Result<Vec<_>>>()?)
             }
             Generator::PlaneUnderBox { height } => {
                 positive("height", height)?;
                 merge([
-                    ground(-3.0, 3.0, 0.0, 6.0, 2),
-                    cuboid([-1.0, height, -1.0], [1.0, height + 0.5, 1.0], 4),
+                    ground(-3.0, 3.0, 0.0, 6.0, 2)?,
+                    cuboid([-1.0, height, -1.0], [1.0, height + 0.5, 1.0], 4)?,
                 ])
             }
         })
@@ -500,13 +513,13 @@ impl Transform {
             ));
         }
         let r = SphereRotation::from_degrees(self.yaw, self.pitch, self.roll)?;
-        Ok(mesh.mapped(
+        mesh.mapped(
             |p| {
                 let q = r.apply(p.map(|x| x * self.scale));
                 std::array::from_fn(|k| q[k] + self.translate[k])
             },
             |n| r.apply(n),
-        ))
+        )
     }
 }
 
@@ -664,6 +677,21 @@ pub struct CameraSpec {
     pub fov: f64,
 }
 
+impl CameraSpec {
+    /// Checks the position and the point looked at against
+    /// [`MAX_COORDINATE`](super::validate::MAX_COORDINATE), as a scene file is read.
+    ///
+    /// ```
+    /// use haarshift::relight::CameraSpec;
+    /// let far = CameraSpec { position: [0.0, 2.0, 5.0], look_at: [0.0, 1e308, 0.0], fov: 40.0 };
+    /// assert!(matches!(far.check(), Err(haarshift::Error::Scene { .. })));
+    /// ```
+    pub fn check(&self) -> Result<()> {
+        validate::check_point("the camera's position", self.position)?;
+        validate::check_point("the camera's look_at", self.look_at)
+    }
+}
+
 fn default_fov() -> f64 {
     45.0
 }
@@ -715,8 +743,9 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// A scene of one mesh with the default material (and, if asked, the ground plane).
-    pub fn from_mesh(mesh: Mesh, ground_plane: bool) -> Scene {
+    /// A scene of one mesh with the default material (and, if asked, the ground plane:
+    /// errors as [`add_ground_plane`] does).
+    pub fn from_mesh(mesh: Mesh, ground_plane: bool) -> Result<Scene> {
         let mut scene = Scene {
             albedo: Array2::zeros((0, 3)),
             mesh,
@@ -727,9 +756,9 @@ impl Scene {
         scene.albedo =
             Array2::from_shape_fn((scene.mesh.vertex_count(), 3), |(_, c)| DEFAULT_ALBEDO[c]);
         if ground_plane {
-            scene.add_ground_plane();
+            scene.add_ground_plane()?;
         }
-        scene
+        Ok(scene)
     }
 
     /// Appends the ground plane ([`add_ground_plane`]) with albedo [`GROUND_ALBEDO`], unless the
@@ -737,24 +766,27 @@ impl Scene {
     ///
     /// ```
     /// use haarshift::relight::{Generator, Scene};
-    /// let mut scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true);
+    /// let mut scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true).unwrap();
     /// let v = scene.mesh.vertex_count();
-    /// scene.add_ground_plane();
+    /// scene.add_ground_plane().unwrap();
     /// assert_eq!((scene.mesh.vertex_count(), scene.ground_plane), (v, true));
     /// ```
-    pub fn add_ground_plane(&mut self) {
+    ///
+    /// Errors (leaving the scene as it was) as [`add_ground_plane`] does.
+    pub fn add_ground_plane(&mut self) -> Result<()> {
         if self.ground_plane {
-            return;
+            return Ok(());
         }
-        self.ground_plane = true;
         let before = self.mesh.vertex_count();
-        add_ground_plane(&mut self.mesh);
+        add_ground_plane(&mut self.mesh)?;
+        self.ground_plane = true;
         let added = Array2::from_shape_fn((self.mesh.vertex_count() - before, 3), |(_, c)| {
             GROUND_ALBEDO[c]
         });
         self.albedo
             .append(ndarray::Axis(0), added.view())
             .expect("both are (V, 3)");
+        Ok(())
     }
 
     /// The vertices of the scene's objects, `0..object_vertices()`: all but the ground plane's
@@ -764,8 +796,8 @@ impl Scene {
     /// ```
     /// use haarshift::relight::{Generator, Scene};
     /// let sphere = Generator::Sphere { cells: 2 }.mesh().unwrap();
-    /// assert_eq!(Scene::from_mesh(sphere.clone(), true).object_vertices(), 54);
-    /// assert_eq!(Scene::from_mesh(sphere, false).object_vertices(), 54);
+    /// assert_eq!(Scene::from_mesh(sphere.clone(), true).unwrap().object_vertices(), 54);
+    /// assert_eq!(Scene::from_mesh(sphere, false).unwrap().object_vertices(), 54);
     /// ```
     pub fn object_vertices(&self) -> usize {
         let ground = if self.ground_plane {
@@ -783,7 +815,7 @@ impl Scene {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
         if !is_json {
-            return Ok(Scene::from_mesh(Mesh::load(path)?, false));
+            return Scene::from_mesh(Mesh::load(path)?, false);
         }
         let (file, dir) = SceneFile::read(path)?;
         file.build(dir).map_err(|e| e.in_file(path))
@@ -811,6 +843,9 @@ impl SceneFile {
     pub fn build(&self, dir: &Path) -> Result<Scene> {
         if self.objects.is_empty() {
             return Err(SceneError::SceneFile("a scene needs at least one object".into()).into());
+        }
+        if let Some(camera) = &self.camera {
+            camera.check()?;
         }
         let mut mesh: Option<Mesh> = None;
         let mut albedo = Array2::<f32>::zeros((0, 3));
@@ -845,7 +880,7 @@ impl SceneFile {
             ground_plane: false,
         };
         if self.ground_plane {
-            scene.add_ground_plane();
+            scene.add_ground_plane()?;
         }
         Ok(scene)
     }

@@ -80,7 +80,7 @@ fn closed_shapes_face_outward_and_spheres_have_radial_normals() {
         assert!((dot(p, p) - 1.0).abs() < 1e-12 && (dot(p, n) - 1.0).abs() < 1e-12);
     }
     assert_outward(
-        &cuboid([0.0, 1.0, 2.0], [1.0, 3.0, 2.5], 3),
+        &cuboid([0.0, 1.0, 2.0], [1.0, 3.0, 2.5], 3).unwrap(),
         [0.5, 2.0, 2.25],
     );
     assert_outward(&cylinder([1.0, 0.0, 1.0], 0.5, 3.0, 12, 4), [1.0, 1.5, 1.0]);
@@ -108,7 +108,7 @@ fn the_ground_plane_follows_its_definition() {
     let bunny = Mesh::load(&path).unwrap();
     let b = bunny.bounds();
     let mut with = bunny.clone();
-    add_ground_plane(&mut with);
+    add_ground_plane(&mut with).unwrap();
     let v = bunny.vertex_count();
     assert_eq!(with.vertex_count(), v + 33 * 33);
     assert_eq!(

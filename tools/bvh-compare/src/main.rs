@@ -166,7 +166,7 @@ fn trace(occ: &impl Occlusion, work: &[Work], rounds: usize) -> (u64, f64) {
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let mut bunny = Mesh::load(&root.join("testdata/meshes/bunny.ply")).unwrap();
-    add_ground_plane(&mut bunny);
+    add_ground_plane(&mut bunny).expect("the bunny has a ground plane");
     let cubes = Generator::Cubes {
         count: 10,
         cells: 10,

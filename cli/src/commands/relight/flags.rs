@@ -38,7 +38,9 @@ impl SceneFlags {
     pub fn load(&self) -> Result<Scene> {
         let mut scene = Scene::load(&self.input)?;
         if self.ground_plane {
-            scene.add_ground_plane();
+            scene
+                .add_ground_plane()
+                .map_err(|e| e.in_file(&self.input))?;
         }
         Ok(scene)
     }

@@ -28,6 +28,7 @@ fn object() -> Mesh {
         .mesh()
         .unwrap()
         .mapped(|p| [1.5 * p[0] + 0.3, p[1], 0.6 * p[2]], |n| n)
+        .unwrap()
 }
 
 fn written(dir: &Path) -> (OcclusionField, PathBuf) {
@@ -273,7 +274,7 @@ fn a_file_built_with_other_options_or_for_another_mesh_is_refused_naming_the_dif
         assert_eq!(reason, format!("with other options: {want}"));
     }
     // Another mesh: the same sphere moved by a hair, and another sphere.
-    let moved = mesh.mapped(|p| [p[0] + 1e-9, p[1], p[2]], |n| n);
+    let moved = mesh.mapped(|p| [p[0] + 1e-9, p[1], p[2]], |n| n).unwrap();
     let other = Generator::Sphere { cells: 2 }.mesh().unwrap();
     for m in [&moved, &other] {
         let reason = mismatch(OcclusionField::read_for(&path, m, &base), &path);

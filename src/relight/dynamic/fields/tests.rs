@@ -23,7 +23,9 @@ fn latlong(n: usize) -> Parameterization {
 /// A box off-centre, so that nothing about it is symmetric.
 fn object() -> Mesh {
     let mut m = Generator::Sphere { cells: 3 }.mesh().unwrap();
-    m = m.mapped(|p| [1.5 * p[0] + 0.3, p[1], 0.6 * p[2]], |n| n);
+    m = m
+        .mapped(|p| [1.5 * p[0] + 0.3, p[1], 0.6 * p[2]], |n| n)
+        .unwrap();
     m
 }
 
@@ -222,7 +224,7 @@ fn a_turned_field_is_the_field_of_the_turned_object() {
     let turned = field.turned(k).unwrap();
     let yaw =
         crate::sphere::SphereRotation::from_degrees(k as f64 * 360.0 / 16.0, 0.0, 0.0).unwrap();
-    let moved = mesh.mapped(|p| yaw.apply(p), |n| yaw.apply(n));
+    let moved = mesh.mapped(|p| yaw.apply(p), |n| yaw.apply(n)).unwrap();
     let points = field.sample_points();
     let (mut differ, mut occluded) = (0, 0);
     for i in [61, 60 + 54 + 7, 60 + 2 * 54 + 30] {
@@ -259,19 +261,51 @@ fn bad_options_are_refused() {
     let mesh = object();
     let mut o = small(param);
     o.shell_radii = (2.0, 1.0);
-    assert!(OcclusionField::build(&mesh, &o).is_err());
+    assert_err!(
+        OcclusionField::build(&mesh, &o),
+        InvalidParameter {
+            name: "shell radii",
+            ..
+        },
+        "increasing"
+    );
     o = small(param);
     o.circle_radii = (f64::NAN, 1.0);
-    assert!(OcclusionField::build(&mesh, &o).is_err());
+    assert_err!(
+        OcclusionField::build(&mesh, &o),
+        InvalidParameter {
+            name: "circle radii",
+            ..
+        },
+        "increasing"
+    );
     o = small(param);
     o.circles = 1;
-    assert!(OcclusionField::build(&mesh, &o).is_err());
+    assert_err!(
+        OcclusionField::build(&mesh, &o),
+        InvalidParameter {
+            name: "field samples",
+            ..
+        },
+        "at least 2 circles"
+    );
     o = small(param);
     o.circle_points = usize::MAX / 2;
-    assert!(OcclusionField::build(&mesh, &o).is_err());
+    assert_err!(
+        OcclusionField::build(&mesh, &o),
+        InvalidParameter {
+            name: "field samples",
+            ..
+        },
+        "4000000 sample points"
+    );
     o = small(param);
     o.keep = Selection::Largest(1000);
-    assert!(OcclusionField::build(&mesh, &o).is_err());
+    assert_err!(
+        OcclusionField::build(&mesh, &o),
+        InvalidParameter { name: "keep", .. },
+        "only 30 details"
+    );
     // No width or depth: no footprint to place the planar field by.
     let flat = Mesh::new(
         ndarray::array![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]],
@@ -279,10 +313,18 @@ fn bad_options_are_refused() {
         None,
     )
     .unwrap();
-    assert!(OcclusionField::build(&flat, &small(param)).is_err());
+    assert_err!(
+        OcclusionField::build(&flat, &small(param)),
+        InvalidParameter { name: "mesh", .. },
+        "width and depth"
+    );
     let cube = Parameterization::new(ParamKind::Cube, 4).unwrap();
     let (field, _) = OcclusionField::build(&mesh, &small(cube)).unwrap();
-    assert!(field.turned(1).is_err());
+    assert_err!(
+        field.turned(1),
+        InvalidParameter { name: "turn", .. },
+        "lat-long"
+    );
 }
 
 proptest! {

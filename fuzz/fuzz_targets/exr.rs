@@ -1,0 +1,7 @@
+#![no_main]
+//! The `exr` reader on arbitrary bytes; see `../harness.rs`.
+
+#[path = "../harness.rs"]
+mod harness;
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| harness::run("exr", data));

@@ -1,0 +1,119 @@
+//! What every fuzz target runs on one input, shared by the libFuzzer targets
+//! (`fuzz_targets/`) and the stable replay test (`tests/fuzz_corpus.rs` in the library), so
+//! that CI guards every corpus file and every crash without a nightly toolchain.
+//!
+//! Each reader takes a path, so the input is written to a file of the target's extension in
+//! a directory of its own and read back; any `Result` is fine, a panic is the finding.
+// Each fuzz target uses only `run`.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use haarshift::io::{CoefficientFile, read_image};
+use haarshift::relight::dynamic::fields::OcclusionField;
+use haarshift::relight::dynamic::motion::MotionPath;
+use haarshift::relight::light::environment::Environment;
+use haarshift::relight::material::merl::MerlBrdf;
+use haarshift::relight::scene::validate::check_ground_extent;
+use haarshift::relight::{Mesh, Scene, SceneCache, add_ground_plane};
+
+/// The fuzz targets: one per reader and validated structure.
+pub const TARGETS: [&str; 15] = [
+    "png",
+    "jpeg",
+    "tiff",
+    "exr",
+    "hdr",
+    "npy",
+    "coefficients",
+    "ply",
+    "obj",
+    "scene",
+    "motion",
+    "hsr",
+    "hsf",
+    "merl",
+    "envmap",
+];
+
+/// A fresh directory for one input.
+fn scratch() -> PathBuf {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("haarshift-fuzz-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes `bytes` to `dir/name` and returns the path.
+fn put(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+/// A mesh that was read goes on through the ground plane's validation and the BVH build, and
+/// one ray is traced.
+fn exercise(mesh: &Mesh) {
+    let mut grounded = mesh.clone();
+    if check_ground_extent(&grounded.bounds()).is_ok() {
+        let _ = add_ground_plane(&mut grounded);
+    }
+    let bvh = haarshift::relight::SceneBvh::new(&grounded);
+    use haarshift::relight::Occlusion;
+    let _ = bvh.occluded([0.0; 3], [0.0, 1.0, 0.0], f32::INFINITY);
+}
+
+/// Runs `target` on `bytes`: panics only if the code under test does.
+pub fn run(target: &str, bytes: &[u8]) {
+    let dir = scratch();
+    match target {
+        "png" | "jpeg" | "tiff" | "exr" | "hdr" | "npy" => {
+            let ext = match target {
+                "jpeg" => "jpg",
+                "tiff" => "tif",
+                other => other,
+            };
+            let _ = read_image::<f32>(put(&dir, &format!("in.{ext}"), bytes));
+        }
+        "coefficients" => {
+            // A valid 2 x 2 coefficient array; the input is its sidecar.
+            let array = dir.join("c.npy");
+            let coefficients = ndarray::array![[4.0f64, -1.0], [-2.0, 0.0]];
+            ndarray_npy::write_npy(&array, &coefficients).unwrap();
+            put(&dir, "c.npy.json", bytes);
+            let _ = CoefficientFile::read(&array);
+        }
+        "ply" | "obj" => {
+            if let Ok(mesh) = Mesh::load(&put(&dir, &format!("in.{target}"), bytes)) {
+                exercise(&mesh);
+            }
+        }
+        "scene" => {
+            if let Ok(scene) = Scene::load(&put(&dir, "in.json", bytes)) {
+                exercise(&scene.mesh);
+            }
+        }
+        "motion" => {
+            if let Ok(path) = MotionPath::load(&put(&dir, "in.json", bytes)) {
+                let _ = path.frame_count();
+            }
+        }
+        "hsr" => {
+            let _ = SceneCache::read(&put(&dir, "in.hsr", bytes));
+        }
+        "hsf" => {
+            let _ = OcclusionField::read(&put(&dir, "in.hsf", bytes));
+        }
+        "merl" => {
+            let _ = MerlBrdf::read(&put(&dir, "in.binary", bytes));
+        }
+        "envmap" => {
+            let _ = Environment::load(&put(&dir, "in.hdr", bytes));
+            let _ = Environment::load(&put(&dir, "in.npy", bytes));
+        }
+        other => panic!("no fuzz target {other}"),
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
