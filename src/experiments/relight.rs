@@ -47,12 +47,12 @@ use crate::experiments::plot::labelled_colour_tiles;
 use crate::metrics::{RelativeError, rms};
 use crate::product::Selection;
 use crate::relight::environment::Environment;
-use crate::relight::glossy::{GlossyOptions, GlossyShader};
+use crate::relight::shade::glossy::{GlossyOptions, GlossyShader};
 use crate::relight::orient::{BrdfRotation, mirror_directions};
 use crate::relight::raster::{
     Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
 };
-use crate::relight::reference::ReferenceVisibility;
+use crate::relight::shade::reference::ReferenceVisibility;
 use crate::relight::{
     Brdf, Lighting, PhongSh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, ShTransfer,
     ShadeOptions, TransportSet, VisibilityOptions, shade_sh, vertex_major,

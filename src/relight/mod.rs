@@ -11,18 +11,16 @@
 //! | [`visibility`] | the precomputation in two loop orders: [`vertex_major`], [`direction_major`] |
 //! | [`sparse`] | [`SparseRows`](sparse::SparseRows): many sparse Haar functions in flat arrays |
 //! | [`transport`] | [`TransportSet`]: every vertex's sparse Haar transport |
-//! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
+//! | [`harmonics`] | [`ShTransfer`]: seed 003's spherical-harmonic transfer |
 //! | [`fields`] | [`OcclusionField`](fields::OcclusionField): an object's occlusion seen from sample points around it (seed 001); on disk, the `.hsf` file ([`fields::file`]) |
 //! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other; [`Jrt`](dynamic::Jrt), just-in-time radiance transfer |
 //! | [`motion`] | [`MotionPath`](motion::MotionPath): animations of dynamic scenes, played with re-formed transfer |
-//! | [`mod@reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
 //! | [`cache`] | [`SceneCache`]: the versioned, checksummed `.hsr` file (its framing, `framed`, is shared with the `.hsf` field file) |
 //! | [`environment`] | the lighting: loaded, downsampled by solid-angle-weighted means, rotated |
 //! | [`lighting`] | [`Lighting`]: the environment's kept Haar coefficients, RGB, in Mallat order |
 //! | [`brdf`] | [`Brdf`]: Lambert, Phong, Blinn-Phong; local copies of a BRDF |
-//! | [`shade`](mod@shade) | per-vertex outgoing radiance: [`PreparedTransport`], one sparse dot per vertex |
+//! | [`shade`](mod@shade) | per-vertex outgoing radiance behind one [`Shader`](shade::Shader), built from a [`ShaderSpec`](shade::ShaderSpec): Lambertian Haar ([`PreparedTransport`]), glossy Haar with the rotation cache, spherical harmonics ([`shade_sh`], [`PhongSh`]), the ground truth by direct quadrature ([`reference()`]), ambient occlusion, dynamic scenes |
 //! | [`orient`] | bringing a BRDF into a vertex's frame: Haar, spatial, reference or direct |
-//! | [`glossy`] | glossy shading: the triple product with the rotated BRDF, the rotation cache |
 //! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
 //! | [`animation`] | frames into an animated GIF |
 //! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
@@ -43,7 +41,11 @@ pub mod error;
 pub mod fields;
 mod framed;
 pub mod gallery;
-pub mod glossy;
+/// Moved to [`shade::glossy`].
+#[deprecated(note = "moved to haarshift::relight::shade::glossy")]
+pub mod glossy {
+    pub use super::shade::glossy::*;
+}
 pub mod harmonics;
 pub mod lighting;
 pub mod memory;
@@ -53,7 +55,11 @@ pub mod orient;
 pub mod precompute;
 pub mod raster;
 pub mod raycast;
-pub mod reference;
+/// Moved to [`shade::reference`]; this path stays for one release (not marked deprecated:
+/// importing the function [`reference()`] by its name imports this module too).
+pub mod reference {
+    pub use super::shade::reference::*;
+}
 pub mod scene;
 pub mod shade;
 pub mod shadowmap;
@@ -64,11 +70,12 @@ pub mod visibility;
 pub use brdf::Brdf;
 pub use cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
 pub use error::SceneError;
-pub use harmonics::{PhongSh, ShTransfer, non_zonal_material, shade_sh, shade_sh_glossy};
+pub use harmonics::ShTransfer;
 pub use lighting::Lighting;
 pub use mesh::{Bounds, Mesh};
 pub use raycast::{Occlusion, SceneBvh};
-pub use reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
+pub use shade::harmonics::{PhongSh, non_zonal_material, shade_sh, shade_sh_glossy};
+pub use shade::reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,

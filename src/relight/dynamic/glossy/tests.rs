@@ -3,7 +3,7 @@ use super::super::tests::{
     relative, scene_file,
 };
 use super::*;
-use crate::relight::glossy::GlossyShader;
+use crate::relight::shade::glossy::GlossyShader;
 use crate::relight::orient::BrdfRotation;
 use crate::relight::shade::ShadeOptions;
 use crate::sphere::param::SphereMap;

@@ -408,7 +408,7 @@ fn bad_inputs_are_refused() {
 
 #[test]
 fn full_coefficients_and_direct_evaluation_equal_the_reference() {
-    use crate::relight::reference::{ReferenceOptions, reference};
+    use crate::relight::{ReferenceOptions, reference};
     use crate::relight::visibility::{VisibilityOptions, vertex_major};
     use crate::relight::{SceneBvh, add_ground_plane};
     use crate::sphere::LatLongMap;
