@@ -22,6 +22,7 @@
 //! | [`shade`](mod@shade) | per-vertex outgoing radiance behind one [`Shader`](shade::Shader), built from a [`ShaderSpec`](shade::ShaderSpec): Lambertian Haar ([`PreparedTransport`]), glossy Haar with the rotation cache, spherical harmonics ([`shade_sh`], [`PhongSh`]), the ground truth by direct quadrature ([`reference()`]), ambient occlusion, dynamic scenes |
 //! | [`orient`] | bringing a BRDF into a vertex's frame: Haar, spatial, reference or direct |
 //! | [`raster`] | the software rasteriser: camera, z-buffer, perspective-correct interpolation, sRGB |
+//! | [`view`] | [`ViewSpec`](view::ViewSpec): the camera resolved (asked for, the scene file's, the framing) and the frame drawn |
 //! | [`animation`] | frames into an animated GIF |
 //! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order |
 //! | [`memory`] | the process's peak resident memory, for reports |
@@ -65,6 +66,7 @@ pub mod shade;
 pub mod shadowmap;
 pub mod sparse;
 pub mod transport;
+pub mod view;
 pub mod visibility;
 
 pub use brdf::Brdf;

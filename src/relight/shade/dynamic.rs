@@ -11,7 +11,7 @@ use super::{FrameSpec, Preparation, Radiance, Shader, Shading, Timing, seconds};
 use crate::Result;
 use crate::named::named_enum;
 use crate::product::Selection;
-use crate::relight::Lighting;
+use crate::relight::{Brdf, Lighting};
 use crate::relight::dynamic::DynamicScene;
 use crate::relight::environment::Environment;
 use crate::sphere::SphereRotation;
@@ -89,7 +89,9 @@ impl<'a> DynamicShader<'a> {
 
 impl Shader for DynamicShader<'_> {
     fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
-        let (radiance, encode_seconds, shade_seconds, description) = match self.method {
+        let param = self.scene.param();
+        let (radiance, encode_seconds, shade_seconds, description, coefficients) = match self.method
+        {
             DynamicMethod::Haar => {
                 let start = Instant::now();
                 let lighting = Lighting::new(
@@ -101,12 +103,26 @@ impl Shader for DynamicShader<'_> {
                 let encode = seconds(start);
                 let start = Instant::now();
                 let radiance = Radiance::F32(self.scene.shade::<f32>(&lighting)?);
-                (radiance, encode, seconds(start), "n-function product integrals")
+                let coefficients = lighting.kept() + param.faces();
+                (
+                    radiance,
+                    encode,
+                    seconds(start),
+                    "n-function product integrals",
+                    coefficients,
+                )
             }
             DynamicMethod::Reference => {
                 let (radiance, encode, shade) =
                     Self::reference(self.scene, frame.environment, &frame.rotation)?;
-                (Radiance::F64(radiance), encode, shade, "ray-cast reference")
+                let n = param.face_size();
+                (
+                    Radiance::F64(radiance),
+                    encode,
+                    shade,
+                    "ray-cast reference",
+                    2 * n * n,
+                )
             }
         };
         Ok(Shading {
@@ -118,6 +134,7 @@ impl Shader for DynamicShader<'_> {
             },
             description: description.into(),
             maps: None,
+            light_coefficients: Some(coefficients),
         })
     }
 
@@ -164,6 +181,36 @@ impl DynamicMethod {
             },
             description: description.into(),
             maps: None,
+            light_coefficients: None,
         })
     }
+}
+
+/// The first glossy material of `scene`'s objects, else Lambert: the one a caller's glossy
+/// options (rotation method, cache, truncation) are checked against (any other glossy
+/// material is rotated alike).
+///
+/// ```
+/// use haarshift::relight::{Brdf, SceneFile};
+/// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+/// use haarshift::relight::shade::dynamic::glossy_material;
+/// use haarshift::sphere::param::{ParamKind, Parameterization};
+/// let file: SceneFile = serde_json::from_str(r#"{"objects": [
+///     {"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
+/// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
+/// (options.field.circles, options.field.circle_points) = (8, 16);
+/// (options.field.shells, options.field.shell_grid) = (4, 3);
+/// let mut scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+/// assert_eq!(glossy_material(&scene).unwrap(), Brdf::Lambert);
+/// scene.set_brdf(0, "phong:30".parse().unwrap()).unwrap();
+/// assert_eq!(glossy_material(&scene).unwrap().to_string(), "phong:30");
+/// ```
+pub fn glossy_material(scene: &DynamicScene) -> Result<Brdf> {
+    for k in 0..scene.object_count() {
+        let brdf = scene.brdf(k)?;
+        if !brdf.is_lambert() {
+            return Ok(brdf.clone());
+        }
+    }
+    Ok(Brdf::Lambert)
 }

@@ -94,6 +94,10 @@ pub struct Shading {
     pub description: String,
     /// A glossy Haar shader's BRDF maps: how many the vertices used and how many were rotated.
     pub maps: Option<glossy::GlossyReport>,
+    /// Coefficients of the lighting used: Haar the kept details and each face's scaling
+    /// coefficient, spherical harmonics `B^2`, the reference its texels.
+    /// `None` where the frame's lighting was encoded elsewhere (a played animation frame).
+    pub light_coefficients: Option<usize>,
 }
 
 /// Per-vertex radiance `(V, 3)` in the precision it was computed in.

@@ -72,6 +72,7 @@ impl Shader for AmbientShader {
                 self.prepare_seconds * 1e3
             ),
             maps: None,
+            light_coefficients: Some(self.white.param().faces()),
         })
     }
 

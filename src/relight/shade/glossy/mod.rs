@@ -758,6 +758,7 @@ where
             },
             description,
             maps: Some(report),
+            light_coefficients: Some(lighting.kept() + lighting.param().faces()),
         })
     }
 

@@ -415,6 +415,7 @@ impl Shader for ShShader {
                 bands * bands
             ),
             maps: None,
+            light_coefficients: Some(bands * bands),
         })
     }
 

@@ -446,6 +446,7 @@ where
                 self.prepare_seconds * 1e3
             ),
             maps: None,
+            light_coefficients: Some(lighting.kept() + lighting.param().faces()),
         })
     }
 

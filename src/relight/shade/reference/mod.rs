@@ -462,6 +462,7 @@ impl Shader for ReferenceShader {
                 report.seconds
             ),
             maps: None,
+            light_coefficients: Some(2 * self.resolution * self.resolution),
         })
     }
 
