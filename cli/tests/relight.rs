@@ -981,7 +981,10 @@ fn render_selects_the_reference_and_ambient_occlusion_by_name() {
         (read_vertices(&npy), stdout)
     };
     let (quadrature, stdout) = render("reference", &[]);
-    assert!(stdout.contains("by quadrature over 8 x 16 texels"), "{stdout}");
+    assert!(
+        stdout.contains("by quadrature over 8 x 16 texels"),
+        "{stdout}"
+    );
     let truth = dir.path().join("truth.npy");
     succeeds(&[
         "relight",

@@ -135,7 +135,10 @@ fn lighting(
 }
 
 /// Radiance as numpy, in the precision it was computed in.
-fn radiance_array(py: Python<'_>, radiance: haarshift::relight::shade::Radiance) -> Bound<'_, PyAny> {
+fn radiance_array(
+    py: Python<'_>,
+    radiance: haarshift::relight::shade::Radiance,
+) -> Bound<'_, PyAny> {
     use haarshift::relight::shade::Radiance;
     match radiance {
         Radiance::F32(r) => r.into_pyarray(py).into_any(),
@@ -401,7 +404,10 @@ impl Shader {
         if let Some(e) = eye
             && !e.iter().all(|x| x.is_finite())
         {
-            return Err(bad_argument("eye", format!("{e:?} is not a finite position")));
+            return Err(bad_argument(
+                "eye",
+                format!("{e:?} is not a finite position"),
+            ));
         }
         let given = env.map(environment).transpose()?;
         let light = LightSpec {
@@ -428,9 +434,18 @@ impl Shader {
             .or_raise()?;
         let mut report: HashMap<String, Py<PyAny>> = HashMap::new();
         let t = shading.timing;
-        report.insert("encode_seconds".into(), t.encode_seconds.into_pyobject(py)?.into_any().unbind());
-        report.insert("rotate_seconds".into(), t.rotate_seconds.into_pyobject(py)?.into_any().unbind());
-        report.insert("shade_seconds".into(), t.shade_seconds.into_pyobject(py)?.into_any().unbind());
+        report.insert(
+            "encode_seconds".into(),
+            t.encode_seconds.into_pyobject(py)?.into_any().unbind(),
+        );
+        report.insert(
+            "rotate_seconds".into(),
+            t.rotate_seconds.into_pyobject(py)?.into_any().unbind(),
+        );
+        report.insert(
+            "shade_seconds".into(),
+            t.shade_seconds.into_pyobject(py)?.into_any().unbind(),
+        );
         report.insert(
             "description".into(),
             shading.description.into_pyobject(py)?.into_any().unbind(),

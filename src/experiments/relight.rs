@@ -48,12 +48,11 @@ use crate::metrics::{RelativeError, rms};
 use crate::product::Selection;
 use crate::relight::environment::Environment;
 use crate::relight::orient::BrdfRotation;
+use crate::relight::raster::{Background, Camera, Mesh as RasterMesh, render, to_srgb8};
 use crate::relight::shade::glossy::GlossyOptions;
-use crate::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
-use crate::relight::raster::{
-    Background, Camera, DEFAULT_FOV, Mesh as RasterMesh, render, to_srgb8,
-};
 use crate::relight::shade::reference::ReferenceVisibility;
+use crate::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
+use crate::relight::view::ViewSpec;
 use crate::relight::{
     Brdf, ReferenceOptions, Scene, SceneBvh, ShadeOptions, TransportSet, VisibilityOptions,
     vertex_major,
@@ -511,13 +510,7 @@ impl<'a> Bench<'a> {
     fn new(subject: &'a Subject, protocol: &'a RelightProtocol) -> Result<Self> {
         let scene = &subject.scene;
         let bvh = SceneBvh::new(&scene.mesh);
-        let first = match &scene.camera {
-            Some(spec) => Camera::new(spec.position, spec.look_at, spec.fov)?,
-            None => {
-                let b = scene.mesh.bounds();
-                Camera::framing(b.min, b.max, DEFAULT_FOV)?
-            }
-        };
+        let first = ViewSpec::default().camera(scene.camera.as_ref(), &scene.mesh)?;
         let cameras = [first, first.orbited(SECOND_CAMERA)?];
         let truth_bits =
             ReferenceVisibility::new(&scene.mesh, &bvh, protocol.truth_resolution, true)?;

@@ -15,7 +15,6 @@
 //! Shading with it (Lambertian [`shade_sh`] and the glossy baseline [`PhongSh`]) is a stage of
 //! its own: [`shade::harmonics`](super::shade::harmonics).
 
-
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 

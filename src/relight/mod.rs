@@ -76,12 +76,12 @@ pub use harmonics::ShTransfer;
 pub use lighting::Lighting;
 pub use mesh::{Bounds, Mesh};
 pub use raycast::{Occlusion, SceneBvh};
-pub use shade::harmonics::{PhongSh, non_zonal_material, shade_sh, shade_sh_glossy};
-pub use shade::reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,
 };
+pub use shade::harmonics::{PhongSh, non_zonal_material, shade_sh, shade_sh_glossy};
+pub use shade::reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
 pub use shade::{PreparedTransport, ShadeOptions, shade};
 pub use shadowmap::ShadowMap;
 pub use transport::TransportSet;

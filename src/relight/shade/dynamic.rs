@@ -11,9 +11,9 @@ use super::{FrameSpec, Preparation, Radiance, Shader, Shading, Timing, seconds};
 use crate::Result;
 use crate::named::named_enum;
 use crate::product::Selection;
-use crate::relight::{Brdf, Lighting};
 use crate::relight::dynamic::DynamicScene;
 use crate::relight::environment::Environment;
+use crate::relight::{Brdf, Lighting};
 use crate::sphere::SphereRotation;
 
 named_enum! {
@@ -160,12 +160,7 @@ impl DynamicMethod {
         rotation: &SphereRotation,
     ) -> Result<Shading> {
         let (radiance, encode_seconds, shade_seconds, description) = match self {
-            DynamicMethod::Haar => (
-                Radiance::F32(played.clone()),
-                0.0,
-                shade_seconds,
-                "shading",
-            ),
+            DynamicMethod::Haar => (Radiance::F32(played.clone()), 0.0, shade_seconds, "shading"),
             DynamicMethod::Reference => {
                 let (radiance, encode, shade) =
                     DynamicShader::reference(scene, environment, rotation)?;

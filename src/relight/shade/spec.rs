@@ -5,12 +5,12 @@ use std::path::Path;
 
 use ndarray::ArrayView2;
 
+use super::Shader;
 use super::ambient::AmbientShader;
 use super::glossy::{GlossyHaarShader, GlossyOptions};
 use super::harmonics::ShShader;
 use super::lambert::{LambertShader, ShadeOptions};
 use super::reference::ReferenceShader;
-use super::Shader;
 use crate::named::named_enum;
 use crate::product::Selection;
 use crate::relight::brdf::DEFAULT_ELEVATIONS;

@@ -75,7 +75,10 @@ fn every_shader_returns_what_its_numeric_code_returns_bit_for_bit() {
         .unwrap()
         .shade(&lighting)
         .unwrap();
-    assert_eq!(shade_with(&spec, &scene, &set).radiance, Radiance::F32(want));
+    assert_eq!(
+        shade_with(&spec, &scene, &set).radiance,
+        Radiance::F32(want)
+    );
     let f64_spec = ShaderSpec {
         precision: Precision::F64,
         ..spec.clone()
@@ -84,7 +87,10 @@ fn every_shader_returns_what_its_numeric_code_returns_bit_for_bit() {
         .unwrap()
         .shade(&lighting)
         .unwrap();
-    assert_eq!(shade_with(&f64_spec, &scene, &set).radiance, Radiance::F64(want));
+    assert_eq!(
+        shade_with(&f64_spec, &scene, &set).radiance,
+        Radiance::F64(want)
+    );
 
     // Glossy Haar with a rotation cache.
     let material = GlossyOptions {
@@ -108,7 +114,10 @@ fn every_shader_returns_what_its_numeric_code_returns_bit_for_bit() {
     let (want, report) = shader.shade(&lighting, EYE).unwrap();
     let got = shade_with(&glossy, &scene, &set);
     assert_eq!(got.radiance, Radiance::F32(want));
-    assert_eq!(got.maps.map(|m| (m.maps, m.rotated)), Some((report.maps, report.rotated)));
+    assert_eq!(
+        got.maps.map(|m| (m.maps, m.rotated)),
+        Some((report.maps, report.rotated))
+    );
 
     // Spherical harmonics, Lambert and Phong.
     let transfer = set.sh().unwrap();
@@ -133,7 +142,10 @@ fn every_shader_returns_what_its_numeric_code_returns_bit_for_bit() {
         .unwrap()
         .shade(transfer, albedo, sh_light.view(), mirror.view(), objects)
         .unwrap();
-    assert_eq!(shade_with(&phong, &scene, &set).radiance, Radiance::F64(want));
+    assert_eq!(
+        shade_with(&phong, &scene, &set).radiance,
+        Radiance::F64(want)
+    );
 
     // The reference at the transport's resolution.
     let truth = ShaderSpec {
@@ -151,7 +163,10 @@ fn every_shader_returns_what_its_numeric_code_returns_bit_for_bit() {
         },
     )
     .unwrap();
-    assert_eq!(shade_with(&truth, &scene, &set).radiance, Radiance::F64(want));
+    assert_eq!(
+        shade_with(&truth, &scene, &set).radiance,
+        Radiance::F64(want)
+    );
 }
 
 #[test]
@@ -330,13 +345,28 @@ fn no_caller_dispatches_on_the_shading_method() {
         let text = std::fs::read_to_string(file).unwrap();
         for (n, line) in text.lines().enumerate() {
             if let Some(what) = dispatch(line) {
-                found.push(format!("{}:{}: {what}: {}", file.display(), n + 1, line.trim()));
+                found.push(format!(
+                    "{}:{}: {what}: {}",
+                    file.display(),
+                    n + 1,
+                    line.trim()
+                ));
             }
         }
     }
-    assert!(found.is_empty(), "dispatch outside relight::shade:\n{}", found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "dispatch outside relight::shade:\n{}",
+        found.join("\n")
+    );
     // The search finds what it looks for.
-    assert_eq!(dispatch("    Method::Sh => shade(),").as_deref(), Some("Method::Sh"));
-    assert_eq!(dispatch("if brdf.is_lambert() {").as_deref(), Some(".is_lambert()"));
+    assert_eq!(
+        dispatch("    Method::Sh => shade(),").as_deref(),
+        Some("Method::Sh")
+    );
+    assert_eq!(
+        dispatch("if brdf.is_lambert() {").as_deref(),
+        Some(".is_lambert()")
+    );
     assert_eq!(dispatch("let s = spec(Method::Haar);"), None);
 }

@@ -10,8 +10,7 @@ use haarshift::relight::shade::{FrameSpec, Method, ShadingInput};
 use haarshift::{Error, Result};
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs,
-    rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 

@@ -87,11 +87,13 @@ pub fn run(args: Args) -> Result<()> {
         ..ShaderSpec::default()
     };
     spec.material.brdf = brdf;
-    let shading = spec.build(&ShadingInput::scene(&scene))?.shade(&FrameSpec {
-        environment: &env,
-        rotation,
-        eye: Some(camera.position()),
-    })?;
+    let shading = spec
+        .build(&ShadingInput::scene(&scene))?
+        .shade(&FrameSpec {
+            environment: &env,
+            rotation,
+            eye: Some(camera.position()),
+        })?;
     let radiance = shading.radiance.to_f32();
     haarshift::io::write_npy(
         radiance.view(),

@@ -10,8 +10,7 @@ use haarshift::relight::shade::{FrameSpec, Method, ShadingInput};
 use haarshift::{Result, SampleDepth};
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs,
-    rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
 };
 use crate::commands::{choice, names, print, refuse_existing};
 

@@ -327,11 +327,12 @@ pub fn run(args: Args) -> Result<()> {
     match &path {
         None => {
             let turn = rotation(angles)?;
-            let shading = DynamicShader::new(&scene, args.method, keep_light).shade(&FrameSpec {
-                environment: &env,
-                rotation: turn,
-                eye: None,
-            })?;
+            let shading =
+                DynamicShader::new(&scene, args.method, keep_light).shade(&FrameSpec {
+                    environment: &env,
+                    rotation: turn,
+                    eye: None,
+                })?;
             let radiance = shading.radiance.to_f32();
             let what = format!(
                 "{}: {} {:.1} ms",

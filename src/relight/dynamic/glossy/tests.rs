@@ -3,9 +3,9 @@ use super::super::tests::{
     relative, scene_file,
 };
 use super::*;
-use crate::relight::shade::glossy::GlossyShader;
 use crate::relight::orient::BrdfRotation;
 use crate::relight::shade::ShadeOptions;
+use crate::relight::shade::glossy::GlossyShader;
 use crate::sphere::param::SphereMap;
 
 const CAMERA: &str = r#""camera": {"position": [1.5, 2.5, 4.0], "look_at": [0, 0, 0]}"#;

@@ -13,8 +13,8 @@ use std::time::Instant;
 use ndarray::Array2;
 
 use super::{
-    FrameSpec, Preparation, PreparedTransport, Radiance, Shader, ShaderSpec, Shading,
-    ShadingInput, Timing, seconds,
+    FrameSpec, Preparation, PreparedTransport, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
+    Timing, seconds,
 };
 use crate::product::Selection;
 use crate::relight::Lighting;

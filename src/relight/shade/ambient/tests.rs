@@ -109,8 +109,8 @@ fn an_open_upward_vertex_reflects_its_albedo() {
     )
     .unwrap();
     let param = Parameterization::new(ParamKind::LatLong, 32).unwrap();
-    let (set, _) = vertex_major(&mesh, &SceneBvh::new(&mesh), &VisibilityOptions::new(param))
-        .unwrap();
+    let (set, _) =
+        vertex_major(&mesh, &SceneBvh::new(&mesh), &VisibilityOptions::new(param)).unwrap();
     let albedo = Array2::from_shape_fn((3, 3), |(_, c)| [0.25f32, 0.5, 0.75][c]);
     let spec = ShaderSpec {
         method: Method::Ambient,
@@ -132,7 +132,11 @@ fn an_open_upward_vertex_reflects_its_albedo() {
         for c in 0..3 {
             let a = f64::from(albedo[[v, c]]);
             // The lat-long midpoint quadrature of the cosine at N = 32: within 1.5e-3.
-            assert!((r[[v, c]] / a - 1.0).abs() < 1.5e-3, "{v} {c}: {}", r[[v, c]]);
+            assert!(
+                (r[[v, c]] / a - 1.0).abs() < 1.5e-3,
+                "{v} {c}: {}",
+                r[[v, c]]
+            );
         }
     }
 }

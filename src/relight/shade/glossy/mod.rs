@@ -45,20 +45,20 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
+use super::lambert::{PreparedTransport, ShadeOptions, select_kept, within_depth};
+use super::{
+    Filled, FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading,
+    ShadingInput, Timing, seconds,
+};
+use crate::product::Selection;
 use crate::relight::Mesh;
 use crate::relight::brdf::Brdf;
 use crate::relight::lighting::Lighting;
 use crate::relight::orient::{BrdfRotation, Frame, Orientation, to_pole, unit};
-use super::lambert::{PreparedTransport, ShadeOptions, select_kept, within_depth};
 use crate::relight::transport::TransportSet;
-use crate::product::Selection;
 use crate::sphere::latlong::{angles, direction};
 use crate::sphere::param::Parameterization;
 use crate::transform::{Normalization, pyramid};
-use super::{
-    FrameSpec, Filled, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
-    Timing, seconds,
-};
 use crate::{Error, Result, Sample};
 
 /// The most bins per axis of the rotation cache (`N x 2N` bins).

@@ -42,7 +42,9 @@ use rayon::prelude::*;
 
 use std::time::Instant;
 
-use super::{FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds};
+use super::{
+    FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds,
+};
 use crate::relight::harmonics::{ShTransfer, check_bands};
 use crate::relight::orient::mirror_directions;
 use crate::relight::{Brdf, Mesh};

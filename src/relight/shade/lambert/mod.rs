@@ -38,18 +38,18 @@
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use crate::relight::brdf::check_albedo;
-use crate::relight::lighting::Lighting;
-use crate::relight::transport::TransportSet;
+use super::{
+    FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
+    Timing, seconds,
+};
 use crate::product::Selection;
 use crate::product::selection::{Candidate, keep_largest};
 use crate::product::tree::mallat_detail;
+use crate::relight::brdf::check_albedo;
+use crate::relight::lighting::Lighting;
+use crate::relight::transport::TransportSet;
 use crate::sphere::Parameterization;
 use crate::sphere::integrate::layout;
-use super::{
-    FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing,
-    seconds,
-};
 use crate::{Error, Result, Sample};
 
 /// Coefficients summed in the working precision before the sum is added in f64.

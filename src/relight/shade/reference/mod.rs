@@ -32,14 +32,16 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2, Axis};
 use rayon::prelude::*;
 
+use super::{
+    FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds,
+};
+use crate::relight::SceneBvh;
 use crate::relight::mesh::dot;
 use crate::relight::raycast::Occlusion;
 use crate::relight::visibility::{f32x3, origin_and_normal, progress_bar, ray_offset};
 use crate::relight::{Brdf, Mesh};
 use crate::sphere::LatLongMap;
 use crate::sphere::latlong::{direction, pixel_centre, pixel_solid_angle};
-use super::{FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds};
-use crate::relight::SceneBvh;
 use crate::{Error, Result};
 
 /// How to compute the reference.
@@ -432,7 +434,9 @@ impl ReferenceShader {
 impl Shader for ReferenceShader {
     fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
         let start = Instant::now();
-        let lighting = frame.environment.lat_long(self.resolution, &frame.rotation)?;
+        let lighting = frame
+            .environment
+            .lat_long(self.resolution, &frame.rotation)?;
         let encode_seconds = seconds(start);
         let options = ReferenceOptions {
             eye: frame.eye,
