@@ -17,7 +17,7 @@ use haarshift::relight::shade::{
 use haarshift::relight::view::ViewSpec;
 use haarshift::relight::{Brdf, EnvironmentSpec, Scene, SceneCache, VisibilityOptions};
 use haarshift::sphere::{LatLongMap, ParamKind, Parameterization, SphereRotation};
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 
 use crate::arrays::ArrayArg;
@@ -305,7 +305,8 @@ fn precompute(
 /// command line's flags of the same names.
 #[pyclass(module = "haarshift.relight")]
 pub struct Shader {
-    shader: Box<dyn LibraryShader>,
+    /// Locked only to be shared with Python's threads: each call has it to itself.
+    shader: std::sync::Mutex<Box<dyn LibraryShader>>,
     mesh: haarshift::relight::Mesh,
     environment: Option<EnvironmentSpec>,
     camera: Option<haarshift::relight::CameraSpec>,
@@ -379,7 +380,7 @@ impl Shader {
             })
             .or_raise()?;
         Ok(Shader {
-            shader,
+            shader: std::sync::Mutex::new(shader),
             mesh: source.mesh.clone(),
             environment: source.environment.clone(),
             camera: source.camera.clone(),
@@ -416,7 +417,10 @@ impl Shader {
             pitch,
             roll,
         };
-        let shader = &mut self.shader;
+        let shader = self
+            .shader
+            .get_mut()
+            .map_err(|_| bad_argument("shader", "a previous call panicked"))?;
         let (mesh, file, camera) = (&self.mesh, self.environment.as_ref(), self.camera.as_ref());
         let shading = py
             .detach(|| -> haarshift::Result<_> {

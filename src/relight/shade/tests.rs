@@ -280,7 +280,9 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
         let path = entry.unwrap().path();
         if path.is_dir() {
             sources(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
+        } else if path.extension().is_some_and(|e| e == "rs")
+            && path.file_name().is_some_and(|n| n != "tests.rs")
+        {
             out.push(path);
         }
     }
@@ -334,6 +336,8 @@ fn dispatch(line: &str) -> Option<String> {
 fn no_caller_dispatches_on_the_shading_method() {
     // The command line, the Python bindings and the experiments build a ShaderSpec (or a
     // DynamicShader of a DynamicMethod) and loop; only this module chooses between methods.
+    // Test files (tests.rs), which check the shaders against their numeric code, are not
+    // searched.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     for dir in ["cli/src", "python/src", "src/experiments"] {

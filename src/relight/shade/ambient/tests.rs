@@ -36,7 +36,7 @@ fn ambient(scene: &Scene, set: &crate::relight::TransportSet) -> Box<dyn Shader>
     spec.build(&input).unwrap()
 }
 
-fn map(n: usize, f: impl Fn([f64; 3]) -> f64) -> LatLongMap<f64> {
+fn map(n: usize, f: impl Fn([f64; 3]) -> f64 + Sync) -> LatLongMap<f64> {
     LatLongMap::from_fn(n, 1, |d, o| o[0] = f(d)).unwrap()
 }
 
