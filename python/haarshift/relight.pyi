@@ -1,5 +1,5 @@
 import os
-from typing import Literal, Optional, Union
+from typing import Dict, Literal, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -23,3 +23,74 @@ def scene(
     shell_grid: int = 9,
 ) -> np.ndarray:
     """Every vertex's outgoing radiance (V, 3) of the scene file as placed."""
+
+class Cache:
+    """A precomputed scene: mesh, albedo and every vertex's transport (an `.hsr` file)."""
+
+    @staticmethod
+    def read(path: Union[str, "os.PathLike[str]"]) -> "Cache": ...
+    def write(self, path: Union[str, "os.PathLike[str]"], *, force: bool = False) -> int: ...
+    @property
+    def vertex_count(self) -> int: ...
+    @property
+    def object_vertices(self) -> int: ...
+    @property
+    def positions(self) -> np.ndarray: ...
+    @property
+    def normals(self) -> np.ndarray: ...
+    @property
+    def triangles(self) -> np.ndarray: ...
+    @property
+    def albedo(self) -> np.ndarray: ...
+    @property
+    def param(self) -> Tuple[str, int]: ...
+    @property
+    def sh_bands(self) -> Optional[int]: ...
+
+def precompute(
+    scene: Union[str, "os.PathLike[str]"],
+    *,
+    param: Literal["latlong", "cube"] = "latlong",
+    resolution: int = 32,
+    ground_plane: bool = False,
+    keep_visibility: Optional[int] = None,
+    samples: int = 1,
+    seed: int = 0,
+    order: Literal["vertex", "direction"] = "vertex",
+    sh_bands: Optional[int] = None,
+    output: Union[str, "os.PathLike[str]", None] = None,
+    force: bool = False,
+) -> Cache:
+    """Precomputes a mesh or scene file as `haarshift relight precompute` does."""
+
+class Shader:
+    """Per-vertex shading of a cache, built once from `relight render`'s options."""
+
+    def __init__(
+        self,
+        cache: Cache,
+        *,
+        basis: Literal["haar", "sh", "reference", "ambient"] = "haar",
+        brdf: str = "lambert",
+        albedo: Optional[Tuple[float, float, float]] = None,
+        keep_light: Optional[int] = None,
+        keep_visibility: Optional[int] = None,
+        depth: Optional[int] = None,
+        brdf_rotation: str = "haar",
+        level: Optional[int] = None,
+        keep_brdf: Optional[int] = None,
+        brdf_levels: Optional[int] = None,
+        rotation_cache: Optional[int] = None,
+        elevations: int = ...,
+        fill_cache: bool = False,
+    ) -> None: ...
+    def shade(
+        self,
+        env: Union[str, "os.PathLike[str]", npt.ArrayLike, None] = None,
+        *,
+        yaw: Optional[float] = None,
+        pitch: Optional[float] = None,
+        roll: Optional[float] = None,
+        eye: Optional[Tuple[float, float, float]] = None,
+    ) -> Tuple[np.ndarray, Dict[str, Union[float, str]]]:
+        """Every vertex's outgoing radiance (V, 3) and the timing report."""

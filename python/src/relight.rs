@@ -1,15 +1,24 @@
-//! `haarshift.relight`: a dynamic scene file relit per vertex, as `haarshift relight scene`
-//! relights it.
+//! `haarshift.relight`: scenes precomputed into caches and shaded per vertex as
+//! `haarshift relight precompute` and `relight render` do it, and dynamic scene files relit as
+//! `relight scene` relights them. Every shading goes through the library's one `Shader`.
 
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
-use haarshift::relight::Lighting;
-use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions, DynamicScene};
 use haarshift::relight::light::environment::Environment;
+use haarshift::relight::precompute::{Order, PrecomputeOptions};
+use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader};
+use haarshift::relight::shade::glossy::GlossyOptions;
+use haarshift::relight::shade::{
+    FrameSpec, LightSpec, Method, ShadeOptions, Shader as LibraryShader, ShaderSpec, ShadingInput,
+};
+use haarshift::relight::{Brdf, EnvironmentSpec, Scene, SceneCache, VisibilityOptions};
+use haarshift::render::view::ViewSpec;
 use haarshift::sphere::{LatLongMap, SphereRotation};
-use numpy::IntoPyArray;
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 
 use crate::arrays::ArrayArg;
@@ -78,67 +87,387 @@ fn scene<'py>(
     shells: usize,
     shell_grid: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let reference = match method {
-        "haar" => false,
-        "reference" => true,
-        other => {
-            return Err(bad_argument(
-                "method",
-                format!("unknown value {other:?} (expected one of: haar, reference)"),
-            ));
-        }
-    };
+    let method = parse::<DynamicMethod>(method)?;
     let param = Parameterization::new(parse::<ParamKind>(param)?, resolution).or_raise()?;
-    let largest = |k: Option<usize>| k.map_or(Selection::All, Selection::Largest);
-    let mut options = DynamicOptions::new(param);
-    options.keep_visibility = largest(keep_visibility);
-    options.field.keep = largest(keep_field);
-    options.field.circles = circles;
-    options.field.circle_points = circle_points;
-    options.field.shells = shells;
-    options.field.shell_grid = shell_grid;
+    let options = DynamicOptions::from_budgets(&DynamicBudgets {
+        keep_visibility,
+        keep_field,
+        circles,
+        circle_points,
+        shells,
+        shell_grid,
+        ..DynamicBudgets::new(param)
+    });
     let given = env.map(environment).transpose()?;
-    let radiance = py.detach(|| -> haarshift::Result<_> {
+    let light = LightSpec {
+        env: None,
+        yaw,
+        pitch,
+        roll,
+    };
+    let keep_light = keep_light.map_or(Selection::All, Selection::Largest);
+    let shading = py.detach(|| -> haarshift::Result<_> {
         let built = DynamicScene::load(&scene, &options)?;
-        let file = built.environment.as_ref();
-        let env = match (given, file) {
-            (Some(env), _) => env,
-            (None, Some(spec)) => Environment::load(&spec.path)?,
-            (None, None) => {
-                return Err(haarshift::Error::InvalidParameter {
-                    name: "env",
-                    reason: "give env= (the scene names no environment)".into(),
-                });
-            }
-        };
-        let in_file = file.map_or([0.0; 3], |s| [s.yaw, s.pitch, s.roll]);
-        let turn = SphereRotation::from_degrees(
-            yaw.unwrap_or(in_file[0]),
-            pitch.unwrap_or(in_file[1]),
-            roll.unwrap_or(in_file[2]),
-        )?;
-        Ok(if reference {
-            Radiance::Truth(built.reference(&env.lat_long(param.face_size(), &turn)?)?)
-        } else {
-            let lighting = Lighting::new(&env, param, &turn, largest(keep_light))?;
-            Radiance::Haar(built.shade::<f32>(&lighting)?)
+        let (env, angles) = lighting(&light, given, built.environment.as_ref())?;
+        DynamicShader::new(&built, method, keep_light).shade(&FrameSpec {
+            environment: &env,
+            rotation: SphereRotation::from_degrees(angles[0], angles[1], angles[2])?,
+            eye: None,
         })
     });
-    Ok(match radiance.or_raise()? {
-        Radiance::Haar(haar) => haar.into_pyarray(py).into_any(),
-        Radiance::Truth(truth) => truth.into_pyarray(py).into_any(),
+    Ok(radiance_array(py, shading.or_raise()?.radiance))
+}
+
+/// The lighting of a frame: `given` (an array or a file read), else the scene file's, with the
+/// angles of `light` resolved against the file's.
+fn lighting(
+    light: &LightSpec,
+    given: Option<Environment>,
+    file: Option<&EnvironmentSpec>,
+) -> haarshift::Result<(Environment, [f64; 3])> {
+    match given {
+        Some(env) => Ok((env, light.angles(file))),
+        None if file.is_none() => Err(haarshift::Error::InvalidParameter {
+            name: "env",
+            reason: "give env= (the scene names no environment)".into(),
+        }),
+        None => light.load(file),
+    }
+}
+
+/// Radiance as numpy, in the precision it was computed in.
+fn radiance_array(
+    py: Python<'_>,
+    radiance: haarshift::relight::shade::Radiance,
+) -> Bound<'_, PyAny> {
+    use haarshift::relight::shade::Radiance;
+    match radiance {
+        Radiance::F32(r) => r.into_pyarray(py).into_any(),
+        Radiance::F64(r) => r.into_pyarray(py).into_any(),
+    }
+}
+
+/// A precomputed scene: its mesh, albedo and every vertex's transport, as the `.hsr` file
+/// `haarshift relight precompute` writes holds it.
+///
+/// >>> import json, os, tempfile, numpy as np, haarshift
+/// >>> d = tempfile.mkdtemp(); path = os.path.join(d, "ball.json")
+/// >>> with open(path, "w") as f:
+/// ...     json.dump({"objects": [{"generator": {"sphere": {"cells": 2}}}]}, f)
+/// >>> cache = haarshift.relight.precompute(path, resolution=8, output=os.path.join(d, "ball.hsr"))
+/// >>> cache.vertex_count, cache.positions.shape, cache.triangles.dtype
+/// (54, (54, 3), dtype('uint32'))
+/// >>> again = haarshift.relight.Cache.read(os.path.join(d, "ball.hsr"))
+/// >>> bool(np.array_equal(again.albedo, cache.albedo))
+/// True
+#[pyclass(module = "haarshift.relight", frozen)]
+pub struct Cache {
+    cache: SceneCache,
+    path: Option<PathBuf>,
+}
+
+#[pymethods]
+impl Cache {
+    /// Reads a cache file (`.hsr`), refusing a damaged one or another format version.
+    #[staticmethod]
+    fn read(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let cache = py.detach(|| SceneCache::read(&path)).or_raise()?;
+        Ok(Cache {
+            cache,
+            path: Some(path),
+        })
+    }
+
+    /// Writes the cache to `path` (atomically; an existing file only with `force=True`);
+    /// returns the bytes written.
+    #[pyo3(signature = (path, *, force = false))]
+    fn write(&self, py: Python<'_>, path: PathBuf, force: bool) -> PyResult<u64> {
+        py.detach(|| self.cache.write(&path, force)).or_raise()
+    }
+
+    /// The number of vertices, the ground plane's (if any) last.
+    #[getter]
+    fn vertex_count(&self) -> usize {
+        self.cache.mesh.vertex_count()
+    }
+
+    /// The vertices of the objects (those before the ground plane's).
+    #[getter]
+    fn object_vertices(&self) -> usize {
+        self.cache.object_vertices()
+    }
+
+    /// Vertex positions, (V, 3) float64.
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.cache.mesh.positions().to_owned().into_pyarray(py)
+    }
+
+    /// Unit vertex normals, (V, 3) float64.
+    #[getter]
+    fn normals<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.cache.mesh.normals().to_owned().into_pyarray(py)
+    }
+
+    /// Triangles as vertex indices, (T, 3) uint32.
+    #[getter]
+    fn triangles<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<u32>> {
+        let t = self.cache.mesh.triangles();
+        ndarray::Array2::from_shape_fn((t.len(), 3), |(i, k)| t[i][k]).into_pyarray(py)
+    }
+
+    /// RGB albedo per vertex, (V, 3) float32.
+    #[getter]
+    fn albedo<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f32>> {
+        self.cache.albedo.clone().into_pyarray(py)
+    }
+
+    /// The parameterisation (`"latlong"` or `"cube"`) and its face size.
+    #[getter]
+    fn param(&self) -> (String, usize) {
+        let p = self.cache.transport.param();
+        (p.kind().to_string(), p.face_size())
+    }
+
+    /// Spherical-harmonic bands stored beside the Haar transport (None: none).
+    #[getter]
+    fn sh_bands(&self) -> Option<usize> {
+        self.cache.transport.sh().map(|t| t.bands())
+    }
+
+    fn __repr__(&self) -> String {
+        let (kind, n) = self.param();
+        format!(
+            "Cache({} vertices, {kind} {n}{})",
+            self.vertex_count(),
+            self.path
+                .as_ref()
+                .map_or(String::new(), |p| format!(", {}", p.display()))
+        )
+    }
+}
+
+/// Precomputes `scene` (a mesh .obj/.ply or a scene file .json) as `haarshift relight
+/// precompute` does: every vertex's visibility x cosine over a `param` map of side
+/// `resolution`, Haar-transformed and truncated to `keep_visibility` detail coefficients
+/// (None: all), with `sh_bands` bands of spherical harmonics beside it when asked. With
+/// `output` the cache is also written there (an existing file only with `force=True`).
+#[pyfunction]
+#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, output = None, force = false))]
+#[allow(clippy::too_many_arguments)] // the keyword arguments of one Python function
+fn precompute(
+    py: Python<'_>,
+    scene: PathBuf,
+    param: &str,
+    resolution: usize,
+    ground_plane: bool,
+    keep_visibility: Option<usize>,
+    samples: usize,
+    seed: u64,
+    order: &str,
+    sh_bands: Option<usize>,
+    output: Option<PathBuf>,
+    force: bool,
+) -> PyResult<Cache> {
+    let param = Parameterization::new(parse::<ParamKind>(param)?, resolution).or_raise()?;
+    let mut visibility = VisibilityOptions::new(param);
+    visibility.samples = samples;
+    visibility.seed = seed;
+    visibility.sh_bands = sh_bands;
+    visibility.keep = keep_visibility.map_or(Selection::All, Selection::Largest);
+    let mut options = PrecomputeOptions::new(visibility);
+    options.order = parse::<Order>(order)?;
+    let cache = py
+        .detach(|| -> haarshift::Result<_> {
+            let mut loaded = Scene::load(&scene)?;
+            if ground_plane {
+                loaded.add_ground_plane()?;
+            }
+            let (cache, _) = haarshift::relight::precompute::precompute(loaded, &options)?;
+            if let Some(path) = &output {
+                cache.write(path, force)?;
+            }
+            Ok(cache)
+        })
+        .or_raise()?;
+    Ok(Cache {
+        cache,
+        path: output,
     })
 }
 
-/// Per-vertex radiance by either method, in its own precision.
-enum Radiance {
-    Haar(ndarray::Array2<f32>),
-    Truth(ndarray::Array2<f64>),
+/// A way of shading a cache's vertices, built once from the same options as `haarshift
+/// relight render` takes and asked for frame after frame (a glossy shader keeps its rotation
+/// cache between frames).
+///
+/// `basis`: "haar", "sh" (the stored spherical-harmonic transfer), "reference" (direct
+/// quadrature with ray casting at the cache's resolution) or "ambient" (ambient occlusion).
+/// `brdf`: "lambert", "phong:EXP", "blinn:EXP" or "merl:FILE". The other keywords are the
+/// command line's flags of the same names.
+#[pyclass(module = "haarshift.relight")]
+pub struct Shader {
+    /// Locked only to be shared with Python's threads: each call has it to itself.
+    shader: std::sync::Mutex<Box<dyn LibraryShader>>,
+    mesh: haarshift::relight::Mesh,
+    environment: Option<EnvironmentSpec>,
+    camera: Option<haarshift::relight::CameraSpec>,
+}
+
+/// A shading's radiance (a numpy array) and its timing report.
+type ShadeResult<'py> = (Bound<'py, PyAny>, HashMap<String, Py<PyAny>>);
+
+#[pymethods]
+impl Shader {
+    #[new]
+    #[pyo3(signature = (cache, *, basis = "haar", brdf = "lambert", albedo = None, keep_light = None, keep_visibility = None, depth = None, brdf_rotation = "haar", level = None, keep_brdf = None, brdf_levels = None, rotation_cache = None, elevations = haarshift::relight::material::brdf::DEFAULT_ELEVATIONS, fill_cache = false))]
+    #[allow(clippy::too_many_arguments)] // the keyword arguments of one Python class
+    fn new(
+        py: Python<'_>,
+        cache: &Cache,
+        basis: &str,
+        brdf: &str,
+        albedo: Option<[f64; 3]>,
+        keep_light: Option<usize>,
+        keep_visibility: Option<usize>,
+        depth: Option<usize>,
+        brdf_rotation: &str,
+        level: Option<usize>,
+        keep_brdf: Option<usize>,
+        brdf_levels: Option<usize>,
+        rotation_cache: Option<usize>,
+        elevations: usize,
+        fill_cache: bool,
+    ) -> PyResult<Self> {
+        let spec = ShaderSpec {
+            method: parse::<Method>(basis)?,
+            material: GlossyOptions {
+                brdf: parse::<Brdf>(brdf)?,
+                rotation: parse(brdf_rotation)?,
+                level,
+                keep_brdf,
+                brdf_levels,
+                cache_bins: rotation_cache,
+                elevations,
+            },
+            fill_cache,
+            shade: ShadeOptions {
+                keep_visibility: keep_visibility.map(Selection::Largest),
+                depth,
+            },
+            keep_light: keep_light.map_or(Selection::All, Selection::Largest),
+            ..ShaderSpec::default()
+        };
+        let source = &cache.cache;
+        let painted = match albedo {
+            Some(a) if a.iter().any(|x| !(0.0..=1.0).contains(x)) => {
+                return Err(bad_argument(
+                    "albedo",
+                    format!("{a:?}: every channel must be from 0 to 1"),
+                ));
+            }
+            Some(a) => Some(ndarray::Array2::from_shape_fn(
+                (source.mesh.vertex_count(), 3),
+                |(_, c)| a[c] as f32,
+            )),
+            None => None,
+        };
+        let shader = py
+            .detach(|| {
+                let mut input = ShadingInput::cache(source);
+                if let Some(a) = &painted {
+                    input.albedo = a.view();
+                }
+                if let Some(path) = &cache.path {
+                    input = input.from_file(path);
+                }
+                spec.build(&input)
+            })
+            .or_raise()?;
+        Ok(Shader {
+            shader: std::sync::Mutex::new(shader),
+            mesh: source.mesh.clone(),
+            environment: source.environment.clone(),
+            camera: source.camera.clone(),
+        })
+    }
+
+    /// Every vertex's outgoing radiance (V, 3) under `env` (a lat-long file or array; default
+    /// the scene file's) turned by `yaw`, `pitch`, `roll` degrees (default the scene file's),
+    /// seen from `eye` (default the scene file's camera, else the one that frames the scene,
+    /// as `relight render` places it), and the timing report: a dict of `encode_seconds`,
+    /// `rotate_seconds`, `shade_seconds` and `description`.
+    #[pyo3(signature = (env = None, *, yaw = None, pitch = None, roll = None, eye = None))]
+    fn shade<'py>(
+        &mut self,
+        py: Python<'py>,
+        env: Option<&Bound<'py, PyAny>>,
+        yaw: Option<f64>,
+        pitch: Option<f64>,
+        roll: Option<f64>,
+        eye: Option<[f64; 3]>,
+    ) -> PyResult<ShadeResult<'py>> {
+        if let Some(e) = eye
+            && !e.iter().all(|x| x.is_finite())
+        {
+            return Err(bad_argument(
+                "eye",
+                format!("{e:?} is not a finite position"),
+            ));
+        }
+        let given = env.map(environment).transpose()?;
+        let light = LightSpec {
+            env: None,
+            yaw,
+            pitch,
+            roll,
+        };
+        let shader = self
+            .shader
+            .get_mut()
+            .map_err(|_| bad_argument("shader", "a previous call panicked"))?;
+        let (mesh, file, camera) = (&self.mesh, self.environment.as_ref(), self.camera.as_ref());
+        let shading = py
+            .detach(|| -> haarshift::Result<_> {
+                let (env, angles) = lighting(&light, given, file)?;
+                let eye = match eye {
+                    Some(e) => e,
+                    None => ViewSpec::default().camera(camera, mesh)?.position(),
+                };
+                shader.shade(&FrameSpec {
+                    environment: &env,
+                    rotation: SphereRotation::from_degrees(angles[0], angles[1], angles[2])?,
+                    eye: Some(eye),
+                })
+            })
+            .or_raise()?;
+        let mut report: HashMap<String, Py<PyAny>> = HashMap::new();
+        let t = shading.timing;
+        report.insert(
+            "encode_seconds".into(),
+            t.encode_seconds.into_pyobject(py)?.into_any().unbind(),
+        );
+        report.insert(
+            "rotate_seconds".into(),
+            t.rotate_seconds.into_pyobject(py)?.into_any().unbind(),
+        );
+        report.insert(
+            "shade_seconds".into(),
+            t.shade_seconds.into_pyobject(py)?.into_any().unbind(),
+        );
+        report.insert(
+            "description".into(),
+            shading.description.into_pyobject(py)?.into_any().unbind(),
+        );
+        Ok((radiance_array(py, shading.radiance), report))
+    }
 }
 
 /// The `haarshift.relight` submodule.
 pub fn module<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyModule>> {
     let m = PyModule::new(py, "relight")?;
     m.add_function(wrap_pyfunction!(scene, &m)?)?;
+    m.add_function(wrap_pyfunction!(precompute, &m)?)?;
+    m.add_class::<Cache>()?;
+    m.add_class::<Shader>()?;
     Ok(m)
 }

@@ -79,3 +79,109 @@ def test_bad_input(scene, tmp_path):
         haarshift.relight.scene(broken, **FIELDS)
     with pytest.raises(ValueError, match="lat-long"):
         haarshift.relight.scene(path, env=np.ones((8, 8)), **FIELDS)
+
+
+
+@pytest.fixture
+def cached(tmp_path):
+    """Two balls on a ground plane precomputed at lat-long 8 with 3 bands of harmonics, its
+    cache written, and a sky (a file) brighter overhead."""
+    sky = np.ones((16, 32, 3))
+    sky[:5] = [4.0, 3.0, 2.0]
+    np.save(tmp_path / "sky.npy", sky)
+    ball = {"generator": {"sphere": {"cells": 3}}}
+    spec = {
+        "objects": [dict(ball, name="a"), dict(ball, name="b", transform={"translate": [2.5, 0, 0]})],
+        "ground_plane": True,
+    }
+    path = tmp_path / "balls.json"
+    path.write_text(json.dumps(spec))
+    out = tmp_path / "balls.hsr"
+    cache = haarshift.relight.precompute(path, resolution=8, sh_bands=3, output=out)
+    return cache, out, tmp_path / "sky.npy"
+
+
+RENDERS = [
+    (dict(), []),
+    (dict(keep_light=30, keep_visibility=20), ["--keep-light", "30", "--keep-visibility", "20"]),
+    (dict(brdf="phong:20"), ["--brdf", "phong:20"]),
+    (dict(brdf="phong:20", rotation_cache=8), ["--brdf", "phong:20", "--rotation-cache", "8"]),
+    (dict(brdf="blinn:20"), ["--brdf", "blinn:20"]),
+    (dict(basis="sh"), ["--basis", "sh"]),
+    (dict(basis="sh", brdf="phong:10"), ["--basis", "sh", "--brdf", "phong:10"]),
+    (dict(basis="ambient"), ["--basis", "ambient"]),
+]
+
+
+@pytest.mark.parametrize("options,flags", RENDERS)
+def test_a_shader_agrees_with_relight_render(cli, cached, tmp_path, options, flags):
+    cache, path, sky = cached
+    shader = haarshift.relight.Shader(haarshift.relight.Cache.read(path), **options)
+    ours, report = shader.shade(sky, yaw=40.0)
+    assert ours.shape == (cache.vertex_count, 3)
+    assert set(report) == {"encode_seconds", "rotate_seconds", "shade_seconds", "description"}
+    out = tmp_path / "v.npy"
+    cli("relight", "render", path, "--env", sky, "--yaw", "40", *flags, "--vertices", out,
+        "--width", "32", "--height", "24", "-o", tmp_path / "frame.png")
+    want = np.load(out)
+    assert np.array_equal(ours.astype(np.float32), want)
+    # The same frame again (a glossy shader's cache now warm) gives the same radiance.
+    again, _ = shader.shade(sky, yaw=40.0)
+    assert np.array_equal(again, ours)
+
+
+def test_the_cache_object(cached):
+    cache, path, _ = cached
+    read = haarshift.relight.Cache.read(path)
+    assert read.vertex_count == cache.vertex_count == read.positions.shape[0]
+    assert read.object_vertices < read.vertex_count  # the ground plane's come last
+    assert read.param == ("latlong", 8) and read.sh_bands == 3
+    assert read.triangles.max() < read.vertex_count
+    assert np.allclose(np.linalg.norm(read.normals, axis=1), 1.0)
+    assert np.array_equal(read.albedo, cache.albedo)
+
+
+def test_a_shader_turns_the_lighting_and_follows_the_eye(cached):
+    cache, _, sky = cached
+    lambert = haarshift.relight.Shader(cache)
+    a, _ = lambert.shade(sky)
+    b, _ = lambert.shade(sky, yaw=90.0)
+    assert not np.array_equal(a, b)
+    c, _ = lambert.shade(np.load(sky), eye=(0.0, 9.0, 0.0))
+    assert np.array_equal(a, c)  # Lambertian: the eye changes nothing
+    phong = haarshift.relight.Shader(cache, brdf="phong:20")
+    d, _ = phong.shade(sky, eye=(0.0, 9.0, 0.0))
+    e, _ = phong.shade(sky, eye=(9.0, 1.0, 0.0))
+    assert not np.array_equal(d, e)
+
+
+def test_bad_shader_input(cached, tmp_path):
+    cache, path, sky = cached
+    with pytest.raises(FileNotFoundError, match="missing.hsr"):
+        haarshift.relight.Cache.read(tmp_path / "missing.hsr")
+    (tmp_path / "junk.hsr").write_bytes(b"not a cache")
+    with pytest.raises(OSError, match="junk.hsr"):
+        haarshift.relight.Cache.read(tmp_path / "junk.hsr")
+    with pytest.raises(ValueError, match='unknown value "pixel"'):
+        haarshift.relight.Shader(cache, basis="pixel")
+    with pytest.raises(ValueError, match="uses every band stored"):
+        haarshift.relight.Shader(cache, basis="sh", keep_light=10)
+    with pytest.raises(ValueError, match="sh shades zonal lobes only"):
+        haarshift.relight.Shader(cache, basis="sh", brdf="blinn:20")
+    with pytest.raises(ValueError, match="the BRDF is lambert"):
+        haarshift.relight.Shader(cache, rotation_cache=8)
+    with pytest.raises(ValueError, match="albedo"):
+        haarshift.relight.Shader(cache, albedo=(2.0, 0.0, 0.0))
+    bare_path = tmp_path / "bare.hsr"
+    haarshift.relight.precompute(tmp_path / "balls.json", resolution=8, output=bare_path)
+    with pytest.raises(OSError, match="bare.hsr: the cache holds no spherical-harmonic"):
+        haarshift.relight.Shader(haarshift.relight.Cache.read(bare_path), basis="sh")
+    shader = haarshift.relight.Shader(cache)
+    with pytest.raises(ValueError, match="give env="):
+        shader.shade()
+    with pytest.raises(ValueError, match="eye"):
+        shader.shade(sky, eye=(float("nan"), 0.0, 0.0))
+    with pytest.raises(ValueError, match="lat-long"):
+        shader.shade(np.ones((8, 8)))
+    with pytest.raises(FileExistsError):
+        haarshift.relight.precompute(tmp_path / "balls.json", resolution=8, output=bare_path)

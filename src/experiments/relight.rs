@@ -40,24 +40,25 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
 
-use ndarray::{Array2, Array3, Axis, s};
+use ndarray::{Array2, Array3, Axis};
 use serde::Serialize;
 
 use crate::experiments::plot::labelled_colour_tiles;
 use crate::faces::{ParamKind, Parameterization};
 use crate::metrics::{RelativeError, rms};
 use crate::product::Selection;
-use crate::relight::glossy::{GlossyOptions, GlossyShader};
 use crate::relight::light::environment::Environment;
-use crate::relight::material::orient::{BrdfRotation, mirror_directions};
-use crate::relight::reference::ReferenceVisibility;
+use crate::relight::material::orient::BrdfRotation;
+use crate::relight::shade::glossy::GlossyOptions;
+use crate::relight::shade::reference::ReferenceVisibility;
+use crate::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
 use crate::relight::{
-    Brdf, Lighting, PhongSh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, ShTransfer,
-    ShadeOptions, TransportSet, VisibilityOptions, shade_sh, vertex_major,
+    Brdf, ReferenceOptions, Scene, SceneBvh, ShadeOptions, TransportSet, VisibilityOptions,
+    vertex_major,
 };
-use crate::render::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
+use crate::render::view::ViewSpec;
+use crate::render::{Background, Camera, LitMesh, render, to_srgb8};
 use crate::sphere::SphereRotation;
-use crate::sphere::harmonics::SphericalHarmonics;
 use crate::{Error, PlanarImage, Result};
 
 /// How far the second camera orbits the first about the vertical, degrees.
@@ -471,8 +472,13 @@ impl<'a> Setting<'a> {
         })
     }
 
-    fn lighting(&self, param: Parameterization, keep: Selection) -> Result<Lighting> {
-        Lighting::new(&self.light.environment, param, &self.rotation, keep)
+    /// The frame of this setting seen from `eye`.
+    fn frame(&self, eye: [f64; 3]) -> FrameSpec<'_> {
+        FrameSpec {
+            environment: &self.light.environment,
+            rotation: self.rotation,
+            eye: Some(eye),
+        }
     }
 }
 
@@ -505,13 +511,7 @@ impl<'a> Bench<'a> {
     fn new(subject: &'a Subject, protocol: &'a RelightProtocol) -> Result<Self> {
         let scene = &subject.scene;
         let bvh = SceneBvh::new(&scene.mesh);
-        let first = match &scene.camera {
-            Some(spec) => Camera::new(spec.position, spec.look_at, spec.fov)?,
-            None => {
-                let b = scene.mesh.bounds();
-                Camera::framing(b.min, b.max, DEFAULT_FOV)?
-            }
-        };
+        let first = ViewSpec::default().camera(scene.camera.as_ref(), &scene.mesh)?;
         let cameras = [first, first.orbited(SECOND_CAMERA)?];
         let truth_bits =
             ReferenceVisibility::new(&scene.mesh, &bvh, protocol.truth_resolution, true)?;
@@ -594,49 +594,32 @@ impl<'a> Bench<'a> {
         let eye = self.eye(setting);
         let subject: &'a Subject = self.subject;
         let scene = &subject.scene;
-        let albedo = scene.albedo.view();
-        let objects = scene.object_vertices();
         let precomputed = self.transport(kind, n, false)?;
         let set = &precomputed.set;
-        let param = set.param();
-        let start = Instant::now();
-        let (radiance, kept, prepare, relight) = if setting.brdf.is_lambert() {
-            let prepared = PreparedTransport::<f32>::new(set, albedo, shade)?;
-            let prepare = start.elapsed().as_secs_f64();
-            let start = Instant::now();
-            let lighting = setting.lighting(param, light)?;
-            let radiance = prepared.shade(&lighting)?;
-            (
-                radiance,
-                lighting.kept(),
-                prepare,
-                start.elapsed().as_secs_f64(),
-            )
-        } else {
-            let options = GlossyOptions {
+        let spec = ShaderSpec {
+            material: GlossyOptions {
                 brdf: setting.brdf.clone(),
                 ..glossy.clone()
-            };
-            let shader =
-                GlossyShader::<f32>::new(set, &scene.mesh, albedo, shade, &options, objects)?;
-            let prepare = start.elapsed().as_secs_f64();
-            let start = Instant::now();
-            let lighting = setting.lighting(param, light)?;
-            let (radiance, _) = shader.shade(&lighting, eye)?;
-            (
-                radiance,
-                lighting.kept(),
-                prepare,
-                start.elapsed().as_secs_f64(),
-            )
+            },
+            shade: *shade,
+            keep_light: light,
+            ..ShaderSpec::default()
         };
+        let input = ShadingInput::new(
+            &scene.mesh,
+            scene.albedo.view(),
+            Some(set),
+            scene.object_vertices(),
+        );
+        let mut shader = spec.build(&input)?;
+        let shading = shader.shade(&setting.frame(eye))?;
         Ok((
             Shaded {
-                radiance: radiance.mapv(f64::from),
-                precompute_seconds: precomputed.seconds + prepare,
-                relight_seconds: relight,
+                radiance: shading.radiance.to_f64(),
+                precompute_seconds: precomputed.seconds + shader.preparation().seconds,
+                relight_seconds: shading.timing.total_seconds(),
             },
-            kept + param.faces(),
+            shading.light_coefficients.unwrap_or(0),
         ))
     }
 
@@ -931,49 +914,31 @@ impl<'a> Bench<'a> {
         let param = Parameterization::new(ParamKind::LatLong, n)?;
         let mut out = Vec::new();
         let eye = self.eye(setting);
-        let objects = self.subject.scene.object_vertices();
-        let exponent = match setting.brdf {
-            Brdf::Lambert => None,
-            Brdf::Phong { exponent } => Some(*exponent),
-            other => return Err(crate::relight::non_zonal_material(&other.to_string())),
-        };
+        let subject: &'a Subject = self.subject;
         for &bands in &self.protocol.sh_bands.clone() {
             let precomputed = self.transport(ParamKind::LatLong, n, true)?;
-            let stored = precomputed.set.sh().ok_or_else(|| {
-                Error::parameter("harmonics", "the precomputation kept no harmonics")
-            })?;
             let seconds = precomputed.seconds;
-            let transfer = ShTransfer::new(
-                bands,
-                stored
-                    .coefficients()
-                    .slice(s![.., ..bands * bands])
-                    .to_owned(),
-            )?;
-            let start = Instant::now();
-            let map = setting
-                .light
-                .environment
-                .sphere_map(param, &setting.rotation)?;
-            let lighting = SphericalHarmonics::new(bands)?.project(&map);
-            let albedo = self.subject.scene.albedo.view();
-            let radiance = match exponent {
-                None => shade_sh(&transfer, albedo, lighting.view())?.mapv(f64::from),
-                Some(e) => {
-                    let mirror = mirror_directions(&self.subject.scene.mesh, eye);
-                    PhongSh::new(bands, e)?.shade(
-                        &transfer,
-                        albedo,
-                        lighting.view(),
-                        mirror.view(),
-                        objects,
-                    )?
-                }
+            let scene = &subject.scene;
+            let spec = ShaderSpec {
+                method: Method::Sh,
+                material: GlossyOptions {
+                    brdf: setting.brdf.clone(),
+                    ..GlossyOptions::default()
+                },
+                sh_bands: Some(bands),
+                ..ShaderSpec::default()
             };
+            let input = ShadingInput::new(
+                &scene.mesh,
+                scene.albedo.view(),
+                Some(&precomputed.set),
+                scene.object_vertices(),
+            );
+            let shading = spec.build(&input)?.shade(&setting.frame(eye))?;
             let shaded = Shaded {
-                radiance,
+                radiance: shading.radiance.to_f64(),
                 precompute_seconds: seconds,
-                relight_seconds: start.elapsed().as_secs_f64(),
+                relight_seconds: shading.timing.total_seconds(),
             };
             let mut r = self.record("harmonics", setting, &shaded, param)?;
             r.method = "sh".into();
@@ -1000,7 +965,7 @@ impl<'a> Bench<'a> {
             let (s, kept) = self.haar(setting, (ParamKind::LatLong, n), keep, &shade, &glossy)?;
             let mut r = self.record("harmonics", setting, &s, param)?;
             r.light_coefficients = kept;
-            r.brdf_coefficients = exponent.map(|_| count);
+            r.brdf_coefficients = (!setting.brdf.is_lambert()).then_some(count);
             r.parameters = format!("{count} coefficients");
             out.push(r);
         }

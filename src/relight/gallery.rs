@@ -6,9 +6,10 @@
 //! **What is made.** The scene is precomputed once (vertex order, lat-long `N x 2N`, every
 //! coefficient kept, spherical-harmonics transfer of `B` bands beside it). For each map
 //! (`*.hdr`, `*.exr`, `*.npy` in the directory, in name order):
-//! * the per-vertex radiance three ways: Haar with the lighting truncated to `K` detail
-//!   coefficients ([`Lighting`] and [`PreparedTransport`]), spherical harmonics of `B` bands
-//!   ([`shade_sh`]), and the [`fn@reference`] quadrature at the same `N`;
+//! * the per-vertex radiance three ways, each a [`Shader`] of its [`ShaderSpec`]: Haar with the
+//!   lighting truncated to `K` detail coefficients ([`Method::Haar`], in `f64`), spherical
+//!   harmonics of `B` bands ([`Method::Sh`]), and the reference quadrature at the same `N`
+//!   ([`Method::Reference`]);
 //! * `NAME.png`: the three renders side by side, Haar | SH | reference, each `W x H`, all at one
 //!   exposure: the one that brings the reference's mean vertex luminance to 0.18 x 2 (mid grey
 //!   one stop up);
@@ -29,13 +30,10 @@ use crate::metrics::relative_rms_error;
 use crate::product::Selection;
 use crate::relight::light::environment::Environment;
 use crate::relight::precompute::{PrecomputeOptions, precompute};
-use crate::relight::{
-    Lighting, Mesh, PreparedTransport, ReferenceOptions, Scene, SceneBvh, SceneCache, ShadeOptions,
-    VisibilityOptions, reference, shade_sh,
-};
+use crate::relight::shade::{FrameSpec, Method, Precision, Shader, ShaderSpec, ShadingInput};
+use crate::relight::{Mesh, Scene, SceneCache, VisibilityOptions};
 use crate::render::{Background, Camera, DEFAULT_FOV, LitMesh, render, to_srgb8};
 use crate::sphere::SphereRotation;
-use crate::sphere::harmonics::SphericalHarmonics;
 use crate::{Channels, Error, PlanarImage, Result, SampleDepth};
 
 /// What to make; see the [module docs](self).
@@ -154,21 +152,33 @@ pub fn gallery(
     visibility.progress = true;
     visibility.sh_bands = Some(options.sh_bands);
     let (cache, _) = precompute(scene, &PrecomputeOptions::new(visibility))?;
-    let transfer = cache
-        .transport
-        .sh()
-        .expect("the precomputation was asked for spherical harmonics");
-    let harmonics = SphericalHarmonics::new(options.sh_bands)?;
-    let bvh = SceneBvh::new(&cache.mesh);
     let camera = {
         let b = cache.mesh.bounds();
         Camera::framing(b.min, b.max, DEFAULT_FOV)?
     };
-    let full = PreparedTransport::<f64>::new(
-        &cache.transport,
-        cache.albedo.view(),
-        &ShadeOptions::default(),
-    )?;
+    let input = ShadingInput::cache(&cache);
+    let haar = ShaderSpec {
+        precision: Precision::F64,
+        ..ShaderSpec::default()
+    };
+    let mut full = haar.build(&input)?;
+    let mut truncated = ShaderSpec {
+        keep_light: Selection::Largest(options.keep_light),
+        ..haar
+    }
+    .build(&input)?;
+    let mut harmonics = ShaderSpec {
+        method: Method::Sh,
+        ..ShaderSpec::default()
+    }
+    .build(&input)?;
+    let mut quadrature = ShaderSpec {
+        method: Method::Reference,
+        reference_resolution: Some(options.resolution),
+        progress: true,
+        ..ShaderSpec::default()
+    }
+    .build(&input)?;
     let identity = SphereRotation::identity();
     std::fs::create_dir_all(out_dir).map_err(|source| Error::Io {
         path: out_dir.to_path_buf(),
@@ -176,28 +186,18 @@ pub fn gallery(
     })?;
     let mut rows = Vec::with_capacity(maps.len());
     for (path, env) in maps.iter().zip(&environments) {
-        let haar_all = full.shade(&Lighting::new(env, param, &identity, Selection::All)?)?;
-        let kept = Lighting::new(
-            env,
-            param,
-            &identity,
-            Selection::Largest(options.keep_light),
-        )?;
-        let haar_kept = full.shade(&kept)?;
-        let sh_light = harmonics.project(&env.sphere_map(param, &identity)?);
-        let sh = shade_sh(transfer, cache.albedo.view(), sh_light.view())?.mapv(f64::from);
-        let quadrature = ReferenceOptions {
-            progress: true,
-            ..Default::default()
+        let frame = FrameSpec {
+            environment: env,
+            rotation: identity,
+            eye: Some(camera.position()),
         };
-        let lighting = env.lat_long(options.resolution, &identity)?;
-        let (truth, _) = reference(
-            &cache.mesh,
-            &bvh,
-            cache.albedo.view(),
-            &lighting,
-            &quadrature,
-        )?;
+        let shade = |shader: &mut Box<dyn Shader>| -> Result<Array2<f64>> {
+            Ok(shader.shade(&frame)?.radiance.to_f64())
+        };
+        let haar_all = shade(&mut full)?;
+        let haar_kept = shade(&mut truncated)?;
+        let sh = shade(&mut harmonics)?;
+        let truth = shade(&mut quadrature)?;
         rows.push(GalleryRow {
             name: stem(path),
             haar_all: relative_rms_error(haar_all.view(), truth.view())?,
@@ -301,26 +301,30 @@ fn turntable(
     path: &Path,
     options: &GalleryOptions,
 ) -> Result<()> {
-    let param = cache.transport.param();
-    let prepared = PreparedTransport::<f32>::new(
-        &cache.transport,
-        cache.albedo.view(),
-        &ShadeOptions::default(),
-    )?;
-    let first = prepared.shade(&Lighting::new(
-        env,
-        param,
-        &SphereRotation::identity(),
-        Selection::All,
-    )?)?;
-    let exposure = exposure_for(&first.mapv(f64::from));
+    let input = ShadingInput::cache(cache);
+    let first = ShaderSpec::default().build(&input)?.shade(&FrameSpec {
+        environment: env,
+        rotation: SphereRotation::identity(),
+        eye: None,
+    })?;
+    let exposure = exposure_for(&first.radiance.to_f64());
+    let mut shader = ShaderSpec {
+        keep_light: Selection::Largest(options.keep_light),
+        ..ShaderSpec::default()
+    }
+    .build(&input)?;
     let frames = (0..options.frames)
         .map(|k| {
             let turn =
                 SphereRotation::from_degrees(360.0 * k as f64 / options.frames as f64, 0.0, 0.0)?;
-            let lighting =
-                Lighting::new(env, param, &turn, Selection::Largest(options.keep_light))?;
-            let radiance = prepared.shade(&lighting)?;
+            let radiance = shader
+                .shade(&FrameSpec {
+                    environment: env,
+                    rotation: turn,
+                    eye: None,
+                })?
+                .radiance
+                .to_f32();
             let backdrop = env.lat_long(env.map().height().min(512), &turn)?;
             let mesh = LitMesh {
                 positions: cache.mesh.positions(),

@@ -1,7 +1,7 @@
 //! All-frequency relighting, in the order the data flows: a scene is read and checked
 //! ([`scene`]), its per-vertex transport precomputed ([`precompute`]), the lighting encoded
 //! ([`light`]), a material brought into each vertex's frame ([`material`]), the outgoing
-//! radiance computed ([`shade`](mod@shade), [`glossy`], [`harmonics`], [`mod@reference`]), and
+//! radiance computed behind one [`Shader`](shade::Shader) ([`shade`](mod@shade)), and
 //! scenes whose objects move relit by just-in-time radiance transfer ([`dynamic`]). Images of
 //! the result are [`crate::render`]'s.
 //!
@@ -12,10 +12,8 @@
 //! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order: [`precompute::raycast`] ([`Occlusion`], answered by [`SceneBvh`]), [`precompute::shadowmap`] ([`ShadowMap`], the PRT patent's depth buffer), [`precompute::visibility`] ([`vertex_major`], [`direction_major`]), [`precompute::transport`] ([`TransportSet`]), [`precompute::sparse`] (many sparse Haar functions in flat arrays) |
 //! | [`light`] | [`light::environment`]: the lighting loaded, downsampled by solid-angle-weighted means, rotated; [`light::lighting`] ([`Lighting`]): its kept Haar coefficients, RGB, in Mallat order |
 //! | [`material`] | [`material::brdf`] ([`Brdf`]: Lambert, Phong, Blinn-Phong, local copies), [`material::merl`] (measured BRDFs), [`material::orient`] (a BRDF into a vertex's frame: Haar, spatial, reference or direct) |
-//! | [`shade`](mod@shade) | per-vertex outgoing radiance: [`PreparedTransport`], one sparse dot per vertex |
-//! | [`glossy`] | glossy shading: the triple product with the rotated BRDF, the rotation cache |
-//! | [`harmonics`] | [`ShTransfer`]: the PRT patent's spherical-harmonic transfer, its shading [`shade_sh`], and the glossy baseline [`PhongSh`] |
-//! | [`mod@reference`] | [`reference()`]: the ground truth by direct quadrature, independent of every Haar path |
+//! | [`shade`](mod@shade) | per-vertex outgoing radiance behind one [`Shader`](shade::Shader), built from a [`ShaderSpec`](shade::ShaderSpec): Lambertian Haar ([`PreparedTransport`]), glossy Haar with the rotation cache ([`shade::glossy`]), spherical harmonics ([`shade_sh`], [`PhongSh`]), the ground truth by direct quadrature ([`reference()`]), ambient occlusion, dynamic scenes |
+//! | [`harmonics`] | [`ShTransfer`]: the PRT patent's spherical-harmonic transfer |
 //! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other (Sun 2006); [`dynamic::fields`] (occlusion fields, the `.hsf` file), [`dynamic::motion`] (animations played with re-formed transfer) |
 //! | [`gallery`] | the committed diffuse renders: Haar, SH and the reference under several maps |
 //!
@@ -27,17 +25,25 @@
 pub mod dynamic;
 pub mod error;
 pub mod gallery;
-pub mod glossy;
+/// Moved to [`shade::glossy`].
+#[deprecated(note = "moved to haarshift::relight::shade::glossy")]
+pub mod glossy {
+    pub use super::shade::glossy::*;
+}
 pub mod harmonics;
 pub mod light;
 pub mod material;
 pub mod precompute;
-pub mod reference;
+/// Moved to [`shade::reference`]; this path stays for one release (not marked deprecated:
+/// importing the function [`reference()`] by its name imports this module too).
+pub mod reference {
+    pub use super::shade::reference::*;
+}
 pub mod scene;
 pub mod shade;
 
 pub use error::SceneError;
-pub use harmonics::{PhongSh, ShTransfer, non_zonal_material, shade_sh, shade_sh_glossy};
+pub use harmonics::ShTransfer;
 pub use light::lighting::Lighting;
 pub use material::brdf::Brdf;
 pub use precompute::raycast::{Occlusion, SceneBvh};
@@ -46,13 +52,14 @@ pub use precompute::transport::TransportSet;
 pub use precompute::visibility::{
     PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major,
 };
-pub use reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
 pub use scene::cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
 pub use scene::mesh::{Bounds, Mesh};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,
 };
+pub use shade::harmonics::{PhongSh, non_zonal_material, shade_sh, shade_sh_glossy};
+pub use shade::reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
 pub use shade::{PreparedTransport, ShadeOptions, shade};
 
 /// The paths of the modules before they were grouped by pipeline stage, kept for one release

@@ -16,7 +16,7 @@
 
 use glam::DVec3;
 
-use crate::relight::scene::validate::MAX_COORDINATE;
+use crate::relight::scene::validate::{MAX_COORDINATE, in_range};
 use crate::{Error, Result};
 
 /// The default vertical field of view, degrees.
@@ -46,11 +46,7 @@ impl Camera {
     /// A camera at `position` looking at `look_at` (a different point), +Y up, with a vertical
     /// field of view of `fov_degrees` (above 0 and below 180).
     pub fn new(position: [f64; 3], look_at: [f64; 3], fov_degrees: f64) -> Result<Self> {
-        if position
-            .iter()
-            .chain(&look_at)
-            .any(|v| v.is_nan() || v.abs() > MAX_COORDINATE)
-        {
+        if position.iter().chain(&look_at).any(|&v| !in_range(v)) {
             return Err(Error::parameter(
                 "camera",
                 format!(

@@ -6,6 +6,7 @@ pub mod animation;
 pub mod camera;
 pub mod output;
 pub mod raster;
+pub mod view;
 
 pub use camera::{Camera, DEFAULT_FOV};
 pub use output::{render_format, srgb_encode, to_srgb8, write_render};

@@ -18,6 +18,8 @@ struct Cost {
 
 /// Runs `haarshift ARGS` in `dir` and returns its exit code, stdout, stderr and cost; kills it
 /// (and fails) after 60 s of wall time.
+// The child is reaped by `wait4` (which also gives its resource use), not by `Child::wait`.
+#[allow(clippy::zombie_processes)]
 fn run(dir: &Path, args: &[&str]) -> (Option<i32>, String, String, Cost) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_haarshift"))
         .current_dir(dir)

@@ -962,3 +962,72 @@ fn an_orbiting_glossy_animation_shows_new_views_from_a_filled_cache() {
     fails_cleanly(&args, &["blinn:5", "depends on the view"]);
     assert!(!out.exists());
 }
+
+#[test]
+fn render_selects_the_reference_and_ambient_occlusion_by_name() {
+    // Methods are one list in the library: `--basis reference` is the quadrature of `relight
+    // reference` at the cache's resolution, `--basis ambient` the transport's integral.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = sphere_on_plane(dir.path());
+    let cache = small_cache(dir.path());
+    let env = env32();
+    let render = |basis: &str, extra: &[&str]| {
+        let npy = dir.path().join(format!("{basis}.npy"));
+        let png = dir.path().join(format!("{basis}.png"));
+        let mut args = render_args(&cache, &png, &["--env", p(&env), "--basis", basis]);
+        args.extend(["--vertices", p(&npy)]);
+        args.extend(extra);
+        let stdout = succeeds_with_stdout(&args);
+        (read_vertices(&npy), stdout)
+    };
+    let (quadrature, stdout) = render("reference", &[]);
+    assert!(
+        stdout.contains("by quadrature over 8 x 16 texels"),
+        "{stdout}"
+    );
+    let truth = dir.path().join("truth.npy");
+    succeeds(&[
+        "relight",
+        "reference",
+        p(&scene),
+        "--resolution",
+        "8",
+        "--env",
+        p(&env),
+        "--vertices",
+        p(&truth),
+    ]);
+    assert_eq!(quadrature, read_vertices(&truth));
+    // Ambient occlusion under a white sky of radiance 1 is the Lambertian render under it.
+    let white = dir.path().join("white.npy");
+    haarshift::io::write_npy(
+        ndarray::Array3::<f64>::ones((16, 32, 3)).view(),
+        haarshift::SampleDepth::F32,
+        &white,
+        false,
+    )
+    .unwrap();
+    let (ambient, stdout) = render("ambient", &[]);
+    assert!(stdout.contains("ambient occlusion"), "{stdout}");
+    let lit = dir.path().join("lit.npy");
+    let lit_png = dir.path().join("lit.png");
+    let mut args = render_args(&cache, &lit_png, &["--env", p(&white)]);
+    args.extend(["--vertices", p(&lit)]);
+    succeeds(&args);
+    let lit = read_vertices(&lit);
+    let worst = ambient
+        .iter()
+        .zip(&lit)
+        .fold(0.0f32, |a, (x, y)| a.max((x - y).abs()));
+    assert!(worst < 1e-5, "{worst}");
+    // The ground plane next to the sphere is occluded: darker than an open plane (0.8).
+    assert!(ambient.column(0).iter().any(|&r| r < 0.6));
+    fails_cleanly(
+        &render_args(
+            &cache,
+            &dir.path().join("g.png"),
+            &["--env", p(&env), "--basis", "ambient", "--brdf", "phong:10"],
+        ),
+        &["ambient occlusion is Lambertian"],
+    );
+}

@@ -1,6 +1,11 @@
+use ndarray::s;
+
 use super::*;
-use crate::relight::{Generator, reference};
+use crate::relight::shade::glossy::GlossyShader;
+use crate::relight::{Generator, Lighting, PreparedTransport, ShTransfer, reference, shade_sh};
+use crate::render::DEFAULT_FOV;
 use crate::sphere::LatLongMap;
+use crate::sphere::harmonics::SphericalHarmonics;
 
 /// A box floating over a plane (shadows), under a sky with a sun, a tiny protocol.
 fn setup() -> (Subject, Light, RelightProtocol) {

@@ -72,20 +72,20 @@ impl DynamicScene {
     /// # (options.field.circles, options.field.circle_points) = (4, 8);
     /// # (options.field.shells, options.field.shell_grid) = (2, 2);
     /// let scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
-    /// assert_eq!(scene.glossy(), &haarshift::relight::glossy::GlossyOptions::default());
+    /// assert_eq!(scene.glossy(), &haarshift::relight::shade::glossy::GlossyOptions::default());
     /// ```
     pub fn glossy(&self) -> &GlossyOptions {
         &self.glossy
     }
 
     /// Sets how glossy BRDFs are brought into vertex frames and truncated: `rotation`, `level`,
-    /// `elevations`, `keep_brdf` and `brdf_levels` as [`GlossyShader`](crate::relight::glossy::GlossyShader)
+    /// `elevations`, `keep_brdf` and `brdf_levels` as [`GlossyShader`](crate::relight::shade::glossy::GlossyShader)
     /// reads them. Its `brdf` is not read (each object has its own, [`set_brdf`](Self::set_brdf)),
     /// and a rotation cache is refused: every vertex's lobe is rotated in its exact frame.
     ///
     /// ```
     /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
-    /// use haarshift::relight::glossy::GlossyOptions;
+    /// use haarshift::relight::shade::glossy::GlossyOptions;
     /// use haarshift::relight::material::orient::BrdfRotation;
     /// use haarshift::relight::SceneFile;
     /// use haarshift::faces::{ParamKind, Parameterization};

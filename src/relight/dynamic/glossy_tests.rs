@@ -4,9 +4,9 @@ use crate::relight::dynamic::tests::{
     THREE, build, each_moved_object_is_the_full_product_integral, lighting, options, param,
     relative, scene_file,
 };
-use crate::relight::glossy::GlossyShader;
 use crate::relight::material::orient::BrdfRotation;
 use crate::relight::shade::ShadeOptions;
+use crate::relight::shade::glossy::GlossyShader;
 
 const CAMERA: &str = r#""camera": {"position": [1.5, 2.5, 4.0], "look_at": [0, 0, 0]}"#;
 

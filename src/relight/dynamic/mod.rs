@@ -57,16 +57,16 @@ use crate::relight::dynamic::fields::file::{FieldOrigin, FieldStore};
 use crate::relight::dynamic::fields::{
     Blend, FieldOptions, OcclusionField, Truncation, select_rows, yaw_sparse,
 };
-use crate::relight::glossy::GlossyOptions;
 use crate::relight::light::lighting::Lighting;
 use crate::relight::material::brdf::Brdf;
 use crate::relight::material::orient::Orientation;
 use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::visibility::{VisibilityOptions, ray_offset, vertex_major};
-use crate::relight::reference::ReferenceVisibility;
 use crate::relight::scene::{
     CameraSpec, EnvironmentSpec, SceneFile, Transform, ground_plane_under, merge,
 };
+use crate::relight::shade::glossy::GlossyOptions;
+use crate::relight::shade::reference::ReferenceVisibility;
 use crate::relight::shade::{select_kept, within_depth};
 use crate::relight::{Mesh, ReferenceOptions, SceneBvh, SceneError};
 use crate::sphere::{LatLongMap, SphereRotation};
@@ -114,6 +114,44 @@ impl DynamicOptions {
         self.field.param
     }
 
+    /// The options of `budgets`: the fields' sample counts and every truncation, as
+    /// `relight scene` and `haarshift.relight.scene` take them.
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions};
+    /// use haarshift::relight::dynamic::fields::Truncation;
+    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
+    /// let budgets = DynamicBudgets { keep_field: Some(40), truncate_after: true, ..DynamicBudgets::new(param) };
+    /// let o = DynamicOptions::from_budgets(&budgets);
+    /// assert_eq!((o.field.keep, o.truncation), (Selection::Largest(40), Truncation::After(Selection::Largest(40))));
+    /// assert_eq!(DynamicOptions::from_budgets(&DynamicBudgets::new(param)), DynamicOptions::new(param));
+    /// ```
+    pub fn from_budgets(budgets: &DynamicBudgets) -> Self {
+        let largest = |k: Option<usize>| k.map_or(Selection::All, Selection::Largest);
+        DynamicOptions {
+            field: FieldOptions {
+                keep: largest(budgets.keep_field),
+                circles: budgets.circles,
+                circle_points: budgets.circle_points,
+                shells: budgets.shells,
+                shell_grid: budgets.shell_grid,
+                progress: budgets.progress,
+                ..FieldOptions::new(budgets.param)
+            },
+            keep_visibility: largest(budgets.keep_visibility),
+            truncation: if budgets.truncate_after {
+                Truncation::After(largest(budgets.keep_field))
+            } else {
+                Truncation::Before
+            },
+            keep_product: largest(budgets.keep_product),
+            depth: budgets.depth,
+            progress: budgets.progress,
+        }
+    }
+
     fn check(&self) -> Result<usize> {
         let p = self.param();
         let details = p.texels() - p.faces();
@@ -133,6 +171,62 @@ impl DynamicOptions {
             )),
             Some(d) => Ok(d),
             None => Ok(levels),
+        }
+    }
+}
+
+/// A dynamic scene's budgets as a caller states them: the fields' parameterisation and sample
+/// counts, and how many detail coefficients each factor keeps (`None`: all);
+/// [`DynamicOptions::from_budgets`] makes the options.
+///
+/// ```
+/// use haarshift::relight::dynamic::DynamicBudgets;
+/// use haarshift::sphere::{ParamKind, Parameterization};
+/// let b = DynamicBudgets::new(Parameterization::new(ParamKind::LatLong, 32).unwrap());
+/// assert_eq!((b.circles, b.circle_points, b.shells, b.shell_grid), (100, 200, 20, 9));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DynamicBudgets {
+    /// Every map's parameterisation.
+    pub param: Parameterization,
+    /// Detail coefficients of each vertex's own transport.
+    pub keep_visibility: Option<usize>,
+    /// Detail coefficients of each occlusion map.
+    pub keep_field: Option<usize>,
+    /// Detail coefficients of each vertex's fixed product (animations).
+    pub keep_product: Option<usize>,
+    /// Truncate looked-up occlusion maps after blending them (to `keep_field`), not before.
+    pub truncate_after: bool,
+    /// Detail levels taking part, `0..D` (`None`: all).
+    pub depth: Option<usize>,
+    /// Circles of the planar field.
+    pub circles: usize,
+    /// Points per circle.
+    pub circle_points: usize,
+    /// Shells of the spherical field.
+    pub shells: usize,
+    /// Points per face edge of each shell's cube grid.
+    pub shell_grid: usize,
+    /// Progress bars on standard error.
+    pub progress: bool,
+}
+
+impl DynamicBudgets {
+    /// Seed 001's fields in `param`, everything kept.
+    pub fn new(param: Parameterization) -> Self {
+        let f = FieldOptions::new(param);
+        DynamicBudgets {
+            param,
+            keep_visibility: None,
+            keep_field: None,
+            keep_product: None,
+            truncate_after: false,
+            depth: None,
+            circles: f.circles,
+            circle_points: f.circle_points,
+            shells: f.shells,
+            shell_grid: f.shell_grid,
+            progress: false,
         }
     }
 }

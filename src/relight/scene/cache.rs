@@ -258,6 +258,13 @@ impl SceneCache {
         })
     }
 
+    /// The vertices of the scene's objects: all but the ground plane's, which stays
+    /// Lambertian ([`Scene::object_vertices`](super::Scene::object_vertices) of the scene
+    /// it was precomputed from).
+    pub fn object_vertices(&self) -> usize {
+        super::object_vertices(self.mesh.vertex_count(), self.params.ground_plane)
+    }
+
     /// Reads a cache, refusing a damaged file or another version; see the [module docs](self).
     pub fn read(path: &Path) -> Result<Self> {
         let bytes = std::fs::read(path).map_err(|source| Error::Io {

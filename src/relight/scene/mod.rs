@@ -72,6 +72,19 @@ pub const GROUND_CELLS: usize = 32;
 /// Vertices the ground plane adds: `(GROUND_CELLS + 1)^2`.
 pub const GROUND_VERTICES: usize = (GROUND_CELLS + 1) * (GROUND_CELLS + 1);
 
+/// Of `vertices`, those of the objects: all but the ground plane's (the last
+/// [`GROUND_VERTICES`]) when there is one.
+///
+/// ```
+/// use haarshift::relight::scene::{GROUND_VERTICES, object_vertices};
+/// assert_eq!(object_vertices(GROUND_VERTICES + 54, true), 54);
+/// assert_eq!(object_vertices(54, false), 54);
+/// ```
+pub fn object_vertices(vertices: usize, ground_plane: bool) -> usize {
+    let ground = if ground_plane { GROUND_VERTICES } else { 0 };
+    vertices.saturating_sub(ground)
+}
+
 /// The ground plane's albedo in a scene file.
 pub const GROUND_ALBEDO: [f32; 3] = [0.8, 0.8, 0.8];
 
@@ -253,7 +266,7 @@ impl Generator {
 /// use haarshift::relight::{Generator, add_ground_plane};
 /// let mut m = Generator::Sphere { cells: 4 }.mesh().unwrap();
 /// let before = m.vertex_count();
-/// add_ground_plane(&mut m);
+/// add_ground_plane(&mut m).unwrap();
 /// assert_eq!(m.vertex_count(), before + 33 * 33);
 /// let b = m.bounds();
 /// assert_eq!((b.min[1], b.max[0]), (-1.0, 4.0)); // at the lowest y, side 4 x 2
@@ -800,12 +813,7 @@ impl Scene {
     /// assert_eq!(Scene::from_mesh(sphere, false).unwrap().object_vertices(), 54);
     /// ```
     pub fn object_vertices(&self) -> usize {
-        let ground = if self.ground_plane {
-            GROUND_VERTICES
-        } else {
-            0
-        };
-        self.mesh.vertex_count().saturating_sub(ground)
+        object_vertices(self.mesh.vertex_count(), self.ground_plane)
     }
 
     /// Reads a scene: a JSON scene file (`.json`), or a mesh file (OBJ or PLY) as a scene of

@@ -37,10 +37,20 @@ pub const MAX_COORDINATE: f64 = 1e15;
 /// points once the BVH converts them.
 pub const MIN_GROUND_EXTENT_RATIO: f64 = 1e-6;
 
+/// Whether `v` is finite and within [`MAX_COORDINATE`] of zero (a NaN is not).
+///
+/// ```
+/// use haarshift::relight::scene::validate::in_range;
+/// assert!(in_range(-1e15) && !in_range(2e15) && !in_range(f64::NAN));
+/// ```
+pub fn in_range(v: f64) -> bool {
+    v.abs() <= MAX_COORDINATE
+}
+
 /// Checks that `point` is finite and within [`MAX_COORDINATE`] of the origin in every
 /// coordinate; `what` names it in the error.
 pub fn check_point(what: &str, point: [f64; 3]) -> Result<()> {
-    match point.iter().find(|v| !(v.abs() <= MAX_COORDINATE)) {
+    match point.iter().find(|v| !in_range(**v)) {
         Some(v) => Err(SceneError::OutOfRange {
             what: what.to_owned(),
             value: *v,
@@ -53,7 +63,7 @@ pub fn check_point(what: &str, point: [f64; 3]) -> Result<()> {
 /// Checks every row of a `(V, 3)` array of vertex positions with [`check_point`]; the error
 /// names the first vertex out of range.
 pub fn check_positions(positions: ArrayView2<'_, f64>) -> Result<()> {
-    let outside = |r: &ArrayView1<'_, f64>| r.iter().any(|v| !(v.abs() <= MAX_COORDINATE));
+    let outside = |r: &ArrayView1<'_, f64>| r.iter().any(|&v| !in_range(v));
     match positions.outer_iter().position(|r| outside(&r)) {
         Some(k) => {
             let r = positions.row(k);

@@ -3,18 +3,14 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::relight::light::environment::SphereMapping;
-use haarshift::relight::{Lighting, SceneCache};
+use haarshift::relight::SceneCache;
+use haarshift::relight::shade::{FrameSpec, Method, ShadingInput};
 use haarshift::render::animation::{numbered_path, write_gif};
 use haarshift::render::{to_srgb8, write_render};
 use haarshift::{Error, Result};
 
-use haarshift::relight::PreparedTransport;
-use haarshift::relight::glossy::GlossyShader;
-
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, filled_note, ms,
-    refuse_inputs, rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
 };
 use crate::commands::{print, refuse_existing};
 
@@ -79,14 +75,6 @@ pub struct Args {
     pub force: bool,
 }
 
-/// How the frames are shaded.
-enum Shader {
-    /// One sparse dot per vertex.
-    Lambert(PreparedTransport<f32>),
-    /// The triple product with the rotated BRDF.
-    Glossy(Box<GlossyShader<f32>>),
-}
-
 /// The most frames in one animation.
 const MAX_FRAMES: usize = 3600;
 
@@ -123,68 +111,55 @@ pub fn run(args: Args) -> Result<()> {
     inputs.extend(args.material.brdf_file());
     refuse_inputs(&inputs, &output_refs)?;
     refuse_existing(&output_refs, args.force)?;
-    let background = args.camera.background()?;
+    let view = args.camera.view()?;
     let mut cache = SceneCache::read(&args.cache)?;
     args.material.apply(&mut cache.albedo)?;
     let (env, [yaw, pitch, roll]) = args.light.load(cache.environment.as_ref())?;
-    let camera = args.camera.camera(cache.camera.as_ref(), &cache.mesh)?;
+    let camera = view.camera(cache.camera.as_ref(), &cache.mesh)?;
     let brdf = args.material.brdf()?;
-    args.glossy.check(&brdf)?;
-    let start = Instant::now();
     // Lambertian: one sparse dot per vertex and frame. Glossy: with a rotation cache, a frame
     // rotates only the maps no earlier frame (or --fill-cache) rotated: with a fixed view,
     // the first frame's.
-    let (shader, filled) = if brdf.is_lambert() {
-        (Shader::Lambert(args.shading.prepare(&cache)?), None)
-    } else {
-        let glossy = args.shading.prepare_glossy(&cache, &brdf, &args.glossy)?;
-        let filled = args.glossy.fill(&glossy)?;
-        (Shader::Glossy(Box::new(glossy)), filled)
-    };
-    // The lat-long-to-working mapping (a cube's conversion table) is built once, not per frame.
-    let mapping = SphereMapping::new(env.map().height(), cache.transport.param())?;
+    let spec = args.shading.spec(Method::Haar, &brdf, &args.glossy);
+    spec.check()?;
+    let mut shader = spec.build(&ShadingInput::cache(&cache).from_file(&args.cache))?;
+    let prepared = shader.preparation();
     let mut text = format!(
         "{}transport prepared once in {:.1} ms\n",
-        filled_note(filled),
-        ms(start) - filled.map_or(0.0, |f| f.ms)
+        prepared.filled.map_or(String::new(), |f| format!(
+            "cache filled ahead: {} maps rotated in {:.1} ms; ",
+            f.maps,
+            f.seconds * 1e3
+        )),
+        prepared.seconds * 1e3
     );
-    let mut radiance = ndarray::Array2::<f32>::zeros((cache.mesh.vertex_count(), 3));
     let mut frames = Vec::with_capacity(if gif { args.frames } else { 0 });
     for k in 0..args.frames {
-        let start = Instant::now();
         let step = 360.0 * k as f64 / args.frames as f64;
         let (frame_yaw, orbit) = if args.orbit {
             (yaw, step)
         } else {
             (yaw + step, 0.0)
         };
-        let view = camera.orbited(orbit)?;
+        let view_camera = camera.orbited(orbit)?;
         let turn = rotation([frame_yaw, pitch, roll])?;
-        let lighting = Lighting::encode(&env, &mapping, &turn, args.shading.light_selection())?;
-        let mut maps = String::new();
-        match &shader {
-            Shader::Lambert(prepared) => prepared.shade_into(&lighting, &mut radiance)?,
-            Shader::Glossy(glossy) => {
-                let report;
-                (radiance, report) = glossy.shade(&lighting, view.position())?;
-                maps = format!(
-                    ", BRDF maps {} ({} rotated in {:.1} ms)",
-                    report.maps,
-                    report.rotated,
-                    1e3 * report.rotate_seconds
-                );
-            }
-        }
-        let shade_ms = ms(start);
+        let shading = shader.shade(&FrameSpec {
+            environment: &env,
+            rotation: turn,
+            eye: Some(view_camera.position()),
+        })?;
+        let maps = shading.maps.map_or(String::new(), |report| {
+            format!(
+                ", BRDF maps {} ({} rotated in {:.1} ms)",
+                report.maps,
+                report.rotated,
+                1e3 * report.rotate_seconds
+            )
+        });
+        let shade_ms = shading.timing.total_seconds() * 1e3;
+        let radiance = shading.radiance.to_f32();
         let start = Instant::now();
-        let image = args.camera.draw(
-            &view,
-            &cache.mesh,
-            radiance.view(),
-            &background,
-            &env,
-            &turn,
-        )?;
+        let image = view.draw(&view_camera, &cache.mesh, radiance.view(), &env, &turn)?;
         let raster_ms = ms(start);
         match frame_paths.get(k) {
             Some(path) => write_render(&image, path, args.camera.exposure, args.force)?,

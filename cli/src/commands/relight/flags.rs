@@ -3,22 +3,19 @@
 
 use std::path::{Path, PathBuf};
 
-use haarshift::PlanarImage;
 use haarshift::product::Selection;
-use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
 use haarshift::relight::light::environment::Environment;
 use haarshift::relight::material::brdf::DEFAULT_ELEVATIONS;
 use haarshift::relight::material::orient::BrdfRotation;
-use haarshift::relight::scene::GROUND_VERTICES;
-use haarshift::relight::{Brdf, PreparedTransport, SceneCache, ShadeOptions};
-use haarshift::relight::{CameraSpec, EnvironmentSpec, Mesh, Scene};
-use haarshift::render::{Background, Camera, DEFAULT_FOV};
-use haarshift::render::{LitMesh, render};
-use haarshift::sphere::{LatLongMap, SphereRotation};
+use haarshift::relight::shade::glossy::GlossyOptions;
+use haarshift::relight::shade::{LightSpec, Method, ShadeOptions, ShaderSpec};
+use haarshift::relight::{Brdf, EnvironmentSpec, Scene};
+use haarshift::render::view::{Backdrop, ViewSpec};
 use haarshift::{Error, Result};
 
+pub use haarshift::relight::shade::frame::rotation;
+
 use crate::commands::{choice, names};
-use ndarray::ArrayView2;
 
 /// A mesh or a scene file, and the ground plane.
 #[derive(clap::Args, Debug)]
@@ -94,40 +91,21 @@ pub struct LightFlags {
 }
 
 impl LightFlags {
-    /// The environment's file and rotation angles `[yaw, pitch, roll]` in degrees: the flags,
-    /// else the scene file's `environment`.
-    fn resolve(&self, scene: Option<&EnvironmentSpec>) -> Result<(PathBuf, [f64; 3])> {
-        let path = match (&self.env, scene) {
-            (Some(path), _) => path.clone(),
-            (None, Some(spec)) => spec.path.clone(),
-            (None, None) => {
-                return Err(Error::InvalidParameter {
-                    name: "environment",
-                    reason: "give --env ENV (the scene names none)".into(),
-                });
-            }
-        };
-        let angle = |flag: Option<f64>, file: fn(&EnvironmentSpec) -> f64| {
-            flag.or(scene.map(file)).unwrap_or(0.0)
-        };
-        let angles = [
-            angle(self.yaw, |s| s.yaw),
-            angle(self.pitch, |s| s.pitch),
-            angle(self.roll, |s| s.roll),
-        ];
-        Ok((path, angles))
+    /// The lighting asked for.
+    pub fn spec(&self) -> LightSpec {
+        LightSpec {
+            env: self.env.clone(),
+            yaw: self.yaw,
+            pitch: self.pitch,
+            roll: self.roll,
+        }
     }
 
-    /// The environment (read) and its rotation angles `[yaw, pitch, roll]`, degrees.
+    /// The environment (read) and its rotation angles `[yaw, pitch, roll]`, degrees: the
+    /// flags, else the scene file's `environment`.
     pub fn load(&self, scene: Option<&EnvironmentSpec>) -> Result<(Environment, [f64; 3])> {
-        let (path, angles) = self.resolve(scene)?;
-        Ok((Environment::load(&path)?, angles))
+        self.spec().load(scene)
     }
-}
-
-/// The rotation `R = Rz(roll) Ry(yaw) Rx(pitch)` of `[yaw, pitch, roll]` in degrees.
-pub fn rotation([yaw, pitch, roll]: [f64; 3]) -> Result<SphereRotation> {
-    SphereRotation::from_degrees(yaw, pitch, roll)
 }
 
 /// The material: the BRDF and its albedo.
@@ -218,7 +196,7 @@ pub struct GlossyFlags {
 }
 
 impl GlossyFlags {
-    /// The glossy options for `brdf`.
+    /// The material: `brdf` and how it is rotated, truncated and cached.
     pub fn options(&self, brdf: &Brdf) -> GlossyOptions {
         GlossyOptions {
             brdf: brdf.clone(),
@@ -230,55 +208,6 @@ impl GlossyFlags {
             elevations: self.elevations,
         }
     }
-
-    /// Refuses these flags for a Lambertian `brdf`: they would change nothing.
-    pub fn check(&self, brdf: &Brdf) -> Result<()> {
-        let set = self.brdf_rotation != BrdfRotation::default()
-            || self.level.is_some()
-            || self.keep_brdf.is_some()
-            || self.brdf_levels.is_some()
-            || self.rotation_cache.is_some()
-            || self.elevations != DEFAULT_ELEVATIONS
-            || self.fill_cache;
-        if set && brdf.is_lambert() {
-            return Err(Error::InvalidParameter {
-                name: "brdf-rotation",
-                reason: "--brdf-rotation, --level, --keep-brdf, --brdf-levels, --rotation-cache, \
-                         --elevations and --fill-cache apply to glossy BRDFs; the BRDF is lambert"
-                    .into(),
-            });
-        }
-        if self.fill_cache && self.rotation_cache.is_none() {
-            return Err(Error::InvalidParameter {
-                name: "fill-cache",
-                reason: "--fill-cache fills the rotation cache: give --rotation-cache N".into(),
-            });
-        }
-        Ok(())
-    }
-
-    /// With `--fill-cache`, fills `shader`'s rotation cache ahead and says what that took.
-    pub fn fill(&self, shader: &GlossyShader<f32>) -> Result<Option<Filled>> {
-        if !self.fill_cache {
-            return Ok(None);
-        }
-        let start = std::time::Instant::now();
-        let maps = shader.fill_cache()?;
-        Ok(Some(Filled {
-            maps,
-            ms: ms(start),
-        }))
-    }
-}
-
-/// The vertices of `cache`'s objects: all but the ground plane's, which stays Lambertian.
-pub fn object_vertices(cache: &SceneCache) -> usize {
-    let ground = if cache.params.ground_plane {
-        GROUND_VERTICES
-    } else {
-        0
-    };
-    cache.mesh.vertex_count().saturating_sub(ground)
 }
 
 /// The camera and the image.
@@ -319,67 +248,27 @@ pub struct CameraFlags {
     pub background: String,
 }
 
-/// The background a render shows.
-pub enum BackgroundChoice {
-    /// The lighting, as the surfaces see it.
-    Environment,
-    /// A constant linear colour.
-    Colour([f32; 3]),
-}
-
 impl CameraFlags {
-    /// The camera: the flags, else the scene file's, else [`Camera::framing`] of `mesh`.
-    pub fn camera(&self, scene: Option<&CameraSpec>, mesh: &Mesh) -> Result<Camera> {
-        match (self.camera, self.look_at, scene) {
-            (Some(position), Some(look_at), _) => {
-                Camera::new(position, look_at, self.fov.unwrap_or(DEFAULT_FOV))
-            }
-            (_, _, Some(spec)) => {
-                Camera::new(spec.position, spec.look_at, self.fov.unwrap_or(spec.fov))
-            }
-            _ => {
-                let b = mesh.bounds();
-                Camera::framing(b.min, b.max, self.fov.unwrap_or(DEFAULT_FOV))
-            }
-        }
-    }
-
-    /// `mesh` with per-vertex `radiance` as `camera` sees it, `--width x --height`, in front
-    /// of `background`: the lighting `env` rotated by `rotation`, or a colour.
-    pub fn draw(
-        &self,
-        camera: &Camera,
-        mesh: &Mesh,
-        radiance: ArrayView2<'_, f32>,
-        background: &BackgroundChoice,
-        env: &Environment,
-        rotation: &SphereRotation,
-    ) -> Result<PlanarImage<f32>> {
-        let backdrop;
-        let background = match *background {
-            BackgroundChoice::Environment => {
-                backdrop = background_map(env, rotation)?;
-                Background::Environment(&backdrop)
-            }
-            BackgroundChoice::Colour(c) => Background::Colour(c),
-        };
-        let drawn = LitMesh {
-            positions: mesh.positions(),
-            triangles: mesh.triangles(),
-            radiance,
-        };
-        render(camera, self.width, self.height, &drawn, background)
+    /// The view these flags ask for (`--background` parsed).
+    pub fn view(&self) -> Result<ViewSpec> {
+        Ok(ViewSpec {
+            camera: self.camera.zip(self.look_at),
+            fov: self.fov,
+            width: self.width,
+            height: self.height,
+            backdrop: self.backdrop()?,
+        })
     }
 
     /// `--background`, parsed.
-    pub fn background(&self) -> Result<BackgroundChoice> {
+    fn backdrop(&self) -> Result<Backdrop> {
         if self.background == "env" {
-            return Ok(BackgroundChoice::Environment);
+            return Ok(Backdrop::Environment);
         }
         triple(&self.background)
             .ok()
             .filter(|c| c.iter().all(|&x| x >= 0.0))
-            .map(|c| BackgroundChoice::Colour(c.map(|x| x as f32)))
+            .map(|c| Backdrop::Colour(c.map(|x| x as f32)))
             .ok_or_else(|| Error::InvalidParameter {
                 name: "background",
                 reason: format!(
@@ -448,11 +337,6 @@ impl ShadingFlags {
         self.keep_light.map_or(Selection::All, Selection::Largest)
     }
 
-    /// Whether any truncation was asked for.
-    pub fn is_set(&self) -> bool {
-        self.keep_light.is_some() || self.keep_visibility.is_some() || self.depth.is_some()
-    }
-
     /// The transport's truncation.
     pub fn options(&self) -> ShadeOptions {
         ShadeOptions {
@@ -461,58 +345,21 @@ impl ShadingFlags {
         }
     }
 
-    /// `cache`'s transport prepared for Lambertian shading with its albedo.
-    pub fn prepare(&self, cache: &SceneCache) -> Result<PreparedTransport<f32>> {
-        PreparedTransport::new(&cache.transport, cache.albedo.view(), &self.options())
+    /// The shader these flags, `method` and the material (`brdf` under `glossy`) ask for.
+    pub fn spec(&self, method: Method, brdf: &Brdf, glossy: &GlossyFlags) -> ShaderSpec {
+        ShaderSpec {
+            method,
+            material: glossy.options(brdf),
+            fill_cache: glossy.fill_cache,
+            shade: self.options(),
+            keep_light: self.light_selection(),
+            progress: true,
+            ..ShaderSpec::default()
+        }
     }
-
-    /// `cache`'s transport prepared for shading with `brdf` (glossy on the objects, the ground
-    /// plane Lambertian) under `glossy`.
-    pub fn prepare_glossy(
-        &self,
-        cache: &SceneCache,
-        brdf: &Brdf,
-        glossy: &GlossyFlags,
-    ) -> Result<GlossyShader<f32>> {
-        GlossyShader::new(
-            &cache.transport,
-            &cache.mesh,
-            cache.albedo.view(),
-            &self.options(),
-            &glossy.options(brdf),
-            object_vertices(cache),
-        )
-    }
-}
-
-/// The background's lat-long height: the environment's, at most this (a background is seen,
-/// not integrated).
-const BACKGROUND_HEIGHT: usize = 512;
-
-/// The environment as a background: rotated like the lighting, at most
-/// [`BACKGROUND_HEIGHT`] rows.
-fn background_map(env: &Environment, rotation: &SphereRotation) -> Result<LatLongMap<f64>> {
-    env.lat_long(env.map().height().min(BACKGROUND_HEIGHT), rotation)
 }
 
 /// Milliseconds since `start`.
 pub fn ms(start: std::time::Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
-}
-
-/// What `--fill-cache` did: the maps rotated and the milliseconds that took.
-#[derive(Clone, Copy, Debug)]
-pub struct Filled {
-    pub maps: usize,
-    pub ms: f64,
-}
-
-/// What `--fill-cache` did, for a command's report ("" without it).
-pub fn filled_note(filled: Option<Filled>) -> String {
-    filled.map_or(String::new(), |f| {
-        format!(
-            "cache filled ahead: {} maps rotated in {:.1} ms; ",
-            f.maps, f.ms
-        )
-    })
 }

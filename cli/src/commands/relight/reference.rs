@@ -2,15 +2,12 @@
 //! texels with ray casting, independent of every Haar path.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
-use haarshift::relight::{ReferenceOptions, SceneBvh, reference};
+use haarshift::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
 use haarshift::render::{render_format, write_render};
 use haarshift::{Result, SampleDepth};
 
-use super::flags::{
-    CameraFlags, LightFlags, MaterialFlags, SceneFlags, ms, refuse_inputs, rotation,
-};
+use super::flags::{CameraFlags, LightFlags, MaterialFlags, SceneFlags, refuse_inputs, rotation};
 use crate::commands::{print, refuse_existing};
 
 const HELP: &str = "\
@@ -76,29 +73,28 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(image) = &args.output {
         render_format(image)?;
     }
-    let background = args.camera.background()?;
+    let view = args.camera.view()?;
     let brdf = args.material.brdf()?;
     let mut scene = args.scene.load()?;
     args.material.apply(&mut scene.albedo)?;
     let (env, angles) = args.light.load(scene.environment.as_ref())?;
     let rotation = rotation(angles)?;
-    let start = Instant::now();
-    let lighting = env.lat_long(args.resolution, &rotation)?;
-    let lighting_ms = ms(start);
-    let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh)?;
-    let (radiance, report) = reference(
-        &scene.mesh,
-        &SceneBvh::new(&scene.mesh),
-        scene.albedo.view(),
-        &lighting,
-        &ReferenceOptions {
-            progress: true,
-            brdf: brdf.clone(),
+    let camera = view.camera(scene.camera.as_ref(), &scene.mesh)?;
+    let mut spec = ShaderSpec {
+        method: Method::Reference,
+        reference_resolution: Some(args.resolution),
+        progress: true,
+        ..ShaderSpec::default()
+    };
+    spec.material.brdf = brdf;
+    let shading = spec
+        .build(&ShadingInput::scene(&scene))?
+        .shade(&FrameSpec {
+            environment: &env,
+            rotation,
             eye: Some(camera.position()),
-            object_vertices: Some(scene.object_vertices()),
-        },
-    )?;
-    let radiance = radiance.mapv(|v| v as f32);
+        })?;
+    let radiance = shading.radiance.to_f32();
     haarshift::io::write_npy(
         radiance.view(),
         SampleDepth::F32,
@@ -106,25 +102,14 @@ pub fn run(args: Args) -> Result<()> {
         args.force,
     )?;
     let mut text = format!(
-        "{}: ({}, 3) radiance ({}) by quadrature over {} x {} texels: rays {}, {:.3} s \
-         (lighting downsampled in {lighting_ms:.1} ms)\n",
+        "{}: ({}, 3) {} (lighting downsampled in {:.1} ms)\n",
         args.vertices.display(),
         scene.mesh.vertex_count(),
-        brdf,
-        args.resolution,
-        2 * args.resolution,
-        report.rays,
-        report.seconds,
+        shading.description,
+        shading.timing.encode_seconds * 1e3,
     );
     if let Some(path) = &args.output {
-        let image = args.camera.draw(
-            &camera,
-            &scene.mesh,
-            radiance.view(),
-            &background,
-            &env,
-            &rotation,
-        )?;
+        let image = view.draw(&camera, &scene.mesh, radiance.view(), &env, &rotation)?;
         write_render(&image, path, args.camera.exposure, args.force)?;
         text += &format!(
             "{}: {} x {} image\n",

@@ -7,10 +7,11 @@ use std::time::Instant;
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::dynamic::fields::file::FieldStore;
-use haarshift::relight::dynamic::fields::{FieldOptions, Truncation};
 use haarshift::relight::dynamic::motion::{MotionPath, play};
-use haarshift::relight::dynamic::{Change, DynamicOptions, DynamicScene};
-use haarshift::relight::{Brdf, CameraSpec, Lighting};
+use haarshift::relight::dynamic::{Change, DynamicBudgets, DynamicOptions, DynamicScene};
+use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
+use haarshift::relight::shade::{FrameSpec, Shader, ShaderSpec};
+use haarshift::relight::{Brdf, CameraSpec};
 use haarshift::render::animation::{numbered_path, write_gif};
 use haarshift::render::{Camera, render_format, to_srgb8, write_render};
 use haarshift::{Error, Result, SampleDepth};
@@ -64,15 +65,6 @@ Examples:
   haarshift relight scene testdata/scenes/bunny.json --param cube --resolution 64 --keep-field 120 --fields-dir fields -o bunny.png
       (the first run builds fields/bunny.hsf; the same command again loads it)";
 
-/// The method the radiance is computed by.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
-    /// Occlusion fields and Haar product integrals.
-    Haar,
-    /// Ray-cast visibility against the placed scene, direct quadrature.
-    Reference,
-}
-
 /// When a looked-up occlusion map is truncated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum TruncateWhen {
@@ -103,9 +95,11 @@ pub struct Args {
     #[arg(long, value_name = "OUT.npy")]
     pub vertices: Option<PathBuf>,
 
-    /// How the radiance is computed
-    #[arg(long, value_enum, default_value = "haar")]
-    pub method: Method,
+    /// How the radiance is computed: `haar` (occlusion fields and Haar product integrals) or
+    /// `reference` (ray-cast visibility against the placed scene, direct quadrature)
+    #[arg(long, value_name = "METHOD", default_value = "haar",
+          value_parser = choice::<DynamicMethod>(names!(DynamicMethod)))]
+    pub method: DynamicMethod,
 
     /// Parameterisation of every map: `latlong` N x 2N (objects can turn) or `cube` 6 x N x N
     #[arg(long, default_value = "latlong", value_parser = choice::<ParamKind>(names!(ParamKind)))]
@@ -184,27 +178,19 @@ pub struct Args {
 
 impl Args {
     fn options(&self) -> Result<DynamicOptions> {
-        let param = Parameterization::new(self.param, self.resolution)?;
-        let largest = |k: Option<usize>| k.map_or(Selection::All, Selection::Largest);
-        Ok(DynamicOptions {
-            field: FieldOptions {
-                keep: largest(self.keep_field),
-                circles: self.circles,
-                circle_points: self.circle_points,
-                shells: self.shells,
-                shell_grid: self.shell_grid,
-                progress: true,
-                ..FieldOptions::new(param)
-            },
-            keep_visibility: largest(self.keep_visibility),
-            truncation: match self.truncate {
-                TruncateWhen::Before => Truncation::Before,
-                TruncateWhen::After => Truncation::After(largest(self.keep_field)),
-            },
-            keep_product: largest(self.keep_product),
+        Ok(DynamicOptions::from_budgets(&DynamicBudgets {
+            param: Parameterization::new(self.param, self.resolution)?,
+            keep_visibility: self.keep_visibility,
+            keep_field: self.keep_field,
+            keep_product: self.keep_product,
+            truncate_after: self.truncate == TruncateWhen::After,
             depth: self.depth,
+            circles: self.circles,
+            circle_points: self.circle_points,
+            shells: self.shells,
+            shell_grid: self.shell_grid,
             progress: true,
-        })
+        }))
     }
 }
 
@@ -249,7 +235,7 @@ pub fn run(args: Args) -> Result<()> {
     );
     refuse_inputs(&inputs, &outputs)?;
     refuse_existing(&outputs, args.force)?;
-    let background = args.camera.background()?;
+    let view = args.camera.view()?;
     let options = args.options()?;
     let mut store = args
         .fields_dir
@@ -261,7 +247,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut scene = DynamicScene::load_with(&args.scene, &options, store.as_mut())?;
     let build_ms = ms(start);
     let (env, angles) = args.light.load(scene.environment.as_ref())?;
-    let camera = args.camera.camera(scene.camera.as_ref(), &scene.mesh())?;
+    let camera = view.camera(scene.camera.as_ref(), &scene.mesh())?;
     if let Some(spec) = &args.brdf {
         let brdf: Brdf = spec.parse()?;
         for k in 0..scene.object_count() {
@@ -269,14 +255,14 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     // The glossy flags apply to the first glossy material (any other is rotated alike).
-    let glossy = (0..scene.object_count())
-        .map(|k| scene.brdf(k).cloned())
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .find(|b| !b.is_lambert())
-        .unwrap_or(Brdf::Lambert);
-    args.glossy.check(&glossy)?;
-    scene.set_glossy(&args.glossy.options(&glossy))?;
+    let glossy = args.glossy.options(&glossy_material(&scene)?);
+    ShaderSpec {
+        material: glossy.clone(),
+        fill_cache: args.glossy.fill_cache,
+        ..ShaderSpec::default()
+    }
+    .check()?;
+    scene.set_glossy(&glossy)?;
     scene.set_eye(camera.position())?;
     // The camera as resolved from the flags and the file: eye segments orbit its look-at point.
     scene.camera = Some(CameraSpec {
@@ -325,14 +311,7 @@ pub fn run(args: Args) -> Result<()> {
                     what: String|
      -> Result<()> {
         let start = Instant::now();
-        let image = args.camera.draw(
-            camera,
-            &scene.mesh(),
-            radiance.view(),
-            &background,
-            &env,
-            turn,
-        )?;
+        let image = view.draw(camera, &scene.mesh(), radiance.view(), &env, turn)?;
         let raster_ms = ms(start);
         match (frame_paths.get(index), gif) {
             (Some(p), _) => write_render(&image, p, args.camera.exposure, args.force)?,
@@ -345,25 +324,22 @@ pub fn run(args: Args) -> Result<()> {
         }
         Ok(())
     };
-    let reference = |scene: &DynamicScene, turn: &haarshift::sphere::SphereRotation| {
-        let map = env.lat_long(param.face_size(), turn)?;
-        Ok::<_, Error>(scene.reference(&map)?.mapv(|x| x as f32))
-    };
     match &path {
         None => {
             let turn = rotation(angles)?;
-            let start = Instant::now();
-            let (radiance, what) = match args.method {
-                Method::Haar => {
-                    let lighting = Lighting::new(&env, param, &turn, keep_light)?;
-                    (
-                        scene.shade::<f32>(&lighting)?,
-                        "n-function product integrals",
-                    )
-                }
-                Method::Reference => (reference(&scene, &turn)?, "ray-cast reference"),
-            };
-            let what = format!("{}: {what} {:.1} ms", args.output.display(), ms(start));
+            let shading =
+                DynamicShader::new(&scene, args.method, keep_light).shade(&FrameSpec {
+                    environment: &env,
+                    rotation: turn,
+                    eye: None,
+                })?;
+            let radiance = shading.radiance.to_f32();
+            let what = format!(
+                "{}: {} {:.1} ms",
+                args.output.display(),
+                shading.description,
+                shading.timing.total_seconds() * 1e3
+            );
             draw(&scene, &camera, &radiance, &turn, 0, &mut text, what)?;
         }
         Some(path) => {
@@ -374,19 +350,15 @@ pub fn run(args: Args) -> Result<()> {
                 keep_light,
                 path,
                 |scene, radiance, turn, report| {
-                    let (radiance, shade) = match args.method {
-                        Method::Haar => (
-                            radiance.clone(),
-                            format!("shading {:.1} ms", report.shade_seconds * 1e3),
-                        ),
-                        Method::Reference => {
-                            let start = Instant::now();
-                            (
-                                reference(scene, turn)?,
-                                format!("reference {:.1} ms", ms(start)),
-                            )
-                        }
-                    };
+                    let shading =
+                        args.method
+                            .played(scene, radiance, report.shade_seconds, &env, turn)?;
+                    let shade = format!(
+                        "{} {:.1} ms",
+                        shading.description,
+                        shading.timing.total_seconds() * 1e3
+                    );
+                    let radiance = shading.radiance.to_f32();
                     let vertices = scene.vertex_count().max(1) as f64;
                     let reformed = report.reformed.map_or(String::new(), |r| {
                         format!(

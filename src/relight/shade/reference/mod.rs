@@ -32,6 +32,10 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2, Axis};
 use rayon::prelude::*;
 
+use super::{
+    FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds,
+};
+use crate::relight::SceneBvh;
 use crate::relight::precompute::raycast::Occlusion;
 use crate::relight::precompute::visibility::{f32x3, origin_and_normal, progress_bar, ray_offset};
 use crate::relight::scene::mesh::dot;
@@ -261,7 +265,7 @@ fn quadrature(
 ///
 /// ```
 /// use haarshift::relight::{Mesh, ReferenceOptions, SceneBvh, reference};
-/// use haarshift::relight::reference::ReferenceVisibility;
+/// use haarshift::relight::shade::reference::ReferenceVisibility;
 /// use haarshift::sphere::LatLongMap;
 /// use ndarray::{Array2, array};
 /// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
@@ -382,6 +386,96 @@ fn outgoing(mesh: &Mesh, v: usize, n: [f64; 3], e: [f64; 3]) -> [f64; 3] {
     let d: [f64; 3] = std::array::from_fn(|k| e[k] - mesh.positions()[[v, k]]);
     let len = dot(d, d).sqrt();
     if len > 0.0 { d.map(|x| x / len) } else { n }
+}
+
+/// The reference behind [`Shader`](super::Shader): each frame's environment downsampled to
+/// `N x 2N` ([`ShaderSpec::reference_resolution`], default the transport's face size) and
+/// integrated by [`reference()`] toward the frame's eye, against the scene's own bounding
+/// volume hierarchy (built once).
+pub struct ReferenceShader {
+    mesh: Mesh,
+    bvh: SceneBvh,
+    albedo: Array2<f32>,
+    options: ReferenceOptions,
+    resolution: usize,
+    prepare_seconds: f64,
+}
+
+impl ReferenceShader {
+    /// The reference of `input` for `spec`'s material.
+    pub(crate) fn new(spec: &ShaderSpec, input: &ShadingInput<'_>) -> Result<Self> {
+        let start = Instant::now();
+        let resolution = match (spec.reference_resolution, input.transport) {
+            (Some(n), _) => n,
+            (None, Some(set)) => set.param().face_size(),
+            (None, None) => {
+                return Err(Error::parameter(
+                    "resolution",
+                    "the reference of a scene without a transport needs its lat-long height N",
+                ));
+            }
+        };
+        Ok(ReferenceShader {
+            mesh: input.mesh.clone(),
+            bvh: SceneBvh::new(input.mesh),
+            albedo: input.albedo.to_owned(),
+            options: ReferenceOptions {
+                progress: spec.progress,
+                brdf: spec.material.brdf.clone(),
+                eye: None,
+                object_vertices: Some(input.object_vertices),
+            },
+            resolution,
+            prepare_seconds: seconds(start),
+        })
+    }
+}
+
+impl Shader for ReferenceShader {
+    fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
+        let start = Instant::now();
+        let lighting = frame
+            .environment
+            .lat_long(self.resolution, &frame.rotation)?;
+        let encode_seconds = seconds(start);
+        let options = ReferenceOptions {
+            eye: frame.eye,
+            ..self.options.clone()
+        };
+        let start = Instant::now();
+        let (radiance, report) = reference(
+            &self.mesh,
+            &self.bvh,
+            self.albedo.view(),
+            &lighting,
+            &options,
+        )?;
+        Ok(Shading {
+            radiance: Radiance::F64(radiance),
+            timing: Timing {
+                encode_seconds,
+                rotate_seconds: 0.0,
+                shade_seconds: seconds(start),
+            },
+            description: format!(
+                "radiance ({}) by quadrature over {} x {} texels: rays {}, {:.3} s",
+                options.brdf,
+                self.resolution,
+                2 * self.resolution,
+                report.rays,
+                report.seconds
+            ),
+            maps: None,
+            light_coefficients: Some(2 * self.resolution * self.resolution),
+        })
+    }
+
+    fn preparation(&self) -> Preparation {
+        Preparation {
+            seconds: self.prepare_seconds,
+            filled: None,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -38,6 +38,10 @@
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
+use super::{
+    FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
+    Timing, seconds,
+};
 use crate::faces::Parameterization;
 use crate::faces::integrate::layout;
 use crate::product::Selection;
@@ -394,6 +398,64 @@ fn retruncate<T: Sample>(
         .collect();
     out.sort_unstable_by_key(|&(i, _)| i);
     out.into_iter().unzip()
+}
+
+/// Lambertian Haar shading behind [`Shader`](super::Shader): the transport prepared once
+/// ([`PreparedTransport`]), each frame's lighting encoded and dotted with it.
+#[derive(Debug)]
+pub struct LambertShader<T> {
+    prepared: PreparedTransport<T>,
+    encoder: HaarEncoder,
+    prepare_seconds: f64,
+}
+
+impl<T: Sample> LambertShader<T> {
+    /// `input`'s transport prepared with its albedo and `spec`'s truncation.
+    pub(crate) fn new(spec: &ShaderSpec, input: &ShadingInput<'_>) -> Result<Self> {
+        let start = std::time::Instant::now();
+        let set = input.transport(spec.method)?;
+        let prepared = PreparedTransport::new(set, input.albedo, &spec.shade)?;
+        Ok(LambertShader {
+            encoder: HaarEncoder::new(set.param(), spec.keep_light),
+            prepared,
+            prepare_seconds: seconds(start),
+        })
+    }
+}
+
+impl<T: Sample> Shader for LambertShader<T>
+where
+    Radiance: From<Array2<T>>,
+{
+    fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
+        let (lighting, encode_seconds) = self.encoder.encode(frame)?;
+        let start = std::time::Instant::now();
+        let radiance = self.prepared.shade(&lighting)?;
+        Ok(Shading {
+            radiance: radiance.into(),
+            timing: Timing {
+                encode_seconds,
+                rotate_seconds: 0.0,
+                shade_seconds: seconds(start),
+            },
+            description: format!(
+                "Haar, lighting kept {} detail coefficients, transport {} coefficients; \
+                 transport prepared once in {:.1} ms",
+                lighting.kept(),
+                self.prepared.coefficient_count(),
+                self.prepare_seconds * 1e3
+            ),
+            maps: None,
+            light_coefficients: Some(lighting.kept() + lighting.param().faces()),
+        })
+    }
+
+    fn preparation(&self) -> Preparation {
+        Preparation {
+            seconds: self.prepare_seconds,
+            filled: None,
+        }
+    }
 }
 
 #[cfg(test)]

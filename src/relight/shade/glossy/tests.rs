@@ -409,7 +409,7 @@ fn bad_inputs_are_refused() {
 #[test]
 fn full_coefficients_and_direct_evaluation_equal_the_reference() {
     use crate::relight::precompute::visibility::{VisibilityOptions, vertex_major};
-    use crate::relight::reference::{ReferenceOptions, reference};
+    use crate::relight::{ReferenceOptions, reference};
     use crate::relight::{SceneBvh, add_ground_plane};
     use crate::sphere::LatLongMap;
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");

@@ -45,14 +45,18 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use crate::faces::param::Parameterization;
+use super::lambert::{PreparedTransport, ShadeOptions, select_kept, within_depth};
+use super::{
+    Filled, FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading,
+    ShadingInput, Timing, seconds,
+};
+use crate::faces::Parameterization;
 use crate::product::Selection;
 use crate::relight::Mesh;
 use crate::relight::light::lighting::Lighting;
 use crate::relight::material::brdf::Brdf;
 use crate::relight::material::orient::{BrdfRotation, Frame, Orientation, to_pole, unit};
 use crate::relight::precompute::transport::TransportSet;
-use crate::relight::shade::{PreparedTransport, ShadeOptions, select_kept, within_depth};
 use crate::sphere::latlong::{angles, direction};
 use crate::transform::{Normalization, pyramid};
 use crate::{Error, Result, Sample};
@@ -63,7 +67,7 @@ pub const MAX_CACHE_BINS: usize = 1024;
 /// How glossy vertices are shaded; see the [module docs](self).
 ///
 /// ```
-/// use haarshift::relight::glossy::GlossyOptions;
+/// use haarshift::relight::shade::glossy::GlossyOptions;
 /// use haarshift::relight::material::orient::BrdfRotation;
 /// let o = GlossyOptions::default();
 /// assert_eq!((o.rotation, o.level, o.keep_brdf, o.cache_bins), (BrdfRotation::Haar, None, None, None));
@@ -93,7 +97,7 @@ impl GlossyOptions {
     /// details, more levels than its faces have, a cache bin count outside `1..=1024`.
     ///
     /// ```
-    /// use haarshift::relight::glossy::GlossyOptions;
+    /// use haarshift::relight::shade::glossy::GlossyOptions;
     /// use haarshift::faces::{ParamKind, Parameterization};
     /// let param = Parameterization::new(ParamKind::LatLong, 8).unwrap(); // 2 x 8^2 texels
     /// assert!(GlossyOptions::default().check(param).is_ok());
@@ -175,7 +179,7 @@ pub struct GlossyReport {
 /// ```
 /// use haarshift::product::Selection;
 /// use haarshift::relight::{Brdf, Lighting, Mesh, ShadeOptions, TransportSet};
-/// use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
+/// use haarshift::relight::shade::glossy::{GlossyOptions, GlossyShader};
 /// use haarshift::relight::material::orient::BrdfRotation;
 /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// use ndarray::{Array2, Axis, array};
@@ -357,7 +361,7 @@ impl<T: Sample> GlossyShader<T> {
     /// ```
     /// # use haarshift::product::Selection;
     /// # use haarshift::relight::{Brdf, Mesh, ShadeOptions, TransportSet};
-    /// # use haarshift::relight::glossy::{GlossyOptions, GlossyShader};
+    /// # use haarshift::relight::shade::glossy::{GlossyOptions, GlossyShader};
     /// # use haarshift::faces::param::{ParamKind, Parameterization};
     /// # use ndarray::{Array2, Array3, array};
     /// # let mesh = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
@@ -650,6 +654,117 @@ fn product_rows<T: Sample>(
         }
     }
     Ok(())
+}
+
+/// Glossy Haar shading behind [`Shader`](super::Shader): a [`GlossyShader`] made once (and
+/// with [`ShaderSpec::fill_cache`] its rotation cache filled), each frame's lighting encoded
+/// and shaded from the frame's eye; the rotation cache lasts from frame to frame.
+#[derive(Debug)]
+pub struct GlossyHaarShader<T> {
+    shader: GlossyShader<T>,
+    encoder: HaarEncoder,
+    options: GlossyOptions,
+    preparation: Preparation,
+}
+
+impl<T: Sample> GlossyHaarShader<T> {
+    /// `input`'s transport prepared for `spec`'s material on its objects.
+    pub(crate) fn new(spec: &ShaderSpec, input: &ShadingInput<'_>) -> Result<Self> {
+        let start = Instant::now();
+        let set = input.transport(spec.method)?;
+        let shader = GlossyShader::new(
+            set,
+            input.mesh,
+            input.albedo,
+            &spec.shade,
+            &spec.material,
+            input.object_vertices,
+        )?;
+        let prepare_seconds = seconds(start);
+        let filled = if spec.fill_cache {
+            let start = Instant::now();
+            let maps = shader.fill_cache()?;
+            Some(Filled {
+                maps,
+                seconds: seconds(start),
+            })
+        } else {
+            None
+        };
+        Ok(GlossyHaarShader {
+            shader,
+            encoder: HaarEncoder::new(set.param(), spec.keep_light),
+            options: spec.material.clone(),
+            preparation: Preparation {
+                seconds: prepare_seconds,
+                filled,
+            },
+        })
+    }
+
+    /// What the frame's shading did with the BRDF maps, for its description.
+    fn cache_note(&self, report: &GlossyReport) -> String {
+        let filled = self.preparation.filled.map_or(String::new(), |f| {
+            format!(
+                "cache filled ahead: {} maps rotated in {:.1} ms; ",
+                f.maps,
+                f.seconds * 1e3
+            )
+        });
+        match self.options.cache_bins {
+            Some(n) => format!(
+                "rotation cache {n} x {}: {filled}{} maps rotated in {:.1} ms, {} from the cache",
+                2 * n,
+                report.rotated,
+                report.rotate_seconds * 1e3,
+                report.maps - report.rotated
+            ),
+            None => format!("no rotation cache: {} maps rotated", report.rotated),
+        }
+    }
+}
+
+impl<T: Sample> Shader for GlossyHaarShader<T>
+where
+    Radiance: From<Array2<T>>,
+{
+    fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
+        let eye = frame.eye()?;
+        let (lighting, encode_seconds) = self.encoder.encode(frame)?;
+        let start = Instant::now();
+        let (radiance, report) = self.shader.shade(&lighting, eye)?;
+        let shade_seconds = seconds(start);
+        let o = &self.options;
+        let description = format!(
+            "Haar triple product, {} rotated by {}{}, lighting kept {} detail coefficients, \
+             transport {} coefficients; {}; transport prepared once in {:.1} ms",
+            o.brdf,
+            o.rotation,
+            o.level.map_or(String::new(), |l| format!(
+                " from level {l} (thesis level {})",
+                l + 1
+            )),
+            lighting.kept(),
+            self.shader.transport().coefficient_count(),
+            self.cache_note(&report),
+            self.preparation.seconds * 1e3
+        );
+        Ok(Shading {
+            radiance: radiance.into(),
+            timing: Timing {
+                encode_seconds,
+                rotate_seconds: report.rotate_seconds,
+                shade_seconds,
+            },
+            description,
+            maps: Some(report),
+            light_coefficients: Some(lighting.kept() + lighting.param().faces()),
+        })
+    }
+
+    fn preparation(&self) -> Preparation {
+        self.preparation
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,258 @@
+//! [`ShaderSpec`]: how per-vertex radiance is computed, and the one place that chooses the
+//! [`Shader`] that computes it.
+
+use std::path::Path;
+
+use ndarray::ArrayView2;
+
+use super::Shader;
+use super::ambient::AmbientShader;
+use super::glossy::{GlossyHaarShader, GlossyOptions};
+use super::harmonics::ShShader;
+use super::lambert::{LambertShader, ShadeOptions};
+use super::reference::ReferenceShader;
+use crate::named::named_enum;
+use crate::product::Selection;
+use crate::relight::material::brdf::DEFAULT_ELEVATIONS;
+use crate::relight::material::orient::BrdfRotation;
+use crate::relight::{Mesh, Scene, SceneCache, TransportSet};
+use crate::{Error, Result};
+
+named_enum! {
+    /// How the radiance is computed: the names `relight render --basis` takes.
+    ///
+    /// ```
+    /// use haarshift::relight::shade::Method;
+    /// assert_eq!("sh".parse::<Method>().unwrap(), Method::Sh);
+    /// assert_eq!(Method::ALL.iter().map(|m| m.name()).collect::<Vec<_>>(),
+    ///            ["haar", "sh", "reference", "ambient"]);
+    /// ```
+    pub enum Method ("basis") {
+        /// The sparse Haar transport and lighting (all-frequency); glossy BRDFs by the triple
+        /// product with the rotated BRDF.
+        Haar = "haar",
+        /// Spherical harmonics: the transfer stored by `precompute --sh-bands B` and the
+        /// lighting projected onto the same bands (low-frequency PRT).
+        Sh = "sh",
+        /// Direct quadrature over the lighting's texels with ray casting: the ground truth.
+        Reference = "reference",
+        /// Ambient occlusion: `albedo / pi x` the integral of the transport, whatever the
+        /// lighting.
+        Ambient = "ambient",
+    }
+}
+
+/// The arithmetic of the Haar shaders (the other methods have their own).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Precision {
+    /// `f32`: the fast path.
+    #[default]
+    F32,
+    /// `f64`: for checks and committed tables.
+    F64,
+}
+
+/// How per-vertex radiance is computed; [`build`](Self::build) makes the [`Shader`].
+///
+/// ```
+/// use haarshift::relight::shade::{Method, ShaderSpec};
+/// let spec = ShaderSpec::default();
+/// assert_eq!((spec.method, spec.material.brdf.is_lambert(), spec.fill_cache), (Method::Haar, true, false));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShaderSpec {
+    /// The method.
+    pub method: Method,
+    /// The material: the objects' BRDF (the ground plane stays Lambertian) and, for a glossy
+    /// one, how it is brought into each vertex's frame, truncated and cached.
+    pub material: GlossyOptions,
+    /// Rotate every bin of the rotation cache before the first frame (Phong only).
+    pub fill_cache: bool,
+    /// The transport's truncation (`keep_visibility`, `depth`), Haar only.
+    pub shade: ShadeOptions,
+    /// The lighting's truncation, Haar only.
+    pub keep_light: Selection,
+    /// The Haar shaders' arithmetic.
+    pub precision: Precision,
+    /// Spherical harmonics: use the first `B` of the bands stored [default: all].
+    pub sh_bands: Option<usize>,
+    /// The reference's lat-long height `N` [default: the transport's face size].
+    pub reference_resolution: Option<usize>,
+    /// The reference draws a progress bar on standard error.
+    pub progress: bool,
+}
+
+impl Default for ShaderSpec {
+    /// Haar, Lambertian, every coefficient, `f32`.
+    fn default() -> Self {
+        ShaderSpec {
+            method: Method::Haar,
+            material: GlossyOptions::default(),
+            fill_cache: false,
+            shade: ShadeOptions::default(),
+            keep_light: Selection::All,
+            precision: Precision::F32,
+            sh_bands: None,
+            reference_resolution: None,
+            progress: false,
+        }
+    }
+}
+
+impl ShaderSpec {
+    /// Refuses options that would change nothing for this method and material, with a
+    /// message naming the `relight` flags.
+    ///
+    /// ```
+    /// use haarshift::relight::shade::ShaderSpec;
+    /// let mut spec = ShaderSpec::default(); // Lambertian
+    /// spec.material.cache_bins = Some(16);
+    /// assert!(spec.check().is_err()); // a rotation cache rotates glossy BRDFs only
+    /// ```
+    pub fn check(&self) -> Result<()> {
+        let m = &self.material;
+        let glossy_set = m.rotation != BrdfRotation::default()
+            || m.level.is_some()
+            || m.keep_brdf.is_some()
+            || m.brdf_levels.is_some()
+            || m.cache_bins.is_some()
+            || m.elevations != DEFAULT_ELEVATIONS
+            || self.fill_cache;
+        if glossy_set && m.brdf.is_lambert() {
+            return Err(Error::InvalidParameter {
+                name: "brdf-rotation",
+                reason: "--brdf-rotation, --level, --keep-brdf, --brdf-levels, --rotation-cache, \
+                         --elevations and --fill-cache apply to glossy BRDFs; the BRDF is lambert"
+                    .into(),
+            });
+        }
+        if self.fill_cache && m.cache_bins.is_none() {
+            return Err(Error::InvalidParameter {
+                name: "fill-cache",
+                reason: "--fill-cache fills the rotation cache: give --rotation-cache N".into(),
+            });
+        }
+        let truncated = self.keep_light != Selection::All
+            || self.shade.keep_visibility.is_some()
+            || self.shade.depth.is_some();
+        if self.method == Method::Sh && truncated {
+            return Err(Error::InvalidParameter {
+                name: "basis",
+                reason: "--keep-light, --keep-visibility and --depth truncate the Haar \
+                         basis; --basis sh uses every band stored"
+                    .into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The shader of this spec for `input`, prepared (and with
+    /// [`fill_cache`](Self::fill_cache), its rotation cache filled).
+    pub fn build(&self, input: &ShadingInput<'_>) -> Result<Box<dyn Shader>> {
+        self.check()?;
+        Ok(match (self.method, self.precision) {
+            (Method::Haar, precision) if self.material.brdf.is_lambert() => match precision {
+                Precision::F32 => Box::new(LambertShader::<f32>::new(self, input)?),
+                Precision::F64 => Box::new(LambertShader::<f64>::new(self, input)?),
+            },
+            (Method::Haar, Precision::F32) => Box::new(GlossyHaarShader::<f32>::new(self, input)?),
+            (Method::Haar, Precision::F64) => Box::new(GlossyHaarShader::<f64>::new(self, input)?),
+            (Method::Sh, _) => Box::new(ShShader::new(self, input)?),
+            (Method::Reference, _) => Box::new(ReferenceShader::new(self, input)?),
+            (Method::Ambient, _) => Box::new(AmbientShader::new(self, input)?),
+        })
+    }
+}
+
+/// What a shader is built from: the mesh, its albedo, the precomputed transport (absent for a
+/// scene that was not precomputed: only the reference shades it), and where the objects'
+/// vertices end (the ground plane's, after them, stay Lambertian).
+///
+/// ```
+/// use haarshift::relight::shade::ShadingInput;
+/// use haarshift::relight::{Generator, Scene};
+/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true);
+/// let input = ShadingInput::scene(&scene);
+/// assert!(input.transport.is_none());
+/// assert_eq!(input.object_vertices, scene.object_vertices());
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingInput<'a> {
+    /// The mesh, objects first.
+    pub mesh: &'a Mesh,
+    /// RGB albedo per vertex, `(V, 3)`.
+    pub albedo: ArrayView2<'a, f32>,
+    /// Every vertex's transport, when precomputed.
+    pub transport: Option<&'a TransportSet>,
+    /// Vertices `0..object_vertices` carry the material's BRDF.
+    pub object_vertices: usize,
+    /// The file the input came from, named by errors about its contents.
+    pub origin: Option<&'a Path>,
+}
+
+impl<'a> ShadingInput<'a> {
+    /// An input from its parts.
+    pub fn new(
+        mesh: &'a Mesh,
+        albedo: ArrayView2<'a, f32>,
+        transport: Option<&'a TransportSet>,
+        object_vertices: usize,
+    ) -> Self {
+        ShadingInput {
+            mesh,
+            albedo,
+            transport,
+            object_vertices,
+            origin: None,
+        }
+    }
+
+    /// A scene cache's mesh, albedo and transport.
+    pub fn cache(cache: &'a SceneCache) -> Self {
+        Self::new(
+            &cache.mesh,
+            cache.albedo.view(),
+            Some(&cache.transport),
+            cache.object_vertices(),
+        )
+    }
+
+    /// A scene without a transport (for the reference).
+    pub fn scene(scene: &'a Scene) -> Self {
+        Self::new(
+            &scene.mesh,
+            scene.albedo.view(),
+            None,
+            scene.object_vertices(),
+        )
+    }
+
+    /// This input, read from `path`.
+    pub fn from_file(self, path: &'a Path) -> Self {
+        ShadingInput {
+            origin: Some(path),
+            ..self
+        }
+    }
+
+    /// The transport, or the refusal of `method` without one.
+    pub(crate) fn transport(&self, method: Method) -> Result<&'a TransportSet> {
+        self.transport.ok_or_else(|| {
+            Error::parameter(
+                "basis",
+                format!("{method} needs a precomputed transport: give a scene cache (.hsr)"),
+            )
+        })
+    }
+
+    /// A refusal of the input's contents: naming its file when it has one.
+    pub(crate) fn refusal(&self, reason: &str) -> Error {
+        match self.origin {
+            Some(path) => Error::Format {
+                path: path.to_path_buf(),
+                reason: reason.into(),
+            },
+            None => Error::parameter("scene", reason),
+        }
+    }
+}
