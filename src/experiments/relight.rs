@@ -597,10 +597,7 @@ impl<'a> Bench<'a> {
         let precomputed = self.transport(kind, n, false)?;
         let set = &precomputed.set;
         let spec = ShaderSpec {
-            material: GlossyOptions {
-                brdf: setting.brdf.clone(),
-                ..glossy.clone()
-            },
+            material: glossy.for_brdf(&setting.brdf),
             shade: *shade,
             keep_light: light,
             ..ShaderSpec::default()

@@ -132,6 +132,29 @@ impl GlossyOptions {
     }
 }
 
+impl GlossyOptions {
+    /// These options for `brdf`: as they are for a glossy one, the defaults for a Lambertian
+    /// one (which they would not change).
+    ///
+    /// ```
+    /// use haarshift::relight::Brdf;
+    /// use haarshift::relight::shade::glossy::GlossyOptions;
+    /// let o = GlossyOptions { keep_brdf: Some(40), ..GlossyOptions::default() };
+    /// assert_eq!(o.for_brdf(&Brdf::Lambert), GlossyOptions::default());
+    /// assert_eq!(o.for_brdf(&"phong:9".parse().unwrap()).keep_brdf, Some(40));
+    /// ```
+    pub fn for_brdf(&self, brdf: &Brdf) -> GlossyOptions {
+        if brdf.is_lambert() {
+            GlossyOptions::default()
+        } else {
+            GlossyOptions {
+                brdf: brdf.clone(),
+                ..self.clone()
+            }
+        }
+    }
+}
+
 impl Default for GlossyOptions {
     fn default() -> Self {
         GlossyOptions {
