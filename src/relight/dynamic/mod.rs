@@ -121,7 +121,7 @@ impl DynamicOptions {
     /// use haarshift::product::Selection;
     /// use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions};
     /// use haarshift::relight::dynamic::fields::Truncation;
-    /// use haarshift::sphere::{ParamKind, Parameterization};
+    /// use haarshift::faces::{ParamKind, Parameterization};
     /// let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
     /// let budgets = DynamicBudgets { keep_field: Some(40), truncate_after: true, ..DynamicBudgets::new(param) };
     /// let o = DynamicOptions::from_budgets(&budgets);
@@ -181,7 +181,7 @@ impl DynamicOptions {
 ///
 /// ```
 /// use haarshift::relight::dynamic::DynamicBudgets;
-/// use haarshift::sphere::{ParamKind, Parameterization};
+/// use haarshift::faces::{ParamKind, Parameterization};
 /// let b = DynamicBudgets::new(Parameterization::new(ParamKind::LatLong, 32).unwrap());
 /// assert_eq!((b.circles, b.circle_points, b.shells, b.shell_grid), (100, 200, 20, 9));
 /// ```

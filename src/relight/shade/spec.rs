@@ -171,7 +171,7 @@ impl ShaderSpec {
 /// ```
 /// use haarshift::relight::shade::ShadingInput;
 /// use haarshift::relight::{Generator, Scene};
-/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true);
+/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true).unwrap();
 /// let input = ShadingInput::scene(&scene);
 /// assert!(input.transport.is_none());
 /// assert_eq!(input.object_vertices, scene.object_vertices());
