@@ -3,7 +3,7 @@
 //! 512 x 1024 map to 128 x 256 beside the plain block mean, and the projection of a
 //! 128 x 256 RGB map onto 9 bands (81) of spherical harmonics.
 //!
-//! And the relighting itself (`relight_cubes_85860`): seed 002's Cubes scene (85,860 vertices)
+//! And the relighting itself (`relight_cubes_85860`): Vollick and Lessig's Cubes scene (85,860 vertices)
 //! at cube `6 x 64^2`, each vertex's transport keeping its 420 largest coefficients, a
 //! lighting keeping its 200 largest, Lambertian: the lighting's encoding (the 512 x 1024 map
 //! downsampled by solid-angle means, turned, converted to the cube, transformed, selected) and

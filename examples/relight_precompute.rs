@@ -4,12 +4,12 @@
 //!
 //! ```text
 //! cargo run --release --example relight_precompute -- SCENE PARAM RESOLUTION KEEP ORDER [SH]
-//!   SCENE       bunny (the bunny on its ground plane) | cubes (seed 002, 85,860 vertices)
+//!   SCENE       bunny (the bunny on its ground plane) | cubes (Vollick and Lessig, 85,860 vertices)
 //!               | cylinder-and-bump | plane-with-sphere
 //!   PARAM       latlong | cube
 //!   RESOLUTION  face side: lat-long N x 2N, cube 6 x N x N
 //!   KEEP        visibility coefficients kept per vertex, or all
-//!   ORDER       vertex (rays through the BVH) | direction (seed 003's shadow maps, 2048^2)
+//!   ORDER       vertex (rays through the BVH) | direction (Microsoft 2003's shadow maps, 2048^2)
 //!   SH          optional: also project onto this many bands of spherical harmonics
 //! ```
 //!

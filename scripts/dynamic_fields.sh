@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Writes the section "Occlusion fields on disk" of results/dynamic/speed.md (replacing it, the
-# rest of the file kept): the bunny's fields at seed 001's size (cube 6 x 64^2, 29,720
+# rest of the file kept): the bunny's fields at Sun 2006's size (cube 6 x 64^2, 29,720
 # samples, 730 million rays, 120 coefficients a map) built and written to a field file by one
 # `relight scene --fields-dir` run, then loaded by the same command run again.
 # Usage: scripts/dynamic_fields.sh   (from the repository's root; about 90 s on two cores;

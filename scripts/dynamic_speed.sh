@@ -3,14 +3,14 @@
 # played along a path (a small object moves, a large one moves, the lighting turns) with
 # looked-up occlusion maps truncated before and after the blend; the same scene glossy (Phong
 # 40) with the ball moving, the lighting turning and the eye orbiting; and one object's fields
-# at seed 001's size.
+# at Sun 2006's size.
 # Usage: scripts/dynamic_speed.sh   (from the repository root; about seven minutes on two cores)
 set -euo pipefail
 source "$(dirname "$0")/timing.sh"
 out=results/dynamic
 mkdir -p "$out"
 # Speed: about 30,000 vertices, three objects, 200 / 70 / 70 kept coefficients; and one
-# object's fields at seed 001's size (cube 6 x 64^2: 29,720 samples, 730 million rays).
+# object's fields at Sun 2006's size (cube 6 x 64^2: 29,720 samples, 730 million rays).
 for truncate in before after; do
   timed "speed_$truncate" relight scene testdata/scenes/speed_three_objects.json \
     --animate testdata/scenes/speed_path.json --keep-light 200 --keep-visibility 70 \

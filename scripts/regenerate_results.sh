@@ -26,6 +26,6 @@ run experiment sphere --out-dir results/sphere --force
 # Dynamic scenes: occlusion fields and just-in-time transfer against ray casting (the
 # animations and the speed table are scripts/dynamic.sh's and scripts/dynamic_speed.sh's).
 run experiment dynamic --out-dir results/dynamic --force
-# Relighting methods against the ray-cast truth over the seeds' axes (quick protocol, a few
+# Relighting methods against the ray-cast truth over the sources' axes (quick protocol, a few
 # minutes; scripts/relight_experiments.sh also runs the full one).
 run experiment relight --out-dir results/relight/experiments --force

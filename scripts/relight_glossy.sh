@@ -5,7 +5,7 @@
 # no rotation) at the same lat-long resolution.
 #   scripts/relight_glossy.sh SCENE ENV.hdr [ENV.hdr ...]
 # SCENE is `bunny` (testdata/meshes/bunny.ply on its ground plane, which stays Lambertian) or a
-# scene file (testdata/scenes/cylinder_and_bump.json: seed 002's procedural scene, all glossy).
+# scene file (testdata/scenes/cylinder_and_bump.json: Vollick and Lessig's procedural scene, all glossy).
 # Writes results/relight/glossy/NAME/ENV/*.png and results/relight/glossy/NAME/errors.md (NAME:
 # `bunny` or the scene file's stem, ENV: the map's file stem); for the bunny also a glossy
 # turntable under the first map, results/relight/glossy/turntable.gif.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The two loop orders of the visibility precomputation timed on one scene: vertex-major (rays
-# through the BVH) and direction-major (seed 003: a 2048 x 2048 shadow buffer per direction),
+# through the BVH) and direction-major (Microsoft 2003: a 2048 x 2048 shadow buffer per direction),
 # each under /usr/bin/time -v for its CPU time and peak resident memory. Prints Markdown:
 #   scripts/relight_orders.sh > results/relight/orders.md
 # SCENE (first argument) is a mesh or scene file; the default is the bunny (its ground plane

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# The relighting speed figures on this machine: the 85,860-vertex "cubes" scene of seed 002
+# The relighting speed figures on this machine: the 85,860-vertex "cubes" scene of Vollick and Lessig
 # (testdata/scenes/cubes.json) precomputed at cube 6 x 64^2, then one render (new lighting,
 # fixed view, Lambertian) and eight animation frames, keeping 200 lighting and 420 visibility
 # coefficients in all (194 and
-# 414 detail coefficients, plus the 6 faces' scaling coefficients: seed 001's 70 per cube face),
+# 414 detail coefficients, plus the 6 faces' scaling coefficients: Sun 2006's 70 per cube face),
 # each run under /usr/bin/time -v for its peak resident memory and CPU time. Prints a Markdown
 # report on standard output:
 #   scripts/relight_speed.sh > results/relight/speed.md

@@ -43,7 +43,7 @@ fn environment(env: &Bound<'_, PyAny>) -> PyResult<Environment> {
 /// meshes, materials, transforms, the environment, the camera) with its objects where the file
 /// places them: what `haarshift relight scene SCENE --vertices OUT.npy` writes for one frame.
 ///
-/// Each object gets seed 001's occlusion fields (`circles` x `circle_points` points on its
+/// Each object gets Sun 2006's occlusion fields (`circles` x `circle_points` points on its
 /// ground plane, `shells` shells of 6 x `shell_grid` x `shell_grid` points, one ray per texel
 /// of a `param` map of side `resolution`), and a vertex reflects the n-function product
 /// integral of its own transport, the lighting and each other object's looked-up occlusion

@@ -29,10 +29,8 @@ use crate::relight::dynamic::{
     Change, DynamicOptions, DynamicScene, JustInTimeTransfer, Placement,
 };
 use crate::relight::light::environment::Environment;
-use crate::relight::{
-    Lighting, PreparedTransport, SceneBvh, SceneFile, ShadeOptions, Transform, VisibilityOptions,
-    vertex_major,
-};
+use crate::relight::shade::{FrameSpec, ShaderSpec, ShadingInput};
+use crate::relight::{Lighting, SceneBvh, SceneFile, Transform, VisibilityOptions, vertex_major};
 use crate::sphere::SphereRotation;
 use crate::{Error, Result};
 
@@ -73,7 +71,7 @@ fn selection(k: Option<usize>) -> Selection {
 pub struct DynamicProtocol {
     /// Lat-long heights `N` of the maps (the resolution axis).
     pub resolutions: Vec<usize>,
-    /// Sample densities relative to seed 001's fields (the density axis): circles, points
+    /// Sample densities relative to Sun 2006's fields (the density axis): circles, points
     /// per circle and shells scale by it, the shell grid by its square root.
     pub densities: Vec<f64>,
     /// The resolution of the budget, depth and timing axes.
@@ -422,11 +420,17 @@ impl Built {
         let start = Instant::now();
         let (set, _) = vertex_major(&mesh, &SceneBvh::new(&mesh), &VisibilityOptions::new(param))?;
         let reform = start.elapsed().as_secs_f64();
-        let prepared =
-            PreparedTransport::<f32>::new(&set, scene.albedo().view(), &ShadeOptions::default())?;
-        let start = Instant::now();
-        let got = prepared.shade(&self.lighting(env, rotation, Budget::ALL)?)?;
-        let frame = start.elapsed().as_secs_f64();
+        // The default spec: Lambertian Haar in f32, every coefficient.
+        let albedo = scene.albedo();
+        let input = ShadingInput::new(&mesh, albedo.view(), Some(&set), mesh.vertex_count());
+        let frame = FrameSpec {
+            environment: env,
+            rotation: *rotation,
+            eye: None,
+        };
+        let shading = ShaderSpec::default().build(&input)?.shade(&frame)?;
+        let got = shading.radiance.to_f32();
+        let frame = shading.timing.total_seconds();
         let mut r = Built {
             scene,
             moving: self.moving,

@@ -7,7 +7,7 @@
 //! * [`shift_chain`]: one shift against a chain of small ones (the seed's Table 3.1).
 //! * [`stability`]: the numerical extremes, each check with its figure, tolerance and verdict.
 //! * [`tradeoff`]: every kernel and parameter through the rotation cycle; Pareto frontiers.
-//! * [`relight`]: every relighting method against the ray-cast truth over the seeds' axes;
+//! * [`relight`]: every relighting method against the ray-cast truth over the sources' axes;
 //!   picture grids.
 //! * [`dynamic`]: occlusion fields and just-in-time radiance transfer against the ray-cast truth.
 //! * [`output`]: CSV, JSON and PNG files side by side, written atomically.

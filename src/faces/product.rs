@@ -1,6 +1,6 @@
 //! The product of lat-long maps as a map on the sphere, computed in the Haar domain: the
 //! maps' trees multiplied by [`product::multiply::product`](crate::product::multiply::product)
-//! (seed 001 section 3.4.4), not pixel by pixel.
+//! (Sun 2006 section 3.4.4), not pixel by pixel.
 //!
 //! [`map_product`] takes the maps as [`integrate`](super::integrate::integrate) does (one size,
 //! `H` a power of two, one-channel maps broadcast over the channels of the others; lat-long at

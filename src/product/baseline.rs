@@ -1,10 +1,10 @@
 //! The baselines every tree algorithm is measured against, as first-class methods.
 //!
-//! * [`pixel_integral`]: seed 001's "pixel domain" (section 3.2.3, `O(M N)`): the weighted
+//! * [`pixel_integral`]: Sun 2006's "pixel domain" (section 3.2.3, `O(M N)`): the weighted
 //!   pixel sum of the product of stored pixel maps.
 //! * [`pixel_integral_of_trees`]: the same from Haar trees, the inverse transforms included
 //!   (what the pixel domain costs when the functions live as coefficients).
-//! * [`pairwise_integral`]: seed 001's "recursive Haar" (eq. 3.8): multiply two functions into
+//! * [`pairwise_integral`]: Sun 2006's "recursive Haar" (eq. 3.8): multiply two functions into
 //!   a tree ([`multiply`](super::multiply)), then that with the next, and so on, and end with a
 //!   two-function product integral.
 //!
@@ -86,7 +86,7 @@ pub fn pixel_integral_of_trees<T: Sample, const C: usize>(
     Ok(pixel_product_sum(&views))
 }
 
-/// Seed 001's recursive two-function products: `((transport x f_1) x f_2) ...`, each product
+/// Sun 2006's recursive two-function products: `((transport x f_1) x f_2) ...`, each product
 /// a full tree, then a two-function integral with the last factor. `visited` counts the
 /// nodes of the intermediate products and of the final integral.
 ///

@@ -11,14 +11,14 @@
 //!
 //! # Normalisation
 //!
-//! Values here are in seed 001's *continuous* normalisation: the face is the unit square and a
+//! Values here are in Sun 2006's *continuous* normalisation: the face is the unit square and a
 //! function on a level-`l` node has amplitude `2^l` (so its `L2` norm over the unit square is
 //! 1). The transform's *discrete orthonormal* basis of a `2^n x 2^n` face (pixel-sum inner
 //! product, [`Normalization::Orthonormal`](crate::transform::Normalization)) is the same
 //! function divided by `S = 2^n` and sampled at pixel centres: `+-1 / (S >> l)` on the block
 //! ([`BasisFunction::discrete`]).
 //!
-//! # Products of two basis functions (seed 001 section 3.3.2, derived here, not copied)
+//! # Products of two basis functions (Sun 2006 section 3.3.2, derived here, not copied)
 //!
 //! [`product`] multiplies two basis functions by looking only at their definitions:
 //! the sign of a function on each quadrant of its node is read off the mother function at
@@ -57,7 +57,7 @@ pub const WAVELETS: [Band; 3] = [Band::Horizontal, Band::Vertical, Band::Diagona
 pub struct BasisFunction {
     /// Scaling (a box) or one of the three wavelets.
     pub band: Band,
-    /// Detail level of the node, 0 coarsest (seed 001's "scale j").
+    /// Detail level of the node, 0 coarsest (Sun 2006's "scale j").
     pub level: usize,
     /// Block row of the node, `0..2^level`.
     pub row: usize,
@@ -172,7 +172,7 @@ impl BasisFunction {
 /// A basis function times a signed magnitude: what a product of basis functions is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scaled {
-    /// The signed magnitude (seed 001's `|P|`), continuous normalisation.
+    /// The signed magnitude (Sun 2006's `|P|`), continuous normalisation.
     pub magnitude: f64,
     /// The basis function (possibly a child scaling function).
     pub function: BasisFunction,
@@ -215,7 +215,7 @@ pub fn product(a: &BasisFunction, b: &BasisFunction) -> Option<Scaled> {
 }
 
 /// The integral over the unit square of a scaled basis function: `magnitude x 2^-level` for a
-/// box (seed 001 observation 7), 0 for a wavelet (observation 6).
+/// box (Sun 2006 observation 7), 0 for a wavelet (observation 6).
 pub fn integral(scaled: &Scaled) -> f64 {
     match scaled.function.band {
         Band::Scaling => scaled.magnitude / (1u64 << scaled.function.level) as f64,

@@ -1,5 +1,5 @@
 //! The integral coefficient of `N` basis functions, `C = integral of b_1 ... b_N`, in closed
-//! form (seed 001 section 3.3.4, the "generalized Haar integral coefficient theorem"; seed 000
+//! form (Sun 2006 section 3.3.4, the "generalized Haar integral coefficient theorem"; Sun and Mukherjee 2012
 //! eqs. 20-22).
 //!
 //! **Theorem (as checked here).** Let `j0` be the finest level among the functions. `C` is
@@ -18,7 +18,7 @@
 //! [`discrete_integral_coefficient`] `= 2^((2 - N) n) C`.
 //!
 //! [`integral_coefficient_by_products`] computes the same number a second way, multiplying the
-//! functions two at a time with [`basis::product`] (seed 001's lemmas
+//! functions two at a time with [`basis::product`] (Sun 2006's lemmas
 //! 2-7); the tests check both against the brute-force pixel sum.
 
 use super::basis::{self, BasisFunction, Scaled, quadrant_sign};

@@ -1,4 +1,4 @@
-//! The product integral of `N` functions on sparse trees: seed 001's tree traversal
+//! The product integral of `N` functions on sparse trees: Sun 2006's tree traversal
 //! (sections 3.4.2-3.4.3), derived again for the discrete orthonormal basis.
 //!
 //! **Derivation.** Write the integral over a face as the pixel sum `I = sum_p prod_k f_k(p)`.
@@ -12,15 +12,15 @@
 //! The bracket is the scaling component of the product of the functions' four-component
 //! vectors `(m, h, v, d)` under the Klein-group product of the quadrant sign patterns
 //! (`H x V = D` and so on: [`basis::product`](super::basis::product) on one node), minus the
-//! product of the means. It is folded function by function in `O(1)` each (seed 001's table
+//! product of the means. It is folded function by function in `O(1)` each (Sun 2006's table
 //! `T`, `getProductIntegralDP`, but without the `2^j`, `4^j` factors that its continuous
 //! normalisation needs), tracking the excess over `prod m` directly so that nothing cancels.
 //! A node contributes only when at least two functions have a node there: with one, the
 //! bracket is zero (its details sum to zero over the quadrants) and so is everything below.
-//! A function without a node at `X` is constant there and multiplies the bracket (seed 001's
+//! A function without a node at `X` is constant there and multiplies the bracket (Sun 2006's
 //! `cum`). Cost: `O(N)` per visited node.
 //!
-//! **Depth limit** (seed 001 Fig. 3.5): with [`IntegralOptions::finest_level`] `= Some(L)` only
+//! **Depth limit** (Sun 2006 Fig. 3.5): with [`IntegralOptions::finest_level`] `= Some(L)` only
 //! nodes of detail levels `0..=L` are visited, which is exactly the integral of the functions
 //! averaged over blocks of side `S >> (L + 1)`.
 //!

@@ -1,6 +1,6 @@
-//! The product of `N` functions as a Haar tree (seed 001 section 3.4.4, eq. 3.13): the
+//! The product of `N` functions as a Haar tree (Sun 2006 section 3.4.4, eq. 3.13): the
 //! coefficients of the pointwise product, computed on the trees, so that a product of fixed
-//! factors is computed once and reused (seed 001's just-in-time radiance transfer, eq. 3.9).
+//! factors is computed once and reused (Sun 2006's just-in-time radiance transfer, eq. 3.9).
 //!
 //! **Derivation.** The product's block sums are built bottom-up in one synchronous traversal:
 //! on a node where two or more functions have nodes, the sum over each quadrant is either
@@ -11,7 +11,7 @@
 //! Where none has, the product is constant and gets no node. The output has a node wherever an
 //! input has one; cost `O(N)` per node of the union of the inputs' supports.
 //!
-//! Seed 001's `FunctionProduct` instead adds every node's contribution to all its ancestors'
+//! Sun 2006's `FunctionProduct` instead adds every node's contribution to all its ancestors'
 //! details (`updateParents`, `O(depth)` per node); the bottom-up sums give the same numbers
 //! without the walk back up.
 

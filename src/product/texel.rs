@@ -1,6 +1,6 @@
 //! Products of sparse functions through their texels: each factor's sparse orthonormal
 //! coefficients are inverse-transformed face by face, the texels multiplied, and the product
-//! transformed back (seed 001 section 3.2.3's "pixel domain", per product).
+//! transformed back (Sun 2006 section 3.2.3's "pixel domain", per product).
 //!
 //! It is the same product as [`multiply::product`](super::multiply::product) (a product of
 //! functions that are constant on texels is computed exactly texel by texel; tested against

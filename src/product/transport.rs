@@ -6,7 +6,7 @@
 //! one is from [`WeightedPixels`], whose only constructor multiplies values by weights, once.
 //! [`product_integral`](super::product_integral) takes one transport and any number of plain
 //! [`HaarTree`] factors, so a weight can be neither forgotten nor applied twice. (The name is
-//! seed 001's: the transport is visibility x cosine x solid angle, or any product that
+//! Sun 2006's: the transport is visibility x cosine x solid angle, or any product that
 //! includes it, eq. 3.9.)
 //!
 //! This module knows no geometry: the weights are whatever the caller passes (texel solid

@@ -1,4 +1,4 @@
-//! The sparse coefficient quadtree of a function on a set of square faces (seed 001's
+//! The sparse coefficient quadtree of a function on a set of square faces (Sun 2006's
 //! augmented quadtree, section 2.2.1), stored flat.
 //!
 //! **Storage.** One arena of [`Node`]s for all faces (face after face, breadth first within
@@ -7,7 +7,7 @@
 //! node's position, used only when a tree is turned back into arrays.
 //!
 //! **What a node holds** (for each of the `C` channels):
-//! * `mean`: the mean of the (pruned) function over the node's block, seed 001's "parent
+//! * `mean`: the mean of the (pruned) function over the node's block, Sun 2006's "parent
 //!   sum" `p_sum` (section 2.2.2) in value units: the face mean plus, for every ancestor, its
 //!   details' signs on the quadrant that leads here times their steps.
 //! * `step[H, V, D]`: each detail's orthonormal coefficient divided by the block side

@@ -1,6 +1,6 @@
 //! The triple product integral (`N = 3`, lighting x transport x BRDF), two fast paths:
 //! sparse on trees ([`triple_integral`]) and dense over full coefficient arrays
-//! ([`dense_triple_integral`], `O(M)`, seed 002 sections 3.6 and 4.4).
+//! ([`dense_triple_integral`], `O(M)`, Vollick and Lessig sections 3.6 and 4.4).
 //!
 //! On a node of side `B` where all three functions have nodes, with means `m_k` and detail
 //! steps `s_k = (h_k, v_k, d_k)` (orthonormal detail over `B`), the node adds
@@ -8,7 +8,7 @@
 //! `B^2 [ m_1 (s_2 . s_3) + m_2 (s_1 . s_3) + m_3 (s_1 . s_2) + h_1 (v_2 d_3 + d_2 v_3) + v_1 (h_2 d_3 + d_2 h_3) + d_1 (h_2 v_3 + v_2 h_3) ]`
 //!
 //! to the integral, and where only two do, `B^2 m_absent (s_i . s_j)`. These are Ng et al.'s
-//! three cases of tripling coefficients (seed 002 Theorem 7): a parent times two equal
+//! three cases of tripling coefficients (Vollick and Lessig Theorem 7): a parent times two equal
 //! wavelets (the dot products, whose parent factor is the mean `m`, i.e. the parent sum), three
 //! different wavelets on one node (the last three terms), and the three scaling functions
 //! (`S^2 m_1 m_2 m_3` per face). In the orthonormal basis the case-2 coefficient `2^j` and the
@@ -18,7 +18,7 @@
 //!
 //! The dense path stores, per function and channel, the mean (the parent sum, carried down
 //! level by level) and the three steps of every node of the complete quadtree as structure-of-
-//! arrays chunks of 16 nodes, level after level ("vectorised parent sums", seed 002 section
+//! arrays chunks of 16 nodes, level after level ("vectorised parent sums", Vollick and Lessig section
 //! 4.4); the transport's values carry their block area `B^2`, so the whole sum is one
 //! branch-free loop over all nodes that the compiler vectorises. Regrouped by the transport's
 //! four components, the excess is `m_1 (s_2 . s_3) + h_1 (m_2 h_3 + h_2 m_3 + v_2 d_3 + d_2

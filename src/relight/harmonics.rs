@@ -1,4 +1,4 @@
-//! Spherical-harmonic transfer: seed 003's low-frequency precomputed radiance transfer, the
+//! Spherical-harmonic transfer: Microsoft 2003's low-frequency precomputed radiance transfer, the
 //! method all-frequency relighting is compared against.
 //!
 //! **Transfer.** For vertex `v` and `B` bands ([`SphericalHarmonics`]: degrees `0..B`, `B^2`

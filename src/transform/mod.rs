@@ -8,7 +8,7 @@
 //!
 //! # Normalisations
 //!
-//! * [`Normalization::Average`], the seeds' convention: a parent is the mean of its children and
+//! * [`Normalization::Average`], the sources' convention: a parent is the mean of its children and
 //!   a detail is `(first - second) / 2` per axis. On a 2x2 block `[[p, q], [r, s]]`:
 //!   `A = (p+q+r+s)/4`, `a = (p-q+r-s)/4`, `b = (p+q-r-s)/4`, `c = (p-q-r+s)/4`.
 //! * [`Normalization::Orthonormal`]: `1/sqrt(2)` per axis step (so `/2` on a 2x2 block); the
@@ -46,7 +46,7 @@ named_enum! {
     #[derive(Default)]
     pub enum Normalization ("normalisation") {
         #[default]
-        /// Parent = mean of children, detail = (first - second) / 2 per axis (the seeds').
+        /// Parent = mean of children, detail = (first - second) / 2 per axis (the sources').
         Average = "average",
         /// `1/sqrt(2)` per axis step: orthogonal, energy preserving.
         Orthonormal = "orthonormal",

@@ -50,7 +50,7 @@ pub struct TransformFlags {
     pub layout: Option<Layout>,
 
     /// `average`: parent = mean of children, detail = (first - second) / 2 per axis (the
-    /// seeds' convention). `orthonormal`: 1/sqrt(2) per axis step, energy preserving
+    /// sources' convention). `orthonormal`: 1/sqrt(2) per axis step, energy preserving
     /// [default: average]
     #[arg(long, value_parser = choice::<Normalization>(names!(Normalization)))]
     pub norm: Option<Normalization>,

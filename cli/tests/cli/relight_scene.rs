@@ -58,7 +58,7 @@ fn a_frame_agrees_with_the_ray_cast_reference_and_reports_its_build() {
     let dir = tempfile::tempdir().unwrap();
     let scene = two_spheres(dir.path());
     let (haar, truth) = (dir.path().join("h.npy"), dir.path().join("t.npy"));
-    // Seed 001's field density (the default), and the coarse fields of the other tests.
+    // Sun 2006's field density (the default), and the coarse fields of the other tests.
     let stdout = run_scene(
         &scene,
         &dir.path().join("h.png"),

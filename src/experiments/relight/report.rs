@@ -29,9 +29,9 @@ pub fn report(protocol: &RelightProtocol, results: &RelightResults) -> String {
         ("coefficients", "BRDF coefficients (thesis Fig. 4.7)"),
         (
             "resolution",
-            "Resolution and kept ratio (seed 002's tables)",
+            "Resolution and kept ratio (Vollick and Lessig's tables)",
         ),
-        ("depth", "Traversal depth (seed 001's Fig. 3.5)"),
+        ("depth", "Traversal depth (Sun 2006's Fig. 3.5)"),
         ("harmonics", "Haar against spherical harmonics"),
     ] {
         let rows: Vec<&RelightRecord> = results.records.iter().filter(|r| r.axis == axis).collect();

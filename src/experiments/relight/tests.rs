@@ -1,10 +1,18 @@
-use ndarray::s;
+use ndarray::{Array2, s};
 
+use super::picture::false_colour;
 use super::*;
+use crate::faces::{ParamKind, Parameterization};
+use crate::metrics::RelativeError;
+use crate::product::Selection;
+use crate::relight::shade::glossy::GlossyOptions;
 use crate::relight::shade::glossy::GlossyShader;
 use crate::relight::{Generator, Lighting, PreparedTransport, ShTransfer, reference, shade_sh};
+use crate::relight::{ReferenceOptions, SceneBvh, ShadeOptions, VisibilityOptions, vertex_major};
+use crate::render::Camera;
 use crate::render::DEFAULT_FOV;
 use crate::sphere::LatLongMap;
+use crate::sphere::SphereRotation;
 use crate::sphere::harmonics::SphericalHarmonics;
 
 /// A box floating over a plane (shadows), under a sky with a sun, a tiny protocol.

@@ -1,6 +1,6 @@
 //! Glossy materials in dynamic scenes: the BRDF rotated into a vertex's frame is one more
 //! factor of its n-function product integral, `B_v = a_v x integral of T_v x L x prod O_k x
-//! rho_v` (seed 001 eq. 3.1 with the BRDF kept), `rho_v(w) = rho(w, w_o)` with `w_o` the unit
+//! rho_v` (Sun 2006 eq. 3.1 with the BRDF kept), `rho_v(w) = rho(w, w_o)` with `w_o` the unit
 //! direction from the vertex to the [eye](DynamicScene::eye). The lobe is the glossy module's
 //! ([`Orientation::lobe`], by [`GlossyOptions::rotation`] in the vertex's exact frame), taken to
 //! Haar coefficients as the lighting is ([`Lighting::from_map`]: `keep_brdf` keeps its largest

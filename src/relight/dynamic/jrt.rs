@@ -1,4 +1,4 @@
-//! Just-in-time radiance transfer (seed 001 sections 3.2.2 and 3.5.3): per vertex the product
+//! Just-in-time radiance transfer (Sun 2006 sections 3.2.2 and 3.5.3): per vertex the product
 //! `T` of the factors that stay fixed while one varies, formed once ([`JustInTimeTransfer::form`]); a frame is
 //! then one sparse dot product per vertex with the varying factor.
 
@@ -35,7 +35,7 @@ pub struct TransferReport {
     pub bytes: usize,
 }
 
-/// Just-in-time radiance transfer (seed 001 sections 3.2.2 and 3.5.3): per vertex the product
+/// Just-in-time radiance transfer (Sun 2006 sections 3.2.2 and 3.5.3): per vertex the product
 /// `T` of the factors that stay fixed while one [`Change`] varies, pruned to the options'
 /// `keep_product`; each frame is then `<T, F>` with `F` the varying factor (the looked-up map
 /// of the moving object, or the new lighting): one sparse dot product per vertex. Re-form it

@@ -1,17 +1,17 @@
-//! Dynamic scenes (seed 001 chapter 3): rigid objects that move, scale, turn about the
+//! Dynamic scenes (Sun 2006 chapter 3): rigid objects that move, scale, turn about the
 //! vertical and are cloned at run time, each shadowing the others through its
 //! [occlusion field](crate::relight::dynamic::fields), shaded by n-function product integrals and by
 //! just-in-time radiance transfer ([`JustInTimeTransfer`]).
 //!
 //! **What is computed.** A Lambertian vertex `v` of albedo `a` reflects
-//! `B_v = a / pi x integral of T_v x L x prod_(k != own) O_k`, seed 001 eq. 3.1-3.3 with the
+//! `B_v = a / pi x integral of T_v x L x prod_(k != own) O_k`, Sun 2006 eq. 3.1-3.3 with the
 //! BRDF constant: `T_v` the vertex's own transport (its object's self-visibility, the ground
 //! plane's occlusion where the scene has one, cosine and solid angle; [`TransportSet`](crate::relight::precompute::transport::TransportSet)
 //! semantics), `L` the lighting, `O_k` object `k`'s occlusion looked up at the vertex
 //! ([`OcclusionField::lookup`], with the options' [`Truncation`]); a vertex beyond an object's
 //! outermost shell takes `O_k = 1`. Each factor is truncated as the options say (the lighting
 //! by the caller's [`Lighting`]) and, with a `depth`, all factors are limited to the detail
-//! levels `0..depth` (seed 001 Fig. 3.5's traversal depth: every factor is then constant on
+//! levels `0..depth` (Sun 2006 Fig. 3.5's traversal depth: every factor is then constant on
 //! blocks of side `S >> depth`, and so is their product).
 //!
 //! **Glossy materials** (a scene file's `phong` or `blinn` [`Material`](crate::relight::Material), or
@@ -34,10 +34,10 @@
 //! the vertical by whole columns of a lat-long parameterisation (`360 / 2N` degrees; a file's
 //! yaw is rounded to the nearest column and the rounded angle is the scene's, reference
 //! included); a cube map cannot turn (refused). Pitch and roll are refused: an occlusion
-//! field turns exactly about the vertical only (seed 001 cannot turn objects at all).
+//! field turns exactly about the vertical only (Sun 2006 cannot turn objects at all).
 //!
 //! **Shapes and clones.** Objects with the same mesh file or generator share one shape: one
-//! set of fields (seed 001's instancing); [`DynamicScene::clone_object`] adds an instance of an
+//! set of fields (Sun 2006's instancing); [`DynamicScene::clone_object`] adds an instance of an
 //! object's shape at run time, whose own transport is the original's.
 
 use std::path::Path;
@@ -78,7 +78,7 @@ use crate::{Error, Result, Sample};
 /// use haarshift::relight::dynamic::DynamicOptions;
 /// use haarshift::faces::{ParamKind, Parameterization};
 /// let o = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 32).unwrap());
-/// assert_eq!(o.field.samples(), 29_720); // seed 001's fields
+/// assert_eq!(o.field.samples(), 29_720); // Sun 2006's fields
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicOptions {
@@ -97,7 +97,7 @@ pub struct DynamicOptions {
 }
 
 impl DynamicOptions {
-    /// Seed 001's fields, everything kept, every level.
+    /// Sun 2006's fields, everything kept, every level.
     pub fn new(param: Parameterization) -> Self {
         DynamicOptions {
             field: FieldOptions::new(param),
@@ -212,7 +212,7 @@ pub struct DynamicBudgets {
 }
 
 impl DynamicBudgets {
-    /// Seed 001's fields in `param`, everything kept.
+    /// Sun 2006's fields in `param`, everything kept.
     pub fn new(param: Parameterization) -> Self {
         let f = FieldOptions::new(param);
         DynamicBudgets {

@@ -1,6 +1,6 @@
 //! Animations of dynamic scenes: a path file of segments, each varying one thing (one object
 //! moving, the lighting turning, or the eye orbiting), played with just-in-time radiance transfer re-formed
-//! whenever the kind of change switches (seed 001 section 3.5.3).
+//! whenever the kind of change switches (Sun 2006 section 3.5.3).
 //!
 //! **Path file** (JSON, unknown keys refused):
 //!

@@ -24,8 +24,8 @@
 //! vertex's global frame `rho_v(w) = rho(w, w_o)` is a spherical map, the third factor of the
 //! triple product `B_v = integral of T_v L rho_v` ([`triple_integral`](crate::product::triple::triple_integral)).
 //! haarshift keeps one copy in a local frame ([`Brdf::local_map`]) and brings it to each vertex
-//! ([`crate::relight::material::orient`]), seed 004 chapter 4:
-//! * **the reflection-vector parameterisation** (seed 001): a Phong lobe depends only on the
+//! ([`crate::relight::material::orient`]), Alnasser 2008 chapter 4:
+//! * **the reflection-vector parameterisation** (Sun 2006): a Phong lobe depends only on the
 //!   angle between `w_i` and `r`, so its local copy is the lobe about +Y (the lat-long north
 //!   pole) and one rotation taking `r` to +Y brings it to any vertex, whatever its normal and
 //!   view;
@@ -182,6 +182,18 @@ impl Brdf {
     /// Whether the BRDF is Lambertian, so that it leaves the integral as a constant.
     pub fn is_lambert(&self) -> bool {
         matches!(self, Brdf::Lambert)
+    }
+
+    /// Whether the outgoing radiance depends on the eye (every BRDF but Lambert's), so that
+    /// a render from another camera needs shading again.
+    ///
+    /// ```
+    /// use haarshift::relight::Brdf;
+    /// assert!(!Brdf::Lambert.is_view_dependent());
+    /// assert!(Brdf::Phong { exponent: 10.0 }.is_view_dependent());
+    /// ```
+    pub fn is_view_dependent(&self) -> bool {
+        !self.is_lambert()
     }
 
     /// Whether the BRDF depends on the incoming direction only through its angle to the

@@ -1,4 +1,4 @@
-//! Measured BRDFs in the MERL binary format (Matusik et al. 2003, the materials of seed 004's
+//! Measured BRDFs in the MERL binary format (Matusik et al. 2003, the materials of Alnasser 2008's
 //! renders).
 //!
 //! **The file**: three little-endian `i32` dimensions `90, 90, 180`, then `3 x 1,458,000`

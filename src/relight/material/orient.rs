@@ -1,4 +1,4 @@
-//! Bringing a BRDF into a vertex's frame: one local copy, rotated at render time (seed 004
+//! Bringing a BRDF into a vertex's frame: one local copy, rotated at render time (Alnasser 2008
 //! chapter 4, sections 4.3-4.6).
 //!
 //! A vertex with unit normal `n`, seen from the unit direction `w_o` (toward the camera), needs
@@ -9,7 +9,7 @@
 //!
 //! * **Phong** (mirror-symmetric): one lobe about +Y; `R` is the rotation taking the mirror
 //!   direction `r = 2 (n . w_o) n - w_o` to +Y about the axis `r x Y` ([`to_pole`]), so
-//!   `rho_v(w) = f(R w)` is the lobe about `r`. This is the seed 001 reflection-vector
+//!   `rho_v(w) = f(R w)` is the lobe about `r`. This is the Sun 2006 reflection-vector
 //!   parameterisation: one map serves every normal and view.
 //! * **View-dependent BRDFs** (Blinn-Phong, measured): the table's map of the outgoing
 //!   elevation nearest `w_o`'s (normal at +Y, viewer at azimuth 0); `R0 = to_pole(n)` takes the

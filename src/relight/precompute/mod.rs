@@ -28,7 +28,7 @@ named_enum! {
         #[default]
         /// Vertices outer, directions inner, rays through a BVH.
         Vertex = "vertex",
-        /// Seed 003's order: directions outer, a shadow buffer per direction.
+        /// Microsoft 2003's order: directions outer, a shadow buffer per direction.
         Direction = "direction",
     }
 }

@@ -1,5 +1,5 @@
 //! A software shadow buffer: the orthographic depth map of the scene seen along one direction
-//! (seed 003's direction-major visibility, where each direction's shadow buffer answers the
+//! (Microsoft 2003's direction-major visibility, where each direction's shadow buffer answers the
 //! visibility of every vertex at once).
 //!
 //! **Frame.** For a direction `d` (towards the light) the map looks down `-d` onto the plane

@@ -1,7 +1,7 @@
 //! Per-vertex transport, stored sparse: what the precomputation makes and the cache keeps.
 //!
 //! For vertex `v` the transport is the function on the sphere's texels
-//! `T_v(t) = V(v, t) max(0, n_v . w_t) dOmega_t` (seed 001 eq. 3.9: visibility x cosine, with
+//! `T_v(t) = V(v, t) max(0, n_v . w_t) dOmega_t` (Sun 2006 eq. 3.9: visibility x cosine, with
 //! the texel solid angle folded in, [`crate::product::Transport`]), Haar-transformed
 //! (orthonormal, face by face) and truncated to the coefficients a [`Selection`] keeps. Only the
 //! kept non-zero coefficients are stored: for each vertex a run of `(index, value)` pairs, all
@@ -12,7 +12,7 @@
 //! `(face, 0, 0)`.
 //!
 //! A set may also carry the same transport projected onto spherical harmonics
-//! ([`ShTransfer`], seed 003's low-frequency transfer), made from the same values by the same
+//! ([`ShTransfer`], Microsoft 2003's low-frequency transfer), made from the same values by the same
 //! precomputation, for the comparison method.
 
 use ndarray::{Array3, Array4, ArrayView3, Axis};

@@ -16,7 +16,7 @@
 //! * [`vertex_major`]: vertices outer (rayon), directions inner, rays through a BVH
 //!   ([`Occlusion`]); each vertex is encoded as soon as it is done, so the working memory is one
 //!   `(faces, S, S)` array per thread.
-//! * [`direction_major`]: seed 003's order: directions outer, vertices inner, a software shadow
+//! * [`direction_major`]: Microsoft 2003's order: directions outer, vertices inner, a software shadow
 //!   buffer per direction ([`ShadowMap`]) instead of rays. Visibility of all (vertex, direction)
 //!   pairs is held as bits, one column of `V` bits per direction (`V x D / 8` bytes: 352 MB for
 //!   85,860 vertices x 32,768 directions, against 11 GB as f32), then each vertex is encoded.
@@ -263,7 +263,7 @@ pub fn vertex_major(
 }
 
 /// Direction-major precomputation with a shadow buffer of `map_size x map_size` texels per
-/// direction (seed 003); see the [module docs](self).
+/// direction (Microsoft 2003); see the [module docs](self).
 ///
 /// ```
 /// use haarshift::relight::{Mesh, SceneBvh, VisibilityOptions, direction_major, vertex_major};

@@ -14,8 +14,8 @@
 //!
 //! | [`Generator`] | what | vertices |
 //! |---|---|---|
-//! | `cylinder_and_bump` | seed 002's "Cylinder & Bump" (section 6.1.1): on a `[-4, 4]^2` ground (`cells` x `cells`, default 96) a Gaussian bump (height 1, sigma 0.6, at `(1.5, 1)`) and a cylinder (radius 0.5, height 3, 48 segments x 24 rings, capped) at `(-1.5, -1)` | 10,707 at 96 cells |
-//! | `cubes` | seed 002's "Cubes" (section 6.1.2, after Durand 2005): a wall (`z = 0`, facing `+Z`, 12.9 x 10.1, 129 x 101 cells) and in front of it, at distance `distance` (default 1.5), a `count x count` array (default 10) of cubes of side 0.6 every 1.2 across and 1.0 up, each face `cells x cells` (default 10); every cube face has its own vertices (sharp normals). The default is seed 002's Table 2 scale | 85,860 by default: `6 count^2 (cells + 1)^2 + 13,260` |
+//! | `cylinder_and_bump` | Vollick and Lessig's "Cylinder & Bump" (section 6.1.1): on a `[-4, 4]^2` ground (`cells` x `cells`, default 96) a Gaussian bump (height 1, sigma 0.6, at `(1.5, 1)`) and a cylinder (radius 0.5, height 3, 48 segments x 24 rings, capped) at `(-1.5, -1)` | 10,707 at 96 cells |
+//! | `cubes` | Vollick and Lessig's "Cubes" (section 6.1.2, after Durand 2005): a wall (`z = 0`, facing `+Z`, 12.9 x 10.1, 129 x 101 cells) and in front of it, at distance `distance` (default 1.5), a `count x count` array (default 10) of cubes of side 0.6 every 1.2 across and 1.0 up, each face `cells x cells` (default 10); every cube face has its own vertices (sharp normals). The default is Vollick and Lessig's Table 2 scale | 85,860 by default: `6 count^2 (cells + 1)^2 + 13,260` |
 //! | `plane_with_sphere` | a `[-3, 3]^2` ground (64 x 64 cells) with a unit sphere resting on it (a cube sphere, 16 x 16 cells a face) | 5,959 |
 //! | `sphere` | a unit sphere at the origin tessellated as a cube sphere, `cells x cells` per face, normals exact (radial) | `6 (cells + 1)^2` |
 //! | `table` | a table standing on `y = 0`: a top `[-1, 1] x [0.9, 1] x [-0.6, 0.6]` on four legs 0.08 thick at its corners, each box `cells x cells` a face | `30 (cells + 1)^2` |
@@ -312,13 +312,13 @@ pub fn ground_plane_under(b: &crate::relight::Bounds) -> Result<Mesh> {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Generator {
-    /// Seed 002's "Cylinder & Bump": a cylinder beside a Gaussian bump on an 8 x 8 ground.
+    /// Vollick and Lessig's "Cylinder & Bump": a cylinder beside a Gaussian bump on an 8 x 8 ground.
     CylinderAndBump {
         /// Cells per side of the ground.
         #[serde(default = "default_ground_cells")]
         cells: usize,
     },
-    /// Seed 002's "Cubes": an array of cubes in front of a wall.
+    /// Vollick and Lessig's "Cubes": an array of cubes in front of a wall.
     Cubes {
         /// Cubes per row and per column.
         #[serde(default = "default_cube_count")]
@@ -338,7 +338,7 @@ pub enum Generator {
         cells: usize,
     },
     /// A table: a top 2 x 0.1 x 1.2 at height 0.9 to 1 on four legs 0.08 thick, standing on
-    /// `y = 0` (seed 001's dynamic-scene setting).
+    /// `y = 0` (Sun 2006's dynamic-scene setting).
     Table {
         /// Cells per side of each box face.
         cells: usize,

@@ -1,5 +1,5 @@
 //! Dynamic scenes behind [`Shader`]: moving objects shadowing each other through occlusion
-//! fields ([`DynamicScene`], seed 001), by n-function product integrals or by the ray-cast
+//! fields ([`DynamicScene`], Sun 2006), by n-function product integrals or by the ray-cast
 //! reference, and the frames an animation plays ([`play`](crate::relight::dynamic::motion::play),
 //! just-in-time radiance transfer) reported alike.
 

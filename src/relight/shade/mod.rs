@@ -14,10 +14,10 @@
 //! |---|---|---|
 //! | [`lambert`] | [`LambertShader`](lambert::LambertShader): one sparse dot per vertex | [`PreparedTransport`] |
 //! | [`glossy`] | [`GlossyHaarShader`](glossy::GlossyHaarShader): the triple product with the rotated BRDF | [`GlossyShader`](glossy::GlossyShader), the rotation cache |
-//! | [`harmonics`] | [`ShShader`](harmonics::ShShader): seed 003's spherical-harmonic baseline | [`shade_sh`](harmonics::shade_sh), [`PhongSh`](harmonics::PhongSh) |
+//! | [`harmonics`] | [`ShShader`](harmonics::ShShader): Microsoft 2003's spherical-harmonic baseline | [`shade_sh`](harmonics::shade_sh), [`PhongSh`](harmonics::PhongSh) |
 //! | [`mod@reference`] | [`ReferenceShader`](reference::ReferenceShader): the ground truth | [`reference()`](reference::reference) |
 //! | [`ambient`] | [`AmbientShader`](ambient::AmbientShader): `albedo / pi x <T, 1>` | [`PreparedTransport`] under a white sky |
-//! | [`dynamic`] | [`DynamicShader`](dynamic::DynamicShader): moving objects (seed 001) | [`DynamicScene`](crate::relight::dynamic::DynamicScene) |
+//! | [`dynamic`] | [`DynamicShader`](dynamic::DynamicShader): moving objects (Sun 2006) | [`DynamicScene`](crate::relight::dynamic::DynamicScene) |
 //! | [`frame`] | [`FrameSpec`], [`LightSpec`]: the lighting of a frame, resolved | |
 
 pub mod ambient;

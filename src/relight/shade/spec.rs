@@ -146,6 +146,28 @@ impl ShaderSpec {
         Ok(())
     }
 
+    /// The method's short name as tables and records print it: the basis (`haar`, `sh`,
+    /// `reference`, `ambient`), except that a glossy Haar shader is named by how it brings
+    /// the BRDF into each frame (`haar`, `haar-cubic`, `spatial`, `reference`, `direct`).
+    ///
+    /// ```
+    /// use haarshift::relight::material::orient::BrdfRotation;
+    /// use haarshift::relight::shade::{Method, ShaderSpec};
+    /// let mut spec = ShaderSpec::default();
+    /// assert_eq!(spec.label(), "haar");
+    /// spec.material.brdf = "phong:20".parse().unwrap();
+    /// spec.material.rotation = BrdfRotation::Spatial;
+    /// assert_eq!(spec.label(), "spatial");
+    /// spec.method = Method::Sh;
+    /// assert_eq!(spec.label(), "sh");
+    /// ```
+    pub fn label(&self) -> String {
+        match self.method {
+            Method::Haar if !self.material.brdf.is_lambert() => self.material.rotation.to_string(),
+            method => method.to_string(),
+        }
+    }
+
     /// The shader of this spec for `input`, prepared (and with
     /// [`fill_cache`](Self::fill_cache), its rotation cache filled).
     pub fn build(&self, input: &ShadingInput<'_>) -> Result<Box<dyn Shader>> {

@@ -309,23 +309,18 @@ fn dispatch(line: &str) -> Option<String> {
     if let Some(found) = REACHES.iter().find(|r| line.contains(*r)) {
         return Some((*found).to_owned());
     }
-    if let Some(v) = ["Lambert", "Phong", "Blinn", "Merl"]
-        .iter()
-        .find(|v| line.contains(&format!("Brdf::{v}")))
-    {
-        return Some(format!("Brdf::{v}"));
-    }
-    // A method named in a match arm, a comparison or a pattern.
-    let names = Method::ALL
-        .iter()
-        .map(|m| format!("{m:?}"))
-        .chain(dynamic::DynamicMethod::ALL.iter().map(|m| format!("{m:?}")));
-    for name in names {
-        let variant = format!("Method::{name}");
-        let named = line.match_indices(&variant).any(|(at, _)| {
-            let before = &line[..at];
-            before.ends_with("Dynamic") || !before.ends_with(|c: char| c.is_alphanumeric())
-        });
+    // A method or a material named in a match arm, a comparison or a pattern (naming one to
+    // build a spec or a protocol is not dispatch).
+    let methods = Method::ALL.iter().map(|m| format!("Method::{m:?}")).chain(
+        dynamic::DynamicMethod::ALL
+            .iter()
+            .map(|m| format!("DynamicMethod::{m:?}")),
+    );
+    let materials = ["Lambert", "Phong", "Blinn", "Merl"].map(|v| format!("Brdf::{v}"));
+    for variant in methods.chain(materials) {
+        let named = line
+            .match_indices(&variant)
+            .any(|(at, _)| !line[..at].ends_with(|c: char| c.is_alphanumeric() || c == '_'));
         if named
             && ["=>", "==", "!=", "if let", "matches!"]
                 .iter()
@@ -350,13 +345,7 @@ fn no_caller_dispatches_on_the_shading_method() {
     }
     assert!(files.len() > 20, "{} files", files.len());
     let mut found = Vec::new();
-    // Left to convert: the dynamic-scene experiment's static baseline, and the relighting
-    // experiment's choice of camera and record fields by material.
-    let pending = [
-        root.join("src/experiments/dynamic.rs"),
-        root.join("src/experiments/relight.rs"),
-    ];
-    for file in files.iter().filter(|f| !pending.contains(f)) {
+    for file in &files {
         let text = std::fs::read_to_string(file).unwrap();
         for (n, line) in text.lines().enumerate() {
             if let Some(what) = dispatch(line) {
@@ -384,5 +373,17 @@ fn no_caller_dispatches_on_the_shading_method() {
         Some(".is_lambert()")
     );
     assert_eq!(dispatch("let s = spec(Method::Haar);"), None);
+    assert_eq!(
+        dispatch("DynamicMethod::Reference => truth(),").as_deref(),
+        Some("DynamicMethod::Reference")
+    );
+    assert_eq!(
+        dispatch("if let Brdf::Phong { exponent } = brdf {").as_deref(),
+        Some("Brdf::Phong")
+    );
+    assert_eq!(
+        dispatch("materials: vec![Brdf::Lambert, phong(10.0)],"),
+        None
+    );
     assert_eq!(dispatch("ShiftMethod::Haar => {"), None);
 }

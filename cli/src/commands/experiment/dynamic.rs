@@ -23,12 +23,12 @@ Examples:
 A scenario FILE:NAME:X,Y,Z is a scene file, the object that moves and the point it moves to
 (translation only). The default scenarios, relative to the repository's root, are
 testdata/scenes/bunny_and_ball.json:ball:1.5,1.2,4.5 (a ball passing by the bunny) and
-testdata/scenes/table_and_chair.json:chair:0.9,0,1.3 (seed 001's table with a chair beside
+testdata/scenes/table_and_chair.json:chair:0.9,0,1.3 (Sun 2006's table with a chair beside
 it). For each setting the scene is built, just-in-time transfer is formed for the moving
 object where the file places it, the object moves to its target and the frame is shaded;
 the ground truth ray-casts the moved scene against every object (`relight scene --method
 reference`), over the lighting at the protocol's reference resolution. Axes, each its own
-rows: resolution (lat-long N x 2N maps, seed 001's field density), density (the base
+rows: resolution (lat-long N x 2N maps, Sun 2006's field density), density (the base
 resolution, the circles, points and shells scaled), budget (lighting / own transport /
 occlusion-map details kept, occlusion maps truncated before or after the blend), depth
 (traversal depth at the base budget), change (the transfer formed for a change of lighting
@@ -51,7 +51,7 @@ pub struct Args {
     #[arg(long, value_name = "ENV")]
     pub env: Option<PathBuf>,
 
-    /// The full protocol (64 x 128 maps, twice seed 001's density, reference 128)
+    /// The full protocol (64 x 128 maps, twice Sun 2006's density, reference 128)
     #[arg(long)]
     pub full: bool,
 
@@ -152,7 +152,7 @@ pub fn run_command(args: Args) -> Result<()> {
     }
     bar.finish_and_clear();
     let header = format!(
-        "protocol: {}; resolutions {:?}, densities {:?} (x seed 001's 100 x 200 circle points \
+        "protocol: {}; resolutions {:?}, densities {:?} (x Sun 2006's 100 x 200 circle points \
          and 20 x 6 x 9 x 9 shell points), base resolution {}, budgets (light / visibility / \
          field) {}, depth and change at {}, reference lighting {} x {}\n",
         if args.full { "full" } else { "quick" },

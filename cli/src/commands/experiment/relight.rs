@@ -1,5 +1,5 @@
 //! `haarshift experiment relight`: every relighting method against the ray-cast ground truth,
-//! over the seeds' axes, with picture grids.
+//! over the sources' axes, with picture grids.
 
 use std::path::PathBuf;
 
@@ -17,7 +17,7 @@ Examples:
   haarshift experiment relight --scene testdata/scenes/cylinder_and_bump.json --env park.hdr
 
 Defaults, relative to the repository's root: --scene testdata/scenes/bunny.json and
-testdata/scenes/cylinder_and_bump.json (seed 002's procedural scene), --env the four maps
+testdata/scenes/cylinder_and_bump.json (Vollick and Lessig's procedural scene), --env the four maps
 testdata/envmaps/*_1k.hdr (512 x 1024). --quick runs the first scene under the first map;
 --full the first scene under every map (each material; Phong 50 also under the lighting
 rotated by yaw 90, pitch 30 and from the second camera, orbited 120 degrees), the second
@@ -36,8 +36,8 @@ evaluated exactly in each vertex's frame. Axes, each its own table:
                 fine (cutoff: the thesis's Fig. 4.7) or the largest, and all of them
   resolution    lat-long 32 x 64 to 128 x 256 (--full: 256 x 512) and cube 6 x 16^2 to
                 6 x 32^2 (--full: 6 x 128^2) times kept ratio 1, 0.1, 0.05, 0.01 of the
-                lighting's and each transport's (and BRDF map's) details (seed 002's tables)
-  depth         traversal depth 1 to 7 at 128 x 256 (seed 001's Fig. 3.5)
+                lighting's and each transport's (and BRDF map's) details (Vollick and Lessig's tables)
+  depth         traversal depth 1 to 7 at 128 x 256 (Sun 2006's Fig. 3.5)
   harmonics     spherical harmonics of 2 to 8 bands against Haar at the same number of
                 lighting and transport coefficients, and Haar at 128 to 1024 of them
 Materials: Phong 50 (--full also Phong 10, Phong 200 and Blinn-Phong 50). The thesis's
@@ -60,7 +60,7 @@ rotation axis's renders over their false-colour error images).";
 #[command(after_help = EXAMPLES)]
 pub struct Args {
     /// A scene file (JSON) or a mesh put on its ground plane (repeatable) [default: the
-    /// bunny and seed 002's cylinder and bump]
+    /// bunny and Vollick and Lessig's cylinder and bump]
     #[arg(long, value_name = "FILE")]
     pub scene: Vec<PathBuf>,
 

@@ -63,7 +63,7 @@ pub struct Args {
     pub seed: u64,
 
     /// `vertex`: vertices outer, rays through a BVH. `direction`: directions outer, a shadow
-    /// buffer per direction (seed 003), texel centres only
+    /// buffer per direction (Microsoft 2003), texel centres only
     #[arg(long, default_value = "vertex", value_parser = choice::<Order>(names!(Order)))]
     pub order: Order,
 

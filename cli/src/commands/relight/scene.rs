@@ -23,7 +23,7 @@ use super::flags::{
 use crate::commands::{choice, names, print, refuse_existing};
 
 const HELP: &str = "\
-Every object of the scene file gets occlusion fields (seed 001): from sample points on 100
+Every object of the scene file gets occlusion fields (Sun 2006): from sample points on 100
 circles x 200 points on its ground plane (0.05 r to 10 r) and on 20 shells of 6 x 9 x 9
 points around it (0.2 R to 6 R), the visibility of the object over the sphere, one ray per
 texel, Haar-transformed and truncated to --keep-field. Each vertex's own transport is

@@ -1,4 +1,4 @@
-//! Occlusion fields of rigid objects (seed 001 sections 2.3.1 and 3.5.1): an object's
+//! Occlusion fields of rigid objects (Sun 2006 sections 2.3.1 and 3.5.1): an object's
 //! visibility as seen from sample points around it, one sparse Haar map over the sphere per
 //! point, looked up by interpolation wherever another object's vertex is.
 //!
@@ -14,7 +14,7 @@
 //! vertex from `c` (the bounding sphere), `r` the largest horizontal distance from the
 //! vertical through `c` (the footprint), `y0` its lowest `y` (the virtual ground plane):
 //! * the **planar field**: `circles` concentric circles on the plane `y = y0` about the
-//!   vertical through `c`, radii from `circle_radii.0 x r` to `circle_radii.1 x r` (seed 001:
+//!   vertical through `c`, radii from `circle_radii.0 x r` to `circle_radii.1 x r` (Sun 2006:
 //!   100 circles, 0.05 r to 10 r), each with `circle_points` points at equal angles from +X
 //!   towards +Z (001: 200); points are lifted by the ray offset so rays leave the plane;
 //! * the **spherical field**: `shells` concentric spheres about `c`, radii `shell_radii.0 x R`
@@ -119,7 +119,7 @@ pub struct FieldOptions {
 }
 
 impl FieldOptions {
-    /// Seed 001's field: 100 circles x 200 points from 0.05 r to 10 r, 20 shells of 6 x 9 x 9
+    /// Sun 2006's field: 100 circles x 200 points from 0.05 r to 10 r, 20 shells of 6 x 9 x 9
     /// points from 0.2 R to 6 R, every coefficient kept.
     pub fn new(param: Parameterization) -> Self {
         FieldOptions {

@@ -14,7 +14,7 @@
 //! **How.** The triple product of the three truncated functions is the integral of the
 //! product of their reconstructions, so `B_v = a_v <T_v, Q>` with `Q` the orthonormal Haar
 //! coefficients of the pixel-wise product `L~ x rho~_v`: one dense `O(N)` product and forward
-//! transform per distinct BRDF map, then one sparse dot product per vertex. This is seed 001's
+//! transform per distinct BRDF map, then one sparse dot product per vertex. This is Sun 2006's
 //! just-in-time radiance transfer (section 3.5) with the lighting and the BRDF as the fixed
 //! pair: the same number as [`triple_integral`](crate::product::triple::triple_integral) on the
 //! three trees (tested to 1e-12), and with a depth limit the same as the traversal stopped at

@@ -1,4 +1,4 @@
-//! Shading from spherical-harmonic transfer ([`ShTransfer`], seed 003's low-frequency
+//! Shading from spherical-harmonic transfer ([`ShTransfer`], Microsoft 2003's low-frequency
 //! precomputed radiance transfer), the baseline all-frequency relighting is compared against.
 //!
 //! **Shading.** The lighting's coefficients are its own projection,

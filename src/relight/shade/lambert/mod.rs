@@ -7,7 +7,7 @@
 //! functions in one orthonormal basis the integral of the product is the dot product of their
 //! coefficients (Parseval, face by face), so it is a sparse dot product of the vertex's stored
 //! `(index, value)` pairs with the lighting's dense `(texels, 3)` rows ([`Lighting`]). This is
-//! seed 001's just-in-time radiance transfer (section 3.5, eq. 3.9): the fixed factors
+//! Sun 2006's just-in-time radiance transfer (section 3.5, eq. 3.9): the fixed factors
 //! (visibility, cosine, solid angle, and the BRDF's constant) are formed once, at
 //! precomputation and in [`PreparedTransport::new`]; a change of lighting costs one sparse dot
 //! per vertex. The same number as [`product_integral`](crate::product::product_integral) of
@@ -19,7 +19,7 @@
 //!   coefficients always kept, ties by the layout's index), exactly what
 //!   [`Transport::select`](crate::product::Transport::select) keeps. Asking for more than a
 //!   vertex stores keeps what it stores.
-//! * `depth = d`: the traversal depth of seed 001 Fig. 3.5: only the detail levels `0..d` take
+//! * `depth = d`: the traversal depth of Sun 2006 Fig. 3.5: only the detail levels `0..d` take
 //!   part, i.e. the integral of the two functions averaged over blocks of side `S >> d` (faces
 //!   `2^d` texels wide, the thesis's "level `d`"). `d = 0` keeps only the scaling
 //!   coefficients (the product of face means); `d = log2 S` is the full integral.
