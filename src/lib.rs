@@ -16,6 +16,7 @@
 //! * [`relight`]: meshes and scenes lit by environment maps: ray casting, per-vertex visibility
 //!   precomputed into sparse Haar transport, the scene cache, the lighting, the rasteriser and
 //!   animations.
+//! * [`progress`]: where long computations report their progress (the library draws nothing).
 //! * [`experiments`], [`metrics`], [`patterns`]: error-accumulation experiments, the error
 //!   measures they report, and the synthetic test patterns they use.
 //! * [`io`]: PNG, JPEG, TIFF, OpenEXR, Radiance HDR and `.npy` in and out of [`PlanarImage`]
@@ -45,6 +46,7 @@ mod named;
 pub mod patterns;
 mod planar_image;
 pub mod product;
+pub mod progress;
 pub mod relight;
 pub mod render;
 pub mod rotate;

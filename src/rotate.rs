@@ -90,6 +90,31 @@ pub struct RotateOptions {
     pub memory_budget: u64,
 }
 
+impl RotateOptions {
+    /// Checks the options that do not depend on the image or the kernel: the supersampling
+    /// (at most [`MAX_SUPERSAMPLE`]) and the outside (a finite fill value).
+    ///
+    /// ```
+    /// use haarshift::rotate::RotateOptions;
+    /// let too_fine = RotateOptions { supersample: 9, ..RotateOptions::default() };
+    /// assert_eq!(too_fine.validate().unwrap_err().to_string(),
+    ///            "invalid supersample: 9 is above the largest, 8");
+    /// assert!(RotateOptions::default().validate().is_ok());
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        if self.supersample > MAX_SUPERSAMPLE {
+            return Err(Error::parameter(
+                "supersample",
+                format!(
+                    "{} is above the largest, {MAX_SUPERSAMPLE}",
+                    self.supersample
+                ),
+            ));
+        }
+        self.outside.validate().map(|_| ())
+    }
+}
+
 impl Default for RotateOptions {
     fn default() -> Self {
         RotateOptions {
@@ -203,13 +228,7 @@ fn validate_plane<T: Sample>(plane: ArrayView2<'_, T>, options: &RotateOptions) 
     if h == 0 || w == 0 {
         return Err(Error::shape(&[h, w], "image is empty"));
     }
-    if options.supersample > MAX_SUPERSAMPLE {
-        return Err(Error::parameter(
-            "supersample",
-            format!("{} (at most {MAX_SUPERSAMPLE})", options.supersample),
-        ));
-    }
-    options.outside.validate()?;
+    options.validate()?;
     check_finite(plane)
 }
 

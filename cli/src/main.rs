@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 
 mod commands;
 mod peak;
+mod progress;
 
 /// Counts heap use, so that the experiments can report peak memory per run.
 #[global_allocator]
@@ -54,6 +55,7 @@ fn main() -> ExitCode {
         eprintln!("haarshift: internal error (please report it): {info}");
     }));
     let cli = Cli::parse();
+    progress::TerminalProgress::install();
     let result = match cli.command {
         Command::Transform(args) => commands::transform::run(args),
         Command::Inverse(args) => commands::inverse::run(args),

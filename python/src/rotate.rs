@@ -4,7 +4,7 @@ use std::sync::Mutex;
 
 use haarshift::Sample;
 use haarshift::kernels::{KernelOptions, Outside, ShiftMethod};
-use haarshift::rotate::{Canvas, MAX_SUPERSAMPLE, RotateOptions, RotationWorkspace, rotated_size};
+use haarshift::rotate::{Canvas, RotateOptions, RotationWorkspace, rotated_size};
 use ndarray::{ArrayView2, ArrayViewMut2};
 use numpy::{Element, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -35,18 +35,13 @@ impl Rotation {
         supersample: u32,
     ) -> PyResult<Self> {
         let (method, kernel) = kernel(method, precision, retain, keys_a)?;
-        if supersample > MAX_SUPERSAMPLE {
-            return Err(bad_argument(
-                "supersample",
-                format!("{supersample} is above the largest, {MAX_SUPERSAMPLE}"),
-            ));
-        }
         let options = RotateOptions {
             canvas: parse::<Canvas>(canvas)?,
             outside: outside(fill, boundary)?,
             supersample,
             ..Default::default()
         };
+        options.validate().or_raise()?;
         Ok(Rotation {
             method,
             kernel,

@@ -120,8 +120,7 @@ impl ImageOutput {
     /// Refuses, before any work, an output that is the file `input` (or any of `inputs`),
     /// and an existing output without `--force`.
     pub fn refuse_overwriting(&self, inputs: &[&Path]) -> Result<()> {
-        refuse_output_among_inputs(inputs, &self.output)?;
-        refuse_existing(&[&self.output], self.force)
+        refuse_outputs(inputs, &[&self.output], self.force)
     }
 
     /// Writes `image` (atomically; replaced only with `--force`; stored at `depth` when given)
@@ -186,27 +185,19 @@ pub fn print(text: &str) -> Result<()> {
     }
 }
 
-/// Refuses, before any work, the first of `outputs` that exists unless `force`: the write
-/// itself would refuse it too, but only after the computation.
-pub fn refuse_existing(outputs: &[&Path], force: bool) -> Result<()> {
+/// Refuses, before any work, an output that is one of `inputs` (the same file by any path),
+/// and the first of `outputs` that exists unless `force`: the write itself would refuse it
+/// too, but only after the computation. Every command checks its outputs here.
+pub fn refuse_outputs(inputs: &[&Path], outputs: &[&Path], force: bool) -> Result<()> {
+    for input in inputs {
+        for output in outputs {
+            haarshift::io::ensure_distinct_paths(input, output)?;
+        }
+    }
     match outputs.iter().find(|p| !force && p.exists()) {
         Some(path) => Err(Error::OutputExists {
             path: path.to_path_buf(),
         }),
         None => Ok(()),
     }
-}
-
-/// Refuses `output` when it is one of `inputs`.
-pub fn refuse_output_among_inputs(inputs: &[&Path], output: &Path) -> Result<()> {
-    inputs
-        .iter()
-        .try_for_each(|input| refuse_overwriting_input(input, &[output]))
-}
-
-/// Refuses `output` (and each of `others`, e.g. a sidecar) when it is the file `input`.
-pub fn refuse_overwriting_input(input: &Path, outputs: &[&Path]) -> Result<()> {
-    outputs
-        .iter()
-        .try_for_each(|out| haarshift::io::ensure_distinct_paths(input, out))
 }

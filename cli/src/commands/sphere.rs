@@ -12,11 +12,8 @@ use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotat
 use haarshift::{Error, PlanarImage, Result, Sample, SampleDepth};
 use indicatif::ProgressBar;
 
-use super::experiment::progress_bar;
-use super::{
-    Compute, ComputeFlag, ImageOutput, choice, names, print, refuse_existing,
-    refuse_overwriting_input,
-};
+use super::{Compute, ComputeFlag, ImageOutput, choice, names, print, refuse_outputs};
+use crate::progress::progress_bar;
 
 /// Operations on lat-long environment maps.
 #[derive(Subcommand, Debug)]
@@ -135,8 +132,7 @@ fn rotate(args: RotateArgs) -> Result<()> {
     } else {
         &[&args.output]
     };
-    refuse_overwriting_input(&args.input, outputs)?;
-    refuse_existing(outputs, args.force)?;
+    refuse_outputs(&[&args.input], outputs, args.force)?;
     let rotation = SphereRotation::from_degrees(args.yaw, args.pitch, args.roll)?;
     let options = SphereOptions {
         method: args.method,
@@ -332,10 +328,8 @@ struct IntegralRecord {
 
 fn integrate(args: IntegrateArgs) -> Result<()> {
     if let Some(json) = &args.json {
-        for m in &args.maps.maps {
-            refuse_overwriting_input(m, &[json])?;
-        }
-        refuse_existing(&[json], args.force)?;
+        let maps: Vec<&Path> = args.maps.maps.iter().map(PathBuf::as_path).collect();
+        refuse_outputs(&maps, &[json], args.force)?;
     }
     match args.maps.compute()? {
         Compute::F32 => integrate_as::<f32>(&args),

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use haarshift::io::{CoefficientFile, WriteOptions, read_image};
 use haarshift::{Result, Sample};
 
-use super::{Compute, TransformFlags, print, refuse_existing, refuse_overwriting_input};
+use super::{Compute, TransformFlags, print, refuse_outputs};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -46,8 +46,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let sidecar = CoefficientFile::<f64>::sidecar_path(&args.output);
-    refuse_overwriting_input(&args.input, &[&args.output, &sidecar])?;
-    refuse_existing(&[&args.output, &sidecar], args.force)?;
+    refuse_outputs(&[&args.input], &[&args.output, &sidecar], args.force)?;
     match args.compute.unwrap_or(Compute::F64) {
         Compute::F32 => transform::<f32>(&args),
         Compute::F64 => transform::<f64>(&args),

@@ -1,12 +1,17 @@
+use std::path::Path;
+
 use super::*;
 use crate::faces::param::SphereMap;
+use crate::relight::SceneBvh;
 use crate::relight::dynamic::tests::{
     THREE, build, each_moved_object_is_the_full_product_integral, lighting, options, param,
     relative, scene_file,
 };
 use crate::relight::material::orient::BrdfRotation;
+use crate::relight::precompute::visibility::{VisibilityOptions, vertex_major};
 use crate::relight::shade::ShadeOptions;
 use crate::relight::shade::glossy::GlossyShader;
+use crate::sphere::LatLongMap;
 
 const CAMERA: &str = r#""camera": {"position": [1.5, 2.5, 4.0], "look_at": [0, 0, 0]}"#;
 

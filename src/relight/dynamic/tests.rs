@@ -1,11 +1,16 @@
 use ndarray::{Array3, Axis};
 
+use std::path::Path;
+
+use super::shading::tree;
 use super::*;
 use crate::faces::param::SphereMap;
 use crate::metrics;
 use crate::relight::Occlusion;
 use crate::relight::dynamic::fields::FieldOptions;
+use crate::relight::precompute::visibility::{VisibilityOptions, ray_offset, vertex_major};
 use crate::relight::shade::{PreparedTransport, ShadeOptions};
+use crate::relight::{SceneBvh, SceneFile};
 
 pub(super) fn param() -> Parameterization {
     Parameterization::new(ParamKind::LatLong, 8).unwrap()

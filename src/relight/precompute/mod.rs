@@ -51,7 +51,7 @@ pub const DEFAULT_MAP_SIZE: usize = 2048;
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrecomputeOptions {
-    /// Directions, samples, truncation, seed, progress bar.
+    /// Directions, samples, truncation, seed, progress reporting.
     pub visibility: VisibilityOptions,
     /// The loop order.
     pub order: Order,

@@ -32,12 +32,12 @@
 
 use std::time::Instant;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use ndarray::Array3;
 use rayon::prelude::*;
 
 use crate::faces::Parameterization;
 use crate::product::Selection;
+use crate::progress::Task;
 use crate::relight::Mesh;
 use crate::relight::harmonics::check_bands;
 use crate::relight::precompute::raycast::Occlusion;
@@ -69,12 +69,12 @@ pub struct VisibilityOptions {
     /// [`MAX_SH_BANDS`](crate::relight::harmonics::MAX_SH_BANDS)); the set then carries an
     /// [`ShTransfer`](crate::relight::harmonics::ShTransfer).
     pub sh_bands: Option<usize>,
-    /// Show a progress bar on standard error (hidden when it is not a terminal).
+    /// Report progress to the installed [reporter](crate::progress) (nothing is drawn without one).
     pub progress: bool,
 }
 
 impl VisibilityOptions {
-    /// One ray per texel centre, every coefficient kept, seed 0, no progress bar.
+    /// One ray per texel centre, every coefficient kept, seed 0, no progress reported.
     pub fn new(param: Parameterization) -> Self {
         VisibilityOptions {
             param,
@@ -136,19 +136,6 @@ pub(crate) fn texel_directions(param: Parameterization) -> Vec<[f64; 3]> {
         .collect()
 }
 
-pub(crate) fn progress_bar(show: bool, len: usize, what: &str) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(len as u64).with_message(what.to_string());
-    if let Ok(style) =
-        ProgressStyle::with_template("{msg} {wide_bar} {pos}/{len} vertices, eta {eta}")
-    {
-        bar.set_style(style);
-    }
-    bar
-}
-
 /// SplitMix64: a well-mixed hash of a 64-bit key.
 fn mix(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
@@ -204,7 +191,7 @@ pub fn vertex_major(
     let samples = options.samples;
     let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
     let mut set = encoder.empty_set()?;
-    let bar = progress_bar(options.progress, mesh.vertex_count(), "visibility (rays)");
+    let bar = Task::begin(options.progress, "visibility (rays)", mesh.vertex_count());
     let encoded: Vec<Result<(Encoded, u64)>> = (0..mesh.vertex_count())
         .into_par_iter()
         .map_init(
@@ -242,12 +229,11 @@ pub fn vertex_major(
                     *value = (visible as f64 / (samples * samples) as f64 * cos) as f32;
                 }
                 let vertex = encoder.encode(values.view())?;
-                bar.inc(1);
+                bar.advance(1);
                 Ok((vertex, rays))
             },
         )
         .collect();
-    bar.finish_and_clear();
     let mut rays = 0;
     for vertex in encoded {
         let (vertex, r) = vertex?;
@@ -325,7 +311,7 @@ pub fn direction_major(
     let maps_bytes = rayon::current_num_threads() * map_size * map_size * 4;
     let s = param.face_size();
     let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
-    let bar = progress_bar(options.progress, vertices, "transport (shadow maps)");
+    let bar = Task::begin(options.progress, "transport (shadow maps)", vertices);
     let encoded: Vec<Result<Encoded>> = (0..vertices)
         .into_par_iter()
         .map(|v| {
@@ -340,11 +326,10 @@ pub fn direction_major(
                 }
             });
             let out = encoder.encode(values.view());
-            bar.inc(1);
+            bar.advance(1);
             out
         })
         .collect();
-    bar.finish_and_clear();
     let mut set = encoder.empty_set()?;
     for vertex in encoded {
         set.extend(&vertex?);

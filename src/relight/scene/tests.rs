@@ -1,7 +1,11 @@
 use std::path::Path;
 
 use super::*;
+use crate::Error;
+use crate::relight::SceneError;
 use crate::relight::scene::mesh::sub;
+use crate::relight::scene::mesh::{cross, dot};
+use crate::relight::scene::shapes::{cuboid, cylinder};
 
 /// Every triangle of a closed convex mesh faces away from `centre`.
 fn assert_outward(mesh: &Mesh, centre: [f64; 3]) {

@@ -17,9 +17,9 @@
 
 use ndarray::{ArrayView1, ArrayView2};
 
-use super::SceneError;
 use super::mesh::Bounds;
 use crate::Result;
+use crate::relight::SceneError;
 
 /// The largest distance from the origin of any coordinate in a scene; see the
 /// [module docs](self).

@@ -125,17 +125,12 @@ impl Shader for DynamicShader<'_> {
                 )
             }
         };
-        Ok(Shading {
+        Ok(unrotated_shading(
             radiance,
-            timing: Timing {
-                encode_seconds,
-                rotate_seconds: 0.0,
-                shade_seconds,
-            },
-            description: description.into(),
-            maps: None,
-            light_coefficients: Some(coefficients),
-        })
+            (encode_seconds, shade_seconds),
+            description,
+            Some(coefficients),
+        ))
     }
 
     fn preparation(&self) -> Preparation {
@@ -167,17 +162,12 @@ impl DynamicMethod {
                 (Radiance::F64(radiance), encode, shade, "reference")
             }
         };
-        Ok(Shading {
+        Ok(unrotated_shading(
             radiance,
-            timing: Timing {
-                encode_seconds,
-                rotate_seconds: 0.0,
-                shade_seconds,
-            },
-            description: description.into(),
-            maps: None,
-            light_coefficients: None,
-        })
+            (encode_seconds, shade_seconds),
+            description,
+            None,
+        ))
     }
 }
 
@@ -208,4 +198,21 @@ pub fn glossy_material(scene: &DynamicScene) -> Result<Brdf> {
         }
     }
     Ok(Brdf::Lambert)
+}
+
+/// A dynamic scene's frame: its timing reports encoding and shading, no separate BRDF
+/// rotation.
+fn unrotated_shading(
+    radiance: Radiance,
+    (encode_seconds, shade_seconds): (f64, f64),
+    description: &str,
+    light_coefficients: Option<usize>,
+) -> Shading {
+    Shading {
+        radiance,
+        timing: Timing::unrotated(encode_seconds, shade_seconds),
+        description: description.into(),
+        maps: None,
+        light_coefficients,
+    }
 }

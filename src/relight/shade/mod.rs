@@ -185,6 +185,21 @@ pub struct Timing {
 }
 
 impl Timing {
+    /// A frame of a method that rotates no BRDF: encoding and shading only.
+    ///
+    /// ```
+    /// use haarshift::relight::shade::Timing;
+    /// let t = Timing::unrotated(0.25, 0.5);
+    /// assert_eq!((t.encode_seconds, t.rotate_seconds, t.shade_seconds), (0.25, 0.0, 0.5));
+    /// ```
+    pub fn unrotated(encode_seconds: f64, shade_seconds: f64) -> Timing {
+        Timing {
+            encode_seconds,
+            rotate_seconds: 0.0,
+            shade_seconds,
+        }
+    }
+
     /// Encoding and shading together.
     pub fn total_seconds(&self) -> f64 {
         self.encode_seconds + self.shade_seconds

@@ -78,7 +78,7 @@ pub struct ShaderSpec {
     pub sh_bands: Option<usize>,
     /// The reference's lat-long height `N` [default: the transport's face size].
     pub reference_resolution: Option<usize>,
-    /// The reference draws a progress bar on standard error.
+    /// The reference reports its progress ([`progress`](crate::progress)).
     pub progress: bool,
 }
 

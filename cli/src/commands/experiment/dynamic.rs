@@ -11,8 +11,9 @@ use haarshift::relight::Transform;
 use haarshift::relight::light::environment::Environment;
 use haarshift::{Error, Result};
 
-use super::{OutputFlags, progress_bar, wrote};
+use super::{OutputFlags, wrote};
 use crate::commands::print;
+use crate::progress::progress_bar;
 
 const EXAMPLES: &str = "\
 Examples:

@@ -1,7 +1,6 @@
 //! `haarshift experiment ...`: the error-accumulation experiments, one module per experiment.
 //! Each prints its table to stdout and writes CSV, JSON and PNG files into `--out-dir`.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -13,10 +12,9 @@ use haarshift::experiments::rotation_cycle::{CycleRecord, MemoryMeter};
 use haarshift::experiments::table::{Table, significant};
 use haarshift::kernels::{KernelOptions, ShiftMethod};
 use haarshift::{Error, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use crate::commands::refuse_output_among_inputs;
+use crate::commands::refuse_outputs;
 
 pub mod dynamic;
 pub mod relight;
@@ -100,10 +98,7 @@ impl OutputFlags {
         let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
         dir.claim(experiment, &inputs)?;
         if let Some(json) = &self.json {
-            refuse_output_among_inputs(&inputs, json)?;
-            if !self.force && json.exists() {
-                return Err(Error::OutputExists { path: json.clone() });
-            }
+            refuse_outputs(&inputs, &[json], self.force)?;
         }
         Ok(Reports {
             dir,
@@ -226,18 +221,6 @@ impl MethodFlags {
             self.precision, self.retained_precision
         )
     }
-}
-
-/// A progress bar on stderr when stderr is a terminal; hidden otherwise.
-pub fn progress_bar(len: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(len as u64);
-    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}") {
-        bar.set_style(style);
-    }
-    bar
 }
 
 /// Parses `--methods`: kernel names separated by commas; `haar` means both Haar modes,

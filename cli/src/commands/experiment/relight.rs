@@ -7,8 +7,9 @@ use haarshift::Result;
 use haarshift::experiments::relight::report::{coefficient_plot, report, time_plot};
 use haarshift::experiments::relight::{Light, RelightProtocol, Subject, run};
 
-use super::{OutputFlags, progress_bar, wrote};
+use super::{OutputFlags, wrote};
 use crate::commands::print;
+use crate::progress::progress_bar;
 
 const EXAMPLES: &str = "\
 Examples:

@@ -12,8 +12,9 @@ use haarshift::experiments::rotation_cycle::{CycleRecord, CycleRun, PROTOCOL};
 use haarshift::experiments::table::significant;
 use ndarray::{Array2, ArrayView2, s};
 
-use super::{MethodFlags, OutputFlags, PeakMeter, Reports, cycle_table, progress_bar, wrote};
+use super::{MethodFlags, OutputFlags, PeakMeter, Reports, cycle_table, wrote};
 use crate::commands::print;
+use crate::progress::progress_bar;
 
 const ABOUT: &str = "\
 Protocol (fixed, printed with the results): luma 0.2125R+0.7154G+0.0721B on the stored values;

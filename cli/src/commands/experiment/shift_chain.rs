@@ -9,8 +9,9 @@ use haarshift::experiments::shift_chain::{ChainRecord, run_chain};
 use haarshift::experiments::table::{Table, significant};
 
 use super::rotation_cycle::load_images;
-use super::{MethodFlags, OutputFlags, Reports, progress_bar};
+use super::{MethodFlags, OutputFlags, Reports};
 use crate::commands::print;
+use crate::progress::progress_bar;
 
 const ABOUT: &str = "\
 Protocol (fixed, printed with the results): luma of each image; its centred square crop whose

@@ -9,8 +9,9 @@ use haarshift::sphere::experiment::{self, Record, STANDARD_ROTATIONS, default_ma
 use haarshift::sphere::{LatLongMap, Method};
 use haarshift::{Error, Result};
 
-use super::{OutputFlags, progress_bar, wrote};
+use super::{OutputFlags, wrote};
 use crate::commands::{choice, names, print};
+use crate::progress::progress_bar;
 
 const EXAMPLES: &str = "\
 Examples:

@@ -12,8 +12,9 @@ use haarshift::experiments::stability::{
 };
 use haarshift::experiments::table::{Table, significant};
 
-use super::{OutputFlags, PeakMeter, Reports, progress_bar};
+use super::{OutputFlags, PeakMeter, Reports};
 use crate::commands::print;
+use crate::progress::progress_bar;
 
 const ABOUT: &str = "\
 Checks (each with its figure, tolerance and pass/fail; see the library's

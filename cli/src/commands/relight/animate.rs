@@ -10,9 +10,9 @@ use haarshift::render::{to_srgb8, write_render};
 use haarshift::{Error, Result};
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, rotation,
 };
-use crate::commands::{print, refuse_existing};
+use crate::commands::{print, refuse_outputs};
 
 const HELP: &str = "\
 Frame k (0 to F - 1) is `relight render` with the lighting's yaw increased by k x 360 / F
@@ -109,8 +109,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut inputs = vec![args.cache.as_path()];
     inputs.extend(args.light.env.as_deref());
     inputs.extend(args.material.brdf_file());
-    refuse_inputs(&inputs, &output_refs)?;
-    refuse_existing(&output_refs, args.force)?;
+    refuse_outputs(&inputs, &output_refs, args.force)?;
     let view = args.camera.view()?;
     let mut cache = SceneCache::read(&args.cache)?;
     args.material.apply(&mut cache.albedo)?;

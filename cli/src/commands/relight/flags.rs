@@ -295,14 +295,6 @@ pub fn bytes(n: u64) -> String {
     }
 }
 
-/// Refuses an output that is one of the inputs.
-pub fn refuse_inputs(inputs: &[&Path], outputs: &[&Path]) -> Result<()> {
-    for input in inputs {
-        crate::commands::refuse_overwriting_input(input, outputs)?;
-    }
-    Ok(())
-}
-
 /// A whole number of at least 1.
 fn positive(s: &str) -> std::result::Result<usize, String> {
     match s.parse::<usize>() {

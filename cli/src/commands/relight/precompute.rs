@@ -10,7 +10,7 @@ use haarshift::relight::VisibilityOptions;
 use haarshift::relight::precompute::{DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute};
 
 use super::flags::{SceneFlags, bytes};
-use crate::commands::{choice, names, print, refuse_existing, refuse_overwriting_input};
+use crate::commands::{choice, names, print, refuse_outputs};
 
 const HELP: &str = "\
 For every vertex, the visibility over the sphere at the texel centres of the chosen
@@ -82,8 +82,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    refuse_overwriting_input(&args.scene.input, &[&args.output])?;
-    refuse_existing(&[&args.output], args.force)?;
+    refuse_outputs(&[&args.scene.input], &[&args.output], args.force)?;
     let param = Parameterization::new(args.param, args.resolution)?;
     let scene = args.scene.load()?;
     let mut visibility = VisibilityOptions::new(param);

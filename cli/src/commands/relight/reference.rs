@@ -7,8 +7,8 @@ use haarshift::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
 use haarshift::render::{render_format, write_render};
 use haarshift::{Result, SampleDepth};
 
-use super::flags::{CameraFlags, LightFlags, MaterialFlags, SceneFlags, refuse_inputs, rotation};
-use crate::commands::{print, refuse_existing};
+use super::flags::{CameraFlags, LightFlags, MaterialFlags, SceneFlags, rotation};
+use crate::commands::{print, refuse_outputs};
 
 const HELP: &str = "\
 The radiance leaving each vertex toward the camera, by direct quadrature:
@@ -68,8 +68,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut inputs = vec![args.scene.input.as_path()];
     inputs.extend(args.light.env.as_deref());
     inputs.extend(args.material.brdf_file());
-    refuse_inputs(&inputs, &outputs)?;
-    refuse_existing(&outputs, args.force)?;
+    refuse_outputs(&inputs, &outputs, args.force)?;
     if let Some(image) = &args.output {
         render_format(image)?;
     }

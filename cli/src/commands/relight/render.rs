@@ -10,9 +10,9 @@ use haarshift::render::{render_format, write_render};
 use haarshift::{Result, SampleDepth};
 
 use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, refuse_inputs, rotation,
+    CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, rotation,
 };
-use crate::commands::{choice, names, print, refuse_existing};
+use crate::commands::{choice, names, print, refuse_outputs};
 
 const HELP: &str = "\
 The radiance leaving each vertex (Lambertian) is albedo / pi x the integral over the sphere of
@@ -84,8 +84,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut inputs = vec![args.cache.as_path()];
     inputs.extend(args.light.env.as_deref());
     inputs.extend(args.material.brdf_file());
-    refuse_inputs(&inputs, &outputs)?;
-    refuse_existing(&outputs, args.force)?;
+    refuse_outputs(&inputs, &outputs, args.force)?;
     render_format(&args.output)?;
     let view = args.camera.view()?;
     let mut cache = SceneCache::read(&args.cache)?;

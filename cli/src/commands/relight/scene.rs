@@ -17,10 +17,8 @@ use haarshift::render::{Camera, render_format, to_srgb8, write_render};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
 
-use super::flags::{
-    CameraFlags, GlossyFlags, LightFlags, brdf, bytes, ms, refuse_inputs, rotation,
-};
-use crate::commands::{choice, names, print, refuse_existing};
+use super::flags::{CameraFlags, GlossyFlags, LightFlags, brdf, bytes, ms, rotation};
+use crate::commands::{choice, names, print, refuse_outputs};
 
 const HELP: &str = "\
 Every object of the scene file gets occlusion fields (Sun 2006): from sample points on 100
@@ -233,8 +231,7 @@ pub fn run(args: Args) -> Result<()> {
             .and_then(|b| b.strip_prefix("merl:"))
             .map(Path::new),
     );
-    refuse_inputs(&inputs, &outputs)?;
-    refuse_existing(&outputs, args.force)?;
+    refuse_outputs(&inputs, &outputs, args.force)?;
     let view = args.camera.view()?;
     let options = args.options()?;
     let mut store = args

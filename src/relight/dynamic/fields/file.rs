@@ -104,7 +104,7 @@ impl FieldRecord {
         }
     }
 
-    /// The options it records (no progress bar), checked as a build checks them.
+    /// The options it records (not whether progress is reported), checked as a build checks them.
     pub fn options(&self) -> Result<FieldOptions> {
         let kind: ParamKind = self.param.parse()?;
         let options = FieldOptions {
@@ -292,7 +292,7 @@ impl OcclusionField {
                 }
             )));
         }
-        // The recorded options equal the asked ones but for the progress bar.
+        // The recorded options equal the asked ones but for progress reporting.
         Ok(OcclusionField {
             options: *options,
             ..field

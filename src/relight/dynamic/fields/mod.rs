@@ -58,11 +58,12 @@ use crate::faces::cube::{face_direction, face_point};
 use crate::faces::param::{ParamKind, Parameterization};
 use crate::product::Selection;
 use crate::product::selection::Candidate;
+use crate::progress::Task;
 use crate::relight::Mesh;
 use crate::relight::precompute::raycast::{Occlusion, SceneBvh};
 use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::transport::encode;
-use crate::relight::precompute::visibility::{f32x3, progress_bar, ray_offset, texel_directions};
+use crate::relight::precompute::visibility::{f32x3, ray_offset, texel_directions};
 use crate::sphere::latlong::atan2;
 use crate::transform::{Normalization, pyramid};
 use crate::{Error, Result};
@@ -114,7 +115,7 @@ pub struct FieldOptions {
     pub shell_grid: usize,
     /// Innermost and outermost shell radius, in bounding radii `R`.
     pub shell_radii: (f64, f64),
-    /// Show a progress bar on standard error.
+    /// Report progress to the installed [reporter](crate::progress) (nothing is drawn without one).
     pub progress: bool,
 }
 
@@ -297,7 +298,7 @@ impl OcclusionField {
         let param = options.param;
         let directions: Vec<[f32; 3]> = texel_directions(param).into_iter().map(f32x3).collect();
         let ones = Array3::<f32>::ones((param.faces(), param.face_size(), param.face_size()));
-        let bar = progress_bar(options.progress, points.len(), "occlusion field");
+        let bar = Task::begin(options.progress, "occlusion field", points.len());
         let encoded = points
             .par_chunks(64)
             .map(|chunk| -> Result<Vec<(Vec<u32>, Vec<f32>)>> {
@@ -317,11 +318,10 @@ impl OcclusionField {
                         encode(values.view(), ones.view(), param, options.keep)
                     })
                     .collect::<Result<Vec<_>>>()?;
-                bar.inc(chunk.len() as u64);
+                bar.advance(chunk.len());
                 Ok(out)
             })
             .collect::<Result<Vec<_>>>()?;
-        bar.finish_and_clear();
         let maps: SparseRows<f32> = encoded.iter().flatten().map(|(i, v)| (i, v)).collect();
         let report = FieldReport {
             rays: (points.len() * directions.len()) as u64,

@@ -60,11 +60,7 @@ impl Shader for AmbientShader {
         let radiance: Array2<f32> = self.prepared.shade(&self.white)?;
         Ok(Shading {
             radiance: Radiance::F32(radiance),
-            timing: Timing {
-                encode_seconds: 0.0,
-                rotate_seconds: 0.0,
-                shade_seconds: seconds(start),
-            },
+            timing: Timing::unrotated(0.0, seconds(start)),
             description: format!(
                 "ambient occlusion, albedo / pi x the transport's integral, transport {} \
                  coefficients; transport prepared once in {:.1} ms",

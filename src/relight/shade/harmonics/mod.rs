@@ -407,11 +407,7 @@ impl Shader for ShShader {
         };
         Ok(Shading {
             radiance,
-            timing: Timing {
-                encode_seconds,
-                rotate_seconds: 0.0,
-                shade_seconds: seconds(start),
-            },
+            timing: Timing::unrotated(encode_seconds, seconds(start)),
             description: format!(
                 "spherical harmonics, {bands} bands ({} coefficients)",
                 bands * bands

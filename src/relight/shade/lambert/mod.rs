@@ -433,11 +433,7 @@ where
         let radiance = self.prepared.shade(&lighting)?;
         Ok(Shading {
             radiance: radiance.into(),
-            timing: Timing {
-                encode_seconds,
-                rotate_seconds: 0.0,
-                shade_seconds: seconds(start),
-            },
+            timing: Timing::unrotated(encode_seconds, seconds(start)),
             description: format!(
                 "Haar, lighting kept {} detail coefficients, transport {} coefficients; \
                  transport prepared once in {:.1} ms",

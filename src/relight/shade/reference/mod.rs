@@ -35,9 +35,10 @@ use rayon::prelude::*;
 use super::{
     FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds,
 };
+use crate::progress::Task;
 use crate::relight::SceneBvh;
 use crate::relight::precompute::raycast::Occlusion;
-use crate::relight::precompute::visibility::{f32x3, origin_and_normal, progress_bar, ray_offset};
+use crate::relight::precompute::visibility::{f32x3, origin_and_normal, ray_offset};
 use crate::relight::scene::mesh::dot;
 use crate::relight::{Brdf, Mesh};
 use crate::sphere::LatLongMap;
@@ -53,7 +54,7 @@ use crate::{Error, Result};
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReferenceOptions {
-    /// Show a progress bar on standard error (hidden when it is not a terminal).
+    /// Report progress to the installed [reporter](crate::progress) (nothing is drawn without one).
     pub progress: bool,
     /// The objects' BRDF.
     pub brdf: Brdf,
@@ -203,7 +204,7 @@ fn quadrature(
     let start = Instant::now();
     let texels = lit_texels(lighting)?;
     let eps = ray_offset(mesh);
-    let bar = progress_bar(options.progress, vertices, "reference (rays)");
+    let bar = Task::begin(options.progress, "reference (rays)", vertices);
     let mut out = Array2::<f64>::zeros((vertices, 3));
     let rays: u64 = out
         .axis_iter_mut(Axis(0))
@@ -245,11 +246,10 @@ fn quadrature(
                     None => a / std::f64::consts::PI * sum[c],
                 };
             }
-            bar.inc(1);
+            bar.advance(1);
             rays
         })
         .sum();
-    bar.finish_and_clear();
     let report = ReferenceReport {
         rays,
         seconds: start.elapsed().as_secs_f64(),
@@ -301,7 +301,7 @@ impl ReferenceVisibility {
         let vertices = mesh.vertex_count();
         let eps = ray_offset(mesh);
         let start = Instant::now();
-        let bar = progress_bar(progress, vertices, "reference visibility (rays)");
+        let bar = Task::begin(progress, "reference visibility (rays)", vertices);
         let mut bits = vec![0u64; vertices * words];
         let rays: u64 = bits
             .par_chunks_mut(words.max(1))
@@ -319,11 +319,10 @@ impl ReferenceVisibility {
                         row[t.index / 64] |= 1 << (t.index % 64);
                     }
                 }
-                bar.inc(1);
+                bar.advance(1);
                 rays
             })
             .sum();
-        bar.finish_and_clear();
         Ok(ReferenceVisibility {
             height,
             vertices,
@@ -452,11 +451,7 @@ impl Shader for ReferenceShader {
         )?;
         Ok(Shading {
             radiance: Radiance::F64(radiance),
-            timing: Timing {
-                encode_seconds,
-                rotate_seconds: 0.0,
-                shade_seconds: seconds(start),
-            },
+            timing: Timing::unrotated(encode_seconds, seconds(start)),
             description: format!(
                 "radiance ({}) by quadrature over {} x {} texels: rays {}, {:.3} s",
                 options.brdf,
