@@ -9,13 +9,13 @@ cargo build --release -p haarshift-cli
 hs=target/release/haarshift
 run() { echo "+ haarshift $*" >&2; "$hs" "$@"; }
 
-# The seed's Table 2.2, with the crops before and after the cycle (Figs. 2.4-2.5).
+# Alnasser 2008's Table 2.2, with the crops before and after the cycle (Figs. 2.4-2.5).
 run experiment rotation-cycle --crops --out-dir results/rotation-cycle --force
-# Retained Haar at h = 3 equals nearest neighbour on an 8x finer grid (tested): the seed's
+# Retained Haar at h = 3 equals nearest neighbour on an 8x finer grid (tested): Alnasser 2008's
 # Table 2.2 figures for its method are what this reaches on camera.
 run experiment rotation-cycle testdata/camera.png --methods nearest --supersample 3 \
     --out-dir results/rotation-cycle-camera-s3 --force
-# The seed's Table 3.1: fractional steps, and steps that are multiples of 1/8 (where retained
+# Alnasser 2008's Table 3.1: fractional steps, and steps that are multiples of 1/8 (where retained
 # Haar at h = 3 moves whole fine samples, so the chain equals the single shift).
 run experiment shift-chain --out-dir results/shift-chain --force
 run experiment shift-chain --dx 7.5 --dy -4.5 --steps 12 --retained-precision 3 \

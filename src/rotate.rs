@@ -1,4 +1,4 @@
-//! Image rotation by three 1D shears (the seed's equation 2.26; Unser, Thevenaz and
+//! Image rotation by three 1D shears (Alnasser 2008's equation 2.26; Unser, Thevenaz and
 //! Yaroslavsky 1995):
 //!
 //! `R(theta) = [[1, -tan(theta/2)], [0, 1]] x [[1, 0], [sin(theta), 1]] x [[1, -tan(theta/2)], [0, 1]]`
@@ -98,7 +98,7 @@ impl RotateOptions {
     /// use haarshift::rotate::RotateOptions;
     /// let too_fine = RotateOptions { supersample: 9, ..RotateOptions::default() };
     /// assert_eq!(too_fine.validate().unwrap_err().to_string(),
-    ///            "invalid supersample: 9 is above the largest, 8");
+    ///            "invalid supersample: 9 is above the largest, 8 (at most 8 doublings of the grid)");
     /// assert!(RotateOptions::default().validate().is_ok());
     /// ```
     pub fn validate(&self) -> Result<()> {
@@ -106,7 +106,8 @@ impl RotateOptions {
             return Err(Error::parameter(
                 "supersample",
                 format!(
-                    "{} is above the largest, {MAX_SUPERSAMPLE}",
+                    "{} is above the largest, {MAX_SUPERSAMPLE} (at most {MAX_SUPERSAMPLE} \
+                     doublings of the grid)",
                     self.supersample
                 ),
             ));

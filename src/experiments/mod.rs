@@ -2,9 +2,9 @@
 //!
 //! * [`table`]: Markdown result tables.
 //! * [`pareto`]: the cost/error Pareto frontier.
-//! * [`rotation_cycle`]: the seed's Table 2.2 protocol: rotate back to the start, measure.
+//! * [`rotation_cycle`]: Alnasser 2008's Table 2.2 protocol: rotate back to the start, measure.
 //! * [`kernel_cycle`]: the library's kernels in the rotation cycle; the default image set.
-//! * [`shift_chain`]: one shift against a chain of small ones (the seed's Table 3.1).
+//! * [`shift_chain`]: one shift against a chain of small ones (Alnasser 2008's Table 3.1).
 //! * [`stability`]: the numerical extremes, each check with its figure, tolerance and verdict.
 //! * [`tradeoff`]: every kernel and parameter through the rotation cycle; Pareto frontiers.
 //! * [`relight`]: every relighting method against the ray-cast truth over the sources' axes;

@@ -1,4 +1,4 @@
-//! The rotation-cycle experiment (the seed's Table 2.2): rotate an image `steps` times by
+//! The rotation-cycle experiment (Alnasser 2008's Table 2.2): rotate an image `steps` times by
 //! `360 / steps` degrees, back to where it started, and measure what the round trip lost.
 //!
 //! The protocol is fixed so that figures from different runs and machines compare:

@@ -1,4 +1,4 @@
-//! The shift-chain experiment (the seed's Table 3.1): one shift by `(dx, dy)` against the same
+//! The shift-chain experiment (Alnasser 2008's Table 3.1): one shift by `(dx, dy)` against the same
 //! shift made as `steps` equal steps, periodic boundary, RMS over the whole frame.
 //!
 //! Every method sees the same input: the centred square crop whose side is the largest power

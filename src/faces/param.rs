@@ -371,6 +371,55 @@ impl<T: Sample> SphereMap<T> {
         self.data
     }
 
+    /// The error of this map against `reference` on the sphere: the solid-angle weighted RMS
+    /// difference over the reference's weighted RMS, every channel alike,
+    /// `sqrt(sum w (a - b)^2 / sum w b^2)`. The measure of a map, where
+    /// [`relative_rms_error`](crate::metrics::relative_rms_error) is that of an image or of
+    /// per-vertex radiance.
+    ///
+    /// ```
+    /// use haarshift::faces::{ParamKind, Parameterization, SphereMap};
+    /// let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
+    /// let one = SphereMap::<f64>::from_fn(param, 1, |_, o| o[0] = 1.0).unwrap();
+    /// let brighter = SphereMap::<f64>::from_fn(param, 1, |_, o| o[0] = 1.25).unwrap();
+    /// assert!((brighter.relative_rms_error(&one).unwrap() - 0.25).abs() < 1e-15);
+    /// let black = SphereMap::<f64>::from_fn(param, 1, |_, o| o[0] = 0.0).unwrap();
+    /// assert!(one.relative_rms_error(&black).is_err()); // no scale to be relative to
+    /// ```
+    ///
+    /// An error when the two differ in parameterisation or channels, or the reference is 0
+    /// everywhere.
+    pub fn relative_rms_error(&self, reference: &SphereMap<T>) -> Result<f64> {
+        if self.param != reference.param || self.channels() != reference.channels() {
+            return Err(Error::shape(
+                &[reference.param.texels(), reference.channels()],
+                format!(
+                    "the map compared has {} texels of {} channels",
+                    self.param.texels(),
+                    self.channels()
+                ),
+            ));
+        }
+        let weights = self.param.solid_angles();
+        let weights = weights.as_slice().expect("fresh array is contiguous");
+        let c = self.channels();
+        let (mut difference, mut scale) = (0.0, 0.0);
+        let pairs = self.data.iter().zip(reference.data.iter());
+        for (k, (&a, &b)) in pairs.enumerate() {
+            let (a, b) = (a.as_f64(), b.as_f64());
+            let w = weights[k / c];
+            difference += w * (a - b) * (a - b);
+            scale += w * b * b;
+        }
+        if scale == 0.0 {
+            return Err(Error::parameter(
+                "reference",
+                "is 0 everywhere: no scale to be relative to",
+            ));
+        }
+        Ok((difference / scale).sqrt())
+    }
+
     /// The integral over the sphere of each channel: `sum over texels of value x solid angle`.
     ///
     /// ```

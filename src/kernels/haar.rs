@@ -2,7 +2,7 @@
 //! [`shift`](crate::shift) module, never by pixel-domain interpolation.
 //!
 //! * Compact (`retain = false`): the row's transform is upsampled by `h` zero-detail levels,
-//!   shifted by `round(s * 2^h)` fine samples and read back at the original levels (the seed's
+//!   shifted by `round(s * 2^h)` fine samples and read back at the original levels (Alnasser 2008's
 //!   sections 2.4 and 2.6). In the pixel domain that is exactly linear interpolation with the
 //!   shift rounded to `1/2^h` (ties toward +infinity), which the shift module documents and
 //!   tests.

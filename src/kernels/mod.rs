@@ -1,5 +1,5 @@
 //! Rotation kernels: 1D fractional shifts of rows, the building block of three-shear rotation
-//! (the seed's equation 2.26) and of pixel-domain subpixel shifts.
+//! (Alnasser 2008's equation 2.26) and of pixel-domain subpixel shifts.
 //!
 //! Every kernel implements [`ShearKernel`]; the drivers ([`shear_rows`], [`shift_plane`] and
 //! the [`rotate`](crate::rotate) module) only talk to that trait, so a user can add a kernel by

@@ -10,7 +10,7 @@
 //!
 //! **Sign convention** (that of `scipy.ndimage.shift`): a shift by `+s` moves content towards
 //! higher indices, `out[n] = in[n - s]`; in 2D `dx` moves columns (right for `dx > 0`) and
-//! `dy` rows (down for `dy > 0`), `out[r][c] = in[r - dy][c - dx]`. The seed writes the
+//! `dy` rows (down for `dy > 0`), `out[r][c] = in[r - dy][c - dx]`. Alnasser 2008 writes the
 //! shifted signal as `x[n + s]`: its `s` is our `-s`.
 //!
 //! # Fractional shifts
@@ -18,7 +18,7 @@
 //! A shift with precision `h` (see [`GridShift`]) means: upsample by `2^h` per axis by adding
 //! `h` levels of zero details under the transform, shift the fine signal by
 //! `r = round(s 2^h)` fine samples (ties towards `+infinity`), and read the transform back at
-//! the original levels (the seed's section 2.4 / 3.6). Adding zero-detail levels repeats each
+//! the original levels (Alnasser 2008's section 2.4 / 3.6). Adding zero-detail levels repeats each
 //! sample `2^h` times (in either normalisation: the coefficients keep their places), and
 //! reading back the original levels box-averages `2^h` fine samples. Hence, exactly:
 //!
@@ -69,7 +69,7 @@
 //! way (see the module docs there). [`shift_image`] is the one-call entry point.
 //!
 //! **Random access** ([`ShiftQuery1d`], [`ShiftQuery2d`]): one coefficient of the shifted
-//! transform, from the original coefficients alone, without materialising the rest. The seed
+//! transform, from the original coefficients alone, without materialising the rest. Alnasser 2008
 //! expresses a shifted coefficient through its *D tables*: `D^l_i = A^l_i - A^0_0`, the
 //! approximations minus the DC value, computed recursively from the details (eq. 2.4-2.6 in
 //! 1D, 3.1-3.4 in 2D), and sums `D` over the window the coefficient's support moves to
@@ -82,10 +82,10 @@
 //! because the integral of the piecewise-constant upsampled signal is piecewise (bi)linear.
 //! The query is prepared once and answers every shift. For "coarse levels only" with shifts
 //! by multiples of `2^t`, [`ShiftQuery2d::with_resolution`] prepares from the coarse
-//! `1 / 4^t` of the coefficients alone (the per-level D tables of the seed's partial
+//! `1 / 4^t` of the coefficients alone (the per-level D tables of Alnasser 2008's partial
 //! transforms, eq. 2.6).
 //!
-//! # Typos in the seed's printed equations
+//! # Typos in Alnasser 2008's printed equations
 //!
 //! Found while re-deriving the closed forms from the definition. The corrected 1D closed
 //! forms (2.13) and (2.23) (with the D tables (2.5)-(2.6)) and the `k = t + 1` cases of
@@ -121,7 +121,7 @@
 //!   precision of `1/(2h)` for `1/2^h`.
 //!
 //! Apart from these, the printed (2.10), (2.13), (2.20), (2.23) and (3.7) and the `k = t + 1`
-//! cases above are right, in the seed's sign convention and the average normalisation (in the
+//! cases above are right, in Alnasser 2008's sign convention and the average normalisation (in the
 //! orthonormal one every level carries an extra `sqrt 2` or `2` per step).
 
 pub mod dense;

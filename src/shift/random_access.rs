@@ -5,7 +5,7 @@
 //! quadrants of its support), divided by its normalisation. After a shift those boxes move,
 //! and a box sum of the *shifted* signal is a box sum of the *original* one over the moved box
 //! (for a fractional shift, the integral of the piecewise-constant upsampled signal over it).
-//! With the prefix sums (1D) or the summed-area table (2D) of `D = x - mean` (the seed's
+//! With the prefix sums (1D) or the summed-area table (2D) of `D = x - mean` (Alnasser 2008's
 //! `D^N`, eq. 2.4 / 3.3: the finest approximation minus the DC value) a box sum is four table
 //! reads, and a fractional corner is the (bi)linear interpolation of the table, because the
 //! integral of a piecewise-constant signal is piecewise (bi)linear. Subtracting the mean keeps

@@ -1,4 +1,4 @@
-//! N-D shifts of the separable ("standard decomposition") transform, the seed's section 2.5:
+//! N-D shifts of the separable ("standard decomposition") transform, Alnasser 2008's section 2.5:
 //! the transform is a 1D transform along each axis in turn, and a shift along one axis
 //! commutes with the 1D transforms along the others, so shifting every lane along an axis with
 //! the 1D Haar-domain shift shifts the whole array along that axis.

@@ -1,6 +1,6 @@
 //! Shift tests: every fast path against the definition ([`oracle`]), exhaustively on small
 //! sizes and by proptest on larger ones; the pixel-domain meaning of fractional shifts against
-//! an independent bilinear interpolation; composition; the seed's own closed forms
+//! an independent bilinear interpolation; composition; Alnasser 2008's own closed forms
 //! (corrected) against the oracle; input validation.
 
 use ndarray::{Array1, Array2, ArrayView1, ArrayView2, s};
@@ -500,7 +500,7 @@ fn retained_signal_chain_is_exact() {
     assert_eq!(r.fine().len(), 32 << 4);
 }
 
-/// The seed's 1D closed forms (2.13) and (2.23), implemented literally with its D tables
+/// Alnasser 2008's 1D closed forms (2.13) and (2.23), implemented literally with its D tables
 /// (2.5)-(2.6), with the typos of the module docs corrected, in its sign convention
 /// (`y[n] = x[n + S]`, so `S = -s`) and the average normalisation.
 fn seed_1d(c: &[f64], levels: usize, shift: i64) -> Vec<f64> {
@@ -602,7 +602,7 @@ fn seed_1d_closed_forms_corrected_agree_with_the_oracle() {
     }
 }
 
-/// The seed's 2D cases `k = t + 1` of (3.13), (3.16) (horizontal shift) and (3.17), (3.19)
+/// Alnasser 2008's 2D cases `k = t + 1` of (3.13), (3.16) (horizontal shift) and (3.17), (3.19)
 /// (vertical shift), literally, in its sign convention and the average normalisation.
 #[test]
 fn seed_2d_half_window_cases_agree_with_the_oracle() {

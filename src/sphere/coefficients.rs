@@ -10,7 +10,7 @@
 //! to the left pyramid when `J < 2^l`. The two scaling coefficients are the hemispheres' means
 //! (in the `(theta, phi)` parameter plane, not weighted by solid angle). Coefficients use the
 //! `average` normalisation (a parent is the mean of its children), in which a detail
-//! coefficient is a finite difference (the seed's section 4.5.2).
+//! coefficient is a finite difference (Alnasser 2008's section 4.5.2).
 //!
 //! The approximation at "resolution of level `L + 1`" (the inverse of levels `0..=L` only)
 //! is the `2^(L+1) x 2^(L+2)` map of block means; the top-left `2^(L+1) x 2^(L+2)` block of

@@ -1,7 +1,7 @@
 //! [`LatLongMap`]: a spherical function stored as a latitude-longitude (equirectangular) map,
 //! with the geometry of its pixels and continuous lookups across the seam and the poles.
 //!
-//! # Conventions (the seed's section 4.5.1)
+//! # Conventions (Alnasser 2008's section 4.5.1)
 //!
 //! Row `i` is the elevation `theta` measured from +Y (up), column `j` the azimuth `phi`;
 //! pixel `(i, j)` of an `H x W` map has its centre at
@@ -39,7 +39,7 @@ pub fn direction(theta: f64, phi: f64) -> [f64; 3] {
 
 /// The angles `(theta, phi)` of a unit direction, `theta` in `[0, pi]`, `phi` in `[0, 2 pi)`.
 ///
-/// The azimuth is `atan2(x, z)`: the seed's (4.13) prints `tan^-1(x / z)`, which loses the
+/// The azimuth is `atan2(x, z)`: Alnasser 2008's (4.13) prints `tan^-1(x / z)`, which loses the
 /// quadrant. The elevation is `atan2(sqrt(x^2 + z^2), y)`, which is `acos y` for a unit
 /// direction and stays accurate next to the poles; both come from [`atan2`].
 ///

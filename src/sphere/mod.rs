@@ -1,5 +1,5 @@
 //! Rotation of spherical functions stored as lat-long maps, in pixels and directly in the 2D
-//! Haar domain (the seed's chapter 4).
+//! Haar domain (Alnasser 2008's chapter 4).
 //!
 //! One entry point, [`rotate_map`] (or [`rotate_coefficients`] when the map is already a
 //! Haar pyramid), computes `g(p) = f(R p)` by a chosen [`Method`]:
@@ -21,7 +21,7 @@
 //! **Level.** [`SphereOptions::level`] `= Some(L)` computes detail levels `0..=L` only, on the
 //! `2^(L+1) x 2^(L+2)` approximation of `f` (its coefficients of levels `0..=L`); the finer
 //! levels of the result are zero. Starting `k` levels below the finest costs `O(N / 4^k)`
-//! (the seed's section 4.5.3) for every method, so the methods can be compared at equal
+//! (Alnasser 2008's section 4.5.3) for every method, so the methods can be compared at equal
 //! cost. Individual coefficients: [`chain_rule::rotate_selected`]. The approximation at a
 //! coarser level is a plain (not solid-angle weighted) block mean, so it carries its own
 //! small energy change (0.1% to 0.6% on the test map for levels 5 to 3 of 6), the same for

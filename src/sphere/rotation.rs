@@ -1,7 +1,7 @@
 //! [`SphereRotation`]: a rotation of the sphere and how it acts on a lat-long map.
 //!
 //! From yaw (about +Y), pitch (about +X) and roll (about +Z) in degrees,
-//! `R = Rz(roll) Ry(yaw) Rx(pitch)` (the seed's (4.10)) with the usual right-handed matrices
+//! `R = Rz(roll) Ry(yaw) Rx(pitch)` (Alnasser 2008's (4.10)) with the usual right-handed matrices
 //! `Rx(a) = [[1, 0, 0], [0, c, -s], [0, s, c]]`, `Ry(a) = [[c, 0, s], [0, 1, 0], [-s, 0, c]]`,
 //! `Rz(a) = [[c, -s, 0], [s, c, 0], [0, 0, 1]]`. The rotated map is `g(p) = f(R p)`
 //! ((4.11)-(4.14)): the pixel of `g` looking along `p` shows what `f` saw along `R p`.

@@ -1,6 +1,6 @@
 //! The 1D Haar transform of a length-2^N signal, full (N steps) or partial (k steps).
 //!
-//! Layout (the seed's chapter 2): after k steps a length-L signal holds its `L / 2^k` scaling
+//! Layout (Alnasser 2008's chapter 2): after k steps a length-L signal holds its `L / 2^k` scaling
 //! coefficients first, then the details level by level, coarsest first. Detail level `l`
 //! (`l = 0` coarsest stored) occupies indices `[n0 << l, n0 << (l + 1))` with `n0 = L >> k`.
 

@@ -14,7 +14,7 @@
 //! * [`Normalization::Orthonormal`]: `1/sqrt(2)` per axis step (so `/2` on a 2x2 block); the
 //!   transform is orthogonal and Parseval's identity holds.
 //!
-//! # Pyramid layout (Mallat, the seed's Figure 3.1)
+//! # Pyramid layout (Mallat, Alnasser 2008's Figure 3.1)
 //!
 //! For an `H x W` array (powers of two) transformed with `K` levels, the scaling coefficients
 //! form the `H0 x W0` block at the top left (`H0 = H >> K`, `W0 = W >> K`); detail level `l`

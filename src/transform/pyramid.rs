@@ -1,4 +1,4 @@
-//! The 2D non-separable Haar transform ("standard pyramid", the seed's chapter 3) on
+//! The 2D non-separable Haar transform ("standard pyramid", Alnasser 2008's chapter 3) on
 //! power-of-two arrays, in the Mallat layout described in the [module docs](super).
 //!
 //! Each level reads the current approximation once and writes its three detail bands straight

@@ -1,5 +1,5 @@
 //! The separable ("standard decomposition") Haar transform of an N-D power-of-two array: a 1D
-//! transform (layout of [`haar1d`]) along each axis in turn, the seed's section
+//! transform (layout of [`haar1d`]) along each axis in turn, Alnasser 2008's section
 //! 2.5. Axis `i` gets `levels[i]` steps.
 
 use ndarray::{ArrayViewMut, Axis, Dimension, Zip};

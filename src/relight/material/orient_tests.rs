@@ -27,14 +27,7 @@ fn peak(map: &SphereMap<f64>) -> [f64; 3] {
 
 /// `sum |a - b|^2 dOmega / sum b^2 dOmega`, square-rooted: the error relative to `b`'s RMS.
 fn relative_rms(a: &SphereMap<f64>, b: &SphereMap<f64>) -> f64 {
-    let w = a.param().solid_angles();
-    let (mut num, mut den) = (0.0, 0.0);
-    for ((f, i, j, _), &x) in a.as_array().indexed_iter() {
-        let y = b.as_array()[[f, i, j, 0]];
-        num += (x - y).powi(2) * w[[f, i, j]];
-        den += y * y * w[[f, i, j]];
-    }
-    (num / den).sqrt()
+    a.relative_rms_error(b).unwrap()
 }
 
 /// Frames with varied normals and views (none on a pole or the seam).

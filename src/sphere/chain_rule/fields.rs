@@ -177,7 +177,7 @@ impl<T: Sample> ChannelFields<'_, T> {
     /// `a = (U[2I][2J] + U[2I+1][2J]) / 4` and `c = C[2I][2J] / 4` (`C` from `V` and `U`),
     /// and returns the fields `(V', U')` one level coarser (the recursive filters (4.21)-(4.22)):
     /// `V' = h_t (along theta) x h_s (along phi) of V / 4`, `U'` with the roles swapped.
-    /// The seed's third recursion, `C' = h_t x h_t of C / 4`, is not needed: it is the mixed
+    /// Alnasser 2008's third recursion, `C' = h_t x h_t of C / 4`, is not needed: it is the mixed
     /// difference of `V'` and `U'` exactly (`h_t` applied to a difference along an axis is
     /// the difference of `h_s` applied along it: `[1 2 1] * [1 -1] = [1 1] * [1 0 -1]`), so
     /// `C` is read off `V` and `U` at every level.

@@ -12,7 +12,7 @@ use super::zonal::ZonalProfile;
 /// How the chain rule reads `f`'s derivatives and turns `g`'s into differences.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Scheme {
-    /// The seed's: two-point differences of `f`, bilinear interpolation at the pre-image,
+    /// Alnasser 2008's: two-point differences of `f`, bilinear interpolation at the pre-image,
     /// `g`'s differences as `delta` times its midpoint derivative ([`Method::Haar`]).
     ///
     /// [`Method::Haar`]: crate::sphere::Method::Haar

@@ -1,4 +1,4 @@
-//! The seed's Haar-domain rotation (section 4.5): detail coefficients are finite-difference
+//! Alnasser 2008's Haar-domain rotation (section 4.5): detail coefficients are finite-difference
 //! derivatives, so the chain rule gives the rotated map's differences at one level, and exact
 //! short recursive filters give every coarser level.
 //!
@@ -6,12 +6,12 @@
 //!
 //! Pick the finest detail level `L` to compute. Everything happens on the grid of the
 //! approximation at resolution `L + 1` (`m x n = 2^(L+1) x 2^(L+2)` cells of side
-//! `delta = pi / m`), the seed's "level `j + 1`":
+//! `delta = pi / m`), Alnasser 2008's "level `j + 1`":
 //!
 //! 1. **Derivatives of `f`** ([`SourceGradient`]). `X_f`, `f`'s approximation at that
 //!    resolution, is the inverse of `f`'s coefficients of levels `0..=L` (cost `O(N / 4^k)`
 //!    for `k` levels below the finest). Its first differences are the finite-difference
-//!    derivatives the seed reads off the Haar coefficients (the in-block ones *are* the
+//!    derivatives Alnasser 2008 reads off the Haar coefficients (the in-block ones *are* the
 //!    level-`L` details: `b = (V[2I][2J] + V[2I][2J+1]) / 4`, below). We keep
 //!    `f_theta` on the edges between rows (`theta = i delta`, `phi = (j + 1/2) delta`, with
 //!    the edge across each pole from the two pixels facing each other over it) and
@@ -32,7 +32,7 @@
 //! 4. **Differences of `g`.** `V[i][j] = X_g[i][j] - X_g[i+1][j] = -delta g_theta` at the
 //!    edge midpoint and `U[i][j] = X_g[i][j] - X_g[i][j+1] = -delta g_phi` (periodic in `j`).
 //!    For a difference of two cell means these midpoint values are second-order accurate.
-//!    *Diagonal choice:* the seed's (4.17) is not the second derivative of (4.14) (see
+//!    *Diagonal choice:* Alnasser 2008's (4.17) is not the second derivative of (4.14) (see
 //!    typos below), and the pure second derivatives it would need are not in the Haar
 //!    coefficients anyway. The mixed difference satisfies the exact discrete identities
 //!    `C = V[i][j] - V[i][j+1] = U[i][j] - U[i+1][j]`; we take the mean of the two ("the
@@ -45,7 +45,7 @@
 //!    `U'` the same with the roles swapped, `C'` with `h_t` along both axes, which is the
 //!    mixed difference of `V'` and `U'` exactly (`[1 2 1] * [1 -1] = [1 1] * [1 0 -1]`), so
 //!    `C` is never stored: the diagonal details read it off `V` and `U`. Applied
-//!    recursively this is the seed's `O(N)` algorithm; expanded, the weight of a level-`l`
+//!    recursively this is Alnasser 2008's `O(N)` algorithm; expanded, the weight of a level-`l`
 //!    coefficient is the tent `h_t` of (4.19) times the box `h_s` of (4.20)
 //!    ([`rotate_selected`] uses that expanded form). At the 1 x 2 root the horizontal field
 //!    gives the difference of the two scaling coefficients.
@@ -108,7 +108,7 @@
 //!
 //! # The higher-order scheme ([`Scheme::Cubic`], `haar-cubic`)
 //!
-//! The seed's scheme has three second-order errors, each replaced by a fourth-order one
+//! Alnasser 2008's scheme has three second-order errors, each replaced by a fourth-order one
 //! (for a map of samples at the texel centres):
 //!
 //! * step 1: `f`'s derivative on an edge from four samples across it,
@@ -128,16 +128,16 @@
 //! (a lobe moved off the pole loses 0.5 % of its sum at 64 x 128, exponent 50), so the
 //! constant is chosen to keep the pole-corrected sum ([`sampled_integral`]), rotation
 //! invariant to `O(delta^4)`. Cost: the same chain-rule evaluations (plus the two pole rows),
-//! 16 taps each instead of 4. Individual coefficients ([`rotate_selected`]) use the seed's
+//! 16 taps each instead of 4. Individual coefficients ([`rotate_selected`]) use Alnasser 2008's
 //! scheme.
 //!
 //! Measured ([`lobes`](super::lobes), 64 x 128, Phong exponents 10 and 50 about the pole
 //! and a horizon direction, pitch 30 to 90 and a compound rotation): against the analytic
 //! rotated lobe at the texel centres `haar-cubic`'s weighted RMS error is 0.37 to 0.83 times
-//! bicubic's (and 3 % to 8 % of the seed's scheme's); against the lobe's texel means, where
+//! bicubic's (and 3 % to 8 % of Alnasser 2008's scheme's); against the lobe's texel means, where
 //! every method carries the point-versus-mean difference of its input, 0.96 to 1.02 times.
 //!
-//! # Typos in the seed's section 4.5
+//! # Typos in Alnasser 2008's section 4.5
 //!
 //! * (4.13) `phi' = tan^-1(R1 p / R3 p)` loses the quadrant: it is `atan2(R1 p, R3 p)`.
 //! * (4.17) is not the chain rule for `d^2 g / dphi dtheta`: that is

@@ -1,4 +1,4 @@
-//! `haarshift experiment rotation-cycle`: the seed's Table 2.2 protocol.
+//! `haarshift experiment rotation-cycle`: Alnasser 2008's Table 2.2 protocol.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -109,7 +109,7 @@ pub fn run_methods(
     Ok(records)
 }
 
-/// Side of the crop shown in the figures: the seed's Figs. 2.4-2.5 show a detail, not the
+/// Side of the crop shown in the figures: Alnasser 2008's Figs. 2.4-2.5 show a detail, not the
 /// whole image.
 const CROP_SIDE: usize = 128;
 

@@ -1,4 +1,4 @@
-//! `haarshift experiment shift-chain`: the seed's Table 3.1 protocol.
+//! `haarshift experiment shift-chain`: Alnasser 2008's Table 3.1 protocol.
 
 use std::fmt::Write;
 use std::path::PathBuf;
