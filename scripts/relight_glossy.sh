@@ -10,8 +10,8 @@
 # `bunny` or the scene file's stem, ENV: the map's file stem); for the bunny also a glossy
 # turntable under the first map, results/relight/glossy/turntable.gif.
 # The errors are RMS over the vertices relative to the reference's RMS radiance
-# (scripts/vertex_error.py, which needs numpy, reads the .npy files the commands write). RESOLUTION (default 128) and BINS (default 128) are
-# the lat-long height and the rotation cache's bins per axis.
+# (`haarshift relight error` over the .npy files the commands write). RESOLUTION (default 128)
+# and BINS (default 128) are the lat-long height and the rotation cache's bins per axis.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scene=${1:?usage: scripts/relight_glossy.sh SCENE ENV.hdr [ENV.hdr ...]}
@@ -61,7 +61,7 @@ fi
     echo
     echo "\`scripts/relight_glossy.sh\` ($name): lat-long $res x $((2 * res)), rotation cache $bins x $((2 * bins))"
     echo "bins, every coefficient kept; error = RMS over the vertices of (render - reference) / RMS"
-    echo "of the reference (\`scripts/vertex_error.py\`). The renders are in the folder of each map."
+    echo "of the reference (\`haarshift relight error\`). The renders are in the folder of each map."
     echo
     echo "| map | material | haar | spatial |"
     echo "|---|---|---|---|"
@@ -69,7 +69,7 @@ fi
         for brdf in "${materials[@]}"; do
             m=${brdf/:/}
             p=$work/$env_name-$m
-            errors=$(python3 scripts/vertex_error.py "$p-reference.npy" "$p-haar.npy" "$p-spatial.npy")
+            errors=$("$hs" relight error "$p-reference.npy" "$p-haar.npy" "$p-spatial.npy" | relative_rms)
             echo "| $env_name | $m | $(echo "$errors" | sed -n 1p) | $(echo "$errors" | sed -n 2p) |"
         done
     done

@@ -29,7 +29,7 @@ row() {
     "$hs" relight render "$work/bunny.hsr" "${view[@]}" --brdf "$brdf" "$@" \
         --vertices "$work/$name.npy" -o "$work/$name.png" >"$work/$name.out"
     local error maps shading
-    error=$(python3 scripts/vertex_error.py "$work/${brdf/:/}-reference.npy" "$work/$name.npy")
+    error=$("$hs" relight error "$work/${brdf/:/}-reference.npy" "$work/$name.npy" | relative_rms)
     maps=$(grep -oE "[0-9]+ maps rotated" "$work/$name.out" | grep -oE "^[0-9]+")
     shading=$(grep -oE "shading [0-9.]+ ms" "$work/$name.out" | grep -oE "[0-9.]+")
     echo "| $brdf | $* | $error | $maps | $shading |"
@@ -40,7 +40,7 @@ echo
 echo "Made by \`scripts/relight_glossy_cache.sh $env_map\` on $(nproc) cores (load: \`$(uptime)\`):"
 echo "the bunny on its ground plane, lat-long $res x $((2 * res)), every coefficient kept, the BRDF"
 echo "rotated by \`haar\` unless the flags say otherwise. Error: RMS over the vertices relative to"
-echo "the RMS of \`relight reference\` at the same resolution (\`scripts/vertex_error.py\`). Shading"
+echo "the RMS of \`relight reference\` at the same resolution (\`haarshift relight error\`). Shading"
 echo "includes every rotation the render makes (a cache starts empty in each command)."
 echo
 echo "| material | flags | error | maps rotated | shading ms |"

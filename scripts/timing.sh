@@ -27,3 +27,5 @@ step_row() {
     report=$(tr '\n' ' ' <"$work/$1.out" | sed "s|$work/||g; s/|/\\\\|/g; s/  */ /g")
     echo "| $1 | $(field "$1" 'Elapsed (wall clock)') | $(cpu "$1") | $(peak_mib "$1") | $report |"
 }
+# The relative RMS figures of `haarshift relight error`'s lines on standard input, one a line.
+relative_rms() { sed -E 's/.*: relative RMS ([^,]+),.*/\1/'; }

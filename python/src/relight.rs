@@ -442,18 +442,13 @@ impl Shader {
             .or_raise()?;
         let mut report: HashMap<String, Py<PyAny>> = HashMap::new();
         let t = shading.timing;
-        report.insert(
-            "encode_seconds".into(),
-            t.encode_seconds.into_pyobject(py)?.into_any().unbind(),
-        );
-        report.insert(
-            "rotate_seconds".into(),
-            t.rotate_seconds.into_pyobject(py)?.into_any().unbind(),
-        );
-        report.insert(
-            "shade_seconds".into(),
-            t.shade_seconds.into_pyobject(py)?.into_any().unbind(),
-        );
+        for (key, seconds) in [
+            ("encode_seconds", t.encode_seconds),
+            ("rotate_seconds", t.rotate_seconds),
+            ("shade_seconds", t.shade_seconds),
+        ] {
+            report.insert(key.into(), seconds.into_pyobject(py)?.into_any().unbind());
+        }
         report.insert(
             "description".into(),
             shading.description.into_pyobject(py)?.into_any().unbind(),

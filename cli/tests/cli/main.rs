@@ -11,6 +11,7 @@ mod hdr;
 mod hostile;
 mod readme;
 mod relight;
+mod relight_error;
 mod relight_scene;
 mod report_overwrite;
 mod rotate_shift;

@@ -7,6 +7,7 @@ use clap::Subcommand;
 use haarshift::Result;
 
 pub mod animate;
+pub mod error;
 pub(crate) mod flags;
 pub mod gallery;
 pub mod precompute;
@@ -15,7 +16,7 @@ pub mod render;
 pub mod scene;
 
 /// Relight meshes under environment maps: precompute, render, reference, animate, gallery,
-/// and dynamic scenes of moving objects (scene).
+/// dynamic scenes of moving objects (scene), and the error of renders against a reference.
 #[derive(Subcommand, Debug)]
 pub enum RelightCommand {
     Precompute(Box<precompute::Args>),
@@ -24,6 +25,7 @@ pub enum RelightCommand {
     Animate(Box<animate::Args>),
     Gallery(Box<gallery::Args>),
     Scene(Box<scene::Args>),
+    Error(Box<error::Args>),
 }
 
 pub fn run(command: RelightCommand) -> Result<()> {
@@ -34,5 +36,6 @@ pub fn run(command: RelightCommand) -> Result<()> {
         RelightCommand::Animate(args) => animate::run(*args),
         RelightCommand::Gallery(args) => gallery::run(*args),
         RelightCommand::Scene(args) => scene::run(*args),
+        RelightCommand::Error(args) => error::run(*args),
     }
 }
