@@ -11,8 +11,10 @@
 //!   picture grids.
 //! * [`dynamic`]: occlusion fields and just-in-time radiance transfer against the ray-cast truth.
 //! * [`output`]: CSV, JSON and PNG files side by side, written atomically.
+//! * [`journal`]: measurements written as they are made, so that a killed run resumes.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
 pub mod dynamic;
+pub mod journal;
 pub mod kernel_cycle;
 pub mod output;
 pub mod pareto;

@@ -14,9 +14,10 @@ use crate::{Error, Result};
 
 /// The directory an experiment writes its reports to.
 ///
-/// An experiment with stem `s` owns the files `s.*` and `s-*` in it. [`ReportDir::claim`],
-/// called before the experiment runs, refuses the run when one of them exists (unless
-/// forced) or when an input is one of them.
+/// An experiment with stem `s` owns the files `s.*` and `s-*` in it, its
+/// [journal](crate::experiments::journal) `s.journal*` aside. [`ReportDir::claim`], called
+/// before the experiment runs, refuses the run when one of them exists (unless forced) or
+/// when an input is one of them.
 ///
 /// ```
 /// use haarshift::experiments::output::ReportDir;
@@ -77,9 +78,11 @@ impl ReportDir {
             path: self.dir.clone(),
             source,
         })?;
+        // The journal of a run is the experiment's to resume or replace, not a report.
         let owned = |name: &str| {
-            name.strip_prefix(stem)
-                .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('-'))
+            name.strip_prefix(stem).is_some_and(|rest| {
+                (rest.starts_with('.') || rest.starts_with('-')) && !rest.starts_with(".journal")
+            })
         };
         let listing = std::fs::read_dir(&self.dir).map_err(|source| Error::Io {
             path: self.dir.clone(),
@@ -168,18 +171,24 @@ impl ReportWriter {
     /// Writes a plot to `<stem>-<name>.png` and returns the path.
     pub fn png(&self, name: &str, plot: &RgbImage) -> Result<PathBuf> {
         let path = self.path(&format!("-{name}"), "png");
-        let mut bytes = Vec::new();
-        plot.write_to(
+        write_png(&path, plot, self.force)?;
+        Ok(path)
+    }
+}
+
+/// Writes `image` as a PNG file at `path`, atomically.
+pub fn write_png(path: &Path, image: &RgbImage, force: bool) -> Result<()> {
+    let mut bytes = Vec::new();
+    image
+        .write_to(
             &mut std::io::Cursor::new(&mut bytes),
             image::ImageFormat::Png,
         )
         .map_err(|e| Error::Format {
-            path: path.clone(),
+            path: path.to_owned(),
             reason: e.to_string(),
         })?;
-        write_file_atomically(&path, self.force, |w| w.write_all(&bytes))?;
-        Ok(path)
-    }
+    write_file_atomically(path, force, |w| w.write_all(&bytes))
 }
 
 /// Writes `value` as pretty JSON to `path`, atomically.

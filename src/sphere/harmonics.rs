@@ -217,28 +217,30 @@ impl SphericalHarmonics {
         let n = self.len();
         let values = map.as_array();
         let values = values.as_slice().expect("standard layout");
-        (0..param.faces() * s)
+        // One partial sum per row, added in row order: the same bits however rayon shares the
+        // rows out (a parallel fold's grouping depends on work stealing).
+        let rows: Vec<Array2<f64>> = (0..param.faces() * s)
             .into_par_iter()
-            .fold(
-                || (Array2::<f64>::zeros((n, ch)), vec![0.0; n]),
-                |(mut acc, mut y), fr| {
-                    let (face, row) = (fr / s, fr % s);
-                    for col in 0..s {
-                        self.evaluate(param.texel_direction(face, row, col), &mut y);
-                        let omega = param.texel_solid_angle(face, row, col);
-                        let texel = &values[((face * s + row) * s + col) * ch..][..ch];
-                        for (i, &yi) in y.iter().enumerate() {
-                            let w = yi * omega;
-                            for (a, v) in acc.row_mut(i).iter_mut().zip(texel) {
-                                *a += w * v.as_f64();
-                            }
+            .map(|fr| {
+                let (face, row) = (fr / s, fr % s);
+                let mut acc = Array2::<f64>::zeros((n, ch));
+                let mut y = vec![0.0; n];
+                for col in 0..s {
+                    self.evaluate(param.texel_direction(face, row, col), &mut y);
+                    let omega = param.texel_solid_angle(face, row, col);
+                    let texel = &values[((face * s + row) * s + col) * ch..][..ch];
+                    for (i, &yi) in y.iter().enumerate() {
+                        let w = yi * omega;
+                        for (a, v) in acc.row_mut(i).iter_mut().zip(texel) {
+                            *a += w * v.as_f64();
                         }
                     }
-                    (acc, y)
-                },
-            )
-            .map(|(acc, _)| acc)
-            .reduce(|| Array2::zeros((n, ch)), |a, b| a + b)
+                }
+                acc
+            })
+            .collect();
+        rows.into_iter()
+            .fold(Array2::zeros((n, ch)), |sum, row| sum + row)
     }
 
     /// `sum_i c_i Y_i` at every texel centre of `param`; `coefficients` is `(B^2, C)`.
@@ -512,6 +514,27 @@ mod tests {
                     (p0, p1) = (p1, next);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_projection_has_the_same_bits_on_any_number_of_threads() {
+        let p = Parameterization::new(ParamKind::LatLong, 64).unwrap();
+        let f = SphereMap::<f64>::from_fn(p, 3, |d, o| {
+            o.copy_from_slice(&[1.0 + d[1], (9.0 * d[0]).sin(), (d[2] * 40.0).exp()]);
+        })
+        .unwrap();
+        let sh = SphericalHarmonics::new(6).unwrap();
+        let on = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| sh.project(&f))
+        };
+        let one = on(1);
+        for threads in [2, 3, 7] {
+            assert_eq!(on(threads), one, "{threads} threads");
         }
     }
 

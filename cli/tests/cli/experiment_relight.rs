@@ -1,7 +1,13 @@
 //! `haarshift experiment relight` checks its inputs and outputs before the work (the numbers
 //! are the library's, tested in `experiments::relight`).
 
-use crate::common::{fails_cleanly, p, succeeds_with_stdout, testdata, usage_error};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+use crate::common::{
+    fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, text, usage_error,
+};
 
 #[test]
 fn it_refuses_stale_reports_and_bad_inputs_before_any_work() {
@@ -85,4 +91,95 @@ fn quick_is_the_default_and_cannot_be_asked_for_with_full() {
             &["--quick", "--full"],
         );
     }
+}
+
+/// The records of `dir/relight.csv` without the columns that depend on the machine.
+fn measured_records(dir: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join("relight.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let machine = ["precompute_seconds", "relight_seconds", "peak_mib"];
+    let keep: Vec<usize> = (0..header.len())
+        .filter(|&i| !machine.contains(&header[i]))
+        .collect();
+    assert_eq!(keep.len() + machine.len(), header.len(), "{header:?}");
+    lines
+        .map(|line| {
+            let cells: Vec<&str> = line.split(',').collect();
+            keep.iter().map(|&i| cells[i]).collect::<Vec<_>>().join(",")
+        })
+        .collect()
+}
+
+#[test]
+fn a_killed_run_resumes_to_the_records_of_an_uninterrupted_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("ball.json");
+    std::fs::write(
+        &scene,
+        r#"{"objects": [{"generator": {"sphere": {"cells": 4}}}],
+            "camera": {"position": [0, 1, 4], "look_at": [0, 0, 0], "fov": 40}}"#,
+    )
+    .unwrap();
+    let env = testdata("envmaps/rooitou_park_1k.hdr");
+    let args = |out: &Path| -> Vec<String> {
+        [
+            "experiment",
+            "relight",
+            "--scene",
+            p(&scene),
+            "--env",
+            p(&env),
+            "--out-dir",
+            p(out),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    fn strs(a: &[String]) -> Vec<&str> {
+        a.iter().map(String::as_str).collect()
+    }
+    let whole = dir.path().join("whole");
+    succeeds(&strs(&args(&whole)));
+    let stopped = dir.path().join("stopped");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_haarshift"))
+        .args(args(&stopped))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Killed once the journal holds the truth, the rotation axis and the coefficient axis.
+    let journal = stopped.join("relight.journal");
+    while std::fs::read_to_string(&journal).map_or(0, |t| t.lines().count()) < 4 {
+        assert!(child.try_wait().unwrap().is_none(), "ended before the kill");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!stopped.join("relight.csv").exists());
+    fails_cleanly(
+        &strs(&args(&stopped)),
+        &["relight.journal", "stopped run", "--resume", "--force"],
+    );
+    let mut resume = args(&stopped);
+    resume.push("--resume".into());
+    let out = succeeds(&strs(&resume));
+    let said = text(&out.stderr);
+    assert!(said.contains("resumed: "), "{said}");
+    assert_eq!(measured_records(&stopped), measured_records(&whole));
+    assert!(!journal.exists());
+    // Another protocol cannot go on with a journal.
+    let copy = dir.path().join("copy");
+    std::fs::create_dir_all(&copy).unwrap();
+    std::fs::write(
+        copy.join("relight.journal"),
+        r#"{"journal":"haarshift journal 1","options":"another run"}"#.to_owned() + "\n",
+    )
+    .unwrap();
+    let mut other = args(&copy);
+    other.push("--resume".into());
+    fails_cleanly(
+        &strs(&other),
+        &["relight.journal", "other options or inputs"],
+    );
 }

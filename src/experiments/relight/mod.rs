@@ -38,8 +38,10 @@
 
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use crate::experiments::journal::Journal;
+use crate::experiments::output::write_png;
 use crate::relight::light::environment::Environment;
 use crate::relight::material::orient::BrdfRotation;
 use crate::relight::{Brdf, Scene};
@@ -268,7 +270,7 @@ impl RelightProtocol {
 }
 
 /// One measured setting; see the [module docs](self).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RelightRecord {
     /// `rotation`, `coefficients`, `resolution`, `depth` or `harmonics`.
     pub axis: String,
@@ -351,10 +353,15 @@ pub struct RelightResults {
 }
 
 /// Runs `protocol` over `subjects` under `lights`; `progress` is called with each record.
+///
+/// Each unit of work (a scene's truth, a condition of the rotation axis, an axis under one
+/// material) goes through `journal` ([`Journal::in_memory`] for none): a resumed journal's
+/// units are taken from it, and a scene whose units are all journaled casts no rays.
 pub fn run(
     subjects: &[Subject],
     lights: &[Light],
     protocol: &RelightProtocol,
+    journal: &mut Journal,
     mut progress: impl FnMut(&RelightRecord),
 ) -> Result<RelightResults> {
     if subjects.is_empty() || lights.is_empty() {
@@ -371,13 +378,19 @@ pub fn run(
     let lights_used = &lights[..protocol.lights.min(lights.len())];
     let scenes = &subjects[..protocol.scenes.min(subjects.len())];
     for (index, subject) in scenes.iter().enumerate() {
-        let mut scene = SceneUnderTest::new(subject, protocol)?;
-        results
-            .truth_seconds
-            .push((subject.name.clone(), scene.truth_bits.report().seconds));
-        let mut push = |r: RelightRecord, out: &mut Vec<RelightRecord>| {
-            progress(&r);
-            out.push(r);
+        // Built (its truth cast) only when a unit of it is not journaled.
+        let mut slot = None;
+        let unit = |name: String| format!("{index} {}/{name}", subject.name);
+        let seconds = journal.unit(&unit("truth".into()), || {
+            Ok(under_test(&mut slot, subject, protocol)?
+                .truth_bits
+                .report()
+                .seconds)
+        })?;
+        results.truth_seconds.push((subject.name.clone(), seconds));
+        let mut push = |records: Vec<RelightRecord>| {
+            records.iter().for_each(&mut progress);
+            results.records.extend(records);
         };
         // The first scene under every map; the others (larger, slower) under the first.
         let maps = if index == 0 {
@@ -386,41 +399,84 @@ pub fn run(
             &lights_used[..1]
         };
         for (k, condition) in rotation_conditions(maps, protocol)?.iter().enumerate() {
-            let (records, grid) =
-                scene.rotation_axis(condition, k < protocol.reference_settings)?;
-            records
-                .into_iter()
-                .for_each(|r| push(r, &mut results.records));
-            if k == 0 {
-                results.grids.push(grid);
+            // The first condition's picture grid is kept beside the journal.
+            let grid_file = (k == 0).then(|| journal.sidecar(&format!("grid-{index}.png")));
+            let mut grid = None;
+            let (records, label): (_, Option<(String, String)>) =
+                journal.unit(&unit(format!("rotation {k}")), || {
+                    let (records, picture) = under_test(&mut slot, subject, protocol)?
+                        .rotation_axis(condition, k < protocol.reference_settings)?;
+                    let label = match &grid_file {
+                        None => None,
+                        Some(file) => {
+                            if let Some(file) = file {
+                                write_png(file, &picture.image, true)?;
+                            }
+                            let label = (picture.name.clone(), picture.caption.clone());
+                            grid = Some(picture);
+                            Some(label)
+                        }
+                    };
+                    Ok((records, label))
+                })?;
+            push(records);
+            if let (Some(Some(file)), Some((name, caption)), None) = (&grid_file, label, &grid) {
+                grid = Some(PictureGrid {
+                    name,
+                    caption,
+                    image: read_png(file)?,
+                });
             }
+            results.grids.extend(grid);
         }
         let first = Condition::new(&lights[0], [0.0; 3], &protocol.coefficient_material, 0)?;
-        for r in scene.coefficient_axis(&first)? {
-            push(r, &mut results.records);
-        }
-        for brdf in &protocol.resolution_materials {
+        push(journal.unit(&unit("coefficients".into()), || {
+            under_test(&mut slot, subject, protocol)?.coefficient_axis(&first)
+        })?);
+        for (m, brdf) in protocol.resolution_materials.iter().enumerate() {
             let condition = Condition::new(&lights[0], [0.0; 3], brdf, 0)?;
-            for r in scene.resolution_axis(&condition)? {
-                push(r, &mut results.records);
-            }
+            push(journal.unit(&unit(format!("resolution {m}")), || {
+                under_test(&mut slot, subject, protocol)?.resolution_axis(&condition)
+            })?);
         }
-        for brdf in &protocol.depth_materials {
+        for (m, brdf) in protocol.depth_materials.iter().enumerate() {
             let condition = Condition::new(&lights[0], [0.0; 3], brdf, 0)?;
-            for r in scene.depth_axis(&condition)? {
-                push(r, &mut results.records);
-            }
+            push(journal.unit(&unit(format!("depth {m}")), || {
+                under_test(&mut slot, subject, protocol)?.depth_axis(&condition)
+            })?);
         }
-        for light in maps {
-            for brdf in &protocol.harmonics_materials {
+        for (l, light) in maps.iter().enumerate() {
+            for (m, brdf) in protocol.harmonics_materials.iter().enumerate() {
                 let condition = Condition::new(light, [0.0; 3], brdf, 0)?;
-                for r in scene.harmonics_axis(&condition)? {
-                    push(r, &mut results.records);
-                }
+                push(journal.unit(&unit(format!("harmonics {l} {m}")), || {
+                    under_test(&mut slot, subject, protocol)?.harmonics_axis(&condition)
+                })?);
             }
         }
     }
     Ok(results)
+}
+
+/// The scene under test in `slot`, built on first use.
+fn under_test<'s, 'a>(
+    slot: &'s mut Option<SceneUnderTest<'a>>,
+    subject: &'a Subject,
+    protocol: &'a RelightProtocol,
+) -> Result<&'s mut SceneUnderTest<'a>> {
+    let scene = match slot.take() {
+        Some(scene) => scene,
+        None => SceneUnderTest::new(subject, protocol)?,
+    };
+    Ok(slot.insert(scene))
+}
+
+/// A picture grid kept beside a journal.
+fn read_png(path: &Path) -> Result<image::RgbImage> {
+    let image = image::open(path).map_err(|e| Error::Format {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    })?;
+    Ok(image.into_rgb8())
 }
 
 /// The conditions of the rotation axis under `maps`: each map under each material of the axis,

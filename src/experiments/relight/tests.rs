@@ -2,6 +2,7 @@ use ndarray::{Array2, s};
 
 use super::picture::false_colour;
 use super::*;
+use crate::experiments::journal::Journal;
 use crate::faces::{ParamKind, Parameterization};
 use crate::metrics::RelativeError;
 use crate::product::Selection;
@@ -108,6 +109,7 @@ fn the_records_agree_with_their_methods_computed_independently() {
         std::slice::from_ref(&subject),
         std::slice::from_ref(&light),
         &protocol,
+        &mut Journal::in_memory(),
         |_| {},
     )
     .unwrap();
@@ -245,7 +247,13 @@ fn the_records_agree_with_their_methods_computed_independently() {
 fn a_bad_protocol_or_no_input_is_refused() {
     let (subject, light, mut protocol) = setup();
     assert_err!(
-        run(&[], std::slice::from_ref(&light), &protocol, |_| {}),
+        run(
+            &[],
+            std::slice::from_ref(&light),
+            &protocol,
+            &mut Journal::in_memory(),
+            |_| {}
+        ),
         InvalidParameter {
             name: "relight experiment",
             ..
@@ -258,6 +266,7 @@ fn a_bad_protocol_or_no_input_is_refused() {
             std::slice::from_ref(&subject),
             std::slice::from_ref(&light),
             &protocol,
+            &mut Journal::in_memory(),
             |_| {}
         ),
         InvalidParameter {
@@ -266,6 +275,59 @@ fn a_bad_protocol_or_no_input_is_refused() {
         },
         "power of 4"
     );
+}
+
+/// The records with the columns that depend on the machine (seconds, memory) cleared.
+fn measured(records: &[RelightRecord]) -> Vec<RelightRecord> {
+    records
+        .iter()
+        .map(|r| RelightRecord {
+            precompute_seconds: 0.0,
+            relight_seconds: 0.0,
+            peak_mib: 0.0,
+            ..r.clone()
+        })
+        .collect()
+}
+
+#[test]
+fn a_run_stopped_after_some_units_resumes_to_the_same_records_and_grids() {
+    let (subject, light, protocol) = setup();
+    let go = |journal: &mut Journal| {
+        run(
+            std::slice::from_ref(&subject),
+            std::slice::from_ref(&light),
+            &protocol,
+            journal,
+            |_| {},
+        )
+        .unwrap()
+    };
+    let whole = go(&mut Journal::in_memory());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("relight.journal");
+    let options = format!("{protocol:?}");
+    go(&mut Journal::create(&path, &options, false).unwrap());
+    // Killed after the truth, the rotation axis's one condition (and its grid) and the
+    // coefficient axis: the header and three units stay.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let kept: Vec<&str> = text.lines().take(4).collect();
+    assert!(
+        kept[2].starts_with(r#"{"unit":"0 box/rotation 0""#),
+        "{}",
+        kept[2]
+    );
+    std::fs::write(&path, kept.join("\n") + "\n").unwrap();
+    let mut journal = Journal::resume(&path, &options).unwrap();
+    let resumed = go(&mut journal);
+    assert_eq!(journal.resumed(), 3);
+    assert_eq!(measured(&resumed.records), measured(&whole.records));
+    assert_eq!(resumed.grids.len(), 1);
+    assert_eq!(resumed.grids[0].image, whole.grids[0].image);
+    assert_eq!(resumed.grids[0].caption, whole.grids[0].caption);
+    assert_eq!(resumed.truth_seconds.len(), 1);
+    journal.finish().unwrap();
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
 #[test]

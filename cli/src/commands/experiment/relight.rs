@@ -3,9 +3,11 @@
 
 use std::path::PathBuf;
 
-use haarshift::Result;
+use haarshift::experiments::journal::Journal;
+use haarshift::experiments::output::ReportDir;
 use haarshift::experiments::relight::report::{coefficient_plot, report, time_plot};
 use haarshift::experiments::relight::{Light, RelightProtocol, Subject, run};
+use haarshift::{Error, Result};
 
 use super::{OutputFlags, wrote};
 use crate::commands::print;
@@ -15,6 +17,8 @@ const EXAMPLES: &str = "\
 Examples:
   haarshift experiment relight                          (the bunny under rooitou_park, --quick)
   haarshift experiment relight --full --out-dir results/relight/experiments --force
+  haarshift experiment relight --full --out-dir results/relight/experiments --resume
+                                                        (goes on with a run that was stopped)
   haarshift experiment relight --scene testdata/scenes/cylinder_and_bump.json --env park.hdr
 
 Defaults, relative to the repository's root: --scene testdata/scenes/bunny.json and
@@ -54,7 +58,10 @@ of the two renders. Times: precompute (ray casting, encoding, preparing the shad
 Writes DIR/relight.csv, .json and .md (every table), DIR/relight-rms-time.png (error against
 relighting time, Pareto frontier joined), DIR/relight-rms-coefficients.png (error against kept
 coefficients per method) and, per scene, DIR/relight-grid-SCENE-ENV-MATERIAL.png (the
-rotation axis's renders over their false-colour error images).";
+rotation axis's renders over their false-colour error images). Each unit of work (a scene's
+truth, a condition, an axis under one material) is appended to DIR/relight.journal as it is
+measured, so that a run killed midway goes on with --resume; the journal is removed once the
+reports are written.";
 
 /// Relighting methods against the ray-cast truth: tables, CSV, JSON, plots, picture grids.
 #[derive(clap::Args, Debug)]
@@ -77,6 +84,12 @@ pub struct Args {
     /// The quick protocol (the default, stated)
     #[arg(long, conflicts_with = "full")]
     pub quick: bool,
+
+    /// Go on with a run that was stopped: the measurements in DIR/relight.journal (written
+    /// as they are made) are kept and the rest measured; refused if the protocol or the
+    /// inputs differ
+    #[arg(long)]
+    pub resume: bool,
 
     #[command(flatten)]
     pub output: OutputFlags,
@@ -114,6 +127,8 @@ pub fn run_command(args: Args) -> Result<()> {
     let envs = &envs[..protocol.lights.min(envs.len())];
     let inputs: Vec<PathBuf> = scenes.iter().chain(envs).cloned().collect();
     let reports = args.output.claim("relight", &inputs)?;
+    let options = format!("{protocol:?}; {}", Journal::fingerprint(&inputs)?);
+    let mut journal = open_journal(&reports.dir, &options, args.resume)?;
     let subjects = scenes
         .iter()
         .map(|p| Subject::load(p))
@@ -123,7 +138,7 @@ pub fn run_command(args: Args) -> Result<()> {
         .map(|p| Light::load(p))
         .collect::<Result<Vec<_>>>()?;
     let bar = progress_bar(0);
-    let results = run(&subjects, &lights, &protocol, |r| {
+    let results = run(&subjects, &lights, &protocol, &mut journal, |r| {
         bar.inc(1);
         bar.set_message(format!(
             "{} {}: {} {}",
@@ -147,5 +162,28 @@ pub fn run_command(args: Args) -> Result<()> {
     for grid in &results.grids {
         written.push(writer.png(&format!("grid-{}", grid.name), &grid.image)?);
     }
+    let resumed = journal.resumed();
+    journal.finish()?;
+    if resumed > 0 {
+        eprintln!("resumed: {resumed} units of work taken from the journal");
+    }
     print(&format!("{text}\n{}", wrote(&written)))
+}
+
+/// The run's journal in `dir`: the stopped run's with `--resume`; else a new one, replacing
+/// a stopped run's only under `--force`.
+fn open_journal(dir: &ReportDir, options: &str, resume: bool) -> Result<Journal> {
+    let path = dir.path().join("relight.journal");
+    if resume {
+        return Journal::resume(&path, options);
+    }
+    if path.exists() && !dir.force() {
+        return Err(Error::Format {
+            path,
+            reason: "holds the measurements of a stopped run: --resume goes on with it, \
+                     --force starts again"
+                .into(),
+        });
+    }
+    Journal::create(&path, options, true)
 }

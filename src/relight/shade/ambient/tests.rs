@@ -149,7 +149,12 @@ fn a_glossy_material_or_a_scene_without_transport_is_refused() {
         method: Method::Ambient,
         ..ShaderSpec::default()
     };
-    assert!(spec.build(&ShadingInput::scene(&scene)).is_err());
+    let e = spec
+        .build(&ShadingInput::scene(&scene))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("needs a precomputed transport"), "{e}");
     spec.material.brdf = "phong:20".parse().unwrap();
     let input = ShadingInput::new(&scene.mesh, scene.albedo.view(), Some(&set), 1);
     let e = spec.build(&input).err().unwrap().to_string();

@@ -1,0 +1,309 @@
+//! A journal of an experiment's measurements, written as they are made, so that a run that is
+//! killed (a preempted job, a closed laptop) resumes where it stopped instead of starting over.
+//!
+//! The journal is a JSON-lines file: a header naming the run's options, then one line per
+//! finished unit of work, `{"unit": KEY, "value": ...}`, appended and flushed to disk the moment
+//! the unit is measured. [`Journal::resume`] reads the units back; [`Journal::unit`] then
+//! returns a journaled unit's value instead of measuring it again. A journal written under
+//! other options is refused, and a last line cut short by the kill is dropped. The experiment's
+//! final files are still written atomically at the end; [`Journal::finish`] then removes the
+//! journal and its sidecar files.
+//!
+//! ```
+//! use haarshift::experiments::journal::Journal;
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("run.journal");
+//! let mut journal = Journal::create(&path, "protocol A", false).unwrap();
+//! let first: Vec<f64> = journal.unit("a", || Ok(vec![1.5, 2.5])).unwrap();
+//! drop(journal); // killed here: unit "b" was never measured
+//!
+//! let mut journal = Journal::resume(&path, "protocol A").unwrap();
+//! let again: Vec<f64> = journal.unit("a", || unreachable!("journaled")).unwrap();
+//! let second: f64 = journal.unit("b", || Ok(3.0)).unwrap();
+//! assert_eq!((again, second, journal.resumed()), (first, 3.0, 1));
+//! assert!(Journal::resume(&path, "protocol B").is_err());
+//! journal.finish().unwrap();
+//! assert!(!path.exists());
+//! ```
+
+use std::collections::HashMap;
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// What the header's `journal` field holds: the format and its version.
+const FORMAT: &str = "haarshift journal 1";
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    journal: String,
+    options: String,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Entry {
+    unit: String,
+    value: serde_json::Value,
+}
+
+/// An append-only record of finished units of work; see the [module docs](self).
+#[derive(Debug)]
+pub struct Journal {
+    /// `None`: a journal kept in memory only ([`Journal::in_memory`]).
+    file: Option<(PathBuf, File)>,
+    done: HashMap<String, serde_json::Value>,
+    resumed: usize,
+    sidecars: Vec<PathBuf>,
+}
+
+impl Journal {
+    /// A journal that writes nothing: every unit is measured (for runs that need no resume).
+    pub fn in_memory() -> Self {
+        Journal {
+            file: None,
+            done: HashMap::new(),
+            resumed: 0,
+            sidecars: Vec::new(),
+        }
+    }
+
+    /// Starts a journal at `path` for a run with `options` (any text that tells runs apart: a
+    /// resume with other options is refused). An existing file is replaced only when `force`
+    /// is set.
+    pub fn create(path: &Path, options: &str, force: bool) -> Result<Self> {
+        if !force && path.exists() {
+            return Err(Error::OutputExists {
+                path: path.to_owned(),
+            });
+        }
+        let io = |source| Error::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let mut file = File::create(path).map_err(io)?;
+        let header = Header {
+            journal: FORMAT.into(),
+            options: options.into(),
+        };
+        let mut line = serde_json::to_string(&header).map_err(|e| Self::bad(path, e))?;
+        line.push('\n');
+        file.write_all(line.as_bytes()).map_err(io)?;
+        file.sync_data().map_err(io)?;
+        Ok(Journal {
+            file: Some((path.to_owned(), file)),
+            ..Self::in_memory()
+        })
+    }
+
+    /// Reopens the journal at `path` of a run with `options` to go on with it. Refused when the
+    /// file is not a journal, was written with other options, or has a damaged line before
+    /// its last; a last line cut short is dropped (the file is truncated to the lines before).
+    pub fn resume(path: &Path, options: &str) -> Result<Self> {
+        let io = |source| Error::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let text = std::fs::read(path).map_err(io)?;
+        // Only whole lines count: a kill can leave the last one unfinished.
+        let complete = text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let body = std::str::from_utf8(&text[..complete])
+            .map_err(|_| Self::refused(path, "is not UTF-8 text"))?;
+        let mut lines = body.lines();
+        let header: Header = lines
+            .next()
+            .and_then(|l| serde_json::from_str(l).ok())
+            .filter(|h: &Header| h.journal == FORMAT)
+            .ok_or_else(|| Self::refused(path, &format!("is not a {FORMAT} file")))?;
+        if header.options != options {
+            return Err(Self::refused(
+                path,
+                "was written by a run with other options or inputs than this one",
+            ));
+        }
+        let mut done = HashMap::new();
+        for (n, line) in lines.enumerate() {
+            let entry: Entry = serde_json::from_str(line)
+                .map_err(|e| Self::refused(path, &format!("line {} is damaged: {e}", n + 2)))?;
+            done.insert(entry.unit, entry.value);
+        }
+        let file = OpenOptions::new().write(true).open(path).map_err(io)?;
+        file.set_len(complete as u64).map_err(io)?;
+        drop(file);
+        let file = OpenOptions::new().append(true).open(path).map_err(io)?;
+        Ok(Journal {
+            file: Some((path.to_owned(), file)),
+            done,
+            resumed: 0,
+            sidecars: Vec::new(),
+        })
+    }
+
+    /// The value of the unit `key`: the journaled one if the unit was finished before, else
+    /// `measure`'s, which is appended to the journal and flushed to disk before it is returned.
+    pub fn unit<T: Serialize + DeserializeOwned>(
+        &mut self,
+        key: &str,
+        measure: impl FnOnce() -> Result<T>,
+    ) -> Result<T> {
+        if let Some(value) = self.done.get(key) {
+            let path = self.file.as_ref().map_or(Path::new(""), |(p, _)| p);
+            let value = T::deserialize(value)
+                .map_err(|e| Self::refused(path, &format!("unit {key} does not read back: {e}")))?;
+            self.resumed += 1;
+            return Ok(value);
+        }
+        let value = measure()?;
+        if let Some((path, file)) = &mut self.file {
+            let entry = Entry {
+                unit: key.into(),
+                value: serde_json::to_value(&value).map_err(|e| Self::bad(path, e))?,
+            };
+            let mut line = serde_json::to_string(&entry).map_err(|e| Self::bad(path, e))?;
+            line.push('\n');
+            let io = |source| Error::Io {
+                path: path.clone(),
+                source,
+            };
+            file.write_all(line.as_bytes()).map_err(io)?;
+            file.sync_data().map_err(io)?;
+        }
+        Ok(value)
+    }
+
+    /// Text that tells the contents of `inputs` apart, for a journal's options: each file's
+    /// path, length and CRC-32, so that a resume after an input changed is refused.
+    pub fn fingerprint(inputs: &[PathBuf]) -> Result<String> {
+        let mut out = Vec::new();
+        for path in inputs {
+            let bytes = std::fs::read(path).map_err(|source| Error::Io {
+                path: path.clone(),
+                source,
+            })?;
+            out.push(format!(
+                "{} ({} bytes, CRC-32 {:08x})",
+                path.display(),
+                bytes.len(),
+                crc32fast::hash(&bytes)
+            ));
+        }
+        Ok(out.join(", "))
+    }
+
+    /// How many units [`Journal::unit`] has taken from the journal instead of measuring.
+    pub fn resumed(&self) -> usize {
+        self.resumed
+    }
+
+    /// The path of a file kept beside the journal, named after it and `name` (for results too
+    /// large for a line, such as a picture), removed with it by [`Journal::finish`]; `None` for
+    /// a journal in memory.
+    pub fn sidecar(&mut self, name: &str) -> Option<PathBuf> {
+        let (path, _) = self.file.as_ref()?;
+        let mut file = path.clone().into_os_string();
+        file.push(format!(".{name}"));
+        let file = PathBuf::from(file);
+        self.sidecars.push(file.clone());
+        Some(file)
+    }
+
+    /// Ends a run whose final files are written: removes the journal and its sidecars.
+    pub fn finish(self) -> Result<()> {
+        let Some((path, file)) = self.file else {
+            return Ok(());
+        };
+        drop(file);
+        for file in self.sidecars.iter().chain([&path]) {
+            match std::fs::remove_file(file) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(Error::Io {
+                        path: file.clone(),
+                        source: e,
+                    });
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn refused(path: &Path, reason: &str) -> Error {
+        Error::Format {
+            path: path.to_owned(),
+            reason: reason.into(),
+        }
+    }
+
+    fn bad(path: &Path, e: serde_json::Error) -> Error {
+        Self::refused(path, &e.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_cut_short_is_dropped_and_the_run_goes_on_after_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("j");
+        let mut journal = Journal::create(&path, "o", false).unwrap();
+        journal.unit("a", || Ok(1u32)).unwrap();
+        journal.unit("b", || Ok(2u32)).unwrap();
+        drop(journal);
+        // The kill came while "b" was being written.
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, &text[..text.len() - 5]).unwrap();
+        let mut journal = Journal::resume(&path, "o").unwrap();
+        assert_eq!(journal.unit("a", || Ok(10u32)).unwrap(), 1);
+        assert_eq!(journal.unit("b", || Ok(20u32)).unwrap(), 20);
+        drop(journal);
+        let mut journal = Journal::resume(&path, "o").unwrap();
+        assert_eq!(journal.unit("b", || Ok(30u32)).unwrap(), 20);
+        assert_eq!(journal.resumed(), 1);
+    }
+
+    #[test]
+    fn other_options_a_damaged_line_or_another_file_are_refused_naming_why() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("j");
+        let mut journal = Journal::create(&path, "quick", false).unwrap();
+        journal.unit("a", || Ok(1u32)).unwrap();
+        drop(journal);
+        let e = Journal::resume(&path, "full").unwrap_err().to_string();
+        assert!(e.contains("a run with other options or inputs"), "{e}");
+        let e = Journal::create(&path, "quick", false).unwrap_err();
+        assert!(matches!(e, Error::OutputExists { .. }), "{e}");
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, text.replace("\"unit\"", "\"u\"") + "{}\n").unwrap();
+        let e = Journal::resume(&path, "quick").unwrap_err().to_string();
+        assert!(e.contains("line 2 is damaged"), "{e}");
+        std::fs::write(&path, "time,rms\n1,2\n").unwrap();
+        let e = Journal::resume(&path, "quick").unwrap_err().to_string();
+        assert!(e.contains("is not a haarshift journal 1 file"), "{e}");
+    }
+
+    #[test]
+    fn a_journal_in_memory_measures_every_unit_and_writes_nothing() {
+        let mut journal = Journal::in_memory();
+        assert_eq!(journal.unit("a", || Ok(1u8)).unwrap(), 1);
+        assert_eq!(journal.unit("a", || Ok(2u8)).unwrap(), 2);
+        assert_eq!(journal.sidecar("grid.png"), None);
+        journal.finish().unwrap();
+    }
+
+    #[test]
+    fn a_fingerprint_changes_with_the_contents_of_an_input() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("scene.json");
+        std::fs::write(&path, "{}").unwrap();
+        let before = Journal::fingerprint(std::slice::from_ref(&path)).unwrap();
+        assert!(before.ends_with("(2 bytes, CRC-32 a3a6bf43)"), "{before}");
+        std::fs::write(&path, "[]").unwrap();
+        assert_ne!(Journal::fingerprint(&[path]).unwrap(), before);
+    }
+}
