@@ -308,9 +308,15 @@ impl StoredCoefficients {
             .into_dimensionality::<ndarray::Ix3>()
             .map_err(|e| format_reason(path, e.to_string()))?;
         let sidecar_path = CoefficientFile::<f64>::sidecar_path(path);
-        let metadata = match std::fs::read(&sidecar_path) {
+        let metadata = match read_sidecar(&sidecar_path) {
             Ok(bytes) => Some(parse_sidecar(&sidecar_path, &bytes, array.dim())?),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(e) if e.kind() == std::io::ErrorKind::FileTooLarge => {
+                return Err(format_reason(
+                    &sidecar_path,
+                    format!("a sidecar is at most {SIDECAR_MAX_BYTES} bytes; this one is longer"),
+                ));
+            }
             Err(e) => return Err(io_error(&sidecar_path, e)),
         };
         Ok(StoredCoefficients {
@@ -359,6 +365,24 @@ impl StoredCoefficients {
         CoefficientFile::from_parts(planes, metadata.channels, metadata.depth)
             .map_err(|e| e.in_file(&path))
     }
+}
+
+/// The longest sidecar read: one is a few hundred bytes, and the limit keeps a sidecar that
+/// is a link to a device (`/dev/zero`) or a huge file from being read into memory.
+const SIDECAR_MAX_BYTES: u64 = 1 << 20;
+
+/// The bytes of the sidecar at `path`; an error of kind `FileTooLarge` beyond
+/// [`SIDECAR_MAX_BYTES`].
+fn read_sidecar(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(SIDECAR_MAX_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > SIDECAR_MAX_BYTES {
+        return Err(std::io::ErrorKind::FileTooLarge.into());
+    }
+    Ok(bytes)
 }
 
 /// Parses and checks a sidecar against the array's shape `(c, h, w)`.

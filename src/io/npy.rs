@@ -69,16 +69,51 @@ fn element_type(descriptor: &str) -> Option<(SampleDepth, usize, bool)> {
 /// The depth of the samples in the `.npy` file at `path`, from its header.
 pub(super) fn stored_depth(path: &Path) -> Result<SampleDepth> {
     let file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
-    Ok(read_header(path, &mut BufReader::new(file))?.1)
+    let file_len = file.metadata().map_err(|e| io_error(path, e))?.len();
+    Ok(read_header(path, &mut BufReader::new(file), file_len)?.1)
 }
 
-/// The header of the `.npy` file `reader` reads, and its element type.
-fn read_header(path: &Path, reader: &mut impl Read) -> Result<(Header, SampleDepth, usize, bool)> {
-    let header = Header::from_reader(reader)
-        .map_err(|e| format_reason(path, format!("invalid .npy header: {e}")))?;
+/// The longest `.npy` header read (numpy writes a few hundred bytes and by default refuses
+/// to read more than 10,000).
+const HEADER_MAX_BYTES: u64 = 1 << 20;
+
+/// The header of the `.npy` file of `file_len` bytes that `reader` reads, and its element
+/// type. The header's length is checked against the file and [`HEADER_MAX_BYTES`] first:
+/// the parser allocates what the length field says before reading.
+fn read_header(
+    path: &Path,
+    reader: &mut impl Read,
+    file_len: u64,
+) -> Result<(Header, SampleDepth, usize, bool)> {
+    // Magic (6 bytes), version (2), then the header's length: 2 bytes in version 1, 4 after.
+    let mut preamble = [0u8; 12];
+    let read = read_up_to(reader, &mut preamble).map_err(|e| io_error(path, e))?;
+    let length_bytes = if preamble[6] == 1 { 2 } else { 4 };
+    if read >= 8 + length_bytes && preamble[..6] == *b"\x93NUMPY" {
+        let mut length = [0u8; 4];
+        length[..length_bytes].copy_from_slice(&preamble[8..8 + length_bytes]);
+        let length = u64::from(u32::from_le_bytes(length));
+        let room = file_len.saturating_sub((8 + length_bytes) as u64);
+        if length > room.min(HEADER_MAX_BYTES) {
+            return Err(format_reason(
+                path,
+                format!(
+                    "invalid .npy header: {length} bytes long, more than the file's {room} \
+                     after the preamble or the limit of {HEADER_MAX_BYTES}"
+                ),
+            ));
+        }
+    }
+    let mut reader = std::io::Cursor::new(&preamble[..read]).chain(reader);
+    let header = Header::from_reader(&mut reader).map_err(|e| {
+        format_reason(
+            path,
+            format!("invalid .npy header: {}", one_line(&e.to_string())),
+        )
+    })?;
     let descriptor = header.type_descriptor.to_string();
-    let descriptor = descriptor.trim_matches(|c| c == '\'' || c == '"');
-    let (depth, size, little) = element_type(descriptor).ok_or_else(|| {
+    let descriptor = one_line(descriptor.trim_matches(|c| c == '\'' || c == '"'));
+    let (depth, size, little) = element_type(&descriptor).ok_or_else(|| {
         format_reason(
             path,
             format!(
@@ -88,6 +123,39 @@ fn read_header(path: &Path, reader: &mut impl Read) -> Result<(Header, SampleDep
         )
     })?;
     Ok((header, depth, size, little))
+}
+
+/// Fills as much of `buffer` as `reader` holds; returns how much that is.
+fn read_up_to(reader: &mut impl Read, buffer: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buffer.len() {
+        match reader.read(&mut buffer[filled..]) {
+            Ok(0) => break,
+            Ok(n) => filled += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(filled)
+}
+
+/// A parser's message as one short line: the header parser's diagnostic spans several lines
+/// and echoes the whole header (which a hostile file makes megabytes long), so only its first
+/// line and its `= expected ...` note are kept, cut to 160 characters.
+fn one_line(message: &str) -> String {
+    const MAX: usize = 160;
+    let mut lines = message.lines();
+    let first = lines.next().unwrap_or("").trim();
+    let notes = lines.filter_map(|l| l.trim().strip_prefix("= "));
+    let line = std::iter::once(first)
+        .chain(notes)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ");
+    match line.char_indices().nth(MAX) {
+        Some((cut, _)) => format!("{}...", &line[..cut]),
+        None => line,
+    }
 }
 
 /// Reads a float16, float32 or float64 array whose shape `accept` allows, after checking its
@@ -101,7 +169,7 @@ pub(super) fn read_array<T: Sample>(
     let path = source.name();
     let file_len = source.len()?;
     let mut reader = source.open()?;
-    let (header, depth, size, little) = read_header(path, &mut reader)?;
+    let (header, depth, size, little) = read_header(path, &mut reader, file_len)?;
     let data_start = reader.stream_position().map_err(|e| io_error(path, e))?;
     let shape = header.shape.clone();
     accept(&shape).map_err(|reason| format_reason(path, reason))?;

@@ -39,10 +39,15 @@ pub(super) fn read<T: Sample>(
 ) -> Result<PlanarImage<T>> {
     let path = source.name();
     let exr_error = |e: exr::error::Error| match e {
-        exr::error::Error::Io(e) if e.kind() != std::io::ErrorKind::UnexpectedEof => {
-            io_error(path, e)
+        exr::error::Error::Io(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+            format_reason(path, "file is truncated")
         }
-        exr::error::Error::Io(_) => format_reason(path, "file is truncated"),
+        // A seek the system refuses (EINVAL) comes from an offset in the file, not the disk.
+        exr::error::Error::Io(e) if e.kind() == std::io::ErrorKind::InvalidInput => format_reason(
+            path,
+            "invalid OpenEXR file: a chunk offset lies outside the file",
+        ),
+        exr::error::Error::Io(e) => io_error(path, e),
         other => format_reason(path, format!("invalid OpenEXR file: {other}")),
     };
     // The header alone first: the sizes it promises are checked before any pixel buffer exists.

@@ -250,8 +250,11 @@ fn counts_that_would_wrap_are_refused_before_allocating() {
         args.extend(["--resolution", "8", "--width", "8", "--height", "8"]);
         args.extend(["--circles", "12", "--circle-points", "24"]);
         args.extend(["--shells", "6", "--shell-grid", "4"]);
-        // The line does not name p.json yet (MotionPath::states reports no file): issue 35.
-        refused(d, &args, &["path segment 0", "more than 3600 frames"]);
+        refused(
+            d,
+            &args,
+            &["p.json", "path segment 0", "more than 3600 frames"],
+        );
     }
 }
 
@@ -303,4 +306,79 @@ fn tiny_triangles(base: f64) -> String {
         obj.push_str(&format!("f {a} {b} {c}\n"));
     }
     obj
+}
+
+#[test]
+fn malformed_headers_and_sidecars_give_one_short_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A .npy header with a syntax error 60 KB long: one line, not the header echoed.
+    let mut header = format!(
+        "{{'descr': '<f4', 'fortran_order': False, 'shape': (4, 4), 'x': '{}' oops}}",
+        "x".repeat(60_000)
+    );
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    npy.extend((header.len() as u16).to_le_bytes());
+    npy.extend(header.as_bytes());
+    npy.extend([0u8; 64]);
+    file(d, "long.npy", npy);
+    let line = refused(
+        d,
+        &["info", "long.npy"],
+        &["long.npy", "invalid .npy header"],
+    );
+    assert!(line.len() < 400, "{} bytes: {line}", line.len());
+    // A 21-byte file whose header says it is 2.4 GB long (found by the exr fuzz target).
+    file(
+        d,
+        "liar.npy",
+        b"\x93NUMPY\x03\x00\x00\x10\x00\x8f#\xcdh**#c\x00$",
+    );
+    refused(
+        d,
+        &["info", "liar.npy"],
+        &["liar.npy", "2399145984 bytes long"],
+    );
+    // A coefficient file whose sidecar is a link to an endless device.
+    let image = testdata("camera.png");
+    let (code, _, err, _) = run(d, &["transform", p(&image), "-o", "c.npy"]);
+    assert_eq!(code, Some(0), "{err}");
+    std::fs::remove_file(d.join("c.npy.json")).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", d.join("c.npy.json")).unwrap();
+    refused(
+        d,
+        &["info", "c.npy"],
+        &["c.npy.json", "at most 1048576 bytes"],
+    );
+    // An OpenEXR file whose first chunk offset is u64::MAX.
+    let env = testdata("envmaps/rooitou_park_32x16.hdr");
+    let (code, _, err, _) = run(d, &["rotate", p(&env), "--angle", "0", "-o", "a.exr"]);
+    assert_eq!(code, Some(0), "{err}");
+    let mut exr = std::fs::read(d.join("a.exr")).unwrap();
+    let table = exr_offset_table(&exr);
+    exr[table..table + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+    file(d, "far.exr", exr);
+    refused(
+        d,
+        &["info", "far.exr"],
+        &["far.exr", "chunk offset lies outside"],
+    );
+}
+
+/// Where a single-part scanline OpenEXR file's offset table starts: after the magic number,
+/// the version and the attributes (`name\0 type\0 size value`), ended by an empty name.
+fn exr_offset_table(exr: &[u8]) -> usize {
+    let mut at = 8;
+    while exr[at] != 0 {
+        for _ in 0..2 {
+            at += exr[at..].iter().position(|&b| b == 0).unwrap() + 1;
+        }
+        let size = u32::from_le_bytes(exr[at..at + 4].try_into().unwrap()) as usize;
+        at += 4 + size;
+    }
+    at + 1
 }

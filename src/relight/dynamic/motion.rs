@@ -109,7 +109,23 @@ pub struct FrameReport {
 impl MotionPath {
     /// Reads a path file.
     pub fn load(path: &Path) -> Result<Self> {
-        crate::relight::scene::read_json(path)
+        let motion: Self = crate::relight::scene::read_json(path)?;
+        motion.check_counts().map_err(|e| e.in_file(path))?;
+        Ok(motion)
+    }
+
+    /// The checks that need no scene: at least one segment, at most [`MAX_FRAMES`] frames.
+    fn check_counts(&self) -> Result<()> {
+        if self.segments.is_empty() {
+            return Err(SceneError::SceneFile("a path needs at least one segment".into()).into());
+        }
+        if self.frame_count() > MAX_FRAMES + 1 {
+            return Err(SceneError::SceneFile(format!(
+                "path segment 0: more than {MAX_FRAMES} frames in all"
+            ))
+            .into());
+        }
+        Ok(())
     }
 
     /// Frames in all, frame 0 included (`usize::MAX` when the sum does not fit: checked, so
@@ -126,12 +142,7 @@ impl MotionPath {
         let bad = |k: usize, why: String| -> Error {
             SceneError::SceneFile(format!("path segment {k}: {why}")).into()
         };
-        if self.segments.is_empty() {
-            return Err(SceneError::SceneFile("a path needs at least one segment".into()).into());
-        }
-        if self.frame_count() > MAX_FRAMES + 1 {
-            return Err(bad(0, format!("more than {MAX_FRAMES} frames in all")));
-        }
+        self.check_counts()?;
         let param = scene.param();
         let mut placements: Vec<Placement> = (0..scene.object_count())
             .map(|k| scene.placement(k))
