@@ -131,10 +131,9 @@ impl Journal {
                 .map_err(|e| Self::refused(path, &format!("line {} is damaged: {e}", n + 2)))?;
             done.insert(entry.unit, entry.value);
         }
-        let file = OpenOptions::new().write(true).open(path).map_err(io)?;
-        file.set_len(complete as u64).map_err(io)?;
-        drop(file);
+        // Appends go to the end of the file as truncated here.
         let file = OpenOptions::new().append(true).open(path).map_err(io)?;
+        file.set_len(complete as u64).map_err(io)?;
         Ok(Journal {
             file: Some((path.to_owned(), file)),
             done,

@@ -86,10 +86,14 @@ fn read_header(
     file_len: u64,
 ) -> Result<(Header, SampleDepth, usize, bool)> {
     // Magic (6 bytes), version (2), then the header's length: 2 bytes in version 1, 4 after.
-    let mut preamble = [0u8; 12];
-    let read = read_up_to(reader, &mut preamble).map_err(|e| io_error(path, e))?;
-    let length_bytes = if preamble[6] == 1 { 2 } else { 4 };
-    if read >= 8 + length_bytes && preamble[..6] == *b"\x93NUMPY" {
+    let mut preamble = Vec::with_capacity(12);
+    reader
+        .by_ref()
+        .take(12)
+        .read_to_end(&mut preamble)
+        .map_err(|e| io_error(path, e))?;
+    let length_bytes = if preamble.get(6) == Some(&1) { 2 } else { 4 };
+    if preamble.len() >= 8 + length_bytes && preamble[..6] == *b"\x93NUMPY" {
         let mut length = [0u8; 4];
         length[..length_bytes].copy_from_slice(&preamble[8..8 + length_bytes]);
         let length = u64::from(u32::from_le_bytes(length));
@@ -104,7 +108,7 @@ fn read_header(
             ));
         }
     }
-    let mut reader = std::io::Cursor::new(&preamble[..read]).chain(reader);
+    let mut reader = std::io::Cursor::new(preamble).chain(reader);
     let header = Header::from_reader(&mut reader).map_err(|e| {
         format_reason(
             path,
@@ -123,20 +127,6 @@ fn read_header(
         )
     })?;
     Ok((header, depth, size, little))
-}
-
-/// Fills as much of `buffer` as `reader` holds; returns how much that is.
-fn read_up_to(reader: &mut impl Read, buffer: &mut [u8]) -> std::io::Result<usize> {
-    let mut filled = 0;
-    while filled < buffer.len() {
-        match reader.read(&mut buffer[filled..]) {
-            Ok(0) => break,
-            Ok(n) => filled += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(filled)
 }
 
 /// A parser's message as one short line: the header parser's diagnostic spans several lines

@@ -1,4 +1,4 @@
-use ndarray::{Array2, Array3, array};
+use ndarray::{Array2, Array3, array, s};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 

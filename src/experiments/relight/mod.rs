@@ -399,28 +399,29 @@ pub fn run(
             &lights_used[..1]
         };
         for (k, condition) in rotation_conditions(maps, protocol)?.iter().enumerate() {
-            // The first condition's picture grid is kept beside the journal.
-            let grid_file = (k == 0).then(|| journal.sidecar(&format!("grid-{index}.png")));
+            // The first condition's picture grid is kept, beside the journal when it has a file.
+            let keep_grid = k == 0;
+            let grid_file = keep_grid
+                .then(|| journal.sidecar(&format!("grid-{index}.png")))
+                .flatten();
             let mut grid = None;
             let (records, label): (_, Option<(String, String)>) =
                 journal.unit(&unit(format!("rotation {k}")), || {
                     let (records, picture) = under_test(&mut slot, subject, protocol)?
                         .rotation_axis(condition, k < protocol.reference_settings)?;
-                    let label = match &grid_file {
-                        None => None,
-                        Some(file) => {
-                            if let Some(file) = file {
-                                write_png(file, &picture.image, true)?;
-                            }
-                            let label = (picture.name.clone(), picture.caption.clone());
-                            grid = Some(picture);
-                            Some(label)
-                        }
-                    };
-                    Ok((records, label))
+                    if !keep_grid {
+                        return Ok((records, None));
+                    }
+                    if let Some(file) = &grid_file {
+                        write_png(file, &picture.image, true)?;
+                    }
+                    let label = (picture.name.clone(), picture.caption.clone());
+                    grid = Some(picture);
+                    Ok((records, Some(label)))
                 })?;
             push(records);
-            if let (Some(Some(file)), Some((name, caption)), None) = (&grid_file, label, &grid) {
+            // Taken from the journal: the grid is read back from its sidecar.
+            if let (None, Some(file), Some((name, caption))) = (&grid, &grid_file, label) {
                 grid = Some(PictureGrid {
                     name,
                     caption,

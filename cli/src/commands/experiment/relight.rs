@@ -177,13 +177,13 @@ fn open_journal(dir: &ReportDir, options: &str, resume: bool) -> Result<Journal>
     if resume {
         return Journal::resume(&path, options);
     }
-    if path.exists() && !dir.force() {
-        return Err(Error::Format {
+    Journal::create(&path, options, dir.force()).map_err(|e| match e {
+        Error::OutputExists { path } => Error::Format {
             path,
             reason: "holds the measurements of a stopped run: --resume goes on with it, \
                      --force starts again"
                 .into(),
-        });
-    }
-    Journal::create(&path, options, true)
+        },
+        e => e,
+    })
 }

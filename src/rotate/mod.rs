@@ -44,13 +44,20 @@
 //! assert_eq!(r, array![[2.0, 4.0], [1.0, 3.0]]);
 //! ```
 
-use ndarray::{Array2, ArrayView2, Axis, CowArray, s};
+use ndarray::{Array2, ArrayView2, Axis, CowArray};
 
 use crate::kernels::shear::{check_finite, shear_pass_into};
-use crate::kernels::{Outside, ShearKernel, grid, transpose};
+use crate::kernels::{Outside, ShearKernel};
 use crate::named::named_enum;
 use crate::sample::round_to_code;
 use crate::{BoundaryMode, Error, PlanarImage, Result, Sample};
+
+mod angle;
+mod chain;
+
+use angle::is_pure_copy;
+pub use angle::{ReducedAngle, expanded_size, quarter_turn, reduce_angle};
+pub use chain::RotationChain;
 
 named_enum! {
     /// The size of the rotated image.
@@ -125,102 +132,6 @@ impl Default for RotateOptions {
             memory_budget: DEFAULT_MEMORY_BUDGET,
         }
     }
-}
-
-/// An angle split into exact quarter turns and a residual.
-///
-/// ```
-/// let r = haarshift::rotate::reduce_angle(1e6).unwrap();
-/// assert_eq!((r.quarter_turns, r.residual_deg), (3, 10.0));
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ReducedAngle {
-    /// Counter-clockwise quarter turns, `0..4`.
-    pub quarter_turns: u8,
-    /// The rest, in `[-45, 45]` degrees.
-    pub residual_deg: f64,
-}
-
-/// Splits `deg` into `quarter_turns * 90 + residual_deg` modulo 360, exactly: `deg % 360` is
-/// exact in floating point, and so is subtracting the nearest multiple of 90 (the two are
-/// within a factor of two). Halfway cases (45, 135, ...) go to an even number of quarter turns.
-///
-/// ```
-/// use haarshift::rotate::reduce_angle;
-/// let r = reduce_angle(-180.0).unwrap();
-/// assert_eq!((r.quarter_turns, r.residual_deg), (2, 0.0));
-/// let nan = reduce_angle(f64::NAN);
-/// assert!(matches!(nan, Err(haarshift::Error::InvalidParameter { name: "angle", .. })));
-/// ```
-pub fn reduce_angle(deg: f64) -> Result<ReducedAngle> {
-    if !deg.is_finite() {
-        return Err(Error::parameter(
-            "angle",
-            format!("{deg} is not a finite number of degrees"),
-        ));
-    }
-    let r = deg % 360.0;
-    let q = (r / 90.0).round_ties_even();
-    let residual = r - 90.0 * q;
-    Ok(ReducedAngle {
-        quarter_turns: (q as i64).rem_euclid(4) as u8,
-        // -0.0 and 0.0 are the same rotation; report the plain zero.
-        residual_deg: residual + 0.0,
-    })
-}
-
-/// `plane` turned counter-clockwise (as displayed) by `turns` quarter turns: a copy, no
-/// arithmetic (`np.rot90`).
-///
-/// ```
-/// use ndarray::array;
-/// let t = haarshift::rotate::quarter_turn(array![[1, 2, 3], [4, 5, 6]].view(), 1);
-/// assert_eq!(t, array![[3, 6], [2, 5], [1, 4]]);
-/// ```
-pub fn quarter_turn<A: Copy + Default + Send + Sync>(
-    plane: ArrayView2<'_, A>,
-    turns: u8,
-) -> Array2<A> {
-    match turns % 4 {
-        0 => plane.to_owned(),
-        1 => transpose(plane).slice(s![..;-1, ..]).to_owned(),
-        2 => plane.slice(s![..;-1, ..;-1]).to_owned(),
-        _ => transpose(plane.slice(s![..;-1, ..])),
-    }
-}
-
-/// The [`Canvas::Expand`] size `(rows, cols)` of an `h x w` image turned by `deg`:
-/// `round(w|cos| + h|sin|)` columns and `round(w|sin| + h|cos|)` rows, with the quarter turns
-/// exact.
-///
-/// ```
-/// use haarshift::rotate::expanded_size;
-/// assert_eq!(expanded_size(100, 100, 45.0).unwrap(), (141, 141));
-/// assert_eq!(expanded_size(30, 50, 90.0).unwrap(), (50, 30));
-/// ```
-pub fn expanded_size(h: usize, w: usize, deg: f64) -> Result<(usize, usize)> {
-    let r = reduce_angle(deg)?;
-    let (h1, w1) = if r.quarter_turns % 2 == 1 {
-        (w, h)
-    } else {
-        (h, w)
-    };
-    let t = r.residual_deg.to_radians();
-    let (sin, cos) = (t.sin().abs(), t.cos().abs());
-    let (h1, w1) = (h1 as f64, w1 as f64);
-    let rows = (w1 * sin + h1 * cos + 0.5).floor();
-    let cols = (w1 * cos + h1 * sin + 0.5).floor();
-    Ok((rows.max(1.0) as usize, cols.max(1.0) as usize))
-}
-
-/// Whether rotating an `h x w` image by `deg` onto `canvas` only moves pixels: a multiple of 90
-/// degrees whose centre stays on the pixel grid.
-fn is_pure_copy(h: usize, w: usize, deg: f64, canvas: Canvas) -> Result<bool> {
-    let r = reduce_angle(deg)?;
-    Ok(r.residual_deg == 0.0
-        && (canvas == Canvas::Expand
-            || r.quarter_turns.is_multiple_of(2)
-            || h.abs_diff(w).is_multiple_of(2)))
 }
 
 /// Checks the plane (non-empty, finite) and the options that do not depend on the kernel.
@@ -571,105 +482,6 @@ pub fn rotated_size(
         }
         Canvas::Expand => expanded_size(h, w, deg)?,
     })
-}
-
-/// Successive rotations of one plane on a persistent working grid, projected to pixels only
-/// by [`finish`](Self::finish): the setting of error-accumulation experiments (rotate by
-/// 22.5 degrees sixteen times and compare with the original).
-///
-/// ```
-/// use haarshift::kernels::ShiftMethod;
-/// use haarshift::rotate::{RotateOptions, RotationChain};
-/// use ndarray::Array2;
-/// let p = Array2::from_shape_fn((8, 8), |(r, c)| (r * 8 + c) as f64);
-/// let k = ShiftMethod::Nearest.kernel::<f64>();
-/// let opts = RotateOptions { supersample: 1, ..Default::default() };
-/// let mut chain = RotationChain::new(p.view(), k.as_ref(), opts).unwrap();
-/// assert_eq!(chain.working().dim(), (16, 16));
-/// for _ in 0..4 {
-///     chain.rotate(90.0).unwrap();
-/// }
-/// assert_eq!(chain.finish(), p);
-/// ```
-pub struct RotationChain<'k, T: Sample> {
-    work: Array2<T>,
-    /// The previous working grid's memory, reused for the next rotation's output.
-    spare: Vec<T>,
-    workspace: RotationWorkspace<T>,
-    exponent: u32,
-    kernel: &'k dyn ShearKernel<T>,
-    options: RotateOptions,
-}
-
-impl<'k, T: Sample> RotationChain<'k, T> {
-    /// Puts `plane` on the working grid (`2^(supersample + kernel.grid_exponent())` samples per
-    /// pixel per axis, nearest replication).
-    pub fn new(
-        plane: ArrayView2<'_, T>,
-        kernel: &'k dyn ShearKernel<T>,
-        options: RotateOptions,
-    ) -> Result<Self> {
-        validate_plane(plane, &options)?;
-        let (h, w) = plane.dim();
-        let exponent = options.supersample + kernel.grid_exponent();
-        if exponent > 30 {
-            return Err(Error::parameter(
-                "grid exponent",
-                format!("2^{exponent} samples per pixel is too fine"),
-            ));
-        }
-        let fine = ((h as u128) << exponent) * ((w as u128) << exponent);
-        check_budget::<T>("the working grid", fine, options.memory_budget)?;
-        Ok(RotationChain {
-            work: grid::upsample_nearest(plane, exponent)?,
-            spare: Vec::new(),
-            workspace: RotationWorkspace::new(),
-            exponent,
-            kernel,
-            options,
-        })
-    }
-
-    /// Rotates the working grid by `deg` (counter-clockwise as displayed).
-    pub fn rotate(&mut self, deg: f64) -> Result<&mut Self> {
-        let granule = 1usize << self.exponent;
-        let rotation = GridRotation::new::<T>(
-            self.work.dim(),
-            deg,
-            granule,
-            self.kernel.support_radius(),
-            &self.options,
-        )?;
-        let (h, w) = rotation.out;
-        let mut out = std::mem::take(&mut self.spare);
-        buffer(&mut out, h * w);
-        out.truncate(h * w);
-        self.workspace.rotate_grid(
-            self.work.view(),
-            &rotation,
-            self.kernel,
-            self.options.outside,
-            &mut out,
-        )?;
-        let out = Array2::from_shape_vec((h, w), out).expect("sized");
-        self.spare = std::mem::replace(&mut self.work, out)
-            .into_raw_vec_and_offset()
-            .0;
-        Ok(self)
-    }
-
-    /// The working grid as it stands.
-    pub fn working(&self) -> ArrayView2<'_, T> {
-        self.work.view()
-    }
-
-    /// Box-averages the working grid back to pixels.
-    pub fn finish(self) -> Array2<T> {
-        if self.exponent == 0 {
-            return self.work;
-        }
-        grid::box_average(self.work.view(), self.exponent)
-    }
 }
 
 /// Rotates one plane by `deg` degrees (counter-clockwise as displayed) with `kernel`.
