@@ -15,7 +15,7 @@ use haarshift::relight::dynamic::fields::OcclusionField;
 use haarshift::relight::dynamic::motion::MotionPath;
 use haarshift::relight::light::environment::Environment;
 use haarshift::relight::material::merl::MerlBrdf;
-use haarshift::relight::scene::validate::check_ground_extent;
+use haarshift::relight::scene::validate::{MemoryBudget, check_ground_extent};
 use haarshift::relight::{Mesh, Scene, SceneCache, add_ground_plane};
 
 /// The fuzz targets: one per reader and validated structure.
@@ -36,6 +36,14 @@ pub const TARGETS: [&str; 15] = [
     "merl",
     "envmap",
 ];
+
+/// The budget of a fuzzed scene: 64 MiB, about 131,000 vertices, so that a valid generator of
+/// millions of vertices is refused by the budget (the behaviour under test) rather than
+/// built for seconds and reported as a timeout.
+const SCENE_BUDGET: MemoryBudget = MemoryBudget {
+    limit: 64 << 20,
+    per_vertex: 0,
+};
 
 /// A fresh directory for one input.
 fn scratch() -> PathBuf {
@@ -91,7 +99,7 @@ pub fn run(target: &str, bytes: &[u8]) {
             }
         }
         "scene" => {
-            if let Ok(scene) = Scene::load(&put(&dir, "in.json", bytes)) {
+            if let Ok(scene) = Scene::load_within(&put(&dir, "in.json", bytes), &SCENE_BUDGET) {
                 exercise(&scene.mesh);
             }
         }

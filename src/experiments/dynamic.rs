@@ -19,8 +19,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use ndarray::Array2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use crate::experiments::journal::Journal;
 use crate::faces::param::{ParamKind, Parameterization};
 use crate::metrics::RelativeError;
 use crate::product::Selection;
@@ -149,7 +150,7 @@ impl Scenario {
 
 /// One measured setting. The `static` axis is the floor under the others: the moved scene
 /// precomputed as a static scene (its "re-form" is that precomputation).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DynamicRecord {
     /// Scenario name.
     pub scene: String,
@@ -194,21 +195,33 @@ pub struct DynamicRecord {
 }
 
 /// Runs `protocol` on `scenario` under `env` (rotated by `angles`, degrees); `progress` is
-/// called with each record as it is made.
+/// called with each record as it is made. Each setup (a resolution or a density, with the
+/// budget, depth, change and static rows measured on its build) is one unit of `journal`
+/// ([`Journal::in_memory`] for none), keyed by the scenario's name: a resumed journal's
+/// setups are taken from it, and a run whose setups are all journaled builds nothing.
+///
+/// ```no_run
+/// use haarshift::experiments::dynamic::{DynamicProtocol, Scenario, run};
+/// use haarshift::experiments::journal::Journal;
+/// use haarshift::relight::Transform;
+/// use haarshift::relight::light::environment::Environment;
+/// let to = Transform { translate: [1.5, 1.2, 4.5], ..Transform::default() };
+/// let scenario = Scenario::load("testdata/scenes/bunny_and_ball.json".as_ref(), "ball", to).unwrap();
+/// let env = Environment::load("testdata/envmaps/rooitou_park_32x16.hdr".as_ref()).unwrap();
+/// let mut journal = Journal::create("dynamic.journal".as_ref(), "quick", false).unwrap();
+/// let records = run(&scenario, &env, [0.0; 3], &DynamicProtocol::quick(), &mut journal, |_| {}).unwrap();
+/// journal.finish().unwrap();
+/// assert!(records.iter().any(|r| r.axis == "static"));
+/// ```
 pub fn run(
     scenario: &Scenario,
     env: &Environment,
     angles: [f64; 3],
     protocol: &DynamicProtocol,
+    journal: &mut Journal,
     mut progress: impl FnMut(&DynamicRecord),
 ) -> Result<Vec<DynamicRecord>> {
     let rotation = SphereRotation::from_degrees(angles[0], angles[1], angles[2])?;
-    let mut out = Vec::new();
-    let mut truth: Option<Array2<f64>> = None;
-    let mut push = |r: DynamicRecord, out: &mut Vec<DynamicRecord>| {
-        progress(&r);
-        out.push(r);
-    };
     let mut setups: Vec<(&str, usize, f64)> = protocol
         .resolutions
         .iter()
@@ -221,16 +234,74 @@ pub fn run(
             .filter(|&&d| d != 1.0)
             .map(|&d| ("density", protocol.base_resolution, d)),
     );
-    for (axis, n, density) in setups {
-        let built = Built::new(scenario, n, density)?;
-        let truth = match &truth {
-            Some(t) => t,
-            None => truth.insert(built.truth(env, &rotation, protocol.reference_resolution)?),
-        };
-        let r = built.measure(scenario, env, &rotation, truth, axis, Budget::ALL)?;
-        push(r, &mut out);
+    let Some(&(_, first_n, first_density)) = setups.first() else {
+        return Err(Error::parameter(
+            "protocol",
+            "no resolution and no density: nothing to measure",
+        ));
+    };
+    // The ground truth ray-casts the moved scene (no field) as the first setup places it (a
+    // turn is whole columns of its resolution); journaled before any setup, so that a resumed
+    // run compares against the same one without building that setup again.
+    let mut first: Option<Built> = None;
+    let rows: Vec<[f64; 3]> = journal.unit(&format!("{} truth", scenario.name), || {
+        let built = Built::new(scenario, first_n, first_density)?;
+        let truth = built.truth(env, &rotation, protocol.reference_resolution)?;
+        first = Some(built);
+        Ok(truth
+            .rows()
+            .into_iter()
+            .map(|r| [r[0], r[1], r[2]])
+            .collect())
+    })?;
+    let truth =
+        Array2::from_shape_vec((rows.len(), 3), rows.into_flattened()).expect("three values a row");
+    let run = Run {
+        scenario,
+        env,
+        rotation,
+        protocol,
+        truth: &truth,
+    };
+    let mut out = Vec::new();
+    for (k, &(axis, n, density)) in setups.iter().enumerate() {
+        let key = format!("{} {axis} {n} {density}", scenario.name);
+        let records = journal.unit(&key, || {
+            let built = match first.take() {
+                Some(built) if k == 0 => built,
+                _ => Built::new(scenario, n, density)?,
+            };
+            run.setup(&built, axis, n)
+        })?;
+        records.iter().for_each(&mut progress);
+        out.extend(records);
+    }
+    Ok(out)
+}
+
+/// What every setup of one [`run`] shares.
+struct Run<'a> {
+    scenario: &'a Scenario,
+    env: &'a Environment,
+    rotation: SphereRotation,
+    protocol: &'a DynamicProtocol,
+    truth: &'a Array2<f64>,
+}
+
+impl Run<'_> {
+    /// The records of one setup, built at resolution `n`: its own row and, at the base
+    /// resolution, the budget, depth, change and static rows on the same build.
+    fn setup(&self, built: &Built, axis: &str, n: usize) -> Result<Vec<DynamicRecord>> {
+        let (scenario, env, rotation, protocol, truth) = (
+            self.scenario,
+            self.env,
+            &self.rotation,
+            self.protocol,
+            self.truth,
+        );
+        let mut out = vec![built.measure(scenario, env, rotation, truth, axis, Budget::ALL)?];
         if axis != "resolution" || n != protocol.base_resolution {
-            continue;
+            return Ok(out);
         }
         for budget in &protocol.budgets {
             for truncation in [
@@ -241,8 +312,7 @@ pub fn run(
                     continue;
                 }
                 let b = built.with_budget(budget, truncation)?;
-                let r = b.measure(scenario, env, &rotation, truth, "budget", *budget)?;
-                push(r, &mut out);
+                out.push(b.measure(scenario, env, rotation, truth, "budget", *budget)?);
             }
         }
         let base = built.with_budget(&protocol.base_budget, Truncation::Before)?;
@@ -251,25 +321,21 @@ pub fn run(
             let mut b = base.clone();
             b.scene
                 .set_shading(Truncation::Before, Selection::All, Some(depth))?;
-            let r = b.measure(
+            out.push(b.measure(
                 scenario,
                 env,
-                &rotation,
+                rotation,
                 truth,
                 "depth",
                 protocol.base_budget,
-            )?;
-            push(r, &mut out);
+            )?);
         }
-        let r = base.measure_lighting(env, &rotation, truth, protocol.base_budget, scenario)?;
-        push(r, &mut out);
-        let r = built.measure_static(env, &rotation, truth, scenario)?;
-        push(r, &mut out);
+        out.push(base.measure_lighting(env, rotation, truth, protocol.base_budget, scenario)?);
+        out.push(built.measure_static(env, rotation, truth, scenario)?);
+        Ok(out)
     }
-    Ok(out)
 }
 
-/// One build of a scenario's scene, with what it cost.
 #[derive(Clone)]
 struct Built {
     scene: DynamicScene,
@@ -483,8 +549,8 @@ mod tests {
     use super::*;
     use crate::sphere::LatLongMap;
 
-    #[test]
-    fn a_record_is_the_error_of_the_moved_frame_against_the_ray_cast_truth() {
+    /// A box over a plane and a small ball that moves, under a sky brighter overhead.
+    fn scenario() -> (Scenario, Environment) {
         let file: SceneFile = serde_json::from_str(
             r#"{"objects": [
                 {"name": "a", "generator": {"plane_under_box": {"height": 0.5}}},
@@ -507,6 +573,12 @@ mod tests {
             LatLongMap::<f64>::from_fn(16, 3, |d, o| o.fill(0.2 + 2.0 * d[1].max(0.0).powi(4)))
                 .unwrap(),
         );
+        (scenario, env)
+    }
+
+    #[test]
+    fn a_record_is_the_error_of_the_moved_frame_against_the_ray_cast_truth() {
+        let (scenario, env) = scenario();
         let protocol = DynamicProtocol {
             resolutions: vec![8],
             densities: vec![1.0],
@@ -515,7 +587,8 @@ mod tests {
             base_budget: Budget::ALL,
             reference_resolution: 8,
         };
-        let records = run(&scenario, &env, [0.0; 3], &protocol, |_| {}).unwrap();
+        let mut journal = Journal::in_memory();
+        let records = run(&scenario, &env, [0.0; 3], &protocol, &mut journal, |_| {}).unwrap();
         // resolution, budget (all: before only), depths 1 to 3, the lighting change, static.
         assert_eq!(records.len(), 1 + 1 + 3 + 1 + 1);
         // Independently: the scene moved, shaded by the n-function product integral, against
@@ -562,5 +635,52 @@ mod tests {
             .find(|r| r.axis == "depth" && r.depth == 1)
             .unwrap();
         assert!(coarse.rms > full_depth.rms);
+    }
+
+    #[test]
+    fn a_truncated_journal_resumes_to_the_records_of_an_uninterrupted_run() {
+        let (scenario, env) = scenario();
+        let protocol = DynamicProtocol {
+            resolutions: vec![4, 8],
+            densities: vec![0.5, 1.0],
+            base_resolution: 8,
+            budgets: vec![Budget::ALL, Budget::of(10, 5, 5)],
+            base_budget: Budget::of(10, 5, 5),
+            reference_resolution: 8,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("dynamic.journal");
+        let mut journal = Journal::create(&path, "protocol", false).unwrap();
+        let whole = run(&scenario, &env, [0.0; 3], &protocol, &mut journal, |_| {}).unwrap();
+        drop(journal);
+        // Killed while the second setup was being written: the header, the truth and the
+        // first setup are whole, the next line is cut short.
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 1 + 1 + 3);
+        let cut = format!(
+            "{}\n{}",
+            lines[..3].join("\n"),
+            &lines[3][..lines[3].len() / 2]
+        );
+        std::fs::write(&path, cut).unwrap();
+        let mut journal = Journal::resume(&path, "protocol").unwrap();
+        let mut seen = 0;
+        let resumed = run(&scenario, &env, [0.0; 3], &protocol, &mut journal, |_| {
+            seen += 1
+        });
+        assert_eq!((journal.resumed(), seen), (2, whole.len()));
+        let machine_free = |records: Vec<DynamicRecord>| -> Vec<DynamicRecord> {
+            records
+                .into_iter()
+                .map(|r| DynamicRecord {
+                    field_seconds: 0.0,
+                    reform_seconds: 0.0,
+                    frame_seconds: 0.0,
+                    ..r
+                })
+                .collect()
+        };
+        assert_eq!(machine_free(resumed.unwrap()), machine_free(whole));
     }
 }

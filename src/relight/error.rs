@@ -50,6 +50,23 @@ pub enum SceneError {
         /// The coordinate.
         value: f64,
     },
+    /// A scene's counts need more memory than its [`MemoryBudget`](crate::relight::scene::validate::MemoryBudget)
+    /// allows; found from the counts, before anything is built.
+    #[error(
+        "{what}: {vertices} vertices need about {:.2} GiB, more than the memory limit of {:.2} GiB",
+        *needed as f64 / GIB,
+        *limit as f64 / GIB
+    )]
+    MemoryLimit {
+        /// What has the vertices (a scene's generators, a scene).
+        what: String,
+        /// Its vertices.
+        vertices: u128,
+        /// The bytes they need, estimated.
+        needed: u128,
+        /// The limit, bytes.
+        limit: u64,
+    },
     /// A ground plane was asked for under a mesh too narrow for one.
     #[error(
         "a ground plane needs a mesh with a width or depth (here {extent:e}) of at least 1e-6 of its largest coordinate ({largest:e})"
@@ -100,3 +117,6 @@ pub enum SceneError {
     #[error("occlusion field file was built {0}; build it again")]
     FieldMismatch(String),
 }
+
+/// Bytes in a GiB, for messages.
+const GIB: f64 = (1u64 << 30) as f64;

@@ -9,6 +9,7 @@ use crate::relight::dynamic::fields::file::{FieldOrigin, FieldStore};
 use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::visibility::{VisibilityOptions, ray_offset, vertex_major};
 use crate::relight::scene::shapes::merge;
+use crate::relight::scene::validate::MemoryBudget;
 use crate::relight::scene::{SceneFile, ground_plane_under};
 use crate::relight::shade::glossy::GlossyOptions;
 use crate::relight::{Mesh, SceneBvh, SceneError};
@@ -84,6 +85,7 @@ impl DynamicScene {
         mut store: Option<&mut FieldStore>,
     ) -> Result<Self> {
         options.check()?;
+        file.check_memory(&MemoryBudget::default())?;
         if file.objects.is_empty() {
             return Err(SceneError::SceneFile("a scene needs at least one object".into()).into());
         }

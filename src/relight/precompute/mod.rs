@@ -6,7 +6,9 @@
 //! **Limits.** A precomputation holds one `(faces, S, S)` array of f32 per thread and, in the
 //! direction order, one bit per (vertex, direction); a transport of more than [`MAX_TEXELS`]
 //! texels (lat-long `2048 x 4096`, cube `6 x 1024^2` are inside) is refused before any work,
-//! so an absurd `--resolution` is a clear error rather than an exhausted machine.
+//! so an absurd `--resolution` is a clear error rather than an exhausted machine. A scene
+//! whose vertices would not fit in [`PrecomputeOptions::budget`] is refused from its count,
+//! before the BVH or any transport is built.
 
 pub mod raycast;
 pub mod shadowmap;
@@ -15,9 +17,11 @@ pub mod transport;
 pub mod visibility;
 
 use crate::named::named_enum;
+use crate::product::Selection;
 use crate::relight::precompute::visibility::{
     PrecomputeReport, VisibilityOptions, direction_major, vertex_major,
 };
+use crate::relight::scene::validate::{DEFAULT_MEMORY_LIMIT, MemoryBudget};
 use crate::relight::{CacheParams, Scene, SceneBvh, SceneCache};
 use crate::{Error, Result};
 
@@ -47,7 +51,7 @@ pub const DEFAULT_MAP_SIZE: usize = 2048;
 /// use haarshift::relight::VisibilityOptions;
 /// use haarshift::faces::{ParamKind, Parameterization};
 /// let o = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 8).unwrap()));
-/// assert_eq!((o.order, o.map_size), (Order::Vertex, 2048));
+/// assert_eq!((o.order, o.map_size, o.memory_limit), (Order::Vertex, 2048, 4 << 30));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrecomputeOptions {
@@ -57,6 +61,8 @@ pub struct PrecomputeOptions {
     pub order: Order,
     /// Shadow-buffer side for [`Order::Direction`].
     pub map_size: usize,
+    /// The most bytes the scene and its transport may take ([`budget`](Self::budget)).
+    pub memory_limit: u64,
 }
 
 impl PrecomputeOptions {
@@ -67,6 +73,51 @@ impl PrecomputeOptions {
             visibility,
             order: Order::Vertex,
             map_size: DEFAULT_MAP_SIZE,
+            memory_limit: DEFAULT_MEMORY_LIMIT,
+        }
+    }
+
+    /// The [`MemoryBudget`] of this precomputation: per vertex, beyond the mesh, the most
+    /// coefficients its selection can keep (every texel's unless it keeps a count), 8 bytes
+    /// each (`u32` index, `f32` value) held twice (the vertices' rows, then the gathered set
+    /// and the file's bytes), its row's 80 bytes of bookkeeping, the spherical-harmonic
+    /// transfer, and in the direction order one bit per texel. The direction order's shadow
+    /// buffers (one per thread, `4 M^2` bytes) are not per vertex and not counted.
+    ///
+    /// ```
+    /// use haarshift::relight::precompute::PrecomputeOptions;
+    /// use haarshift::relight::VisibilityOptions;
+    /// use haarshift::faces::{ParamKind, Parameterization};
+    /// use haarshift::product::Selection;
+    /// let mut o = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap()));
+    /// assert_eq!(o.budget().per_vertex, 2 * 8 * 128 + 80); // every one of 8 x 16 texels
+    /// o.visibility.keep = Selection::Largest(30);
+    /// assert_eq!(o.budget().per_vertex, 2 * 8 * 32 + 80); // 30 details and 2 face scalings
+    /// ```
+    pub fn budget(&self) -> MemoryBudget {
+        let param = self.visibility.param;
+        let (texels, faces) = (param.texels() as u64, param.faces() as u64);
+        let kept = match self.visibility.keep {
+            Selection::All | Selection::Threshold(_) => texels,
+            Selection::Largest(k) => (k as u64).saturating_add(faces).min(texels),
+            Selection::LargestPerFace(k) => (k as u64)
+                .saturating_add(1)
+                .saturating_mul(faces)
+                .min(texels),
+        };
+        let sh = (self.visibility.sh_bands)
+            .map_or(0, |b| (b as u64).saturating_pow(2).saturating_mul(4));
+        let bits = match self.order {
+            Order::Vertex => 0,
+            Order::Direction => texels.div_ceil(8),
+        };
+        MemoryBudget {
+            limit: self.memory_limit,
+            per_vertex: kept
+                .saturating_mul(2 * 8)
+                .saturating_add(80)
+                .saturating_add(sh.saturating_mul(2))
+                .saturating_add(bits),
         }
     }
 
@@ -120,6 +171,9 @@ pub fn precompute(
             ),
         ));
     }
+    options
+        .budget()
+        .check("the scene", scene.mesh.vertex_count() as u128)?;
     let (transport, report) = match options.order {
         Order::Vertex => vertex_major(
             &scene.mesh,

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
-use crate::relight::scene::{Scene, validate};
+use crate::relight::scene::Scene;
+use crate::relight::scene::validate::{self, MemoryBudget};
 use crate::relight::{Brdf, Generator, Mesh, SceneError};
 use crate::sphere::SphereRotation;
 use crate::{Error, Result};
@@ -278,8 +279,46 @@ impl SceneFile {
         Ok((read_json(path)?, path.parent().unwrap_or(Path::new(""))))
     }
 
-    /// The scene, relative paths resolved against `dir`.
+    /// Refuses a file whose generated objects would not fit in `budget`, from their
+    /// settings alone ([`Generator::vertex_count`]), before any of them is built; the error
+    /// names the object at which the running sum of their vertices passes the limit.
+    ///
+    /// ```
+    /// use haarshift::relight::SceneFile;
+    /// use haarshift::relight::scene::validate::MemoryBudget;
+    /// let file: SceneFile = serde_json::from_str(r#"{"objects": [{"mesh": "bunny.ply"},
+    ///     {"generator": {"sphere": {"cells": 3000}}}]}"#).unwrap();
+    /// let err = file.check_memory(&MemoryBudget::default()).unwrap_err().to_string();
+    /// assert!(err.starts_with(r#"object 1 ({"sphere":{"cells":3000}}) and the generators before it: 54036006 vertices"#));
+    /// ```
+    pub fn check_memory(&self, budget: &MemoryBudget) -> Result<()> {
+        let mut vertices: u128 = 0;
+        for (k, object) in self.objects.iter().enumerate() {
+            let Some(generator) = &object.generator else {
+                continue;
+            };
+            // A count past usize is at least 2^64 vertices: refused as that. The sum of at
+            // most 2^64 objects of at most 2^64 vertices each stays inside u128.
+            vertices += generator.vertex_count().map_or(1 << 64, |v| v as u128);
+            let settings = serde_json::to_string(generator).expect("a generator serialises");
+            budget.check(
+                &format!("object {k} ({settings}) and the generators before it"),
+                vertices,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The scene, relative paths resolved against `dir`, within the default
+    /// [`MemoryBudget`].
     pub fn build(&self, dir: &Path) -> Result<Scene> {
+        self.build_within(dir, &MemoryBudget::default())
+    }
+
+    /// [`build`](Self::build), refused first when its generators do not fit in `budget`
+    /// ([`check_memory`](Self::check_memory)).
+    pub fn build_within(&self, dir: &Path, budget: &MemoryBudget) -> Result<Scene> {
+        self.check_memory(budget)?;
         if self.objects.is_empty() {
             return Err(SceneError::SceneFile("a scene needs at least one object".into()).into());
         }

@@ -103,10 +103,58 @@ fn default_cube_distance() -> f64 {
     1.5
 }
 
+/// The cylinder of [`Generator::CylinderAndBump`]: segments and rings.
+const CYLINDER: (usize, usize) = (48, 24);
+/// Its vertices ([`cylinder`]: the side's `(segments + 1) (rings + 1)` and two capped fans).
+const CYLINDER_VERTICES: usize = 1298;
+/// [`Generator::PlaneWithSphere`]: the ground's cells a side, the sphere's a face.
+const PLANE_WITH_SPHERE_CELLS: (usize, usize) = (64, 16);
+/// [`Generator::PlaneUnderBox`]: the ground's cells a side, the box's a face.
+const PLANE_UNDER_BOX_CELLS: (usize, usize) = (2, 4);
+/// [`Generator::Cubes`]'s wall: cells across and up.
+const WALL_CELLS: (usize, usize) = (129, 101);
+
 /// The largest number of vertices a generator may make.
 const MAX_GENERATED_VERTICES: usize = 50_000_000;
 
 impl Generator {
+    /// The vertices [`mesh`](Self::mesh) makes, from the settings alone (nothing is built),
+    /// or `None` when the count does not fit in a `usize`; so a scene's size is known, and
+    /// checked against its [`MemoryBudget`](super::validate::MemoryBudget), before it exists.
+    ///
+    /// ```
+    /// use haarshift::relight::Generator;
+    /// let sphere = Generator::Sphere { cells: 3 };
+    /// assert_eq!(sphere.vertex_count(), Some(sphere.mesh().unwrap().vertex_count()));
+    /// assert_eq!(Generator::Sphere { cells: usize::MAX }.vertex_count(), None);
+    /// ```
+    pub fn vertex_count(&self) -> Option<usize> {
+        let boxes = |cells: usize, n: usize| grid_vertices(cells)?.checked_mul(6 * n);
+        match *self {
+            Generator::CylinderAndBump { cells } => {
+                grid_vertices(cells)?.checked_add(CYLINDER_VERTICES)
+            }
+            Generator::Cubes { count, cells, .. } => {
+                let wall = (WALL_CELLS.0 + 1) * (WALL_CELLS.1 + 1);
+                boxes(cells, 1)?
+                    .checked_mul(count.checked_mul(count)?)?
+                    .checked_add(wall)
+            }
+            Generator::PlaneWithSphere {} => {
+                let (ground, sphere) = PLANE_WITH_SPHERE_CELLS;
+                grid_vertices(ground)?.checked_add(boxes(sphere, 1)?)
+            }
+            Generator::Sphere { cells } => boxes(cells, 1),
+            Generator::Table { cells } | Generator::Chair { cells } => {
+                boxes(cells, self.boxes().len())
+            }
+            Generator::PlaneUnderBox { .. } => {
+                let (ground, cuboid) = PLANE_UNDER_BOX_CELLS;
+                grid_vertices(ground)?.checked_add(boxes(cuboid, 1)?)
+            }
+        }
+    }
+
     /// The mesh.
     pub fn mesh(&self) -> Result<Mesh> {
         let positive = |name: &'static str, x: f64| {
@@ -119,21 +167,28 @@ impl Generator {
                 ))
             }
         };
-        let cells_ok = |what: &str, n: usize, vertices: usize| {
-            if n == 0 || vertices > MAX_GENERATED_VERTICES {
+        let at_least_one = |what: &str, n: usize| {
+            if n == 0 {
                 Err(Error::parameter(
                     "generator",
-                    format!(
-                        "{n} {what}: must be at least 1 and make at most {MAX_GENERATED_VERTICES} vertices"
-                    ),
+                    format!("0 {what}: must be at least 1"),
                 ))
             } else {
                 Ok(())
             }
         };
+        match self.vertex_count() {
+            Some(v) if v <= MAX_GENERATED_VERTICES => {}
+            _ => {
+                return Err(Error::parameter(
+                    "generator",
+                    format!("{self:?} makes more than {MAX_GENERATED_VERTICES} vertices"),
+                ));
+            }
+        }
         Ok(match *self {
             Generator::CylinderAndBump { cells } => {
-                cells_ok("cells", cells, grid_vertices(cells).unwrap_or(usize::MAX))?;
+                at_least_one("cells", cells)?;
                 let mut g = ground(-4.0, 4.0, 0.0, 8.0, cells)?;
                 g = g.mapped(
                     |[x, y, z]| {
@@ -144,7 +199,10 @@ impl Generator {
                 )?;
                 let triangles = g.triangles().to_vec();
                 let g = Mesh::new(g.positions().to_owned(), triangles, None)?;
-                merge([g, cylinder([-1.5, 0.0, -1.0], 0.5, 3.0, 48, 24)])
+                merge([
+                    g,
+                    cylinder([-1.5, 0.0, -1.0], 0.5, 3.0, CYLINDER.0, CYLINDER.1),
+                ])
             }
             Generator::Cubes {
                 count,
@@ -152,17 +210,14 @@ impl Generator {
                 distance,
             } => {
                 positive("distance", distance)?;
-                let vertices = 6usize
-                    .saturating_mul(count.saturating_mul(count))
-                    .saturating_mul(grid_vertices(cells).unwrap_or(usize::MAX));
-                cells_ok("cubes per row", count, vertices)?;
-                cells_ok("cells", cells, vertices)?;
+                at_least_one("cubes per row", count)?;
+                at_least_one("cells", cells)?;
                 let wall = grid(
                     [-6.45, 0.0, 0.0],
                     [12.9, 0.0, 0.0],
                     [0.0, 10.1, 0.0],
-                    129,
-                    101,
+                    WALL_CELLS.0,
+                    WALL_CELLS.1,
                 )?;
                 let (h, c) = (0.3, count as f64);
                 let cubes = (0..count * count).map(|k| {
@@ -181,29 +236,30 @@ impl Generator {
                 )
             }
             Generator::PlaneWithSphere {} => merge([
-                ground(-3.0, 3.0, 0.0, 6.0, 64)?,
-                cube_sphere([0.0, 1.0, 0.0], 1.0, 16)?,
+                ground(-3.0, 3.0, 0.0, 6.0, PLANE_WITH_SPHERE_CELLS.0)?,
+                cube_sphere([0.0, 1.0, 0.0], 1.0, PLANE_WITH_SPHERE_CELLS.1)?,
             ]),
             Generator::Sphere { cells } => {
-                cells_ok(
-                    "cells",
-                    cells,
-                    6usize.saturating_mul(grid_vertices(cells).unwrap_or(usize::MAX)),
-                )?;
+                at_least_one("cells", cells)?;
                 cube_sphere([0.0; 3], 1.0, cells)?
             }
             Generator::Table { cells } | Generator::Chair { cells } => {
-                let boxes = self.boxes();
-                let per_box = 6usize.saturating_mul(grid_vertices(cells).unwrap_or(usize::MAX));
-                cells_ok("cells", cells, per_box.saturating_mul(boxes.len()))?;
-                let boxes = boxes.into_iter().map(|(lo, hi)| cuboid(lo, hi, cells));
+                at_least_one("cells", cells)?;
+                let boxes = self
+                    .boxes()
+                    .into_iter()
+                    .map(|(lo, hi)| cuboid(lo, hi, cells));
                 merge(boxes.collect::<Result<Vec<_>>>()?)
             }
             Generator::PlaneUnderBox { height } => {
                 positive("height", height)?;
                 merge([
-                    ground(-3.0, 3.0, 0.0, 6.0, 2)?,
-                    cuboid([-1.0, height, -1.0], [1.0, height + 0.5, 1.0], 4)?,
+                    ground(-3.0, 3.0, 0.0, 6.0, PLANE_UNDER_BOX_CELLS.0)?,
+                    cuboid(
+                        [-1.0, height, -1.0],
+                        [1.0, height + 0.5, 1.0],
+                        PLANE_UNDER_BOX_CELLS.1,
+                    )?,
                 ])
             }
         })

@@ -74,6 +74,7 @@ use ndarray::Array2;
 use crate::Result;
 use crate::relight::Mesh;
 use crate::relight::scene::file::DEFAULT_ALBEDO;
+use crate::relight::scene::validate::MemoryBudget;
 
 /// A scene ready to precompute: one merged mesh, an albedo per vertex, and the scene file's
 /// lighting and camera with their paths resolved.
@@ -166,16 +167,43 @@ impl Scene {
     }
 
     /// Reads a scene: a JSON scene file (`.json`), or a mesh file (OBJ or PLY) as a scene of
-    /// one object with the default material.
+    /// one object with the default material; within the default [`MemoryBudget`].
     pub fn load(path: &Path) -> Result<Scene> {
+        Self::load_within(path, &MemoryBudget::default())
+    }
+
+    /// [`load`](Self::load) within `budget`: a scene file is refused before anything is built
+    /// when its generators do not fit ([`SceneFile::check_memory`]), and any scene once read
+    /// when its vertices do not.
+    ///
+    /// ```
+    /// use haarshift::relight::Scene;
+    /// use haarshift::relight::scene::validate::MemoryBudget;
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let path = dir.path().join("s.json");
+    /// std::fs::write(&path, r#"{"objects": [{"generator": {"sphere": {"cells": 20}}}]}"#).unwrap();
+    /// let small = MemoryBudget { limit: 1 << 20, per_vertex: 0 };
+    /// let err = Scene::load_within(&path, &small).unwrap_err().to_string();
+    /// assert!(err.starts_with(&format!("{}: object 0", path.display())));
+    /// assert!(err.contains("2646 vertices need about"));
+    /// assert!(Scene::load(&path).is_ok());
+    /// ```
+    pub fn load_within(path: &Path, budget: &MemoryBudget) -> Result<Scene> {
         let is_json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-        if !is_json {
-            return Scene::from_mesh(Mesh::load(path)?, false);
-        }
-        let (file, dir) = SceneFile::read(path)?;
-        file.build(dir).map_err(|e| e.in_file(path))
+        let scene = if is_json {
+            let (file, dir) = SceneFile::read(path)?;
+            file.build_within(dir, budget)
+        } else {
+            Scene::from_mesh(Mesh::load(path)?, false)
+        };
+        let scene = scene.map_err(|e| e.in_file(path))?;
+        // A mesh file's size bounds its reader, not what the caller will store per vertex.
+        budget
+            .check("the scene", scene.mesh.vertex_count() as u128)
+            .map_err(|e| e.in_file(path))?;
+        Ok(scene)
     }
 }
 

@@ -12,6 +12,11 @@
 //!   in f32 ([`check_ground_extent`]), so that its normal exists.
 //! * **Counts** that size allocations (generator cells, path frames) are summed and multiplied
 //!   with checked arithmetic ([`grid_vertices`]), so that no count wraps around a limit.
+//! * **Memory**: a scene file's generators make meshes of any size from a few bytes, so
+//!   their vertex count is known before anything is built, and a [`MemoryBudget`] (by
+//!   default the image readers' [`DEFAULT_MEMORY_LIMIT`], 4 GiB) refuses it when the mesh,
+//!   its BVH and what the caller will store per vertex (a precomputation's transport) would
+//!   not fit. Mesh files are not estimated: their reader's memory is bounded by the file.
 //!
 //! Failures are [`SceneError`]s naming the field; the caller adds the file.
 
@@ -20,6 +25,8 @@ use ndarray::{ArrayView1, ArrayView2};
 use super::mesh::Bounds;
 use crate::Result;
 use crate::relight::SceneError;
+
+pub use crate::io::DEFAULT_MEMORY_LIMIT;
 
 /// The largest distance from the origin of any coordinate in a scene; see the
 /// [module docs](self).
@@ -112,6 +119,67 @@ pub fn grid_vertices(cells: usize) -> Option<usize> {
     side.checked_mul(side)
 }
 
+/// The bytes one vertex of a scene holds while it is loaded, its BVH built and its cache
+/// written, about two triangles a vertex: the mesh (positions and normals in f64, albedo in
+/// f32, indices: 84 bytes), the BVH's f32 triangles and its build, and the file's copy of
+/// the mesh. Measured: a sphere of 543,606 vertices peaks at 646 bytes a vertex through
+/// `relight precompute --resolution 2`, about 136 of them its 8-texel transport, so 640
+/// leaves a quarter to spare.
+pub const MESH_BYTES_PER_VERTEX: u64 = 640;
+
+/// How much memory a scene and the work on it may take, checked from its vertex count
+/// before anything is built: [`MESH_BYTES_PER_VERTEX`] plus `per_vertex` (what the caller
+/// stores for each vertex, e.g. a precomputation's transport) times the vertices, against
+/// `limit`.
+///
+/// ```
+/// use haarshift::relight::scene::validate::{DEFAULT_MEMORY_LIMIT, MemoryBudget};
+/// let budget = MemoryBudget::default();
+/// assert_eq!((budget.limit, budget.per_vertex), (DEFAULT_MEMORY_LIMIT, 0));
+/// assert!(budget.check("the scene", 1_000_000).is_ok());
+/// let err = budget.check("the scene", 100_000_000).unwrap_err();
+/// assert!(err.to_string().contains("more than the memory limit of 4.00 GiB"));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryBudget {
+    /// The most bytes the scene and its work may hold at once.
+    pub limit: u64,
+    /// Bytes each vertex needs beyond [`MESH_BYTES_PER_VERTEX`].
+    pub per_vertex: u64,
+}
+
+impl Default for MemoryBudget {
+    fn default() -> Self {
+        MemoryBudget {
+            limit: DEFAULT_MEMORY_LIMIT,
+            per_vertex: 0,
+        }
+    }
+}
+
+impl MemoryBudget {
+    /// The bytes `vertices` vertices need under this budget (in `u128`: no count wraps).
+    pub fn needed(&self, vertices: u128) -> u128 {
+        vertices.saturating_mul(u128::from(MESH_BYTES_PER_VERTEX) + u128::from(self.per_vertex))
+    }
+
+    /// Refuses `vertices` vertices whose [`needed`](Self::needed) bytes exceed the limit;
+    /// `what` names them in the error.
+    pub fn check(&self, what: &str, vertices: u128) -> Result<()> {
+        let needed = self.needed(vertices);
+        if needed <= u128::from(self.limit) {
+            return Ok(());
+        }
+        Err(SceneError::MemoryLimit {
+            what: what.to_owned(),
+            vertices,
+            needed,
+            limit: self.limit,
+        }
+        .into())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -157,5 +225,28 @@ mod tests {
         assert_eq!(grid_vertices(largest), Some((largest + 1) * (largest + 1)));
         assert_eq!(grid_vertices(largest + 1), None);
         assert_eq!(grid_vertices(usize::MAX), None);
+    }
+
+    #[test]
+    fn a_budget_refuses_from_the_count_and_names_it() {
+        let budget = MemoryBudget {
+            limit: 1 << 20,
+            per_vertex: 1024 - MESH_BYTES_PER_VERTEX,
+        };
+        // 1024 bytes a vertex: exactly 1024 vertices fit in 1 MiB, one more does not.
+        assert_eq!(budget.needed(1024), 1 << 20);
+        budget.check("the scene", 1024).unwrap();
+        assert_err!(
+            budget.check("the scene's generators", 1025),
+            Scene { .. },
+            "the scene's generators: 1025 vertices",
+            "memory limit of 0.00 GiB"
+        );
+        // A count past u64 stays a count, not a wrapped small one.
+        assert_err!(
+            MemoryBudget::default().check("x", u128::from(u64::MAX) * 4),
+            Scene { .. },
+            "memory limit"
+        );
     }
 }

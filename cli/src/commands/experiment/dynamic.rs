@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use haarshift::experiments::dynamic::{DynamicProtocol, DynamicRecord, Scenario, run};
+use haarshift::experiments::journal::Journal;
 use haarshift::experiments::pareto::frontier;
 use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
 use haarshift::experiments::table::{Table, significant};
@@ -11,7 +12,7 @@ use haarshift::relight::Transform;
 use haarshift::relight::light::environment::Environment;
 use haarshift::{Error, Result};
 
-use super::{OutputFlags, wrote};
+use super::{OutputFlags, finish_journal, wrote};
 use crate::commands::print;
 use crate::progress::progress_bar;
 
@@ -38,7 +39,10 @@ resolution alone sets). --quick: resolutions 16 and 32, densities 0.25 to 1, ref
 and density 2, reference 128. Errors are relative to the ground truth's RMS radiance.
 
 Writes DIR/dynamic.csv, .json and .md and, per scene, DIR/dynamic-SCENE-rms-time.png (error
-against frame time, Pareto frontier joined).";
+against frame time, Pareto frontier joined). Each setting's measurements (a resolution or a
+density, with the rows measured on its build) and each scenario's ground truth are appended
+to DIR/dynamic.journal as they are made, so that a run killed midway goes on with --resume;
+the journal is removed once the reports are written.";
 
 /// Occlusion fields and just-in-time transfer against ray casting: table, CSV, JSON, plot.
 #[derive(clap::Args, Debug)]
@@ -59,6 +63,12 @@ pub struct Args {
     /// The quick protocol (the default, stated)
     #[arg(long, conflicts_with = "full")]
     pub quick: bool,
+
+    /// Go on with a run that was stopped: the measurements in DIR/dynamic.journal (written
+    /// as they are made, a setting's build at a time) are kept and the rest measured; refused
+    /// if the protocol, the scenarios or the inputs differ
+    #[arg(long)]
+    pub resume: bool,
 
     #[command(flatten)]
     pub output: OutputFlags,
@@ -104,6 +114,11 @@ pub fn run_command(args: Args) -> Result<()> {
     } else {
         DynamicProtocol::quick()
     };
+    let options = format!(
+        "{protocol:?}; {specs:?}; {}",
+        Journal::fingerprint(&inputs)?
+    );
+    let mut journal = reports.journal(&options, args.resume)?;
     let mut records: Vec<DynamicRecord> = Vec::new();
     let bar = progress_bar(parsed.len());
     for (file, name, to) in &parsed {
@@ -145,7 +160,7 @@ pub fn run_command(args: Args) -> Result<()> {
         };
         let env = Environment::load(&env_path)?;
         bar.set_message(scenario.name.clone());
-        let got = run(&scenario, &env, angles, &protocol, |r| {
+        let got = run(&scenario, &env, angles, &protocol, &mut journal, |r| {
             bar.set_message(format!("{}: {}", r.scene, label(r)));
         })?;
         records.extend(got);
@@ -210,6 +225,7 @@ pub fn run_command(args: Args) -> Result<()> {
             .writer()
             .png(&format!("{scene}-rms-time"), &plot)?]));
     }
+    finish_journal(journal)?;
     print(&format!("{text}\n{written}"))
 }
 

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use clap::Subcommand;
+use haarshift::experiments::journal::Journal;
 use haarshift::experiments::kernel_cycle::KernelCycle;
 use haarshift::experiments::output::{ReportDir, ReportWriter, write_json};
 use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
@@ -109,6 +110,17 @@ impl OutputFlags {
     }
 }
 
+/// Ends a run whose reports are written: removes its journal, saying how much of the run it
+/// gave back.
+pub fn finish_journal(journal: Journal) -> Result<()> {
+    let resumed = journal.resumed();
+    journal.finish()?;
+    if resumed > 0 {
+        eprintln!("resumed: {resumed} units of work taken from the journal");
+    }
+    Ok(())
+}
+
 /// Where a claimed experiment writes: its directory, the stem of its files, `--json`.
 pub struct Reports {
     /// The claimed directory.
@@ -120,6 +132,24 @@ pub struct Reports {
 }
 
 impl Reports {
+    /// The run's journal, `DIR/<stem>.journal`: the stopped run's with `resume`; else a new
+    /// one, replacing a stopped run's only under `--force`.
+    pub fn journal(&self, options: &str, resume: bool) -> Result<Journal> {
+        let path = self.dir.path().join(format!("{}.journal", self.stem));
+        if resume {
+            return Journal::resume(&path, options);
+        }
+        Journal::create(&path, options, self.dir.force()).map_err(|e| match e {
+            Error::OutputExists { path } => Error::Format {
+                path,
+                reason: "holds the measurements of a stopped run: --resume goes on with it, \
+                         --force starts again"
+                    .into(),
+            },
+            e => e,
+        })
+    }
+
     /// The writer of the experiment's main files (`<stem>.*`).
     pub fn writer(&self) -> ReportWriter {
         self.dir.writer(self.stem)

@@ -3,13 +3,12 @@
 
 use std::path::PathBuf;
 
+use haarshift::Result;
 use haarshift::experiments::journal::Journal;
-use haarshift::experiments::output::ReportDir;
 use haarshift::experiments::relight::report::{coefficient_plot, report, time_plot};
 use haarshift::experiments::relight::{Light, RelightProtocol, Subject, run};
-use haarshift::{Error, Result};
 
-use super::{OutputFlags, wrote};
+use super::{OutputFlags, finish_journal, wrote};
 use crate::commands::print;
 use crate::progress::progress_bar;
 
@@ -128,7 +127,7 @@ pub fn run_command(args: Args) -> Result<()> {
     let inputs: Vec<PathBuf> = scenes.iter().chain(envs).cloned().collect();
     let reports = args.output.claim("relight", &inputs)?;
     let options = format!("{protocol:?}; {}", Journal::fingerprint(&inputs)?);
-    let mut journal = open_journal(&reports.dir, &options, args.resume)?;
+    let mut journal = reports.journal(&options, args.resume)?;
     let subjects = scenes
         .iter()
         .map(|p| Subject::load(p))
@@ -162,28 +161,6 @@ pub fn run_command(args: Args) -> Result<()> {
     for grid in &results.grids {
         written.push(writer.png(&format!("grid-{}", grid.name), &grid.image)?);
     }
-    let resumed = journal.resumed();
-    journal.finish()?;
-    if resumed > 0 {
-        eprintln!("resumed: {resumed} units of work taken from the journal");
-    }
+    finish_journal(journal)?;
     print(&format!("{text}\n{}", wrote(&written)))
-}
-
-/// The run's journal in `dir`: the stopped run's with `--resume`; else a new one, replacing
-/// a stopped run's only under `--force`.
-fn open_journal(dir: &ReportDir, options: &str, resume: bool) -> Result<Journal> {
-    let path = dir.path().join("relight.journal");
-    if resume {
-        return Journal::resume(&path, options);
-    }
-    Journal::create(&path, options, dir.force()).map_err(|e| match e {
-        Error::OutputExists { path } => Error::Format {
-            path,
-            reason: "holds the measurements of a stopped run: --resume goes on with it, \
-                     --force starts again"
-                .into(),
-        },
-        e => e,
-    })
 }

@@ -7,6 +7,7 @@ use haarshift::product::Selection;
 use haarshift::relight::light::environment::Environment;
 use haarshift::relight::material::brdf::DEFAULT_ELEVATIONS;
 use haarshift::relight::material::orient::BrdfRotation;
+use haarshift::relight::scene::validate::MemoryBudget;
 use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{LightSpec, Method, ShadeOptions, ShaderSpec};
 use haarshift::relight::{Brdf, EnvironmentSpec, Scene};
@@ -28,12 +29,36 @@ pub struct SceneFlags {
     /// horizontal extent), unless the scene file has one
     #[arg(long)]
     pub ground_plane: bool,
+
+    /// The most memory the scene and its work may take (e.g. 8GiB): a scene file whose
+    /// generators, or a precomputation whose transport, would need more is refused before
+    /// it starts
+    #[arg(long, value_name = "SIZE", default_value = "4GiB", value_parser = memory_size)]
+    pub memory_limit: u64,
+}
+
+/// A size in bytes: a number with an optional unit (`4GiB`, `512 MiB`, `2G`).
+fn memory_size(s: &str) -> std::result::Result<u64, String> {
+    match s.parse::<bytesize::ByteSize>() {
+        Ok(size) if size.as_u64() > 0 => Ok(size.as_u64()),
+        Ok(_) => Err(format!("{s:?}: must be more than 0 bytes")),
+        Err(e) => Err(format!("{s:?}: {e}")),
+    }
 }
 
 impl SceneFlags {
-    /// The scene, with the ground plane when asked.
+    /// The scene, with the ground plane when asked, within the default [`MemoryBudget`]
+    /// under `--memory-limit`.
     pub fn load(&self) -> Result<Scene> {
-        let mut scene = Scene::load(&self.input)?;
+        self.load_within(MemoryBudget {
+            limit: self.memory_limit,
+            ..MemoryBudget::default()
+        })
+    }
+
+    /// [`load`](Self::load) within `budget` (its limit is the caller's).
+    pub fn load_within(&self, budget: MemoryBudget) -> Result<Scene> {
+        let mut scene = Scene::load_within(&self.input, &budget)?;
         if self.ground_plane {
             scene
                 .add_ground_plane()

@@ -24,6 +24,10 @@ scene file's environment and camera; `relight render` reads it.
 The input is a mesh (.obj or .ply; degenerate triangles and open or non-manifold meshes
 work) or a scene file (.json, see the library's relight::scene docs).
 
+Memory: the mesh, its BVH and the transport at the most coefficients --keep-visibility lets a
+vertex keep (every texel's without it) are counted before anything is built, a scene file's
+generators from their settings; a run that would need more than --memory-limit is refused.
+
 Examples:
   haarshift relight precompute testdata/meshes/bunny.ply --ground-plane -o bunny.hsr
   haarshift relight precompute bunny.ply --ground-plane --param cube --resolution 32 -o bunny.hsr
@@ -84,7 +88,6 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     refuse_outputs(&[&args.scene.input], &[&args.output], args.force)?;
     let param = Parameterization::new(args.param, args.resolution)?;
-    let scene = args.scene.load()?;
     let mut visibility = VisibilityOptions::new(param);
     visibility.samples = args.visibility_samples;
     visibility.seed = args.seed;
@@ -97,7 +100,9 @@ pub fn run(args: Args) -> Result<()> {
         visibility,
         order: args.order,
         map_size: args.map_size,
+        memory_limit: args.scene.memory_limit,
     };
+    let scene = args.scene.load_within(options.budget())?;
     let (vertices, triangles) = (scene.mesh.vertex_count(), scene.mesh.triangles().len());
     let (cache, report) = precompute(scene, &options)?;
     let file_bytes = cache.write(&args.output, args.force)?;
