@@ -82,6 +82,21 @@ pub enum SceneError {
     /// The cache file was made for another scene or with other parameters.
     #[error("scene cache was made for another scene ({0}); compute it again")]
     CacheMismatch(String),
+    /// A shard (`relight precompute --shard`) was given where a whole scene cache is needed.
+    #[error(
+        "is shard {}/{} of a scene cache (vertices {}..{}), not a whole cache: merge the shards with `haarshift relight merge`",
+        .0.index, .0.count, .0.first, .0.end
+    )]
+    CacheIsShard(crate::relight::ShardRecord),
+    /// A whole scene cache was given where a shard is needed.
+    #[error("is a whole scene cache, not a shard")]
+    NotAShard,
+    /// A shard belongs to another scene or was made with other options than the others.
+    #[error("not a shard of the same scene and options: {0}")]
+    ShardMismatch(String),
+    /// Shards leave vertices out or hold some twice.
+    #[error("the shards do not cover every vertex exactly once: {0}")]
+    ShardCoverage(String),
     /// The occlusion field file is damaged: its checksum does not match, it is cut short, or
     /// what it holds is not a field.
     #[error("occlusion field file is damaged ({0}); build it again")]

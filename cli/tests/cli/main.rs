@@ -13,6 +13,7 @@ mod readme;
 mod relight;
 mod relight_error;
 mod relight_scene;
+mod relight_shard;
 mod report_overwrite;
 mod rotate_shift;
 mod sphere;

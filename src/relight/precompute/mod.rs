@@ -1,7 +1,8 @@
 //! The whole precomputation of a scene, as `haarshift relight precompute` runs it: the
-//! visibility in the chosen loop order ([`vertex_major`] through a [`SceneBvh`], or
-//! [`direction_major`] with shadow buffers), the transport of every vertex, and the
-//! [`SceneCache`] that records how it was made.
+//! visibility in the chosen loop order ([`vertex_major`](visibility::vertex_major) through a
+//! [`SceneBvh`], or [`direction_major`] with shadow buffers), the transport of every vertex, and
+//! the [`SceneCache`] that records how it was made; or one [`shard`] of the vertices of a
+//! precomputation split across machines ([`precompute_shard`], a [`CacheShard`]).
 //!
 //! **Limits.** A precomputation holds one `(faces, S, S)` array of f32 per thread and, in the
 //! direction order, one bit per (vertex, direction); a transport of more than [`MAX_TEXELS`]
@@ -10,15 +11,22 @@
 
 pub mod raycast;
 pub mod shadowmap;
+pub mod shard;
 pub mod sparse;
 pub mod transport;
 pub mod visibility;
 
 use crate::named::named_enum;
+use std::path::Path;
+
+use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::visibility::{
-    PrecomputeReport, VisibilityOptions, direction_major, vertex_major,
+    PrecomputeReport, VisibilityOptions, direction_major, vertex_range,
 };
-use crate::relight::{CacheParams, Scene, SceneBvh, SceneCache};
+use crate::relight::scene::cache_shard::Provenance;
+use crate::relight::{
+    CacheParams, CacheShard, Scene, SceneBvh, SceneCache, SceneError, TransportSet,
+};
 use crate::{Error, Result};
 
 named_enum! {
@@ -108,6 +116,113 @@ pub fn precompute(
     scene: Scene,
     options: &PrecomputeOptions,
 ) -> Result<(SceneCache, PrecomputeReport)> {
+    let (transport, report) = transport(&scene, options, None)?;
+    let mut cache = SceneCache::new(
+        options.record(scene.ground_plane),
+        scene.mesh,
+        scene.albedo,
+        transport,
+    )?;
+    cache.environment = scene.environment;
+    cache.camera = scene.camera;
+    Ok((cache, report))
+}
+
+/// Precomputes shard `shard` of `scene` ([`shard`] module: the vertices
+/// [`Shard::vertices`] names, traced against the whole scene) into a [`CacheShard`] that
+/// [`merge_shards`](crate::relight::merge_shards) joins with the others. The vertex order only:
+/// the direction order renders every vertex into each shadow buffer at once, so it is refused.
+///
+/// ```
+/// use haarshift::relight::precompute::{Order, PrecomputeOptions, precompute_shard};
+/// use haarshift::relight::precompute::shard::Shard;
+/// use haarshift::relight::{Generator, Scene, VisibilityOptions};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// let scene = || Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true).unwrap();
+/// let mut options = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap()));
+/// let (part, report) = precompute_shard(scene(), &options, Shard::new(0, 2).unwrap()).unwrap();
+/// assert_eq!((part.record.first, part.record.end, part.transport.vertex_count()), (0, 571, 571));
+/// assert!(report.rays > 0);
+/// options.order = Order::Direction;
+/// assert!(precompute_shard(scene(), &options, Shard::new(0, 2).unwrap()).is_err());
+/// ```
+pub fn precompute_shard(
+    scene: Scene,
+    options: &PrecomputeOptions,
+    shard: Shard,
+) -> Result<(CacheShard, PrecomputeReport)> {
+    let (transport, report) = transport(&scene, options, Some(shard))?;
+    let mut part = CacheShard::new(
+        shard,
+        options.record(scene.ground_plane),
+        scene.mesh,
+        scene.albedo,
+        transport,
+    )?;
+    part.environment = scene.environment;
+    part.camera = scene.camera;
+    Ok((part, report))
+}
+
+/// Whether `path` already holds shard `shard` of `scene` made with `options`, complete: a
+/// rerun after a preemption skips it (files are written atomically, so one that reads is
+/// whole). `false` when there is no file; an error when the file is damaged or holds another
+/// shard, scene or options, since replacing it is the caller's decision (`--force`).
+///
+/// ```
+/// use haarshift::relight::precompute::{PrecomputeOptions, precompute_shard, shard_is_done};
+/// use haarshift::relight::precompute::shard::Shard;
+/// use haarshift::relight::{Generator, Scene, VisibilityOptions};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// let scene = || Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
+/// let options = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap()));
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("part-1.hsr");
+/// let one = Shard::new(1, 2).unwrap();
+/// assert!(!shard_is_done(&path, &scene(), &options, one).unwrap());
+/// precompute_shard(scene(), &options, one).unwrap().0.write(&path, false).unwrap();
+/// assert!(shard_is_done(&path, &scene(), &options, one).unwrap());
+/// let err = shard_is_done(&path, &scene(), &options, Shard::new(0, 2).unwrap()).unwrap_err();
+/// assert!(err.to_string().contains("holds shard 1/2"), "{err}");
+/// ```
+pub fn shard_is_done(
+    path: &Path,
+    scene: &Scene,
+    options: &PrecomputeOptions,
+    shard: Shard,
+) -> Result<bool> {
+    if !path.exists() {
+        return Ok(false);
+    }
+    let found = CacheShard::read(path)?;
+    let params = options.record(scene.ground_plane);
+    let wanted = Provenance {
+        params: &params,
+        mesh: &scene.mesh,
+        albedo: &scene.albedo,
+        environment: scene.environment.as_ref(),
+        camera: scene.camera.as_ref(),
+    };
+    let (index, count) = (found.record.index, found.record.count);
+    let reason = match found.provenance().difference(&wanted) {
+        Some(how) => format!("it holds {how} than asked for"),
+        None if (index, count) != (shard.index(), shard.count()) => {
+            format!("it holds shard {index}/{count}, not {shard}")
+        }
+        None => return Ok(true),
+    };
+    Err(Error::from(SceneError::ShardMismatch(format!(
+        "{reason}; --force replaces it"
+    )))
+    .in_file(path))
+}
+
+/// The transport of `scene`'s vertices, all of them or `shard`'s, with the report.
+fn transport(
+    scene: &Scene,
+    options: &PrecomputeOptions,
+    shard: Option<Shard>,
+) -> Result<(TransportSet, PrecomputeReport)> {
     let param = options.visibility.param;
     if param.texels() > MAX_TEXELS {
         return Err(Error::parameter(
@@ -120,21 +235,21 @@ pub fn precompute(
             ),
         ));
     }
-    let (transport, report) = match options.order {
-        Order::Vertex => vertex_major(
-            &scene.mesh,
-            &SceneBvh::new(&scene.mesh),
+    let mesh = &scene.mesh;
+    match (options.order, shard) {
+        (Order::Vertex, shard) => vertex_range(
+            mesh,
+            &SceneBvh::new(mesh),
             &options.visibility,
-        )?,
-        Order::Direction => direction_major(&scene.mesh, &options.visibility, options.map_size)?,
-    };
-    let mut cache = SceneCache::new(
-        options.record(scene.ground_plane),
-        scene.mesh,
-        scene.albedo,
-        transport,
-    )?;
-    cache.environment = scene.environment;
-    cache.camera = scene.camera;
-    Ok((cache, report))
+            shard
+                .unwrap_or(Shard::whole())
+                .vertices(mesh.vertex_count()),
+        ),
+        (Order::Direction, None) => direction_major(mesh, &options.visibility, options.map_size),
+        (Order::Direction, Some(_)) => Err(Error::parameter(
+            "order",
+            "direction: every shadow buffer serves all vertices at once, so it cannot be \
+             sharded; shard with --order vertex",
+        )),
+    }
 }

@@ -51,6 +51,7 @@
 //! * `camera` (optional): position, look-at point, vertical field of view in degrees.
 
 pub mod cache;
+pub mod cache_shard;
 mod file;
 pub(crate) mod framed;
 mod generators;
