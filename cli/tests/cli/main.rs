@@ -4,6 +4,7 @@
 mod common;
 
 mod compute_precision;
+mod deploy;
 mod experiment;
 mod experiment_relight;
 mod flags;
