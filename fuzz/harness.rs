@@ -43,6 +43,7 @@ pub const TARGETS: [&str; 15] = [
 const SCENE_BUDGET: MemoryBudget = MemoryBudget {
     limit: 64 << 20,
     per_vertex: 0,
+    shards: 1,
 };
 
 /// A fresh directory for one input.

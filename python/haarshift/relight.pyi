@@ -1,5 +1,5 @@
 import os
-from typing import Dict, Literal, Optional, Tuple, Union
+from typing import Dict, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -47,6 +47,7 @@ class Cache:
     @property
     def sh_bands(self) -> Optional[int]: ...
 
+@overload
 def precompute(
     scene: Union[str, "os.PathLike[str]"],
     *,
@@ -58,10 +59,38 @@ def precompute(
     seed: int = 0,
     order: Literal["vertex", "direction"] = "vertex",
     sh_bands: Optional[int] = None,
+    shard: None = None,
     output: Union[str, "os.PathLike[str]", None] = None,
     force: bool = False,
 ) -> Cache:
     """Precomputes a mesh or scene file as `haarshift relight precompute` does."""
+
+@overload
+def precompute(
+    scene: Union[str, "os.PathLike[str]"],
+    *,
+    param: Literal["latlong", "cube"] = "latlong",
+    resolution: int = 32,
+    ground_plane: bool = False,
+    keep_visibility: Optional[int] = None,
+    samples: int = 1,
+    seed: int = 0,
+    order: Literal["vertex"] = "vertex",
+    sh_bands: Optional[int] = None,
+    shard: Tuple[int, int],
+    output: Union[str, "os.PathLike[str]"],
+    force: bool = False,
+) -> str:
+    """Precomputes shard `i` of `n` into `output` (skipped when it is there, complete); returns
+    the path."""
+
+def merge(
+    shards: Sequence[Union[str, "os.PathLike[str]"]],
+    *,
+    output: Union[str, "os.PathLike[str]", None] = None,
+    force: bool = False,
+) -> Cache:
+    """Merges shards into the cache an unsharded `precompute` makes (written to `output`)."""
 
 class Shader:
     """Per-vertex shading of a cache, built once from `relight render`'s options."""

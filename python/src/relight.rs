@@ -9,13 +9,16 @@ use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions, DynamicScene};
 use haarshift::relight::light::environment::Environment;
-use haarshift::relight::precompute::{Order, PrecomputeOptions};
+use haarshift::relight::precompute::shard::Shard;
+use haarshift::relight::precompute::{Order, PrecomputeOptions, precompute_shard, shard_is_done};
 use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader};
 use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{
     FrameSpec, LightSpec, Method, ShadeOptions, Shader as LibraryShader, ShaderSpec, ShadingInput,
 };
-use haarshift::relight::{Brdf, EnvironmentSpec, Scene, SceneCache, VisibilityOptions};
+use haarshift::relight::{
+    Brdf, EnvironmentSpec, Scene, SceneCache, VisibilityOptions, merge_shards,
+};
 use haarshift::render::view::ViewSpec;
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use numpy::{IntoPyArray, PyArray2};
@@ -252,8 +255,25 @@ impl Cache {
 /// `resolution`, Haar-transformed and truncated to `keep_visibility` detail coefficients
 /// (None: all), with `sh_bands` bands of spherical harmonics beside it when asked. With
 /// `output` the cache is also written there (an existing file only with `force=True`).
+///
+/// With `shard=(i, n)` only shard `i` of `n` is computed (the vertices `[i V / n, (i + 1) V /
+/// n)`, traced against the whole scene, the bits an unsharded run gives them), written to
+/// `output` (required), and `output` is returned as a string, so that a task on a Dask or Ray
+/// worker returns a path; an `output` that already holds this shard complete is not computed
+/// again (`force=True` recomputes it). `merge` joins the shards.
+///
+/// >>> import json, os, tempfile, haarshift
+/// >>> d = tempfile.mkdtemp(); path = os.path.join(d, "ball.json")
+/// >>> with open(path, "w") as f:
+/// ...     json.dump({"objects": [{"generator": {"sphere": {"cells": 2}}}]}, f)
+/// >>> parts = [haarshift.relight.precompute(path, resolution=8, shard=(i, 2),
+/// ...          output=os.path.join(d, f"part-{i}.hsr")) for i in range(2)]
+/// >>> merged = haarshift.relight.merge(parts, output=os.path.join(d, "ball.hsr"))
+/// >>> whole = haarshift.relight.precompute(path, resolution=8, output=os.path.join(d, "whole.hsr"))
+/// >>> open(os.path.join(d, "ball.hsr"), "rb").read() == open(os.path.join(d, "whole.hsr"), "rb").read()
+/// True
 #[pyfunction]
-#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, output = None, force = false))]
+#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, shard = None, output = None, force = false))]
 #[allow(clippy::too_many_arguments)] // the keyword arguments of one Python function
 fn precompute(
     py: Python<'_>,
@@ -266,9 +286,10 @@ fn precompute(
     seed: u64,
     order: &str,
     sh_bands: Option<usize>,
+    shard: Option<(usize, usize)>,
     output: Option<PathBuf>,
     force: bool,
-) -> PyResult<Cache> {
+) -> PyResult<Py<PyAny>> {
     let param = Parameterization::new(parse::<ParamKind>(param)?, resolution).or_raise()?;
     let mut visibility = VisibilityOptions::new(param);
     visibility.samples = samples;
@@ -277,13 +298,88 @@ fn precompute(
     visibility.keep = keep_visibility.map_or(Selection::All, Selection::Largest);
     let mut options = PrecomputeOptions::new(visibility);
     options.order = parse::<Order>(order)?;
+    let load = || -> haarshift::Result<Scene> {
+        let mut loaded = Scene::load(&scene)?;
+        if ground_plane {
+            loaded.add_ground_plane()?;
+        }
+        Ok(loaded)
+    };
+    if let Some((index, count)) = shard {
+        let shard = Shard::new(index, count).or_raise()?;
+        let Some(path) = output else {
+            return Err(bad_argument(
+                "output",
+                "a shard is written to a file: give output=",
+            ));
+        };
+        py.detach(|| -> haarshift::Result<()> {
+            let loaded = load()?;
+            if !force && shard_is_done(&path, &loaded, &options, shard)? {
+                return Ok(());
+            }
+            precompute_shard(loaded, &options, shard)?
+                .0
+                .write(&path, force)
+                .map(drop)
+        })
+        .or_raise()?;
+        return Ok(path.into_pyobject(py)?.str()?.into_any().unbind());
+    }
     let cache = py
         .detach(|| -> haarshift::Result<_> {
-            let mut loaded = Scene::load(&scene)?;
-            if ground_plane {
-                loaded.add_ground_plane()?;
+            let (cache, _) = haarshift::relight::precompute::precompute(load()?, &options)?;
+            if let Some(path) = &output {
+                cache.write(path, force)?;
             }
-            let (cache, _) = haarshift::relight::precompute::precompute(loaded, &options)?;
+            Ok(cache)
+        })
+        .or_raise()?;
+    let cache = Cache {
+        cache,
+        path: output,
+    };
+    Ok(Py::new(py, cache)?.into_any())
+}
+
+/// Merges the shard files `shards` (any order) into the cache an unsharded `precompute`
+/// makes, as `haarshift relight merge` does: refused, naming the file, unless they come from
+/// the same scene and options and cover every vertex exactly once. With `output` the cache is
+/// written there too (an existing file only with `force=True`), byte for byte the file an
+/// unsharded run writes.
+///
+/// >>> import json, os, tempfile, haarshift
+/// >>> d = tempfile.mkdtemp(); path = os.path.join(d, "ball.json")
+/// >>> with open(path, "w") as f:
+/// ...     json.dump({"objects": [{"generator": {"sphere": {"cells": 2}}}]}, f)
+/// >>> parts = [haarshift.relight.precompute(path, resolution=8, shard=(i, 3),
+/// ...          output=os.path.join(d, f"part-{i}.hsr")) for i in range(3)]
+/// >>> haarshift.relight.merge(parts).vertex_count
+/// 54
+/// >>> try:
+/// ...     haarshift.relight.merge(parts[:2])
+/// ... except OSError as e:
+/// ...     print(str(e).split(": ", 1)[1])
+/// the shards do not cover every vertex exactly once: vertices 36..54 are in no shard (after shard 1/3)
+#[pyfunction]
+#[pyo3(signature = (shards, *, output = None, force = false))]
+fn merge(
+    py: Python<'_>,
+    shards: Vec<PathBuf>,
+    output: Option<PathBuf>,
+    force: bool,
+) -> PyResult<Cache> {
+    let cache = py
+        .detach(|| -> haarshift::Result<_> {
+            if let Some(path) = &output {
+                for shard in &shards {
+                    haarshift::io::ensure_distinct_paths(shard, path)?;
+                }
+                if !force && path.exists() {
+                    return Err(haarshift::Error::OutputExists { path: path.clone() });
+                }
+            }
+            let cache = merge_shards(&shards)?;
             if let Some(path) = &output {
                 cache.write(path, force)?;
             }
@@ -462,6 +558,7 @@ pub fn module<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyModule>> {
     let m = PyModule::new(py, "relight")?;
     m.add_function(wrap_pyfunction!(scene, &m)?)?;
     m.add_function(wrap_pyfunction!(precompute, &m)?)?;
+    m.add_function(wrap_pyfunction!(merge, &m)?)?;
     m.add_class::<Cache>()?;
     m.add_class::<Shader>()?;
     Ok(m)

@@ -8,7 +8,7 @@ import haarshift
 
 PUBLIC = [getattr(haarshift, name) for name in haarshift.__all__ if name not in ("__version__", "relight", "sphere")]
 PUBLIC += [haarshift.sphere.rotate, haarshift.sphere.integrate, haarshift.sphere.product]
-PUBLIC += [haarshift.relight.scene]
+PUBLIC += [haarshift.relight.scene, haarshift.relight.precompute, haarshift.relight.merge]
 
 
 @pytest.mark.parametrize("obj", PUBLIC, ids=lambda o: o.__name__)

@@ -50,23 +50,6 @@ pub enum SceneError {
         /// The coordinate.
         value: f64,
     },
-    /// A scene's counts need more memory than its [`MemoryBudget`](crate::relight::scene::validate::MemoryBudget)
-    /// allows; found from the counts, before anything is built.
-    #[error(
-        "{what}: {vertices} vertices need about {:.2} GiB, more than the memory limit of {:.2} GiB",
-        *needed as f64 / GIB,
-        *limit as f64 / GIB
-    )]
-    MemoryLimit {
-        /// What has the vertices (a scene's generators, a scene).
-        what: String,
-        /// Its vertices.
-        vertices: u128,
-        /// The bytes they need, estimated.
-        needed: u128,
-        /// The limit, bytes.
-        limit: u64,
-    },
     /// A ground plane was asked for under a mesh too narrow for one.
     #[error(
         "a ground plane needs a mesh with a width or depth (here {extent:e}) of at least 1e-6 of its largest coordinate ({largest:e})"
@@ -99,6 +82,21 @@ pub enum SceneError {
     /// The cache file was made for another scene or with other parameters.
     #[error("scene cache was made for another scene ({0}); compute it again")]
     CacheMismatch(String),
+    /// A shard (`relight precompute --shard`) was given where a whole scene cache is needed.
+    #[error(
+        "is shard {}/{} of a scene cache (vertices {}..{}), not a whole cache: merge the shards with `haarshift relight merge`",
+        .0.index, .0.count, .0.first, .0.end
+    )]
+    CacheIsShard(crate::relight::ShardRecord),
+    /// A whole scene cache was given where a shard is needed.
+    #[error("is a whole scene cache, not a shard")]
+    NotAShard,
+    /// A shard belongs to another scene or was made with other options than the others.
+    #[error("not a shard of the same scene and options: {0}")]
+    ShardMismatch(String),
+    /// Shards leave vertices out or hold some twice.
+    #[error("the shards do not cover every vertex exactly once: {0}")]
+    ShardCoverage(String),
     /// The occlusion field file is damaged: its checksum does not match, it is cut short, or
     /// what it holds is not a field.
     #[error("occlusion field file is damaged ({0}); build it again")]
@@ -117,6 +115,3 @@ pub enum SceneError {
     #[error("occlusion field file was built {0}; build it again")]
     FieldMismatch(String),
 }
-
-/// Bytes in a GiB, for messages.
-const GIB: f64 = (1u64 << 30) as f64;

@@ -50,9 +50,10 @@ pub use precompute::raycast::{Occlusion, SceneBvh};
 pub use precompute::shadowmap::ShadowMap;
 pub use precompute::transport::TransportSet;
 pub use precompute::visibility::{
-    PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major,
+    PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major, vertex_range,
 };
-pub use scene::cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, scene_hash};
+pub use scene::cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, ShardRecord, scene_hash};
+pub use scene::cache_shard::{CacheShard, merge_shards};
 pub use scene::mesh::{Bounds, Mesh};
 pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,

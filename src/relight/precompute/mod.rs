@@ -1,7 +1,8 @@
 //! The whole precomputation of a scene, as `haarshift relight precompute` runs it: the
-//! visibility in the chosen loop order ([`vertex_major`] through a [`SceneBvh`], or
-//! [`direction_major`] with shadow buffers), the transport of every vertex, and the
-//! [`SceneCache`] that records how it was made.
+//! visibility in the chosen loop order ([`vertex_major`](visibility::vertex_major) through a
+//! [`SceneBvh`], or [`direction_major`] with shadow buffers), the transport of every vertex, and
+//! the [`SceneCache`] that records how it was made; or one [`shard`] of the vertices of a
+//! precomputation split across machines ([`precompute_shard`], a [`CacheShard`]).
 //!
 //! **Limits.** A precomputation holds one `(faces, S, S)` array of f32 per thread and, in the
 //! direction order, one bit per (vertex, direction); a transport of more than [`MAX_TEXELS`]
@@ -12,17 +13,24 @@
 
 pub mod raycast;
 pub mod shadowmap;
+pub mod shard;
 pub mod sparse;
 pub mod transport;
 pub mod visibility;
 
 use crate::named::named_enum;
+use std::path::Path;
+
 use crate::product::Selection;
+use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::visibility::{
-    PrecomputeReport, VisibilityOptions, direction_major, vertex_major,
+    PrecomputeReport, VisibilityOptions, direction_major, vertex_range,
 };
+use crate::relight::scene::cache_shard::Provenance;
 use crate::relight::scene::validate::{DEFAULT_MEMORY_LIMIT, MemoryBudget};
-use crate::relight::{CacheParams, Scene, SceneBvh, SceneCache};
+use crate::relight::{
+    CacheParams, CacheShard, Scene, SceneBvh, SceneCache, SceneError, TransportSet,
+};
 use crate::{Error, Result};
 
 named_enum! {
@@ -77,12 +85,40 @@ impl PrecomputeOptions {
         }
     }
 
+    /// Refuses a transport of more than [`MAX_TEXELS`] texels, before any scene is read.
+    ///
+    /// ```
+    /// use haarshift::relight::precompute::PrecomputeOptions;
+    /// use haarshift::relight::VisibilityOptions;
+    /// use haarshift::faces::{ParamKind, Parameterization};
+    /// let huge = Parameterization::new(ParamKind::LatLong, 4096).unwrap();
+    /// let err = PrecomputeOptions::new(VisibilityOptions::new(huge)).check().unwrap_err();
+    /// assert!(err.to_string().contains("resolution"));
+    /// ```
+    pub fn check(&self) -> Result<()> {
+        let param = self.visibility.param;
+        if param.texels() <= MAX_TEXELS {
+            return Ok(());
+        }
+        Err(Error::parameter(
+            "resolution",
+            format!(
+                "{} {}: {} texels per vertex, more than the {MAX_TEXELS} a precomputation takes",
+                param.kind(),
+                param.face_size(),
+                param.texels()
+            ),
+        ))
+    }
+
     /// The [`MemoryBudget`] of this precomputation: per vertex, beyond the mesh, the most
     /// coefficients its selection can keep (every texel's unless it keeps a count), 8 bytes
     /// each (`u32` index, `f32` value) held twice (the vertices' rows, then the gathered set
     /// and the file's bytes), its row's 80 bytes of bookkeeping, the spherical-harmonic
     /// transfer, and in the direction order one bit per texel. The direction order's shadow
-    /// buffers (one per thread, `4 M^2` bytes) are not per vertex and not counted.
+    /// buffers (one per thread, `4 M^2` bytes) are not per vertex and not counted. With a
+    /// `shard` of `N`, each vertex's mesh is held but the transport of only the largest
+    /// `N`-th of them.
     ///
     /// ```
     /// use haarshift::relight::precompute::PrecomputeOptions;
@@ -90,11 +126,13 @@ impl PrecomputeOptions {
     /// use haarshift::faces::{ParamKind, Parameterization};
     /// use haarshift::product::Selection;
     /// let mut o = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap()));
-    /// assert_eq!(o.budget().per_vertex, 2 * 8 * 128 + 80); // every one of 8 x 16 texels
+    /// assert_eq!(o.budget(None).per_vertex, 2 * 8 * 128 + 80); // every one of 8 x 16 texels
     /// o.visibility.keep = Selection::Largest(30);
-    /// assert_eq!(o.budget().per_vertex, 2 * 8 * 32 + 80); // 30 details and 2 face scalings
+    /// assert_eq!(o.budget(None).per_vertex, 2 * 8 * 32 + 80); // 30 details and 2 face scalings
+    /// let third = haarshift::relight::precompute::shard::Shard::new(2, 3).unwrap();
+    /// assert_eq!((o.budget(None).shards, o.budget(Some(third)).shards), (1, 3));
     /// ```
-    pub fn budget(&self) -> MemoryBudget {
+    pub fn budget(&self, shard: Option<Shard>) -> MemoryBudget {
         let param = self.visibility.param;
         let (texels, faces) = (param.texels() as u64, param.faces() as u64);
         let kept = match self.visibility.keep {
@@ -113,6 +151,7 @@ impl PrecomputeOptions {
         };
         MemoryBudget {
             limit: self.memory_limit,
+            shards: shard.map_or(1, |s| s.count() as u64),
             per_vertex: kept
                 .saturating_mul(2 * 8)
                 .saturating_add(80)
@@ -159,29 +198,7 @@ pub fn precompute(
     scene: Scene,
     options: &PrecomputeOptions,
 ) -> Result<(SceneCache, PrecomputeReport)> {
-    let param = options.visibility.param;
-    if param.texels() > MAX_TEXELS {
-        return Err(Error::parameter(
-            "resolution",
-            format!(
-                "{} {}: {} texels per vertex, more than the {MAX_TEXELS} a precomputation takes",
-                param.kind(),
-                param.face_size(),
-                param.texels()
-            ),
-        ));
-    }
-    options
-        .budget()
-        .check("the scene", scene.mesh.vertex_count() as u128)?;
-    let (transport, report) = match options.order {
-        Order::Vertex => vertex_major(
-            &scene.mesh,
-            &SceneBvh::new(&scene.mesh),
-            &options.visibility,
-        )?,
-        Order::Direction => direction_major(&scene.mesh, &options.visibility, options.map_size)?,
-    };
+    let (transport, report) = transport(&scene, options, None)?;
     let mut cache = SceneCache::new(
         options.record(scene.ground_plane),
         scene.mesh,
@@ -191,4 +208,120 @@ pub fn precompute(
     cache.environment = scene.environment;
     cache.camera = scene.camera;
     Ok((cache, report))
+}
+
+/// Precomputes shard `shard` of `scene` ([`shard`] module: the vertices
+/// [`Shard::vertices`] names, traced against the whole scene) into a [`CacheShard`] that
+/// [`merge_shards`](crate::relight::merge_shards) joins with the others. The vertex order only:
+/// the direction order renders every vertex into each shadow buffer at once, so it is refused.
+///
+/// ```
+/// use haarshift::relight::precompute::{Order, PrecomputeOptions, precompute_shard};
+/// use haarshift::relight::precompute::shard::Shard;
+/// use haarshift::relight::{Generator, Scene, VisibilityOptions};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// let scene = || Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true).unwrap();
+/// let mut options = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap()));
+/// let (part, report) = precompute_shard(scene(), &options, Shard::new(0, 2).unwrap()).unwrap();
+/// assert_eq!((part.record.first, part.record.end, part.transport.vertex_count()), (0, 571, 571));
+/// assert!(report.rays > 0);
+/// options.order = Order::Direction;
+/// assert!(precompute_shard(scene(), &options, Shard::new(0, 2).unwrap()).is_err());
+/// ```
+pub fn precompute_shard(
+    scene: Scene,
+    options: &PrecomputeOptions,
+    shard: Shard,
+) -> Result<(CacheShard, PrecomputeReport)> {
+    let (transport, report) = transport(&scene, options, Some(shard))?;
+    let mut part = CacheShard::new(
+        shard,
+        options.record(scene.ground_plane),
+        scene.mesh,
+        scene.albedo,
+        transport,
+    )?;
+    part.environment = scene.environment;
+    part.camera = scene.camera;
+    Ok((part, report))
+}
+
+/// Whether `path` already holds shard `shard` of `scene` made with `options`, complete: a
+/// rerun after a preemption skips it (files are written atomically, so one that reads is
+/// whole). `false` when there is no file; an error when the file is damaged or holds another
+/// shard, scene or options, since replacing it is the caller's decision (`--force`).
+///
+/// ```
+/// use haarshift::relight::precompute::{PrecomputeOptions, precompute_shard, shard_is_done};
+/// use haarshift::relight::precompute::shard::Shard;
+/// use haarshift::relight::{Generator, Scene, VisibilityOptions};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// let scene = || Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
+/// let options = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap()));
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("part-1.hsr");
+/// let one = Shard::new(1, 2).unwrap();
+/// assert!(!shard_is_done(&path, &scene(), &options, one).unwrap());
+/// precompute_shard(scene(), &options, one).unwrap().0.write(&path, false).unwrap();
+/// assert!(shard_is_done(&path, &scene(), &options, one).unwrap());
+/// let err = shard_is_done(&path, &scene(), &options, Shard::new(0, 2).unwrap()).unwrap_err();
+/// assert!(err.to_string().contains("holds shard 1/2"), "{err}");
+/// ```
+pub fn shard_is_done(
+    path: &Path,
+    scene: &Scene,
+    options: &PrecomputeOptions,
+    shard: Shard,
+) -> Result<bool> {
+    if !path.exists() {
+        return Ok(false);
+    }
+    let found = CacheShard::read(path)?;
+    let params = options.record(scene.ground_plane);
+    let wanted = Provenance {
+        params: &params,
+        mesh: &scene.mesh,
+        albedo: &scene.albedo,
+        environment: scene.environment.as_ref(),
+        camera: scene.camera.as_ref(),
+    };
+    let (index, count) = (found.record.index, found.record.count);
+    let reason = match found.provenance().difference(&wanted) {
+        Some(how) => format!("it holds {how} than asked for"),
+        None if (index, count) != (shard.index(), shard.count()) => {
+            format!("it holds shard {index}/{count}, not {shard}")
+        }
+        None => return Ok(true),
+    };
+    Err(Error::from(SceneError::ShardMismatch(format!(
+        "{reason}; --force replaces it"
+    )))
+    .in_file(path))
+}
+
+/// The transport of `scene`'s vertices, all of them or `shard`'s, with the report.
+fn transport(
+    scene: &Scene,
+    options: &PrecomputeOptions,
+    shard: Option<Shard>,
+) -> Result<(TransportSet, PrecomputeReport)> {
+    options.check()?;
+    let mesh = &scene.mesh;
+    (options.budget(shard)).check("the scene", mesh.vertex_count() as u128)?;
+    match (options.order, shard) {
+        (Order::Vertex, shard) => vertex_range(
+            mesh,
+            &SceneBvh::new(mesh),
+            &options.visibility,
+            shard
+                .unwrap_or(Shard::whole())
+                .vertices(mesh.vertex_count()),
+        ),
+        (Order::Direction, None) => direction_major(mesh, &options.visibility, options.map_size),
+        (Order::Direction, Some(_)) => Err(Error::parameter(
+            "order",
+            "direction: every shadow buffer serves all vertices at once, so it cannot be \
+             sharded; shard with --order vertex",
+        )),
+    }
 }

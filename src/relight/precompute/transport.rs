@@ -131,6 +131,29 @@ impl TransportSet {
         }
     }
 
+    /// Appends every vertex of `other` after this set's (the merge of shards): both must have
+    /// the same parameterisation, truncation and spherical-harmonic bands.
+    pub(crate) fn append(&mut self, other: &TransportSet) -> Result<()> {
+        let bands = |s: &TransportSet| s.sh.as_ref().map(ShTransfer::bands);
+        if (self.param, self.keep, bands(self)) != (other.param, other.keep, bands(other)) {
+            return Err(Error::parameter(
+                "transport",
+                "only sets of the same parameterisation, truncation and bands are joined",
+            ));
+        }
+        for v in 0..other.vertex_count() {
+            let (indices, values) = other.coefficients(v);
+            self.rows.push(indices, values);
+        }
+        if let (Some(mine), Some(theirs)) = (&mut self.sh, &other.sh) {
+            theirs
+                .as_slice()
+                .chunks_exact(theirs.bands() * theirs.bands())
+                .for_each(|row| mine.push(row));
+        }
+        Ok(())
+    }
+
     /// The spherical-harmonic transfer, when the set was made with it.
     pub fn sh(&self) -> Option<&ShTransfer> {
         self.sh.as_ref()

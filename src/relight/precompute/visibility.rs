@@ -30,6 +30,7 @@
 //! Both report what they did in a [`PrecomputeReport`]: rays cast, wall time, the working
 //! memory the method holds beyond its inputs and outputs.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use ndarray::Array3;
@@ -182,7 +183,45 @@ pub fn vertex_major(
     occlusion: &impl Occlusion,
     options: &VisibilityOptions,
 ) -> Result<(TransportSet, PrecomputeReport)> {
+    vertex_range(mesh, occlusion, options, 0..mesh.vertex_count())
+}
+
+/// [`vertex_major`] for the vertices `vertices` only (a [shard](super::shard)): the set's row
+/// `k` is vertex `vertices.start + k`, with the bits [`vertex_major`] gives that vertex, since
+/// every ray goes through the whole scene's `occlusion` and the jitter is keyed by the global
+/// vertex index.
+///
+/// ```
+/// use haarshift::relight::{Generator, SceneBvh, VisibilityOptions, vertex_major, vertex_range};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// let mesh = Generator::Sphere { cells: 2 }.mesh().unwrap();
+/// let mut options = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap());
+/// options.samples = 2;
+/// let bvh = SceneBvh::new(&mesh);
+/// let (all, _) = vertex_major(&mesh, &bvh, &options).unwrap();
+/// let (part, _) = vertex_range(&mesh, &bvh, &options, 10..20).unwrap();
+/// assert_eq!(part.vertex_count(), 10);
+/// assert_eq!(part.coefficients(3), all.coefficients(13));
+/// assert!(vertex_range(&mesh, &bvh, &options, 50..55).is_err()); // 54 vertices
+/// ```
+pub fn vertex_range(
+    mesh: &Mesh,
+    occlusion: &impl Occlusion,
+    options: &VisibilityOptions,
+    vertices: Range<usize>,
+) -> Result<(TransportSet, PrecomputeReport)> {
     options.check()?;
+    if vertices.start > vertices.end || vertices.end > mesh.vertex_count() {
+        return Err(Error::parameter(
+            "vertices",
+            format!(
+                "{}..{}: the mesh has {} vertices",
+                vertices.start,
+                vertices.end,
+                mesh.vertex_count()
+            ),
+        ));
+    }
     let start = Instant::now();
     let param = options.param;
     let directions = texel_directions(param);
@@ -191,8 +230,8 @@ pub fn vertex_major(
     let samples = options.samples;
     let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
     let mut set = encoder.empty_set()?;
-    let bar = Task::begin(options.progress, "visibility (rays)", mesh.vertex_count());
-    let encoded: Vec<Result<(Encoded, u64)>> = (0..mesh.vertex_count())
+    let bar = Task::begin(options.progress, "visibility (rays)", vertices.len());
+    let encoded: Vec<Result<(Encoded, u64)>> = vertices
         .into_par_iter()
         .map_init(
             || Array3::<f32>::zeros((param.faces(), s, s)),

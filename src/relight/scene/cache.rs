@@ -14,8 +14,14 @@
 //! | | transport: offsets `V + 1` u64, indices `N` u32, values `N` f32 ([`TransportSet`]) |
 //! | | with `sh_bands = B` in the parameters: the spherical-harmonic transfer `V x B^2` f32 ([`ShTransfer`]) |
 //!
+//! A **shard** ([`CacheShard`], what `relight precompute --shard I/N` writes) is the same file
+//! with [`CacheHeader::shard`] set: the whole mesh and albedo, and the transport (and transfer)
+//! of its vertex range only, `V` above read as the range's length in the transport's rows.
+//! [`SceneCache::read`] refuses a shard, and [`CacheShard::read`] a whole cache.
+//!
 //! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
-//! environment and camera in the header; a version-1 file is refused like any other version.
+//! environment and camera in the header; version 3 the shard record. A file of another version
+//! is refused, never guessed at.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
 //! cache"), the version (another version is refused, never guessed at), the checksum (a
@@ -38,7 +44,7 @@ use crate::relight::{Mesh, SceneError};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
-pub const CACHE_VERSION: u32 = 2;
+pub const CACHE_VERSION: u32 = 3;
 
 const FORMAT: Format = Format {
     magic: b"HSRCACHE",
@@ -126,6 +132,23 @@ pub struct CacheHeader {
     pub environment: Option<EnvironmentSpec>,
     /// The scene file's camera, if it had one.
     pub camera: Option<CameraSpec>,
+    /// In a shard, which one and the vertices it holds; `None` in a whole cache.
+    pub shard: Option<ShardRecord>,
+}
+
+/// What a shard's header records of its place in the whole: shard `index` of `count`, holding
+/// the transport of the vertices `first..end`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardRecord {
+    /// `I` of `--shard I/N`.
+    pub index: usize,
+    /// `N`.
+    pub count: usize,
+    /// The first vertex held.
+    pub first: usize,
+    /// One past the last vertex held.
+    pub end: usize,
 }
 
 /// A precomputed scene: the mesh, its albedo and every vertex's sparse transport.
@@ -189,34 +212,7 @@ impl SceneCache {
         albedo: Array2<f32>,
         transport: TransportSet,
     ) -> Result<Self> {
-        let v = mesh.vertex_count();
-        if albedo.dim() != (v, 3) || transport.vertex_count() != v {
-            return Err(Error::shape(
-                albedo.shape(),
-                format!(
-                    "albedo must be ({v}, 3) and the transport have {v} vertices (it has {})",
-                    transport.vertex_count()
-                ),
-            ));
-        }
-        let p = transport.param();
-        let bands = transport.sh().map(|t| t.bands());
-        if params.param != p.kind().to_string()
-            || params.resolution != p.face_size()
-            || params.sh_bands != bands
-        {
-            return Err(Error::parameter(
-                "cache parameters",
-                format!(
-                    "they say {} {} with {:?} sh bands but the transport is {} {} with {bands:?}",
-                    params.param,
-                    params.resolution,
-                    params.sh_bands,
-                    p.kind(),
-                    p.face_size()
-                ),
-            ));
-        }
+        check_parts(&params, &mesh, &albedo, &transport, mesh.vertex_count())?;
         Ok(SceneCache {
             params,
             mesh,
@@ -230,32 +226,21 @@ impl SceneCache {
     /// Writes the cache to `path` atomically (an existing file only with `force`); returns
     /// the file's size in bytes.
     pub fn write(&self, path: &Path, force: bool) -> Result<u64> {
-        let (offsets, indices, values) = self.transport.parts();
-        let header = CacheHeader {
-            params: self.params.clone(),
-            vertices: self.mesh.vertex_count(),
-            triangles: self.mesh.triangles().len(),
-            coefficients: indices.len(),
-            scene_hash: scene_hash(&self.mesh),
-            environment: self.environment.clone(),
-            camera: self.camera.clone(),
-        };
-        let sh = self.transport.sh().map_or(&[][..], |t| t.as_slice());
-        let sizes = [
-            self.mesh.positions().len() * 16,
-            self.transport.stored_bytes(),
-        ];
-        FORMAT.write(path, force, &header, sizes.iter().sum(), |body| {
-            put_all(
-                body,
-                self.mesh.positions().iter().chain(self.mesh.normals()),
-            );
-            put_all(body, self.mesh.triangles().iter().flatten());
-            put_all(body, &self.albedo);
-            put_all(body, offsets);
-            put_all(body, indices);
-            put_all(body, values.iter().chain(sh));
-        })
+        let header = header(
+            &self.params,
+            &self.mesh,
+            &self.transport,
+            (&self.environment, &self.camera),
+            None,
+        );
+        write_parts(
+            path,
+            force,
+            &header,
+            &self.mesh,
+            &self.albedo,
+            &self.transport,
+        )
     }
 
     /// The vertices of the scene's objects: all but the ground plane's, which stays
@@ -265,13 +250,10 @@ impl SceneCache {
         super::object_vertices(self.mesh.vertex_count(), self.params.ground_plane)
     }
 
-    /// Reads a cache, refusing a damaged file or another version; see the [module docs](self).
+    /// Reads a cache, refusing a damaged file, another version or a shard; see the
+    /// [module docs](self).
     pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::parse(&bytes).map_err(|e| e.in_file(path))
+        Self::parse(&read_bytes(path)?).map_err(|e| e.in_file(path))
     }
 
     /// Reads a cache and refuses it unless it was made for `mesh` (same [`scene_hash`]).
@@ -290,49 +272,179 @@ impl SceneCache {
     }
 
     fn parse(bytes: &[u8]) -> Result<Self> {
-        let (header, mut r) = FORMAT.open::<CacheHeader>(bytes)?;
-        let (v, t, n) = (header.vertices, header.triangles, header.coefficients);
-        let positions =
-            Array2::from_shape_vec((v, 3), r.f64s(3 * v)?).map_err(|e| r.corrupt(e.to_string()))?;
-        let normals =
-            Array2::from_shape_vec((v, 3), r.f64s(3 * v)?).map_err(|e| r.corrupt(e.to_string()))?;
-        let flat = r.u32s(3 * t)?;
-        let triangles = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let albedo =
-            Array2::from_shape_vec((v, 3), r.f32s(3 * v)?).map_err(|e| r.corrupt(e.to_string()))?;
-        let offsets = r.u64s(v + 1)?;
-        let indices = r.u32s(n)?;
-        let values = r.f32s(n)?;
-        let sh = match header.params.sh_bands {
-            Some(b) => {
-                let per_vertex = b
-                    .checked_mul(b)
-                    .ok_or_else(|| r.corrupt("size overflows"))?;
-                let flat = r.f32s(
-                    v.checked_mul(per_vertex)
-                        .ok_or_else(|| r.corrupt("size overflows"))?,
-                )?;
-                Some(ShTransfer::from_flat(b, flat)?)
-            }
-            None => None,
-        };
-        r.finish("transport")?;
-        let mesh = Mesh::new(positions, triangles, Some(normals))?;
-        let kind: ParamKind = header.params.param.parse()?;
-        let param = Parameterization::new(kind, header.params.resolution)?;
-        let transport = TransportSet::from_parts(
-            param,
-            header.params.keep.into(),
-            offsets,
-            indices,
-            values,
-            sh,
-        )?;
-        let mut cache = SceneCache::new(header.params, mesh, albedo, transport)?;
+        let (header, parts) = parse_parts(bytes)?;
+        if let Some(shard) = header.shard {
+            return Err(SceneError::CacheIsShard(shard).into());
+        }
+        let mut cache = SceneCache::new(header.params, parts.mesh, parts.albedo, parts.transport)?;
         cache.environment = header.environment;
         cache.camera = header.camera;
         Ok(cache)
     }
+}
+
+/// The arrays of a cache file, whole or shard.
+pub(super) struct Parts {
+    /// The whole scene's mesh.
+    pub mesh: Mesh,
+    /// Its albedo, `(V, 3)`.
+    pub albedo: Array2<f32>,
+    /// The transport of the vertices the file holds.
+    pub transport: TransportSet,
+}
+
+/// Checks that `albedo` and `mesh` describe the same vertices, `transport` has `rows` of
+/// them, and `params` names its parameterisation and spherical-harmonic bands.
+pub(super) fn check_parts(
+    params: &CacheParams,
+    mesh: &Mesh,
+    albedo: &Array2<f32>,
+    transport: &TransportSet,
+    rows: usize,
+) -> Result<()> {
+    let v = mesh.vertex_count();
+    if albedo.dim() != (v, 3) || transport.vertex_count() != rows {
+        return Err(Error::shape(
+            albedo.shape(),
+            format!(
+                "albedo must be ({v}, 3) and the transport have {rows} vertices (it has {})",
+                transport.vertex_count()
+            ),
+        ));
+    }
+    let p = transport.param();
+    let bands = transport.sh().map(|t| t.bands());
+    if params.param != p.kind().to_string()
+        || params.resolution != p.face_size()
+        || params.sh_bands != bands
+    {
+        return Err(Error::parameter(
+            "cache parameters",
+            format!(
+                "they say {} {} with {:?} sh bands but the transport is {} {} with {bands:?}",
+                params.param,
+                params.resolution,
+                params.sh_bands,
+                p.kind(),
+                p.face_size()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The header of a file holding `transport` for `mesh` (the scene file's environment and
+/// camera in `scene_file`), a shard's when `shard` is given.
+pub(super) fn header(
+    params: &CacheParams,
+    mesh: &Mesh,
+    transport: &TransportSet,
+    scene_file: (&Option<EnvironmentSpec>, &Option<CameraSpec>),
+    shard: Option<ShardRecord>,
+) -> CacheHeader {
+    CacheHeader {
+        params: params.clone(),
+        vertices: mesh.vertex_count(),
+        triangles: mesh.triangles().len(),
+        coefficients: transport.coefficient_count(),
+        scene_hash: scene_hash(mesh),
+        environment: scene_file.0.clone(),
+        camera: scene_file.1.clone(),
+        shard,
+    }
+}
+
+/// Writes a cache file, whole or shard: the one writer of both.
+pub(super) fn write_parts(
+    path: &Path,
+    force: bool,
+    header: &CacheHeader,
+    mesh: &Mesh,
+    albedo: &Array2<f32>,
+    transport: &TransportSet,
+) -> Result<u64> {
+    let (offsets, indices, values) = transport.parts();
+    let sh = transport.sh().map_or(&[][..], |t| t.as_slice());
+    let sizes = [
+        mesh.positions().len() * 16,
+        mesh.triangles().len() * 12,
+        albedo.len() * 4,
+        transport.stored_bytes(),
+    ];
+    FORMAT.write(path, force, header, sizes.iter().sum(), |body| {
+        put_all(body, mesh.positions().iter().chain(mesh.normals()));
+        put_all(body, mesh.triangles().iter().flatten());
+        put_all(body, albedo);
+        put_all(body, offsets);
+        put_all(body, indices);
+        put_all(body, values.iter().chain(sh));
+    })
+}
+
+/// A file's bytes, an unreadable file named.
+pub(super) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Parses a cache file, whole or shard: the one reader of both. The transport has the rows
+/// of the shard's range, or of every vertex.
+pub(super) fn parse_parts(bytes: &[u8]) -> Result<(CacheHeader, Parts)> {
+    let (header, mut r) = FORMAT.open::<CacheHeader>(bytes)?;
+    let (v, t, n) = (header.vertices, header.triangles, header.coefficients);
+    let rows = match header.shard {
+        None => v,
+        Some(s) if s.index < s.count && s.first <= s.end && s.end <= v => s.end - s.first,
+        Some(s) => {
+            return Err(r.corrupt(format!(
+                "shard {}/{} of vertices {}..{} among {v}",
+                s.index, s.count, s.first, s.end
+            )));
+        }
+    };
+    let overflow = || FORMAT.corrupt("size overflows");
+    let triple = v.checked_mul(3).ok_or_else(overflow)?;
+    let positions =
+        Array2::from_shape_vec((v, 3), r.f64s(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
+    let normals =
+        Array2::from_shape_vec((v, 3), r.f64s(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
+    let flat = r.u32s(t.checked_mul(3).ok_or_else(overflow)?)?;
+    let triangles = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let albedo =
+        Array2::from_shape_vec((v, 3), r.f32s(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
+    let offsets = r.u64s(rows.checked_add(1).ok_or_else(overflow)?)?;
+    let indices = r.u32s(n)?;
+    let values = r.f32s(n)?;
+    let sh = match header.params.sh_bands {
+        Some(b) => {
+            let per_vertex = b.checked_mul(b).ok_or_else(overflow)?;
+            let flat = r.f32s(rows.checked_mul(per_vertex).ok_or_else(overflow)?)?;
+            Some(ShTransfer::from_flat(b, flat)?)
+        }
+        None => None,
+    };
+    r.finish("transport")?;
+    let mesh = Mesh::new(positions, triangles, Some(normals))?;
+    let kind: ParamKind = header.params.param.parse()?;
+    let param = Parameterization::new(kind, header.params.resolution)?;
+    let transport = TransportSet::from_parts(
+        param,
+        header.params.keep.into(),
+        offsets,
+        indices,
+        values,
+        sh,
+    )?;
+    Ok((
+        header,
+        Parts {
+            mesh,
+            albedo,
+            transport,
+        },
+    ))
 }
 
 #[cfg(test)]

@@ -223,22 +223,28 @@ fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
 }
 
 #[test]
-fn a_version_1_file_is_refused() {
-    // Version 1 had no spherical-harmonic transfer; its files must be remade, not misread.
+fn version_1_and_2_files_are_refused() {
+    // Version 1 had no spherical-harmonic transfer, version 2 no shard record: their files
+    // must be remade, not misread.
     let (_dir, path) = written(&made(2));
-    let mut bytes = std::fs::read(&path).unwrap();
-    bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
-    std::fs::write(&path, &bytes).unwrap();
-    let e = refusal(&path);
-    assert_eq!(
-        e,
-        SceneError::CacheVersion {
-            found: 1,
-            expected: 2
-        }
-    );
-    assert_eq!(
-        e.to_string(),
-        "scene cache has format version 1, this build reads version 2; compute it again"
-    );
+    let good = std::fs::read(&path).unwrap();
+    for old in [1u32, 2] {
+        let mut bytes = good.clone();
+        bytes[8..12].copy_from_slice(&old.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let e = refusal(&path);
+        assert_eq!(
+            e,
+            SceneError::CacheVersion {
+                found: old,
+                expected: 3
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "scene cache has format version {old}, this build reads version 3; compute it again"
+            )
+        );
+    }
 }

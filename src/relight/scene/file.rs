@@ -289,7 +289,7 @@ impl SceneFile {
     /// let file: SceneFile = serde_json::from_str(r#"{"objects": [{"mesh": "bunny.ply"},
     ///     {"generator": {"sphere": {"cells": 3000}}}]}"#).unwrap();
     /// let err = file.check_memory(&MemoryBudget::default()).unwrap_err().to_string();
-    /// assert!(err.starts_with(r#"object 1 ({"sphere":{"cells":3000}}) and the generators before it: 54036006 vertices"#));
+    /// assert!(err.starts_with(r#"object 1, {"sphere":{"cells":3000}}, with the generators before it (54036006 vertices) needs"#));
     /// ```
     pub fn check_memory(&self, budget: &MemoryBudget) -> Result<()> {
         let mut vertices: u128 = 0;
@@ -302,7 +302,7 @@ impl SceneFile {
             vertices += generator.vertex_count().map_or(1 << 64, |v| v as u128);
             let settings = serde_json::to_string(generator).expect("a generator serialises");
             budget.check(
-                &format!("object {k} ({settings}) and the generators before it"),
+                &format!("object {k}, {settings}, with the generators before it"),
                 vertices,
             )?;
         }

@@ -51,6 +51,7 @@
 //! * `camera` (optional): position, look-at point, vertical field of view in degrees.
 
 pub mod cache;
+pub mod cache_shard;
 mod file;
 pub(crate) mod framed;
 mod generators;
@@ -182,10 +183,10 @@ impl Scene {
     /// let dir = tempfile::tempdir().unwrap();
     /// let path = dir.path().join("s.json");
     /// std::fs::write(&path, r#"{"objects": [{"generator": {"sphere": {"cells": 20}}}]}"#).unwrap();
-    /// let small = MemoryBudget { limit: 1 << 20, per_vertex: 0 };
+    /// let small = MemoryBudget { limit: 1 << 20, ..MemoryBudget::default() };
     /// let err = Scene::load_within(&path, &small).unwrap_err().to_string();
     /// assert!(err.starts_with(&format!("{}: object 0", path.display())));
-    /// assert!(err.contains("2646 vertices need about"));
+    /// assert!(err.contains("(2646 vertices) needs 1693440 bytes"));
     /// assert!(Scene::load(&path).is_ok());
     /// ```
     pub fn load_within(path: &Path, budget: &MemoryBudget) -> Result<Scene> {

@@ -128,24 +128,29 @@ pub fn grid_vertices(cells: usize) -> Option<usize> {
 pub const MESH_BYTES_PER_VERTEX: u64 = 640;
 
 /// How much memory a scene and the work on it may take, checked from its vertex count
-/// before anything is built: [`MESH_BYTES_PER_VERTEX`] plus `per_vertex` (what the caller
-/// stores for each vertex, e.g. a precomputation's transport) times the vertices, against
-/// `limit`.
+/// before anything is built: [`MESH_BYTES_PER_VERTEX`] times the vertices, plus `per_vertex`
+/// (what the caller stores for each vertex, e.g. a precomputation's transport) times the
+/// vertices of the largest of `shards` equal shares, against `limit`; more is an
+/// [`Error::MemoryBudget`](crate::Error::MemoryBudget).
 ///
 /// ```
 /// use haarshift::relight::scene::validate::{DEFAULT_MEMORY_LIMIT, MemoryBudget};
 /// let budget = MemoryBudget::default();
-/// assert_eq!((budget.limit, budget.per_vertex), (DEFAULT_MEMORY_LIMIT, 0));
+/// assert_eq!((budget.limit, budget.per_vertex, budget.shards), (DEFAULT_MEMORY_LIMIT, 0, 1));
 /// assert!(budget.check("the scene", 1_000_000).is_ok());
 /// let err = budget.check("the scene", 100_000_000).unwrap_err();
-/// assert!(err.to_string().contains("more than the memory limit of 4.00 GiB"));
+/// assert!(matches!(err, haarshift::Error::MemoryBudget { .. }));
+/// assert!(err.to_string().starts_with("the scene (100000000 vertices) needs"));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MemoryBudget {
     /// The most bytes the scene and its work may hold at once.
     pub limit: u64,
-    /// Bytes each vertex needs beyond [`MESH_BYTES_PER_VERTEX`].
+    /// Bytes each stored vertex needs beyond [`MESH_BYTES_PER_VERTEX`].
     pub per_vertex: u64,
+    /// The work is split into this many shares of the vertices (shards), each storing
+    /// `per_vertex` for its own; 0 counts as 1.
+    pub shards: u64,
 }
 
 impl Default for MemoryBudget {
@@ -153,6 +158,7 @@ impl Default for MemoryBudget {
         MemoryBudget {
             limit: DEFAULT_MEMORY_LIMIT,
             per_vertex: 0,
+            shards: 1,
         }
     }
 }
@@ -160,7 +166,10 @@ impl Default for MemoryBudget {
 impl MemoryBudget {
     /// The bytes `vertices` vertices need under this budget (in `u128`: no count wraps).
     pub fn needed(&self, vertices: u128) -> u128 {
-        vertices.saturating_mul(u128::from(MESH_BYTES_PER_VERTEX) + u128::from(self.per_vertex))
+        let stored = vertices.div_ceil(u128::from(self.shards.max(1)));
+        vertices
+            .saturating_mul(u128::from(MESH_BYTES_PER_VERTEX))
+            .saturating_add(stored.saturating_mul(u128::from(self.per_vertex)))
     }
 
     /// Refuses `vertices` vertices whose [`needed`](Self::needed) bytes exceed the limit;
@@ -170,13 +179,11 @@ impl MemoryBudget {
         if needed <= u128::from(self.limit) {
             return Ok(());
         }
-        Err(SceneError::MemoryLimit {
-            what: what.to_owned(),
-            vertices,
+        Err(crate::Error::MemoryBudget {
+            what: format!("{what} ({vertices} vertices)"),
             needed,
-            limit: self.limit,
-        }
-        .into())
+            budget: u128::from(self.limit),
+        })
     }
 }
 
@@ -232,21 +239,41 @@ mod tests {
         let budget = MemoryBudget {
             limit: 1 << 20,
             per_vertex: 1024 - MESH_BYTES_PER_VERTEX,
+            shards: 1,
         };
         // 1024 bytes a vertex: exactly 1024 vertices fit in 1 MiB, one more does not.
         assert_eq!(budget.needed(1024), 1 << 20);
         budget.check("the scene", 1024).unwrap();
         assert_err!(
             budget.check("the scene's generators", 1025),
-            Scene { .. },
-            "the scene's generators: 1025 vertices",
-            "memory limit of 0.00 GiB"
+            MemoryBudget {
+                needed: 1_049_600,
+                budget: 1_048_576,
+                ..
+            },
+            "the scene's generators (1025 vertices) needs 1049600 bytes"
+        );
+        // In 4 shards each stores 256 of 1024 vertices (and the largest 257 of 1025), the
+        // mesh stays whole.
+        let sharded = MemoryBudget {
+            shards: 4,
+            ..budget
+        };
+        assert_eq!(sharded.needed(1024), 1024 * 640 + 256 * 384);
+        assert_eq!(sharded.needed(1025), 1025 * 640 + 257 * 384);
+        assert_eq!(
+            MemoryBudget {
+                shards: 0,
+                ..budget
+            }
+            .needed(10),
+            10 * 1024
         );
         // A count past u64 stays a count, not a wrapped small one.
         assert_err!(
             MemoryBudget::default().check("x", u128::from(u64::MAX) * 4),
-            Scene { .. },
-            "memory limit"
+            MemoryBudget { .. },
+            "memory budget"
         );
     }
 }

@@ -10,16 +10,18 @@ pub mod animate;
 pub mod error;
 pub(crate) mod flags;
 pub mod gallery;
+pub mod merge;
 pub mod precompute;
 pub mod reference;
 pub mod render;
 pub mod scene;
 
-/// Relight meshes under environment maps: precompute, render, reference, animate, gallery,
+/// Relight meshes under environment maps: precompute (whole or in shards, merged by merge), render, reference, animate, gallery,
 /// dynamic scenes of moving objects (scene), and the error of renders against a reference.
 #[derive(Subcommand, Debug)]
 pub enum RelightCommand {
     Precompute(Box<precompute::Args>),
+    Merge(Box<merge::Args>),
     Render(Box<render::Args>),
     Reference(Box<reference::Args>),
     Animate(Box<animate::Args>),
@@ -31,6 +33,7 @@ pub enum RelightCommand {
 pub fn run(command: RelightCommand) -> Result<()> {
     match command {
         RelightCommand::Precompute(args) => precompute::run(*args),
+        RelightCommand::Merge(args) => merge::run(*args),
         RelightCommand::Render(args) => render::run(*args),
         RelightCommand::Reference(args) => reference::run(*args),
         RelightCommand::Animate(args) => animate::run(*args),

@@ -7,7 +7,10 @@ use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
 use haarshift::relight::VisibilityOptions;
-use haarshift::relight::precompute::{DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute};
+use haarshift::relight::precompute::shard::ShardSpec;
+use haarshift::relight::precompute::{
+    DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_shard, shard_is_done,
+};
 
 use super::flags::{SceneFlags, bytes};
 use crate::commands::{choice, names, print, refuse_outputs};
@@ -33,7 +36,18 @@ Examples:
   haarshift relight precompute bunny.ply --ground-plane --param cube --resolution 32 -o bunny.hsr
   haarshift relight precompute bunny.ply --ground-plane --resolution 64 --sh-bands 9 -o bunny.hsr
   haarshift relight precompute testdata/scenes/cubes.json --param cube --resolution 64 -o cubes.hsr
-  haarshift relight precompute scene.json --order direction --map-size 2048 -o scene.hsr";
+  haarshift relight precompute scene.json --order direction --map-size 2048 -o scene.hsr
+
+Sharded across machines (vertex order only): shard I of N computes the vertices
+[I x V / N, (I + 1) x V / N) against the whole scene, with the bits an unsharded run gives
+them; `relight merge` joins the shards into the cache an unsharded run writes, byte for byte.
+A shard whose output exists and is complete (same scene, options and shard) is skipped, so a
+rerun after a preemption does only what is missing. `--shard auto` reads the shard from a
+Slurm array job (SLURM_ARRAY_TASK_ID, _MIN, _STEP, _COUNT; arrays with gaps are refused) or a
+Kubernetes Indexed Job (JOB_COMPLETION_INDEX, with the Job's completions as --shards N):
+  haarshift relight precompute scene.json --shard 2/8 -o part-2.hsr
+  haarshift relight precompute scene.json --shard auto -o part-$SLURM_ARRAY_TASK_ID.hsr
+  haarshift relight precompute scene.json --shard auto --shards 8 -o part-$JOB_COMPLETION_INDEX.hsr";
 
 /// Precompute a scene's per-vertex visibility and transport into a cache file.
 #[derive(clap::Args, Debug)]
@@ -80,13 +94,34 @@ pub struct Args {
     #[arg(long, value_name = "B")]
     pub sh_bands: Option<usize>,
 
-    /// Replace the output if it exists
+    /// Compute shard I of N only (`I/N`, I from 0), or `auto`: from the Slurm array task or
+    /// the Kubernetes Indexed Job's completion index
+    #[arg(long, value_name = "I/N|auto", value_parser = shard_spec)]
+    pub shard: Option<ShardSpec>,
+
+    /// With `--shard auto` in a Kubernetes Indexed Job: the number of shards (the Job's
+    /// completions); under Slurm it must equal the array's task count
+    #[arg(long, value_name = "N", requires = "shard")]
+    pub shards: Option<usize>,
+
+    /// Replace the output if it exists (a shard: even a complete one)
     #[arg(long)]
     pub force: bool,
 }
 
+/// `--shard`, parsed by the library.
+fn shard_spec(s: &str) -> std::result::Result<ShardSpec, String> {
+    s.parse().map_err(|e: haarshift::Error| e.to_string())
+}
+
 pub fn run(args: Args) -> Result<()> {
-    refuse_outputs(&[&args.scene.input], &[&args.output], args.force)?;
+    let shard = args
+        .shard
+        .map(|spec| spec.resolve(|name| std::env::var(name).ok(), args.shards))
+        .transpose()?;
+    // An existing shard is looked at below (a complete one is skipped), once the scene is read.
+    let existing_allowed = args.force || shard.is_some();
+    refuse_outputs(&[&args.scene.input], &[&args.output], existing_allowed)?;
     let param = Parameterization::new(args.param, args.resolution)?;
     let mut visibility = VisibilityOptions::new(param);
     visibility.samples = args.visibility_samples;
@@ -102,17 +137,38 @@ pub fn run(args: Args) -> Result<()> {
         map_size: args.map_size,
         memory_limit: args.scene.memory_limit,
     };
-    let scene = args.scene.load_within(options.budget())?;
+    options.check()?;
+    let scene = args.scene.load_within(options.budget(shard))?;
     let (vertices, triangles) = (scene.mesh.vertex_count(), scene.mesh.triangles().len());
-    let (cache, report) = precompute(scene, &options)?;
-    let file_bytes = cache.write(&args.output, args.force)?;
+    let (what, transport, file_bytes, report) = match shard {
+        None => {
+            let (cache, report) = precompute(scene, &options)?;
+            let file_bytes = cache.write(&args.output, args.force)?;
+            (String::new(), cache.transport, file_bytes, report)
+        }
+        Some(shard) => {
+            let range = shard.vertices(vertices);
+            let what = format!(" (shard {shard}: vertices {}..{})", range.start, range.end);
+            if !args.force && shard_is_done(&args.output, &scene, &options, shard)? {
+                return print(&format!(
+                    "{}: shard {shard} (vertices {}..{}) is complete: skipped\n",
+                    args.output.display(),
+                    range.start,
+                    range.end
+                ));
+            }
+            let (part, report) = precompute_shard(scene, &options, shard)?;
+            let file_bytes = part.write(&args.output, args.force)?;
+            (what, part.transport, file_bytes, report)
+        }
+    };
     let rate = if report.seconds > 0.0 {
         report.rays as f64 / report.seconds
     } else {
         0.0
     };
     print(&format!(
-        "{}: {vertices} vertices, {triangles} triangles, {} {} ({} texels), {} order\n\
+        "{}: {vertices} vertices{what}, {triangles} triangles, {} {} ({} texels), {} order\n\
          rays {}, {:.3} s, {:.3} M rays/s, working memory {}\n\
          transport {} ({} coefficients), file {}, peak memory {}\n",
         args.output.display(),
@@ -124,8 +180,8 @@ pub fn run(args: Args) -> Result<()> {
         report.seconds,
         rate / 1e6,
         bytes(report.working_bytes as u64),
-        bytes(cache.transport.stored_bytes() as u64),
-        cache.transport.coefficient_count(),
+        bytes(transport.stored_bytes() as u64),
+        transport.coefficient_count(),
         bytes(file_bytes),
         peak_resident_bytes().map_or("unknown".into(), bytes),
     ))

@@ -53,7 +53,7 @@ pub fn succeeds_with_stdout(args: &[&str]) -> String {
 /// (exit code 1): exactly one line on stderr, `haarshift: ...`, containing every needle (the
 /// file or flag at fault and the problem), no panic, nothing on stdout. Returns the line.
 pub fn fails_cleanly_in(dir: Option<&Path>, args: &[&str], needles: &[&str]) -> String {
-    failure(dir, args, 1, "haarshift: ", needles)
+    failure(run_in(dir, args), args, 1, "haarshift: ", needles)
 }
 
 /// [`fails_cleanly_in`] in the current directory.
@@ -66,7 +66,7 @@ pub fn fails_cleanly(args: &[&str], needles: &[&str]) -> String {
 /// no panic, nothing on stdout. Returns the message (clap lists missing arguments on the lines
 /// after `error:`).
 pub fn usage_error_in(dir: Option<&Path>, args: &[&str], needles: &[&str]) -> String {
-    failure(dir, args, 2, "error: ", needles)
+    failure(run_in(dir, args), args, 2, "error: ", needles)
 }
 
 /// [`usage_error_in`] in the current directory.
@@ -74,15 +74,44 @@ pub fn usage_error(args: &[&str], needles: &[&str]) -> String {
     usage_error_in(None, args, needles)
 }
 
-/// The checks behind [`fails_cleanly_in`] and [`usage_error_in`]: exit `code` (a panic exits
-/// with 101), no panic text, the error first on stderr starting with `prefix` and holding every
-/// needle; exactly one line in all for the program's own errors (code 1).
-fn failure(dir: Option<&Path>, args: &[&str], code: i32, prefix: &str, needles: &[&str]) -> String {
+/// The variables a scheduler sets that `--shard auto` reads.
+const SCHEDULER_VARIABLES: [&str; 6] = [
+    "SLURM_ARRAY_TASK_ID",
+    "SLURM_ARRAY_TASK_MIN",
+    "SLURM_ARRAY_TASK_MAX",
+    "SLURM_ARRAY_TASK_STEP",
+    "SLURM_ARRAY_TASK_COUNT",
+    "JOB_COMPLETION_INDEX",
+];
+
+/// Runs `haarshift ARGS` as a scheduler's task with the variables `vars` and no other of
+/// [`SCHEDULER_VARIABLES`] (whatever the test itself runs under).
+pub fn run_scheduled(vars: &[(&str, &str)], args: &[&str]) -> Output {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_haarshift"));
+    for name in SCHEDULER_VARIABLES {
+        command.env_remove(name);
+    }
+    command
+        .envs(vars.iter().copied())
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// [`fails_cleanly`] for [`run_scheduled`].
+pub fn fails_cleanly_scheduled(vars: &[(&str, &str)], args: &[&str], needles: &[&str]) -> String {
+    failure(run_scheduled(vars, args), args, 1, "haarshift: ", needles)
+}
+
+/// The checks behind [`fails_cleanly_in`] and [`usage_error_in`] of the run of `args` that
+/// gave `out`: exit `code` (a panic exits with 101), no panic text, the error first on stderr
+/// starting with `prefix` and holding every needle; exactly one line in all for the program's
+/// own errors (code 1).
+fn failure(out: Output, args: &[&str], code: i32, prefix: &str, needles: &[&str]) -> String {
     assert!(
         !needles.is_empty() && needles.iter().all(|n| !n.trim().is_empty()),
         "an empty needle checks nothing: {needles:?}"
     );
-    let out = run_in(dir, args);
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
     for bad in ["panicked", "internal error", "RUST_BACKTRACE"] {

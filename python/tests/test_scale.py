@@ -1,0 +1,71 @@
+"""The sharded precomputation fanned out over a real Dask cluster (two worker processes) and
+merged: the cache an unsharded run writes, byte for byte."""
+import json
+import os
+
+import pytest
+from dask.distributed import Client, LocalCluster
+
+import haarshift
+
+OPTIONS = dict(param="cube", resolution=4, samples=2, seed=3, sh_bands=2)
+
+
+@pytest.fixture
+def balls(tmp_path):
+    """Two balls on a ground plane: 192 + 1089 vertices, the ground shadowed by the balls."""
+    ball = {"generator": {"sphere": {"cells": 3}}}
+    spec = {
+        "objects": [ball, dict(ball, transform={"translate": [2.5, 0, 0]})],
+        "ground_plane": True,
+    }
+    path = tmp_path / "balls.json"
+    path.write_text(json.dumps(spec))
+    return path
+
+
+def test_shards_on_a_dask_local_cluster_merge_into_the_unsharded_cache(tmp_path, balls):
+    count = 5
+
+    def shard(i):
+        # Runs in a worker process: the path it wrote and who wrote it.
+        path = haarshift.relight.precompute(
+            balls, shard=(i, count), output=tmp_path / f"part-{i}.hsr", **OPTIONS
+        )
+        return path, os.getpid()
+
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, Client(cluster) as client:
+        done = client.gather(client.map(shard, range(count)))
+        workers = set(client.run(os.getpid).values())
+    assert len(workers) == 2 and os.getpid() not in workers
+    assert {pid for _, pid in done} <= workers
+    parts = [path for path, _ in done]
+    assert parts == [str(tmp_path / f"part-{i}.hsr") for i in range(count)]
+
+    merged = haarshift.relight.merge(list(reversed(parts)), output=tmp_path / "merged.hsr")
+    whole = haarshift.relight.precompute(balls, output=tmp_path / "whole.hsr", **OPTIONS)
+    assert merged.vertex_count == whole.vertex_count == 1281
+    assert (tmp_path / "merged.hsr").read_bytes() == (tmp_path / "whole.hsr").read_bytes()
+
+
+def test_a_shard_is_skipped_when_complete_and_bad_shards_are_refused(tmp_path, balls):
+    part = tmp_path / "part-1.hsr"
+    assert haarshift.relight.precompute(balls, shard=(1, 2), output=part, **OPTIONS) == str(part)
+    before = part.stat().st_mtime_ns
+    haarshift.relight.precompute(balls, shard=(1, 2), output=part, **OPTIONS)
+    assert part.stat().st_mtime_ns == before  # complete: not written again
+    with pytest.raises(OSError, match="holds shard 1/2, not 0/2"):
+        haarshift.relight.precompute(balls, shard=(0, 2), output=part, **OPTIONS)
+    with pytest.raises(ValueError, match="give output="):
+        haarshift.relight.precompute(balls, shard=(0, 2), **OPTIONS)
+    with pytest.raises(ValueError, match="below the count"):
+        haarshift.relight.precompute(balls, shard=(2, 2), output=part, **OPTIONS)
+    with pytest.raises(OSError, match="part-1.hsr: the shards do not cover"):
+        haarshift.relight.merge([part])
+    taken = tmp_path / "taken.hsr"
+    taken.write_bytes(b"mine")
+    with pytest.raises(FileExistsError):
+        haarshift.relight.merge([part], output=taken)
+    assert taken.read_bytes() == b"mine"
