@@ -21,7 +21,15 @@
 //! query alike and many copies of one box make PLOC's merging quadratic. The mesh itself is not
 //! touched: cleaning feeds only the BVH. Positions reach it within
 //! [`MAX_COORDINATE`](super::validate::MAX_COORDINATE) (a [`Mesh`] holds no other), so every
-//! box it builds is finite. A ray hits a triangle when the Moller-Trumbore test finds `0 <= t <= t_max`
+//! box it builds is finite. A scene smaller than [`SMALL_EXTENT`] is scaled up by a power of
+//! two, to an extent between 1 and 2, before the build (and rays with it): PLOC ranks merges by
+//! box surface areas in f32, which underflow to zero below about `1e-19`, and a scene whose
+//! areas all tie builds in time quadratic in its triangles (a scene of extent `1e-23` took a
+//! minute for 12,000 under the fuzzer); and the wide BVH's traversal skips a child box the ray
+//! leaves before `t = 1e-4` (an absolute epsilon in `obvhs` 0.4), so such a scene would occlude
+//! nothing. Scaling by `2^k` is exact in floating point: the answers are those of the same
+//! scene at that size. (The epsilon is absolute at every size: in a scene of extent `1e-2`, an
+//! occluder within `1e-4` of a ray's origin is missed too.) A ray hits a triangle when the Moller-Trumbore test finds `0 <= t <= t_max`
 //! ([`obvhs::rt_triangle::RtTriangle::intersect`]); the caller offsets origins off surfaces.
 
 use std::collections::HashSet;
@@ -57,19 +65,49 @@ pub trait Occlusion: Sync {
 /// ```
 pub struct SceneBvh {
     bvh: Option<CwBvh>,
+    /// The power of two the positions were scaled by (1 unless the scene is tiny).
+    scale: f32,
     /// Triangles in the BVH's primitive order (no index indirection when tracing).
     triangles: Vec<RtTriangle>,
 }
 
+/// The extent (largest side of the bounding box, in f32) below which [`SceneBvh`] scales a
+/// scene up: `2^-20`, far above where PLOC's surface areas underflow.
+pub const SMALL_EXTENT: f32 = 1.0 / (1 << 20) as f32;
+
+/// The power of two that brings a scene of f32 bounding box `lo..hi` smaller than
+/// [`SMALL_EXTENT`] to an extent in `[1, 2)` (1 for any other scene, and one of no extent),
+/// keeping every coordinate within `2^50` (about 1e15).
+fn scale_for(lo: [f32; 3], hi: [f32; 3]) -> f32 {
+    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0f32, f32::max);
+    let largest = lo.iter().chain(&hi).fold(0.0f32, |m, v| m.max(v.abs()));
+    if !(extent > 0.0 && extent < SMALL_EXTENT) {
+        return 1.0;
+    }
+    // Whole powers of two: 1 <= extent * 2^up < 2, largest * 2^up <= 2^50.
+    let up = -(extent.log2().floor() as i32);
+    let room = (2f32.powi(50) / largest).log2().floor() as i32;
+    2f32.powi(up.min(room).clamp(0, 126))
+}
+
 impl SceneBvh {
     /// Builds the BVH of `mesh`'s distinct triangles of non-zero area in f32 (see the
-    /// [module docs](self)).
+    /// [module docs](self)), a scene smaller than [`SMALL_EXTENT`] scaled up first.
     pub fn new(mesh: &Mesh) -> Self {
         let p = mesh.positions();
-        let point = |i: u32| {
-            let r = p.row(i as usize);
+        let f32_row = |i: usize| {
+            let r = p.row(i);
             [r[0] as f32, r[1] as f32, r[2] as f32]
         };
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for i in 0..mesh.vertex_count() {
+            let v = f32_row(i);
+            for k in 0..3 {
+                (lo[k], hi[k]) = (lo[k].min(v[k]), hi[k].max(v[k]));
+            }
+        }
+        let scale = scale_for(lo, hi);
+        let point = |i: u32| f32_row(i as usize).map(|x| x * scale);
         let mut seen = HashSet::with_capacity(mesh.triangles().len());
         let triangles: Vec<Triangle> = mesh
             .triangles()
@@ -89,6 +127,7 @@ impl SceneBvh {
         if triangles.is_empty() {
             return SceneBvh {
                 bvh: None,
+                scale,
                 triangles: Vec::new(),
             };
         }
@@ -104,6 +143,7 @@ impl SceneBvh {
             .collect();
         SceneBvh {
             bvh: Some(bvh),
+            scale,
             triangles: ordered,
         }
     }
@@ -115,11 +155,12 @@ impl Occlusion for SceneBvh {
         let Some(bvh) = &self.bvh else {
             return false;
         };
+        // In the BVH's scaled space: origin + t d becomes s origin + (s t) d.
         let ray = Ray::new(
-            Vec3A::from_array(origin),
+            Vec3A::from_array(origin) * self.scale,
             Vec3A::from_array(direction),
             0.0,
-            t_max,
+            t_max * self.scale,
         );
         !bvh.ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
     }

@@ -88,3 +88,40 @@ fn repeated_and_f32_degenerate_triangles_are_kept_once_and_dropped() {
     // The mesh keeps every triangle as read: cleaning feeds only the BVH.
     assert_eq!(mesh.triangles(), &triangles[..]);
 }
+
+#[test]
+fn a_tiny_scene_answers_as_the_same_scene_at_an_extent_between_one_and_two() {
+    // The bunny on its ground scaled by 2^-76 (extent about 1e-23, where PLOC's f32 surface
+    // areas underflow and the traversal's 1e-4 epsilon skips every box) is traced at an
+    // extent in [1, 2): exactly the bunny scaled there directly, powers of two being exact.
+    let mesh = bunny_on_ground();
+    let scaled = |s: f64| {
+        let positions = mesh.positions().mapv(|x| x * s);
+        Mesh::new(positions, mesh.triangles().to_vec(), None).unwrap()
+    };
+    let b = mesh.bounds();
+    let extent = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max);
+    let unit = 2f64.powi(-(extent.log2().floor() as i32));
+    let (near, tiny) = (
+        SceneBvh::new(&scaled(unit)),
+        SceneBvh::new(&scaled(2f64.powi(-76))),
+    );
+    assert_eq!(near.scale, 1.0);
+    assert_eq!(f64::from(tiny.scale), unit * 2f64.powi(76));
+    let mut rng = StdRng::seed_from_u64(7);
+    let mut hits = 0;
+    for _ in 0..20_000 {
+        let o: [f32; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+        let d: [f32; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+        let t_max = if rng.random_bool(0.5) {
+            f32::INFINITY
+        } else {
+            0.3
+        };
+        let answer = near.occluded(o, d, t_max);
+        let t = (2f64.powi(-76) / unit) as f32;
+        assert_eq!(tiny.occluded(o.map(|x| x * t), d, t_max * t), answer);
+        hits += usize::from(answer);
+    }
+    assert!((1_000..19_000).contains(&hits), "{hits}");
+}
