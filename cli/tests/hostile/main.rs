@@ -290,7 +290,8 @@ fn generators_too_large_for_the_memory_limit_are_refused_before_they_are_built()
             ],
         );
     }
-    // The limit is the flag's: 10,086 vertices need 27 MB at lat-long 8 with every coefficient.
+    // The limit is the flag's: 10,086 vertices need 28.7 MB at lat-long 8 with every coefficient
+    // (640 + 16 x 128 + 80 bytes each).
     file(
         d,
         "s.json",

@@ -122,9 +122,10 @@ pub fn grid_vertices(cells: usize) -> Option<usize> {
 /// The bytes one vertex of a scene holds while it is loaded, its BVH built and its cache
 /// written, about two triangles a vertex: the mesh (positions and normals in f64, albedo in
 /// f32, indices: 84 bytes), the BVH's f32 triangles and its build, and the file's copy of
-/// the mesh. Measured: a sphere of 543,606 vertices peaks at 646 bytes a vertex through
-/// `relight precompute --resolution 2`, about 136 of them its 8-texel transport, so 640
-/// leaves a quarter to spare.
+/// the mesh. Measured: `haarshift relight precompute s.json --resolution 2 -o s.hsr` with
+/// `s.json` = `{"objects":[{"generator":{"sphere":{"cells":300}}}]}` (543,606 vertices)
+/// reports a peak of 342.9 MiB, 646 bytes a vertex, about 136 of them its 8-texel transport
+/// and file copy of it; the remaining 510 leave 640 a quarter to spare.
 pub const MESH_BYTES_PER_VERTEX: u64 = 640;
 
 /// How much memory a scene and the work on it may take, checked from its vertex count
