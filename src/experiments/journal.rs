@@ -9,6 +9,15 @@
 //! final files are still written atomically at the end; [`Journal::finish`] then removes the
 //! journal and its sidecar files.
 //!
+//! **Shards** spread a run over machines: [`Journal::create_shard`] makes shard `I` of `N`'s
+//! journal beside the run's (`<journal>.shard-I-of-N`), and [`Journal::assigned`] gives it
+//! every `N`-th unit in the run's order (the units `k` with `k mod N = I`), the others being
+//! left to the other shards. Once every shard is done, [`Journal::resume`] of the run's own
+//! journal takes in every shard journal beside it written with the same options, so the run
+//! measures nothing it already has and its records are merged into the same tables; its
+//! [`finish`](Journal::finish) removes them too. Sidecar files are named after the run's
+//! journal whichever shard writes them, so that the merging run finds them.
+//!
 //! ```
 //! use haarshift::experiments::journal::Journal;
 //! let dir = tempfile::tempdir().unwrap();
@@ -34,6 +43,7 @@ use std::path::{Path, PathBuf};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+use crate::relight::precompute::shard::Shard;
 use crate::{Error, Result};
 
 /// What the header's `journal` field holds: the format and its version.
@@ -56,9 +66,15 @@ struct Entry {
 pub struct Journal {
     /// `None`: a journal kept in memory only ([`Journal::in_memory`]).
     file: Option<(PathBuf, File)>,
+    /// The run's journal, after which sidecars are named (a shard's is not its own file).
+    run_path: Option<PathBuf>,
     done: HashMap<String, serde_json::Value>,
     resumed: usize,
     sidecars: Vec<PathBuf>,
+    /// Shard journals taken in by [`Journal::resume`], removed by [`Journal::finish`].
+    absorbed: Vec<PathBuf>,
+    /// With a shard: which units are this shard's, and how many [`Journal::assigned`] has seen.
+    shard: Option<(Shard, usize)>,
 }
 
 impl Journal {
@@ -66,10 +82,75 @@ impl Journal {
     pub fn in_memory() -> Self {
         Journal {
             file: None,
+            run_path: None,
             done: HashMap::new(),
             resumed: 0,
             sidecars: Vec::new(),
+            absorbed: Vec::new(),
+            shard: None,
         }
+    }
+
+    /// Starts the journal of shard `shard` of the run whose journal is `run`: the file
+    /// `<run>.shard-I-of-N`, which a later [`Journal::resume`] of `run` takes in (see the
+    /// [module docs](self)). An existing shard journal is gone on with, as a resume would: a
+    /// preempted shard redoes only what it had not finished.
+    ///
+    /// ```
+    /// use haarshift::experiments::journal::Journal;
+    /// use haarshift::relight::precompute::shard::Shard;
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let run = dir.path().join("run.journal");
+    /// let mut measured = Vec::new();
+    /// for i in 0..2 {
+    ///     let mut shard = Journal::create_shard(&run, Shard::new(i, 2).unwrap(), "o").unwrap();
+    ///     for unit in ["a", "b", "c"] {
+    ///         if shard.assigned(unit) {
+    ///             measured.push((i, unit));
+    ///             shard.unit(unit, || Ok(unit.len())).unwrap();
+    ///         }
+    ///     }
+    /// }
+    /// assert_eq!(measured, [(0, "a"), (0, "c"), (1, "b")]);
+    /// // The run takes in both shards' units and measures none.
+    /// let mut journal = Journal::resume(&run, "o").unwrap();
+    /// for unit in ["a", "b", "c"] {
+    ///     assert!(journal.assigned(unit));
+    ///     journal.unit(unit, || -> haarshift::Result<usize> { unreachable!("journaled") }).unwrap();
+    /// }
+    /// assert_eq!(journal.resumed(), 3);
+    /// journal.finish().unwrap();
+    /// assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    /// ```
+    pub fn create_shard(run: &Path, shard: Shard, options: &str) -> Result<Self> {
+        let path = Self::shard_path(run, shard);
+        let mut journal = if path.exists() {
+            Self::reopen(&path, options)?
+        } else {
+            Self::create(&path, options, false)?
+        };
+        journal.run_path = Some(run.to_owned());
+        journal.shard = Some((shard, 0));
+        Ok(journal)
+    }
+
+    /// The journal of shard `shard` of the run whose journal is `run`.
+    fn shard_path(run: &Path, shard: Shard) -> PathBuf {
+        let mut name = run.as_os_str().to_owned();
+        name.push(format!(".shard-{}-of-{}", shard.index(), shard.count()));
+        PathBuf::from(name)
+    }
+
+    /// Whether the unit `key`, the next in the run's order, is this journal's to measure or
+    /// read back: every unit without a shard; with one, a unit already journaled or one of the
+    /// shard's share. Call it once per unit, in the same order in every shard.
+    pub fn assigned(&mut self, key: &str) -> bool {
+        let Some((shard, seen)) = &mut self.shard else {
+            return true;
+        };
+        let ordinal = *seen;
+        *seen += 1;
+        self.done.contains_key(key) || ordinal % shard.count() == shard.index()
     }
 
     /// Starts a journal at `path` for a run with `options` (any text that tells runs apart: a
@@ -96,14 +177,65 @@ impl Journal {
         file.sync_data().map_err(io)?;
         Ok(Journal {
             file: Some((path.to_owned(), file)),
+            run_path: Some(path.to_owned()),
             ..Self::in_memory()
         })
     }
 
-    /// Reopens the journal at `path` of a run with `options` to go on with it. Refused when the
-    /// file is not a journal, was written with other options, or has a damaged line before
-    /// its last; a last line cut short is dropped (the file is truncated to the lines before).
+    /// Reopens the journal at `path` of a run with `options` to go on with it, taking in the
+    /// units of every shard journal beside it ([`Journal::create_shard`]); with shard journals
+    /// and no journal of its own, the run's journal is started. Refused when a file is not a
+    /// journal, was written with other options, or has a damaged line before its last; a last
+    /// line cut short is dropped (the file is truncated to the lines before).
     pub fn resume(path: &Path, options: &str) -> Result<Self> {
+        let shards = Self::shard_journals(path)?;
+        let mut journal = if shards.is_empty() || path.exists() {
+            Self::reopen(path, options)?
+        } else {
+            Self::create(path, options, false)?
+        };
+        for shard in shards {
+            let other = Self::reopen(&shard, options)?;
+            for (unit, value) in other.done {
+                journal.done.entry(unit).or_insert(value);
+            }
+            journal.absorbed.push(shard);
+        }
+        Ok(journal)
+    }
+
+    /// The shard journals beside the run journal `run`, in name order.
+    fn shard_journals(run: &Path) -> Result<Vec<PathBuf>> {
+        let dir = match run.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let Some(name) = run.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+            return Ok(Vec::new());
+        };
+        let prefix = format!("{name}.shard-");
+        let listing = std::fs::read_dir(dir).map_err(|source| Error::Io {
+            path: dir.to_owned(),
+            source,
+        })?;
+        let mut found: Vec<PathBuf> = listing
+            .filter_map(|e| e.ok())
+            .filter(|e| {
+                let file = e.file_name().to_string_lossy().into_owned();
+                file.strip_prefix(&prefix).is_some_and(|rest| {
+                    let mut parts = rest.split("-of-");
+                    let number = |p: Option<&str>| p.is_some_and(|p| p.parse::<usize>().is_ok());
+                    number(parts.next()) && number(parts.next()) && parts.next().is_none()
+                })
+            })
+            .map(|e| e.path())
+            .collect();
+        found.sort();
+        Ok(found)
+    }
+
+    /// Reopens one journal file: [`Journal::resume`] without the shards.
+    fn reopen(path: &Path, options: &str) -> Result<Self> {
         let io = |source| Error::Io {
             path: path.to_owned(),
             source,
@@ -136,9 +268,9 @@ impl Journal {
         file.set_len(complete as u64).map_err(io)?;
         Ok(Journal {
             file: Some((path.to_owned(), file)),
+            run_path: Some(path.to_owned()),
             done,
-            resumed: 0,
-            sidecars: Vec::new(),
+            ..Self::in_memory()
         })
     }
 
@@ -174,6 +306,19 @@ impl Journal {
         Ok(value)
     }
 
+    /// [`Journal::assigned`], then [`Journal::unit`] when the unit is this journal's; `None`
+    /// when it is another shard's.
+    pub fn assigned_unit<T: Serialize + DeserializeOwned>(
+        &mut self,
+        key: &str,
+        measure: impl FnOnce() -> Result<T>,
+    ) -> Result<Option<T>> {
+        if !self.assigned(key) {
+            return Ok(None);
+        }
+        self.unit(key, measure).map(Some)
+    }
+
     /// Text that tells the contents of `inputs` apart, for a journal's options: each file's
     /// path, length and CRC-32, so that a resume after an input changed is refused.
     pub fn fingerprint(inputs: &[PathBuf]) -> Result<String> {
@@ -202,21 +347,21 @@ impl Journal {
     /// large for a line, such as a picture), removed with it by [`Journal::finish`]; `None` for
     /// a journal in memory.
     pub fn sidecar(&mut self, name: &str) -> Option<PathBuf> {
-        let (path, _) = self.file.as_ref()?;
-        let mut file = path.clone().into_os_string();
+        let mut file = self.run_path.clone()?.into_os_string();
         file.push(format!(".{name}"));
         let file = PathBuf::from(file);
         self.sidecars.push(file.clone());
         Some(file)
     }
 
-    /// Ends a run whose final files are written: removes the journal and its sidecars.
+    /// Ends a run whose final files are written: removes the journal, its sidecars and the
+    /// shard journals it took in.
     pub fn finish(self) -> Result<()> {
         let Some((path, file)) = self.file else {
             return Ok(());
         };
         drop(file);
-        for file in self.sidecars.iter().chain([&path]) {
+        for file in self.sidecars.iter().chain(&self.absorbed).chain([&path]) {
             match std::fs::remove_file(file) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
                     return Err(Error::Io {

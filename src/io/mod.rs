@@ -76,6 +76,7 @@ use crate::{Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
 mod atomic;
 mod coefficients;
+pub(crate) mod mapped;
 mod npy;
 mod openexr;
 mod raster;

@@ -112,7 +112,7 @@ fn measured_records(dir: &Path) -> Vec<String> {
 }
 
 #[test]
-fn a_killed_run_resumes_to_the_records_of_an_uninterrupted_one() {
+fn a_killed_or_sharded_run_resumes_to_the_records_of_an_uninterrupted_one() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("ball.json");
     std::fs::write(
@@ -168,6 +168,47 @@ fn a_killed_run_resumes_to_the_records_of_an_uninterrupted_one() {
     assert!(said.contains("resumed: "), "{said}");
     assert_eq!(measured_records(&stopped), measured_records(&whole));
     assert!(!journal.exists());
+    // Three shards as separate processes into one directory, then --resume merges them: the
+    // same records, measured by nobody twice, and no journal left behind.
+    let sharded = dir.path().join("sharded");
+    let mut records = 0;
+    for i in 0..3 {
+        let mut shard = args(&sharded);
+        shard.extend(["--shard".into(), format!("{i}/3")]);
+        let said = succeeds_with_stdout(&strs(&shard));
+        assert!(said.contains(&format!("shard {i}/3: ")), "{said}");
+        assert!(
+            sharded
+                .join(format!("relight.journal.shard-{i}-of-3"))
+                .exists()
+        );
+        records += said
+            .split(&format!("shard {i}/3: "))
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse::<usize>()
+            .unwrap();
+    }
+    assert!(!sharded.join("relight.csv").exists());
+    let mut merge = args(&sharded);
+    merge.push("--resume".into());
+    let out = succeeds(&strs(&merge));
+    assert_eq!(measured_records(&sharded), measured_records(&whole));
+    assert_eq!(
+        records,
+        measured_records(&whole).len(),
+        "each record measured once"
+    );
+    let left: Vec<_> = std::fs::read_dir(&sharded)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("journal"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    assert!(text(&out.stderr).contains("resumed: "));
     // Another protocol cannot go on with a journal.
     let copy = dir.path().join("copy");
     std::fs::create_dir_all(&copy).unwrap();

@@ -299,6 +299,8 @@ fn render_writes_the_image_and_vertices_and_times_each_stage() {
         "shading ",
         "rasterisation ",
         "40 x 30",
+        // The transport is not copied: the render reads it from the mapped file.
+        "coefficients read in place from the cache file",
     ] {
         assert!(stdout.contains(needle), "{needle:?} in {stdout}");
     }

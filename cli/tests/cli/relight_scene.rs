@@ -4,7 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::common::{fails_cleanly, p, succeeds_with_stdout, testdata};
+use crate::common::{
+    fails_cleanly, p, run_scheduled, succeeds_with_stdout, testdata, text, usage_error,
+};
 
 /// Two spheres on the ground plane, one named `ball`, under the 32 x 16 test map.
 fn two_spheres(dir: &Path) -> PathBuf {
@@ -528,4 +530,85 @@ fn an_eye_segment_renders_as_the_camera_placed_where_it_orbits_to() {
         "{}",
         differ(&first, &still.view())
     );
+}
+
+#[test]
+fn fields_built_by_shard_load_into_the_render_of_an_unsharded_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("shapes.json");
+    let env = testdata("envmaps/rooitou_park_32x16.hdr");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"{{"objects": [
+                {{"generator": {{"sphere": {{"cells": 3}}}}, "transform": {{"translate": [0, 1, 0]}}}},
+                {{"generator": {{"sphere": {{"cells": 2}}}},
+                  "transform": {{"translate": [2.2, 0.5, 0.4], "scale": 0.5}}}}],
+              "ground_plane": true, "environment": {{"path": "{}"}}}}"#,
+            env.display()
+        ),
+    )
+    .unwrap();
+    let fields = dir.path().join("fields");
+    let shard = |vars: &[(&str, &str)], spec: &str| {
+        let mut args = vec!["relight", "scene", p(&scene), "--fields-dir", p(&fields)];
+        args.extend(["--shard", spec]);
+        args.extend(SMALL);
+        args.extend(COARSE);
+        let out = run_scheduled(vars, &args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+    };
+    // Shard 0 of 2 holds the first shape only.
+    let stdout = shard(&[], "0/2");
+    assert!(
+        stdout.contains("shard 0/2: fields of 1 shapes in "),
+        "{stdout}"
+    );
+    assert!(stdout.contains(": 1 built ("), "{stdout}");
+    assert!(fields.join("sphere-cells-3.hsf").exists());
+    assert!(!fields.join("sphere-cells-2.hsf").exists());
+    // Shard 1 of 2 from a Slurm array's variables; run again, it finds its file.
+    let slurm = [
+        ("SLURM_ARRAY_TASK_ID", "1"),
+        ("SLURM_ARRAY_TASK_MIN", "0"),
+        ("SLURM_ARRAY_TASK_MAX", "1"),
+        ("SLURM_ARRAY_TASK_COUNT", "2"),
+    ];
+    let stdout = shard(&slurm, "auto");
+    assert!(
+        stdout.contains("shard 1/2: fields of 1 shapes in "),
+        "{stdout}"
+    );
+    assert!(fields.join("sphere-cells-2.hsf").exists());
+    let stdout = shard(&slurm, "auto");
+    assert!(
+        stdout.contains(": 0 built (0 rays, 0.0 s), 1 loaded"),
+        "{stdout}"
+    );
+    // A render with the directory loads both and builds nothing; its radiance is that of a
+    // run that built its fields itself.
+    let (sharded, fresh) = (dir.path().join("s.npy"), dir.path().join("f.npy"));
+    let stdout = run_with_fields(&scene, &fields, &sharded, &[]);
+    assert!(stdout.contains(": 2 loaded in "), "{stdout}");
+    assert!(stdout.contains(", 0 written, "), "{stdout}");
+    run_with_fields(&scene, &dir.path().join("other"), &fresh, &[]);
+    let (a, b) = (read_npy(&sharded), read_npy(&fresh));
+    assert!(a.iter().any(|&x| x > 0.0));
+    assert_eq!(a, b);
+    // --shard needs --fields-dir, and renders nothing.
+    let args = ["relight", "scene", p(&scene), "--shard", "0/2"];
+    fails_cleanly(&args, &["--fields-dir DIR"]);
+    let out = dir.path().join("x.png");
+    let args = [
+        "relight",
+        "scene",
+        p(&scene),
+        "--shard",
+        "0/2",
+        "-o",
+        p(&out),
+    ];
+    usage_error(&args, &["--shard"]);
+    usage_error(&["relight", "scene", p(&scene)], &["--output"]);
 }

@@ -356,7 +356,9 @@ pub struct RelightResults {
 ///
 /// Each unit of work (a scene's truth, a condition of the rotation axis, an axis under one
 /// material) goes through `journal` ([`Journal::in_memory`] for none): a resumed journal's
-/// units are taken from it, and a scene whose units are all journaled casts no rays.
+/// units are taken from it, and a scene whose units are all journaled casts no rays. A shard's
+/// journal ([`Journal::create_shard`]) measures its share of the units only, and the results
+/// hold those.
 pub fn run(
     subjects: &[Subject],
     lights: &[Light],
@@ -381,13 +383,15 @@ pub fn run(
         // Built (its truth cast) only when a unit of it is not journaled.
         let mut slot = None;
         let unit = |name: String| format!("{index} {}/{name}", subject.name);
-        let seconds = journal.unit(&unit("truth".into()), || {
+        let truth = journal.assigned_unit(&unit("truth".into()), || {
             Ok(under_test(&mut slot, subject, protocol)?
                 .truth_bits
                 .report()
                 .seconds)
         })?;
-        results.truth_seconds.push((subject.name.clone(), seconds));
+        if let Some(seconds) = truth {
+            results.truth_seconds.push((subject.name.clone(), seconds));
+        }
         let mut push = |records: Vec<RelightRecord>| {
             records.iter().for_each(&mut progress);
             results.records.extend(records);
@@ -405,8 +409,8 @@ pub fn run(
                 .then(|| journal.sidecar(&format!("grid-{index}.png")))
                 .flatten();
             let mut grid = None;
-            let (records, label): (_, Option<(String, String)>) =
-                journal.unit(&unit(format!("rotation {k}")), || {
+            let measured: Option<(_, Option<(String, String)>)> =
+                journal.assigned_unit(&unit(format!("rotation {k}")), || {
                     let (records, picture) = under_test(&mut slot, subject, protocol)?
                         .rotation_axis(condition, k < protocol.reference_settings)?;
                     if !keep_grid {
@@ -419,6 +423,10 @@ pub fn run(
                     grid = Some(picture);
                     Ok((records, Some(label)))
                 })?;
+            // Another shard's unit.
+            let Some((records, label)) = measured else {
+                continue;
+            };
             push(records);
             // Taken from the journal: the grid is read back from its sidecar.
             if let (None, Some(file), Some((name, caption))) = (&grid, &grid_file, label) {
@@ -431,27 +439,43 @@ pub fn run(
             results.grids.extend(grid);
         }
         let first = Condition::new(&lights[0], [0.0; 3], &protocol.coefficient_material, 0)?;
-        push(journal.unit(&unit("coefficients".into()), || {
-            under_test(&mut slot, subject, protocol)?.coefficient_axis(&first)
-        })?);
+        push(
+            journal
+                .assigned_unit(&unit("coefficients".into()), || {
+                    under_test(&mut slot, subject, protocol)?.coefficient_axis(&first)
+                })?
+                .unwrap_or_default(),
+        );
         for (m, brdf) in protocol.resolution_materials.iter().enumerate() {
             let condition = Condition::new(&lights[0], [0.0; 3], brdf, 0)?;
-            push(journal.unit(&unit(format!("resolution {m}")), || {
-                under_test(&mut slot, subject, protocol)?.resolution_axis(&condition)
-            })?);
+            push(
+                journal
+                    .assigned_unit(&unit(format!("resolution {m}")), || {
+                        under_test(&mut slot, subject, protocol)?.resolution_axis(&condition)
+                    })?
+                    .unwrap_or_default(),
+            );
         }
         for (m, brdf) in protocol.depth_materials.iter().enumerate() {
             let condition = Condition::new(&lights[0], [0.0; 3], brdf, 0)?;
-            push(journal.unit(&unit(format!("depth {m}")), || {
-                under_test(&mut slot, subject, protocol)?.depth_axis(&condition)
-            })?);
+            push(
+                journal
+                    .assigned_unit(&unit(format!("depth {m}")), || {
+                        under_test(&mut slot, subject, protocol)?.depth_axis(&condition)
+                    })?
+                    .unwrap_or_default(),
+            );
         }
         for (l, light) in maps.iter().enumerate() {
             for (m, brdf) in protocol.harmonics_materials.iter().enumerate() {
                 let condition = Condition::new(light, [0.0; 3], brdf, 0)?;
-                push(journal.unit(&unit(format!("harmonics {l} {m}")), || {
-                    under_test(&mut slot, subject, protocol)?.harmonics_axis(&condition)
-                })?);
+                push(
+                    journal
+                        .assigned_unit(&unit(format!("harmonics {l} {m}")), || {
+                            under_test(&mut slot, subject, protocol)?.harmonics_axis(&condition)
+                        })?
+                        .unwrap_or_default(),
+                );
             }
         }
     }

@@ -1,18 +1,19 @@
 //! Building a dynamic scene: its shapes, their occlusion fields (computed or read from the
 //! field store) and each object's own transport at its file placement.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::relight::dynamic::fields::OcclusionField;
 use crate::relight::dynamic::fields::file::{FieldOrigin, FieldStore};
+use crate::relight::dynamic::fields::{FieldOptions, OcclusionField};
+use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::visibility::{VisibilityOptions, ray_offset, vertex_major};
 use crate::relight::scene::shapes::merge;
 use crate::relight::scene::validate::MemoryBudget;
 use crate::relight::scene::{SceneFile, ground_plane_under};
 use crate::relight::shade::glossy::GlossyOptions;
-use crate::relight::{Mesh, SceneBvh, SceneError};
+use crate::relight::{Generator, Mesh, SceneBvh, SceneError};
 use crate::{Error, Result};
 
 use crate::relight::dynamic::{
@@ -20,6 +21,51 @@ use crate::relight::dynamic::{
 };
 
 impl DynamicScene {
+    /// Builds or loads, in `store`, the occlusion fields of shard `shard`'s share of the
+    /// distinct shapes of the scene file at `path` ([`Shard::range`] of them, in order of first
+    /// use); a shape whose file already matches is loaded, not built again. Fields are one
+    /// file a shape and independent, so the shards of `relight scene --fields-dir DIR --shard
+    /// I/N` need no merge: a render with the same `DIR` then loads every shape's file.
+    ///
+    /// ```
+    /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+    /// use haarshift::relight::dynamic::fields::file::FieldStore;
+    /// use haarshift::relight::precompute::shard::Shard;
+    /// use haarshift::faces::{ParamKind, Parameterization};
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let scene = dir.path().join("two.json");
+    /// std::fs::write(&scene, r#"{"objects": [{"generator": {"sphere": {"cells": 2}}},
+    ///                                        {"generator": {"table": {"cells": 1}}}]}"#).unwrap();
+    /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
+    /// (options.field.circles, options.field.circle_points) = (3, 6);
+    /// (options.field.shells, options.field.shell_grid) = (2, 2);
+    /// let mut store = FieldStore::new(dir.path(), false);
+    /// let second = Shard::new(1, 2).unwrap();
+    /// let report = DynamicScene::build_fields(&scene, &options, &mut store, second).unwrap();
+    /// assert_eq!(report.fields_written, 1);
+    /// assert!(dir.path().join("table-cells-1.hsf").exists());
+    /// assert!(!dir.path().join("sphere-cells-2.hsf").exists());
+    /// ```
+    pub fn build_fields(
+        path: &Path,
+        options: &DynamicOptions,
+        store: &mut FieldStore,
+        shard: Shard,
+    ) -> Result<BuildReport> {
+        let mut build = || {
+            options.check()?;
+            let (file, dir) = SceneFile::read(path)?;
+            file.check_memory(&MemoryBudget::default())?;
+            let shapes = Shapes::of(&file, dir)?;
+            let mut report = BuildReport::default();
+            for i in shard.range(shapes.meshes.len()) {
+                shapes.field(i, Some(&mut *store), &options.field, &mut report)?;
+            }
+            Ok(report)
+        };
+        build().map_err(|e: Error| e.in_file(path))
+    }
+
     /// Reads a JSON scene file ([`SceneFile`]) and builds it.
     pub fn load(path: &Path, options: &DynamicOptions) -> Result<Self> {
         Self::load_with(path, options, None)
@@ -91,8 +137,7 @@ impl DynamicScene {
         }
         let param = options.param();
         let mut report = BuildReport::default();
-        let mut sources = Vec::new();
-        let mut shapes: Vec<Mesh> = Vec::new();
+        let shapes = Shapes::of(file, dir)?;
         let mut placed = Vec::new();
         let mut names: Vec<Option<String>> = Vec::new();
         for (k, object) in file.objects.iter().enumerate() {
@@ -104,15 +149,7 @@ impl DynamicScene {
                 );
             }
             names.push(object.name.clone());
-            let source = (object.mesh.clone(), object.generator.clone());
-            let shape = match sources.iter().position(|s| *s == source) {
-                Some(i) => i,
-                None => {
-                    shapes.push(object.shape(dir, k)?);
-                    sources.push(source);
-                    shapes.len() - 1
-                }
-            };
+            let shape = shapes.of_object[k];
             let placement =
                 Placement::from_transform(&object.transform, param).map_err(|e| match e {
                     Error::Scene { source, .. } => {
@@ -134,47 +171,19 @@ impl DynamicScene {
         }
         let meshes = placed
             .iter()
-            .map(|(shape, p, _, _)| place_mesh(&shapes[*shape], p, param))
+            .map(|(shape, p, _, _)| place_mesh(&shapes.meshes[*shape], p, param))
             .collect::<Result<Vec<Mesh>>>()?;
         let objects_mesh = merge(meshes.iter().cloned());
         let ground = file
             .ground_plane
             .then(|| ground_plane_under(&objects_mesh.bounds()))
             .transpose()?;
-        let mut fields = Vec::with_capacity(shapes.len());
-        for (mesh, (path, generator)) in shapes.iter().zip(&sources) {
-            let (field, origin) = match store.as_deref_mut() {
-                Some(store) => {
-                    store.field(mesh, path.as_deref(), generator.as_ref(), &options.field)?
-                }
-                None => {
-                    let (field, r) = OcclusionField::build(mesh, &options.field)?;
-                    (
-                        field,
-                        FieldOrigin::Built {
-                            report: r,
-                            bytes: 0,
-                        },
-                    )
-                }
-            };
-            match origin {
-                FieldOrigin::Built { report: r, bytes } => {
-                    report.field_rays += r.rays;
-                    report.field_seconds += r.seconds;
-                    // Nothing is written without a store.
-                    report.fields_written += usize::from(store.is_some());
-                    report.field_file_bytes += bytes;
-                }
-                FieldOrigin::Loaded { bytes, seconds } => {
-                    report.fields_loaded += 1;
-                    report.field_file_bytes += bytes;
-                    report.field_load_seconds += seconds;
-                }
-            }
-            report.field_bytes += field.stored_bytes();
-            fields.push(Arc::new(field));
-        }
+        let fields = (0..shapes.meshes.len())
+            .map(|i| {
+                let field = shapes.field(i, store.as_deref_mut(), &options.field, &mut report)?;
+                Ok(Arc::new(field))
+            })
+            .collect::<Result<Vec<_>>>()?;
         let visibility = VisibilityOptions {
             keep: options.keep_visibility,
             progress: options.progress,
@@ -219,7 +228,7 @@ impl DynamicScene {
         let mut scene = DynamicScene {
             options: *options,
             lift: ray_offset(&all),
-            shapes,
+            shapes: shapes.meshes,
             fields,
             objects,
             ground,
@@ -234,5 +243,80 @@ impl DynamicScene {
         };
         scene.orient()?;
         Ok(scene)
+    }
+}
+
+/// A scene file's distinct shapes: objects with the same mesh file or generator share one.
+struct Shapes {
+    /// Each shape's mesh, in order of first use.
+    meshes: Vec<Mesh>,
+    /// Where each came from: the mesh file or the generator.
+    sources: Vec<(Option<PathBuf>, Option<Generator>)>,
+    /// Each object's shape.
+    of_object: Vec<usize>,
+}
+
+impl Shapes {
+    /// The shapes of `file`, mesh paths relative to `dir`.
+    fn of(file: &SceneFile, dir: &Path) -> Result<Self> {
+        let mut shapes = Shapes {
+            meshes: Vec::new(),
+            sources: Vec::new(),
+            of_object: Vec::with_capacity(file.objects.len()),
+        };
+        for (k, object) in file.objects.iter().enumerate() {
+            let source = (object.mesh.clone(), object.generator.clone());
+            let shape = match shapes.sources.iter().position(|s| *s == source) {
+                Some(i) => i,
+                None => {
+                    shapes.meshes.push(object.shape(dir, k)?);
+                    shapes.sources.push(source);
+                    shapes.meshes.len() - 1
+                }
+            };
+            shapes.of_object.push(shape);
+        }
+        Ok(shapes)
+    }
+
+    /// Shape `i`'s occlusion field: read from or built into `store` when there is one, else
+    /// built; `report` counts what it cost.
+    fn field(
+        &self,
+        i: usize,
+        store: Option<&mut FieldStore>,
+        options: &FieldOptions,
+        report: &mut BuildReport,
+    ) -> Result<OcclusionField> {
+        let mesh = &self.meshes[i];
+        let (path, generator) = &self.sources[i];
+        let stored = store.is_some();
+        let (field, origin) = match store {
+            Some(store) => store.field(mesh, path.as_deref(), generator.as_ref(), options)?,
+            None => {
+                let (field, r) = OcclusionField::build(mesh, options)?;
+                let built = FieldOrigin::Built {
+                    report: r,
+                    bytes: 0,
+                };
+                (field, built)
+            }
+        };
+        match origin {
+            FieldOrigin::Built { report: r, bytes } => {
+                report.field_rays += r.rays;
+                report.field_seconds += r.seconds;
+                // Nothing is written without a store.
+                report.fields_written += usize::from(stored);
+                report.field_file_bytes += bytes;
+            }
+            FieldOrigin::Loaded { bytes, seconds } => {
+                report.fields_loaded += 1;
+                report.field_file_bytes += bytes;
+                report.field_load_seconds += seconds;
+            }
+        }
+        report.field_bytes += field.stored_bytes();
+        Ok(field)
     }
 }

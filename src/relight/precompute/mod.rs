@@ -313,9 +313,7 @@ fn transport(
             mesh,
             &SceneBvh::new(mesh),
             &options.visibility,
-            shard
-                .unwrap_or(Shard::whole())
-                .vertices(mesh.vertex_count()),
+            shard.unwrap_or(Shard::whole()).range(mesh.vertex_count()),
         ),
         (Order::Direction, None) => direction_major(mesh, &options.visibility, options.map_size),
         (Order::Direction, Some(_)) => Err(Error::parameter(

@@ -30,7 +30,7 @@ use crate::{Error, Result};
 ///
 /// ```
 /// use haarshift::relight::precompute::shard::Shard;
-/// let shards: Vec<_> = (0..3).map(|i| Shard::new(i, 3).unwrap().vertices(10)).collect();
+/// let shards: Vec<_> = (0..3).map(|i| Shard::new(i, 3).unwrap().range(10)).collect();
 /// assert_eq!(shards, [0..3, 3..6, 6..10]);
 /// assert_eq!("2/3".parse::<Shard>().unwrap(), Shard::new(2, 3).unwrap());
 /// assert!(Shard::new(3, 3).is_err());
@@ -57,7 +57,7 @@ impl Shard {
     ///
     /// ```
     /// use haarshift::relight::precompute::shard::Shard;
-    /// assert_eq!(Shard::whole().vertices(7), 0..7);
+    /// assert_eq!(Shard::whole().range(7), 0..7);
     /// ```
     pub fn whole() -> Self {
         Shard { index: 0, count: 1 }
@@ -73,8 +73,9 @@ impl Shard {
         self.count
     }
 
-    /// This shard's vertices among `total`: `[I x V / N, (I + 1) x V / N)`.
-    pub fn vertices(&self, total: usize) -> Range<usize> {
+    /// This shard's share of `total` items (vertices, a scene's shapes, an experiment's
+    /// settings): `[I x total / N, (I + 1) x total / N)`.
+    pub fn range(&self, total: usize) -> Range<usize> {
         // In u128: I x V cannot overflow, and the quotient is at most V.
         let bound = |i: usize| (i as u128 * total as u128 / self.count as u128) as usize;
         bound(self.index)..bound(self.index + 1)
@@ -272,7 +273,7 @@ mod tests {
             for count in [1, 2, 3, 7, 8, 64, 1000] {
                 let mut next = 0;
                 for index in 0..count {
-                    let r = Shard::new(index, count).unwrap().vertices(total);
+                    let r = Shard::new(index, count).unwrap().range(total);
                     assert_eq!(r.start, next, "{index}/{count} of {total}");
                     assert!(r.len() == total / count || r.len() == total / count + 1);
                     next = r.end;
@@ -282,7 +283,7 @@ mod tests {
         }
         // Near the largest counts the products would overflow u64.
         let huge = Shard::new(usize::MAX - 1, usize::MAX).unwrap();
-        assert_eq!(huge.vertices(usize::MAX), usize::MAX - 1..usize::MAX);
+        assert_eq!(huge.range(usize::MAX), usize::MAX - 1..usize::MAX);
     }
 
     #[test]
@@ -328,7 +329,7 @@ mod tests {
             Shard::new(3, 5).unwrap()
         );
         assert_eq!(
-            Shard::from_env(env(&stepped), None).unwrap().vertices(1000),
+            Shard::from_env(env(&stepped), None).unwrap().range(1000),
             600..800
         );
     }
@@ -376,7 +377,7 @@ mod tests {
     fn a_kubernetes_indexed_job_needs_its_count() {
         let k8s = [("JOB_COMPLETION_INDEX", "5")];
         assert_eq!(
-            Shard::from_env(env(&k8s), Some(6)).unwrap().vertices(60),
+            Shard::from_env(env(&k8s), Some(6)).unwrap().range(60),
             50..60
         );
         assert!(refusal(Shard::from_env(env(&k8s), None)).contains("--shards N"));

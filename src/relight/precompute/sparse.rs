@@ -5,7 +5,11 @@
 //! Row `r` is a run of `(index, value)` pairs: `indices[offsets[r]..offsets[r + 1]]` are
 //! face-Mallat positions (`face x S^2 + row x S + col`, the layout of
 //! [`TransportSet`](crate::relight::TransportSet)) and `values` the matching coefficients (one channel
-//! as `f32`, or several as an array). No allocation per row.
+//! as `f32`, or several as an array). No allocation per row. The arrays may be read in place
+//! from a memory-mapped file (a scene cache's transport, [`crate::io::mapped`]): reading a row
+//! is the same either way, and appending a row copies a mapped array first.
+
+use crate::io::mapped::Buffer;
 
 /// Rows of sparse coefficients; see the [module docs](self).
 ///
@@ -21,12 +25,12 @@
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct SparseRows<V> {
-    offsets: Vec<u64>,
-    indices: Vec<u32>,
-    values: Vec<V>,
+    offsets: Buffer<u64>,
+    indices: Buffer<u32>,
+    values: Buffer<V>,
 }
 
-impl<V: Copy> Default for SparseRows<V> {
+impl<V: Copy + 'static> Default for SparseRows<V> {
     fn default() -> Self {
         Self::new()
     }
@@ -43,7 +47,7 @@ impl<V: Copy> Default for SparseRows<V> {
 /// assert_eq!(rows.len(), 2);
 /// assert_eq!(rows.row(0), (&[1u32, 4][..], &[0.5f32, 2.0][..]));
 /// ```
-impl<V: Copy, I: AsRef<[u32]>, W: AsRef<[V]>> FromIterator<(I, W)> for SparseRows<V> {
+impl<V: Copy + 'static, I: AsRef<[u32]>, W: AsRef<[V]>> FromIterator<(I, W)> for SparseRows<V> {
     fn from_iter<It: IntoIterator<Item = (I, W)>>(rows: It) -> Self {
         let mut out = SparseRows::new();
         for (indices, values) in rows {
@@ -53,23 +57,33 @@ impl<V: Copy, I: AsRef<[u32]>, W: AsRef<[V]>> FromIterator<(I, W)> for SparseRow
     }
 }
 
-impl<V: Copy> SparseRows<V> {
+impl<V: Copy + 'static> SparseRows<V> {
     /// No rows.
     pub fn new() -> Self {
         SparseRows {
-            offsets: vec![0],
-            indices: Vec::new(),
-            values: Vec::new(),
+            offsets: vec![0].into(),
+            indices: Vec::new().into(),
+            values: Vec::new().into(),
         }
     }
 
     /// Rows from their flat parts, when they are consistent: offsets start at 0, never
-    /// decrease and end at the length of `indices`, which `values` matches.
-    pub(crate) fn from_parts(offsets: Vec<u64>, indices: Vec<u32>, values: Vec<V>) -> Option<Self> {
+    /// decrease and end at the length of `indices`, which `values` matches, and each row's
+    /// indices ascend.
+    pub(crate) fn from_parts(
+        offsets: Buffer<u64>,
+        indices: Buffer<u32>,
+        values: Buffer<V>,
+    ) -> Option<Self> {
         let consistent = offsets.first() == Some(&0)
             && offsets.windows(2).all(|w| w[0] <= w[1])
             && offsets.last().copied() == Some(indices.len() as u64)
-            && indices.len() == values.len();
+            && indices.len() == values.len()
+            && offsets.windows(2).all(|w| {
+                indices[w[0] as usize..w[1] as usize]
+                    .windows(2)
+                    .all(|p| p[0] < p[1])
+            });
         consistent.then_some(SparseRows {
             offsets,
             indices,
@@ -80,9 +94,10 @@ impl<V: Copy> SparseRows<V> {
     /// Appends one row.
     pub fn push(&mut self, indices: &[u32], values: &[V]) {
         debug_assert_eq!(indices.len(), values.len());
-        self.indices.extend_from_slice(indices);
-        self.values.extend_from_slice(values);
-        self.offsets.push(self.indices.len() as u64);
+        self.indices.to_mut().extend_from_slice(indices);
+        self.values.to_mut().extend_from_slice(values);
+        let end = self.indices.len() as u64;
+        self.offsets.to_mut().push(end);
     }
 
     /// Row `r`'s indices and values.
@@ -115,5 +130,20 @@ impl<V: Copy> SparseRows<V> {
     /// The flat arrays: offsets (`rows + 1`), indices, values.
     pub(crate) fn parts(&self) -> (&[u64], &[u32], &[V]) {
         (&self.offsets, &self.indices, &self.values)
+    }
+
+    /// The same rows with values seen as `U` when `U` is `V` itself (sharing a mapped file's
+    /// pages, copying owned arrays); `None` for another type.
+    pub(crate) fn shared_as<U: 'static>(&self) -> Option<SparseRows<U>> {
+        Some(SparseRows {
+            offsets: self.offsets.clone(),
+            indices: self.indices.clone(),
+            values: self.values.shared_as()?,
+        })
+    }
+
+    /// Whether the arrays are read in place from a memory-mapped file.
+    pub(crate) fn is_mapped(&self) -> bool {
+        self.offsets.is_mapped() && self.indices.is_mapped() && self.values.is_mapped()
     }
 }

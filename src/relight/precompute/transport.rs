@@ -19,6 +19,7 @@ use ndarray::{Array3, Array4, ArrayView3, Axis};
 
 use crate::faces::Parameterization;
 use crate::faces::integrate::layout;
+use crate::io::mapped::Buffer;
 use crate::product::{HaarTree, Selection, Transport, WeightedPixels};
 use crate::relight::harmonics::{ShProjector, ShTransfer};
 use crate::relight::precompute::sparse::SparseRows;
@@ -84,9 +85,9 @@ impl TransportSet {
     pub(crate) fn from_parts(
         param: Parameterization,
         keep: Selection,
-        offsets: Vec<u64>,
-        indices: Vec<u32>,
-        values: Vec<f32>,
+        offsets: Buffer<u64>,
+        indices: Buffer<u32>,
+        values: Buffer<f32>,
         sh: Option<ShTransfer>,
     ) -> Result<Self> {
         let texels = param.texels() as u32;
@@ -182,6 +183,25 @@ impl TransportSet {
     /// The flat arrays: per-vertex offsets (`V + 1`), indices, values.
     pub(crate) fn parts(&self) -> (&[u64], &[u32], &[f32]) {
         self.rows.parts()
+    }
+
+    /// Every vertex's coefficients as rows.
+    pub(crate) fn rows(&self) -> &SparseRows<f32> {
+        &self.rows
+    }
+
+    /// Whether the coefficients are read in place from a memory-mapped cache file
+    /// ([`SceneCache::read`](crate::relight::SceneCache::read)) rather than held in memory.
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::TransportSet;
+    /// use haarshift::faces::{ParamKind, Parameterization};
+    /// let param = Parameterization::new(ParamKind::LatLong, 4).unwrap();
+    /// assert!(!TransportSet::new(param, Selection::All).is_mapped());
+    /// ```
+    pub fn is_mapped(&self) -> bool {
+        self.rows.is_mapped()
     }
 
     /// Haar coefficients stored, all vertices.

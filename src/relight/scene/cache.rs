@@ -14,13 +14,20 @@
 //! | | transport: offsets `V + 1` u64, indices `N` u32, values `N` f32 ([`TransportSet`]) |
 //! | | with `sh_bands = B` in the parameters: the spherical-harmonic transfer `V x B^2` f32 ([`ShTransfer`]) |
 //!
+//! Each array starts at a file offset that is a multiple of 8, zero bytes filling the gap
+//! before it, so that [`SceneCache::read`] can map the file and read the transport in place:
+//! a render holds the mesh, albedo and transfer in memory and the transport only as the
+//! file's pages, which the kernel reads when touched and may drop again. Resident anonymous
+//! memory is then near the mesh's, whatever the transport's size (`results/scale/`).
+//!
 //! A **shard** ([`CacheShard`], what `relight precompute --shard I/N` writes) is the same file
 //! with [`CacheHeader::shard`] set: the whole mesh and albedo, and the transport (and transfer)
 //! of its vertex range only, `V` above read as the range's length in the transport's rows.
 //! [`SceneCache::read`] refuses a shard, and [`CacheShard::read`] a whole cache.
 //!
 //! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
-//! environment and camera in the header; version 3 the shard record. A file of another version
+//! environment and camera in the header; version 3 the shard record; version 4 the aligned
+//! arrays. A file of another version
 //! is refused, never guessed at.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
@@ -35,16 +42,17 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use crate::faces::{ParamKind, Parameterization};
+use crate::io::mapped::MappedFile;
 use crate::product::Selection;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::precompute::transport::TransportSet;
-use crate::relight::scene::framed::{Format, put_all};
+use crate::relight::scene::framed::{Format, Reader};
 use crate::relight::scene::{CameraSpec, EnvironmentSpec};
 use crate::relight::{Mesh, SceneError};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
-pub const CACHE_VERSION: u32 = 3;
+pub const CACHE_VERSION: u32 = 4;
 
 const FORMAT: Format = Format {
     magic: b"HSRCACHE",
@@ -251,9 +259,12 @@ impl SceneCache {
     }
 
     /// Reads a cache, refusing a damaged file, another version or a shard; see the
-    /// [module docs](self).
+    /// [module docs](self). The file is memory-mapped and the transport read in place
+    /// ([`TransportSet::is_mapped`]); everything else is copied.
     pub fn read(path: &Path) -> Result<Self> {
-        Self::parse(&read_bytes(path)?).map_err(|e| e.in_file(path))
+        read_parts(path)
+            .and_then(Self::from_file_parts)
+            .map_err(|e| e.in_file(path))
     }
 
     /// Reads a cache and refuses it unless it was made for `mesh` (same [`scene_hash`]).
@@ -271,8 +282,7 @@ impl SceneCache {
         Ok(cache)
     }
 
-    fn parse(bytes: &[u8]) -> Result<Self> {
-        let (header, parts) = parse_parts(bytes)?;
+    fn from_file_parts((header, parts): (CacheHeader, Parts)) -> Result<Self> {
         if let Some(shard) = header.shard {
             return Err(SceneError::CacheIsShard(shard).into());
         }
@@ -364,7 +374,6 @@ pub(super) fn write_parts(
     transport: &TransportSet,
 ) -> Result<u64> {
     let (offsets, indices, values) = transport.parts();
-    let sh = transport.sh().map_or(&[][..], |t| t.as_slice());
     let sizes = [
         mesh.positions().len() * 16,
         mesh.triangles().len() * 12,
@@ -372,27 +381,35 @@ pub(super) fn write_parts(
         transport.stored_bytes(),
     ];
     FORMAT.write(path, force, header, sizes.iter().sum(), |body| {
-        put_all(body, mesh.positions().iter().chain(mesh.normals()));
-        put_all(body, mesh.triangles().iter().flatten());
-        put_all(body, albedo);
-        put_all(body, offsets);
-        put_all(body, indices);
-        put_all(body, values.iter().chain(sh));
+        body.array(mesh.positions().iter().chain(mesh.normals()));
+        body.array(mesh.triangles().iter().flatten());
+        body.array(albedo);
+        body.array(offsets);
+        body.array(indices);
+        body.array(values);
+        if let Some(sh) = transport.sh() {
+            body.array(sh.as_slice());
+        }
     })
 }
 
-/// A file's bytes, an unreadable file named.
-pub(super) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+/// Parses a cache file, whole or shard: the one reader of both. The file is mapped and its
+/// transport read in place ([`crate::io::mapped`]); the mesh and albedo are copied. The
+/// transport has the rows of the shard's range, or of every vertex.
+pub(super) fn read_parts(path: &Path) -> Result<(CacheHeader, Parts)> {
+    let file = MappedFile::open(path)?;
+    let (header, r) = FORMAT.open_mapped::<CacheHeader>(&file)?;
+    parse_parts(header, r)
 }
 
-/// Parses a cache file, whole or shard: the one reader of both. The transport has the rows
-/// of the shard's range, or of every vertex.
-pub(super) fn parse_parts(bytes: &[u8]) -> Result<(CacheHeader, Parts)> {
-    let (header, mut r) = FORMAT.open::<CacheHeader>(bytes)?;
+/// [`read_parts`] of a file's bytes in memory, copied.
+#[cfg(test)]
+pub(super) fn parse_bytes(bytes: &[u8]) -> Result<(CacheHeader, Parts)> {
+    let (header, r) = FORMAT.open::<CacheHeader>(bytes)?;
+    parse_parts(header, r)
+}
+
+fn parse_parts(header: CacheHeader, mut r: Reader<'_>) -> Result<(CacheHeader, Parts)> {
     let (v, t, n) = (header.vertices, header.triangles, header.coefficients);
     let rows = match header.shard {
         None => v,
@@ -407,20 +424,20 @@ pub(super) fn parse_parts(bytes: &[u8]) -> Result<(CacheHeader, Parts)> {
     let overflow = || FORMAT.corrupt("size overflows");
     let triple = v.checked_mul(3).ok_or_else(overflow)?;
     let positions =
-        Array2::from_shape_vec((v, 3), r.f64s(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
+        Array2::from_shape_vec((v, 3), r.values(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
     let normals =
-        Array2::from_shape_vec((v, 3), r.f64s(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
-    let flat = r.u32s(t.checked_mul(3).ok_or_else(overflow)?)?;
+        Array2::from_shape_vec((v, 3), r.values(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
+    let flat = r.values::<u32>(t.checked_mul(3).ok_or_else(overflow)?)?;
     let triangles = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let albedo =
-        Array2::from_shape_vec((v, 3), r.f32s(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
-    let offsets = r.u64s(rows.checked_add(1).ok_or_else(overflow)?)?;
-    let indices = r.u32s(n)?;
-    let values = r.f32s(n)?;
+        Array2::from_shape_vec((v, 3), r.values(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
+    let offsets = r.array(rows.checked_add(1).ok_or_else(overflow)?)?;
+    let indices = r.array(n)?;
+    let values = r.array(n)?;
     let sh = match header.params.sh_bands {
         Some(b) => {
             let per_vertex = b.checked_mul(b).ok_or_else(overflow)?;
-            let flat = r.f32s(rows.checked_mul(per_vertex).ok_or_else(overflow)?)?;
+            let flat = r.values(rows.checked_mul(per_vertex).ok_or_else(overflow)?)?;
             Some(ShTransfer::from_flat(b, flat)?)
         }
         None => None,

@@ -15,7 +15,8 @@ use ndarray::Array2;
 
 use crate::relight::precompute::shard::Shard;
 use crate::relight::scene::cache::{
-    CacheParams, ShardRecord, check_parts, header, parse_parts, read_bytes, scene_hash, write_parts,
+    CacheHeader, CacheParams, Parts, ShardRecord, check_parts, header, read_parts, scene_hash,
+    write_parts,
 };
 use crate::relight::scene::{CameraSpec, EnvironmentSpec};
 use crate::relight::{Mesh, SceneCache, SceneError, TransportSet};
@@ -67,7 +68,7 @@ impl CacheShard {
         albedo: Array2<f32>,
         transport: TransportSet,
     ) -> Result<Self> {
-        let range = shard.vertices(mesh.vertex_count());
+        let range = shard.range(mesh.vertex_count());
         check_parts(&params, &mesh, &albedo, &transport, range.len())?;
         Ok(CacheShard {
             record: ShardRecord {
@@ -107,11 +108,12 @@ impl CacheShard {
 
     /// Reads a shard, refusing a damaged file, another version or a whole cache.
     pub fn read(path: &Path) -> Result<Self> {
-        Self::parse(&read_bytes(path)?).map_err(|e| e.in_file(path))
+        read_parts(path)
+            .and_then(Self::from_file_parts)
+            .map_err(|e| e.in_file(path))
     }
 
-    fn parse(bytes: &[u8]) -> Result<Self> {
-        let (header, parts) = parse_parts(bytes)?;
+    fn from_file_parts((header, parts): (CacheHeader, Parts)) -> Result<Self> {
         let record = header.shard.ok_or(SceneError::NotAShard)?;
         // The reader checked the range against the mesh; it must also be the range the index
         // and count name, so that a merge can trust either.

@@ -59,6 +59,9 @@ fn a_cache_reads_back_exactly() {
     let back = SceneCache::read(&path).unwrap();
     assert_eq!(back, cache);
     assert!(back.transport.stored_bytes() > 0);
+    // The transport is read in place from the mapped file (on a little-endian machine).
+    assert_eq!(back.transport.is_mapped(), cfg!(target_endian = "little"));
+    assert!(!cache.transport.is_mapped());
     // The transport trees are usable as they were.
     assert_eq!(
         back.transport.transport(5).unwrap(),
@@ -82,7 +85,7 @@ fn a_flipped_byte_anywhere_is_refused() {
         let mut bad = good.clone();
         bad[k] ^= 0x10;
         assert!(
-            matches!(SceneCache::parse(&bad), Err(Error::Scene { source: SceneError::CacheCorrupt(r), .. }) if r == "checksum mismatch"),
+            matches!(parse_bytes(&bad).and_then(SceneCache::from_file_parts), Err(Error::Scene { source: SceneError::CacheCorrupt(r), .. }) if r == "checksum mismatch"),
             "byte {k}"
         );
     }
@@ -97,6 +100,30 @@ fn a_flipped_byte_anywhere_is_refused() {
     bad[3] ^= 1;
     std::fs::write(&path, &bad).unwrap();
     assert!(matches!(refusal(&path), SceneError::CacheCorrupt(r) if r.contains("not a")));
+}
+
+#[test]
+fn every_array_starts_at_a_multiple_of_8_with_zeros_before_it() {
+    // Version 4's promise: the header is followed by zeros up to an aligned offset; a non-zero
+    // gap (with a right checksum) is refused rather than read past.
+    let (_dir, path) = written(&made(2));
+    let good = std::fs::read(&path).unwrap();
+    let header_len = u64::from_le_bytes(good[16..24].try_into().unwrap()) as usize;
+    let first_array = (24 + header_len).next_multiple_of(8);
+    assert!(
+        first_array > 24 + header_len,
+        "the test needs a gap: pick another sphere"
+    );
+    assert!(good[24 + header_len..first_array].iter().all(|&b| b == 0));
+    let mut bad = good.clone();
+    bad[24 + header_len] = 1;
+    let checksum = crc32fast::hash(&bad[16..]);
+    bad[12..16].copy_from_slice(&checksum.to_le_bytes());
+    std::fs::write(&path, &bad).unwrap();
+    assert_eq!(
+        refusal(&path),
+        SceneError::CacheCorrupt("padding that is not zero".into())
+    );
 }
 
 #[test]
@@ -223,12 +250,12 @@ fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
 }
 
 #[test]
-fn version_1_and_2_files_are_refused() {
-    // Version 1 had no spherical-harmonic transfer, version 2 no shard record: their files
-    // must be remade, not misread.
+fn version_1_2_and_3_files_are_refused() {
+    // Version 1 had no spherical-harmonic transfer, version 2 no shard record, version 3 no
+    // aligned arrays: their files must be remade, not misread.
     let (_dir, path) = written(&made(2));
     let good = std::fs::read(&path).unwrap();
-    for old in [1u32, 2] {
+    for old in [1u32, 2, 3] {
         let mut bytes = good.clone();
         bytes[8..12].copy_from_slice(&old.to_le_bytes());
         std::fs::write(&path, &bytes).unwrap();
@@ -237,13 +264,13 @@ fn version_1_and_2_files_are_refused() {
             e,
             SceneError::CacheVersion {
                 found: old,
-                expected: 3
+                expected: 4
             }
         );
         assert_eq!(
             e.to_string(),
             format!(
-                "scene cache has format version {old}, this build reads version 3; compute it again"
+                "scene cache has format version {old}, this build reads version 4; compute it again"
             )
         );
     }

@@ -1,16 +1,28 @@
 //! What the binary files of the relighting share (the scene cache `.hsr`, the occlusion field
 //! file `.hsf`): an 8-byte magic, a `u32` format version, the CRC-32 of everything after it, a
-//! JSON header behind its `u64` length, then flat little-endian arrays. Every check on reading
-//! is the format's own typed [`SceneError`], so that one parser serves both files and each
-//! names itself in its messages.
+//! JSON header behind its `u64` length, then flat little-endian arrays, each starting at a file
+//! offset that is a multiple of [`ALIGN`] (zero bytes fill the gaps), so that a memory-mapped
+//! file's arrays can be read in place ([`Buffer`]). Every check on reading is the format's own
+//! typed [`SceneError`], so that one parser serves both files and each names itself in its
+//! messages.
 
 use std::path::Path;
 
+use bytemuck::Pod;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
+use crate::io::mapped::{Buffer, MappedFile};
 use crate::relight::SceneError;
 use crate::{Error, Result};
+
+/// Every array starts at a file offset that is a multiple of this: the widest element, `u64`
+/// and `f64`.
+pub(crate) const ALIGN: usize = 8;
+
+/// Bytes before the body (magic, version, checksum): the body's offsets are the file's minus
+/// this, a multiple of [`ALIGN`].
+const PREFIX: usize = 16;
 
 /// One file format: its magic, version, name and errors.
 pub(crate) struct Format {
@@ -26,10 +38,12 @@ pub(crate) struct Format {
     pub other_version: fn(u32, u32) -> SceneError,
 }
 
-/// A number written as its little-endian bytes.
-pub(crate) trait LittleEndian: Copy {
+/// A number stored as its little-endian bytes.
+pub(crate) trait LittleEndian: Pod {
     /// Appends the bytes to `out`.
     fn put(self, out: &mut Vec<u8>);
+    /// The number of `size_of::<Self>()` bytes.
+    fn from_le(bytes: &[u8]) -> Self;
 }
 
 macro_rules! little_endian {
@@ -38,17 +52,24 @@ macro_rules! little_endian {
             fn put(self, out: &mut Vec<u8>) {
                 out.extend_from_slice(&self.to_le_bytes());
             }
+            fn from_le(bytes: &[u8]) -> Self {
+                <$t>::from_le_bytes(bytes.try_into().expect("the width of the type"))
+            }
         }
     )*};
 }
 little_endian!(u64, u32, f64, f32);
 
-/// Appends every value of `values` to `out`, little endian.
-pub(crate) fn put_all<'a, T: LittleEndian + 'a>(
-    out: &mut Vec<u8>,
-    values: impl IntoIterator<Item = &'a T>,
-) {
-    values.into_iter().for_each(|x| x.put(out));
+/// A file's body as it is written: the header, then arrays at aligned offsets.
+pub(crate) struct Body(Vec<u8>);
+
+impl Body {
+    /// Appends one array, every value of `values`, at the next aligned offset.
+    pub fn array<'a, T: LittleEndian + 'a>(&mut self, values: impl IntoIterator<Item = &'a T>) {
+        let gap = (ALIGN - self.0.len() % ALIGN) % ALIGN;
+        self.0.resize(self.0.len() + gap, 0);
+        values.into_iter().for_each(|x| x.put(&mut self.0));
+    }
 }
 
 impl Format {
@@ -66,13 +87,14 @@ impl Format {
         force: bool,
         header: &impl Serialize,
         capacity: usize,
-        arrays: impl FnOnce(&mut Vec<u8>),
+        arrays: impl FnOnce(&mut Body),
     ) -> Result<u64> {
         let json = serde_json::to_vec(header).expect("the header serialises");
-        let mut body = Vec::with_capacity(8 + json.len() + capacity);
-        (json.len() as u64).put(&mut body);
-        body.extend_from_slice(&json);
+        let mut body = Body(Vec::with_capacity(8 + json.len() + capacity + 8 * ALIGN));
+        (json.len() as u64).put(&mut body.0);
+        body.0.extend_from_slice(&json);
         arrays(&mut body);
+        let body = body.0;
         let checksum = crc32fast::hash(&body);
         crate::io::write_file_atomically(path, force, |w| {
             w.write_all(self.magic)?;
@@ -83,8 +105,18 @@ impl Format {
         Ok((16 + body.len()) as u64)
     }
 
+    /// [`Format::open`] on a mapped file, whose arrays the reader then reads in place.
+    pub fn open_mapped<'a, H: DeserializeOwned>(
+        &'a self,
+        file: &'a MappedFile,
+    ) -> Result<(H, Reader<'a>)> {
+        let (header, mut r) = self.open(file.bytes())?;
+        r.file = Some(file);
+        Ok((header, r))
+    }
+
     /// Checks the magic, the version and the checksum, in this order, and parses the header;
-    /// the arrays are left to the returned reader.
+    /// the arrays are left to the returned reader, which copies them.
     pub fn open<'a, H: DeserializeOwned>(&'a self, bytes: &'a [u8]) -> Result<(H, Reader<'a>)> {
         if bytes.len() < 8 || &bytes[..8] != self.magic {
             return Err(self.corrupt(format!("not a haarshift {}", self.name)));
@@ -103,36 +135,26 @@ impl Format {
         }
         let mut r = Reader {
             bytes: body,
+            offset: PREFIX,
+            file: None,
             format: self,
         };
-        let header_len = usize::try_from(r.u64s(1)?[0]).map_err(|_| self.corrupt("cut short"))?;
+        let header_len =
+            usize::try_from(r.values::<u64>(1)?[0]).map_err(|_| self.corrupt("cut short"))?;
         let header = serde_json::from_slice(r.take(header_len)?)
             .map_err(|e| self.corrupt(format!("header: {e}")))?;
         Ok((header, r))
     }
 }
 
-/// Reads little-endian arrays off the front of a file's body.
+/// Reads little-endian arrays off the front of a file's body: in place from a mapped file
+/// ([`Format::open_mapped`]) where they can be, copied otherwise.
 pub(crate) struct Reader<'a> {
     bytes: &'a [u8],
+    /// The file offset of `bytes[0]`.
+    offset: usize,
+    file: Option<&'a MappedFile>,
     format: &'a Format,
-}
-
-macro_rules! read_array {
-    ($name:ident, $t:ty) => {
-        pub fn $name(&mut self, count: usize) -> Result<Vec<$t>> {
-            const W: usize = std::mem::size_of::<$t>();
-            let raw = self.take(
-                count
-                    .checked_mul(W)
-                    .ok_or_else(|| self.format.corrupt("size overflows"))?,
-            )?;
-            Ok(raw
-                .chunks_exact(W)
-                .map(|c| <$t>::from_le_bytes(c.try_into().expect("W bytes")))
-                .collect())
-        }
-    };
 }
 
 impl<'a> Reader<'a> {
@@ -142,12 +164,41 @@ impl<'a> Reader<'a> {
         }
         let (head, tail) = self.bytes.split_at(n);
         self.bytes = tail;
+        self.offset += n;
         Ok(head)
     }
-    read_array!(u64s, u64);
-    read_array!(u32s, u32);
-    read_array!(f64s, f64);
-    read_array!(f32s, f32);
+
+    /// The next `count` values of `T` (at the next aligned offset), `T`'s width in bytes each.
+    fn next_array<T: LittleEndian>(&mut self, count: usize) -> Result<(usize, &'a [u8])> {
+        let gap = (ALIGN - self.offset % ALIGN) % ALIGN;
+        if self.take(gap)?.iter().any(|&b| b != 0) {
+            return Err(self.format.corrupt("padding that is not zero"));
+        }
+        let n = count
+            .checked_mul(size_of::<T>())
+            .ok_or_else(|| self.format.corrupt("size overflows"))?;
+        let start = self.offset;
+        Ok((start, self.take(n)?))
+    }
+
+    /// The next array of `count` values, copied.
+    pub fn values<T: LittleEndian>(&mut self, count: usize) -> Result<Vec<T>> {
+        let (_, raw) = self.next_array::<T>(count)?;
+        Ok(raw.chunks_exact(size_of::<T>()).map(T::from_le).collect())
+    }
+
+    /// The next array of `count` values, in place when the file is mapped.
+    pub fn array<T: LittleEndian>(&mut self, count: usize) -> Result<Buffer<T>> {
+        let (start, raw) = self.next_array::<T>(count)?;
+        if let Some(buffer) = self.file.and_then(|f| Buffer::mapped(f, start, count)) {
+            return Ok(buffer);
+        }
+        Ok(Buffer::from(
+            raw.chunks_exact(size_of::<T>())
+                .map(T::from_le)
+                .collect::<Vec<_>>(),
+        ))
+    }
 
     /// The format's "damaged" error for `reason`.
     pub fn corrupt(&self, reason: impl Into<String>) -> Error {

@@ -132,10 +132,15 @@ pub struct Reports {
 }
 
 impl Reports {
+    /// `DIR/<stem>.journal`.
+    pub fn journal_path(&self) -> PathBuf {
+        self.dir.path().join(format!("{}.journal", self.stem))
+    }
+
     /// The run's journal, `DIR/<stem>.journal`: the stopped run's with `resume`; else a new
     /// one, replacing a stopped run's only under `--force`.
     pub fn journal(&self, options: &str, resume: bool) -> Result<Journal> {
-        let path = self.dir.path().join(format!("{}.journal", self.stem));
+        let path = self.journal_path();
         if resume {
             return Journal::resume(&path, options);
         }

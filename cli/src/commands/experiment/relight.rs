@@ -10,6 +10,7 @@ use haarshift::experiments::relight::{Light, RelightProtocol, Subject, run};
 
 use super::{OutputFlags, finish_journal, wrote};
 use crate::commands::print;
+use crate::commands::relight::flags::ShardFlags;
 use crate::progress::progress_bar;
 
 const EXAMPLES: &str = "\
@@ -60,7 +61,15 @@ coefficients per method) and, per scene, DIR/relight-grid-SCENE-ENV-MATERIAL.png
 rotation axis's renders over their false-colour error images). Each unit of work (a scene's
 truth, a condition, an axis under one material) is appended to DIR/relight.journal as it is
 measured, so that a run killed midway goes on with --resume; the journal is removed once the
-reports are written.";
+reports are written.
+
+Across machines: --shard I/N (or auto, from a Slurm array or Kubernetes Indexed Job, as for
+relight precompute) measures every N-th unit of work from the I-th into
+DIR/relight.journal.shard-I-of-N (DIR shared by the shards) and writes no report; a rerun
+of a preempted shard goes on with its journal. Once every shard is done, --resume in DIR takes
+in every shard's units and writes the reports, the same tables as one run's:
+  haarshift experiment relight --full --out-dir shared/relight --shard auto
+  haarshift experiment relight --full --out-dir shared/relight --resume";
 
 /// Relighting methods against the ray-cast truth: tables, CSV, JSON, plots, picture grids.
 #[derive(clap::Args, Debug)]
@@ -87,8 +96,11 @@ pub struct Args {
     /// Go on with a run that was stopped: the measurements in DIR/relight.journal (written
     /// as they are made) are kept and the rest measured; refused if the protocol or the
     /// inputs differ
-    #[arg(long)]
+    #[arg(long, conflicts_with = "shard")]
     pub resume: bool,
+
+    #[command(flatten)]
+    pub shard: ShardFlags,
 
     #[command(flatten)]
     pub output: OutputFlags,
@@ -125,9 +137,13 @@ pub fn run_command(args: Args) -> Result<()> {
     let scenes = &scenes[..protocol.scenes.min(scenes.len())];
     let envs = &envs[..protocol.lights.min(envs.len())];
     let inputs: Vec<PathBuf> = scenes.iter().chain(envs).cloned().collect();
+    let shard = args.shard.resolve()?;
     let reports = args.output.claim("relight", &inputs)?;
     let options = format!("{protocol:?}; {}", Journal::fingerprint(&inputs)?);
-    let mut journal = reports.journal(&options, args.resume)?;
+    let mut journal = match shard {
+        Some(shard) => Journal::create_shard(&reports.journal_path(), shard, &options)?,
+        None => reports.journal(&options, args.resume)?,
+    };
     let subjects = scenes
         .iter()
         .map(|p| Subject::load(p))
@@ -145,6 +161,17 @@ pub fn run_command(args: Args) -> Result<()> {
         ));
     })?;
     bar.finish_and_clear();
+    if let Some(shard) = shard {
+        return print(&format!(
+            "shard {shard}: {} records ({} units taken from its journal) in {}.shard-{}-of-{}; \
+             once every shard is done, --resume in the same directory writes the reports\n",
+            results.records.len(),
+            journal.resumed(),
+            reports.journal_path().display(),
+            shard.index(),
+            shard.count(),
+        ));
+    }
     let text = report(&protocol, &results);
     let writer = reports.writer();
     let mut written = vec![

@@ -7,6 +7,7 @@ use haarshift::product::Selection;
 use haarshift::relight::light::environment::Environment;
 use haarshift::relight::material::brdf::DEFAULT_ELEVATIONS;
 use haarshift::relight::material::orient::BrdfRotation;
+use haarshift::relight::precompute::shard::{Shard, ShardSpec};
 use haarshift::relight::scene::validate::MemoryBudget;
 use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{LightSpec, Method, ShadeOptions, ShaderSpec};
@@ -92,6 +93,34 @@ pub fn brdf(s: &str) -> std::result::Result<String, String> {
             .map(|_| s.to_owned())
             .map_err(|e| e.to_string()),
     }
+}
+
+/// `--shard I/N|auto` and `--shards N`: one machine's share of a split job.
+#[derive(clap::Args, Debug)]
+pub struct ShardFlags {
+    /// Do shard I of N only (`I/N`, I from 0), or `auto`: from the Slurm array task or the
+    /// Kubernetes Indexed Job's completion index
+    #[arg(long, value_name = "I/N|auto", value_parser = shard_spec)]
+    pub shard: Option<ShardSpec>,
+
+    /// With `--shard auto` in a Kubernetes Indexed Job: the number of shards (the Job's
+    /// completions); under Slurm it must equal the array's task count
+    #[arg(long, value_name = "N", requires = "shard")]
+    pub shards: Option<usize>,
+}
+
+impl ShardFlags {
+    /// The shard named or read from the scheduler's environment, if any.
+    pub fn resolve(&self) -> Result<Option<Shard>> {
+        self.shard
+            .map(|spec| spec.resolve(|name| std::env::var(name).ok(), self.shards))
+            .transpose()
+    }
+}
+
+/// `--shard`, parsed by the library.
+fn shard_spec(s: &str) -> std::result::Result<ShardSpec, String> {
+    s.parse().map_err(|e: haarshift::Error| e.to_string())
 }
 
 /// The lighting: the environment map and its rotation.

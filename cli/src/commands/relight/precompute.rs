@@ -7,12 +7,11 @@ use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
 use haarshift::relight::VisibilityOptions;
-use haarshift::relight::precompute::shard::ShardSpec;
 use haarshift::relight::precompute::{
     DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_shard, shard_is_done,
 };
 
-use super::flags::{SceneFlags, bytes};
+use super::flags::{SceneFlags, ShardFlags, bytes};
 use crate::commands::{choice, names, print, refuse_outputs};
 
 const HELP: &str = "\
@@ -94,31 +93,16 @@ pub struct Args {
     #[arg(long, value_name = "B")]
     pub sh_bands: Option<usize>,
 
-    /// Compute shard I of N only (`I/N`, I from 0), or `auto`: from the Slurm array task or
-    /// the Kubernetes Indexed Job's completion index
-    #[arg(long, value_name = "I/N|auto", value_parser = shard_spec)]
-    pub shard: Option<ShardSpec>,
-
-    /// With `--shard auto` in a Kubernetes Indexed Job: the number of shards (the Job's
-    /// completions); under Slurm it must equal the array's task count
-    #[arg(long, value_name = "N", requires = "shard")]
-    pub shards: Option<usize>,
+    #[command(flatten)]
+    pub shard: ShardFlags,
 
     /// Replace the output if it exists (a shard: even a complete one)
     #[arg(long)]
     pub force: bool,
 }
 
-/// `--shard`, parsed by the library.
-fn shard_spec(s: &str) -> std::result::Result<ShardSpec, String> {
-    s.parse().map_err(|e: haarshift::Error| e.to_string())
-}
-
 pub fn run(args: Args) -> Result<()> {
-    let shard = args
-        .shard
-        .map(|spec| spec.resolve(|name| std::env::var(name).ok(), args.shards))
-        .transpose()?;
+    let shard = args.shard.resolve()?;
     // An existing shard is looked at below (a complete one is skipped), once the scene is read.
     let existing_allowed = args.force || shard.is_some();
     refuse_outputs(&[&args.scene.input], &[&args.output], existing_allowed)?;
@@ -147,7 +131,7 @@ pub fn run(args: Args) -> Result<()> {
             (String::new(), cache.transport, file_bytes, report)
         }
         Some(shard) => {
-            let range = shard.vertices(vertices);
+            let range = shard.range(vertices);
             let what = format!(" (shard {shard}: vertices {}..{})", range.start, range.end);
             if !args.force && shard_is_done(&args.output, &scene, &options, shard)? {
                 return print(&format!(

@@ -9,6 +9,7 @@ use haarshift::product::Selection;
 use haarshift::relight::dynamic::fields::file::FieldStore;
 use haarshift::relight::dynamic::motion::{MotionPath, play};
 use haarshift::relight::dynamic::{Change, DynamicBudgets, DynamicOptions, DynamicScene};
+use haarshift::relight::precompute::shard::Shard;
 use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
 use haarshift::relight::shade::{FrameSpec, Shader, ShaderSpec};
 use haarshift::relight::{Brdf, CameraSpec};
@@ -17,7 +18,7 @@ use haarshift::render::{Camera, render_format, to_srgb8, write_render};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
 
-use super::flags::{CameraFlags, GlossyFlags, LightFlags, brdf, bytes, ms, rotation};
+use super::flags::{CameraFlags, GlossyFlags, LightFlags, ShardFlags, brdf, bytes, ms, rotation};
 use crate::commands::{choice, names, print, refuse_outputs};
 
 const HELP: &str = "\
@@ -51,6 +52,12 @@ is built and written. A file that does not match (another mesh, other flags, dam
 format version) stops the command with the reason before anything is written; --force builds
 it again and replaces it. The run prints the files' size and the time loading took.
 
+--shard I/N (or auto, from a Slurm array or Kubernetes Indexed Job, as for precompute) with
+--fields-dir DIR builds only the fields of shapes [I x S / N, (I + 1) x S / N) of the scene's
+S distinct shapes (in order of first use) and renders nothing: one machine's share. Each
+shape's file is independent, so nothing is merged; a render with the same DIR and field flags
+loads them all.
+
 --method reference renders the same frames with visibility ray-cast against every object in
 its current placement (the ground truth; no field, no Haar transform).
 
@@ -61,7 +68,9 @@ Examples:
   haarshift relight scene scene.json --method reference --vertices truth.npy -o truth.png
   haarshift relight scene testdata/scenes/table_and_chair.json --brdf phong:40 -o glossy.png
   haarshift relight scene testdata/scenes/bunny.json --param cube --resolution 64 --keep-field 120 --fields-dir fields -o bunny.png
-      (the first run builds fields/bunny.hsf; the same command again loads it)";
+      (the first run builds fields/bunny.hsf; the same command again loads it)
+  haarshift relight scene testdata/scenes/table_and_chair.json --fields-dir fields --shard 1/2
+      (builds the chair's fields only: shape 1 of the table and the chair)";
 
 /// When a looked-up occlusion map is truncated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -81,16 +90,23 @@ pub struct Args {
     #[arg(value_name = "SCENE.json")]
     pub scene: PathBuf,
 
-    /// The image (.png, .exr), or with --animate a .gif or numbered .png frames (%d)
-    #[arg(short, long, value_name = "IMAGE")]
-    pub output: PathBuf,
+    /// The image (.png, .exr), or with --animate a .gif or numbered .png frames (%d); not
+    /// with --shard, which only builds fields
+    #[arg(
+        short,
+        long,
+        value_name = "IMAGE",
+        required_unless_present = "shard",
+        conflicts_with = "shard"
+    )]
+    pub output: Option<PathBuf>,
 
     /// Play this path file (segments moving one object or turning the lighting)
-    #[arg(long, value_name = "PATH.json")]
+    #[arg(long, value_name = "PATH.json", conflicts_with = "shard")]
     pub animate: Option<PathBuf>,
 
     /// Also write the per-vertex radiance, (V, 3) f32 .npy ((frames, V, 3) with --animate)
-    #[arg(long, value_name = "OUT.npy")]
+    #[arg(long, value_name = "OUT.npy", conflicts_with = "shard")]
     pub vertices: Option<PathBuf>,
 
     /// How the radiance is computed: `haar` (occlusion fields and Haar product integrals) or
@@ -151,6 +167,11 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     pub fields_dir: Option<PathBuf>,
 
+    /// With --fields-dir: build (or find) the fields of this shard's share of the shapes
+    /// only, and render nothing
+    #[command(flatten)]
+    pub shard: ShardFlags,
+
     /// Time each GIF frame is shown, milliseconds
     #[arg(long, value_name = "MS", default_value_t = 100)]
     pub delay: u32,
@@ -192,9 +213,48 @@ impl Args {
     }
 }
 
+/// `--shard`: this machine's share of the shapes' fields, built (or found) in --fields-dir.
+fn build_fields(args: &Args, shard: Shard) -> Result<()> {
+    let dir = args
+        .fields_dir
+        .as_ref()
+        .ok_or_else(|| Error::InvalidParameter {
+            name: "shard",
+            reason: "--shard builds fields into a directory: add --fields-dir DIR".into(),
+        })?;
+    let options = args.options()?;
+    let mut store = FieldStore::new(dir, args.force);
+    store.prepare()?;
+    let start = Instant::now();
+    let r = DynamicScene::build_fields(&args.scene, &options, &mut store, shard)?;
+    print(&format!(
+        "{}: shard {shard}: fields of {} shapes in {}: {} built ({} rays, {:.1} s), {} loaded \
+         ({:.2} s), {} on disk; {:.1} s in all\n",
+        args.scene.display(),
+        r.fields_written + r.fields_loaded,
+        dir.display(),
+        r.fields_written,
+        r.field_rays,
+        r.field_seconds,
+        r.fields_loaded,
+        r.field_load_seconds,
+        bytes(r.field_file_bytes),
+        ms(start) / 1e3,
+    ))
+}
+
 pub fn run(args: Args) -> Result<()> {
-    let gif = args
+    if let Some(shard) = args.shard.resolve()? {
+        return build_fields(&args, shard);
+    }
+    let output = args
         .output
+        .as_deref()
+        .ok_or_else(|| Error::InvalidParameter {
+            name: "output",
+            reason: "-o IMAGE is needed to render (only --shard renders nothing)".into(),
+        })?;
+    let gif = output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
     let path = args.animate.as_deref().map(MotionPath::load).transpose()?;
@@ -207,17 +267,17 @@ pub fn run(args: Args) -> Result<()> {
     }
     let frame_paths: Vec<PathBuf> = match (&path, gif) {
         (Some(_), false) => (0..frame_count)
-            .map(|k| numbered_path(&args.output, k))
+            .map(|k| numbered_path(output, k))
             .collect::<Result<_>>()?,
         _ => Vec::new(),
     };
     match frame_paths.first() {
         Some(first) => render_format(first).map(|_| ())?,
-        None if !gif => render_format(&args.output).map(|_| ())?,
+        None if !gif => render_format(output).map(|_| ())?,
         None => {}
     }
     let mut outputs: Vec<&Path> = if frame_paths.is_empty() {
-        vec![args.output.as_path()]
+        vec![output]
     } else {
         frame_paths.iter().map(PathBuf::as_path).collect()
     };
@@ -313,7 +373,7 @@ pub fn run(args: Args) -> Result<()> {
         match (frame_paths.get(index), gif) {
             (Some(p), _) => write_render(&image, p, args.camera.exposure, args.force)?,
             (None, true) => gif_frames.push(to_srgb8(&image, args.camera.exposure)?),
-            (None, false) => write_render(&image, &args.output, args.camera.exposure, args.force)?,
+            (None, false) => write_render(&image, output, args.camera.exposure, args.force)?,
         }
         *text += &format!("{what}, rasterisation {raster_ms:.1} ms\n");
         if args.vertices.is_some() {
@@ -333,7 +393,7 @@ pub fn run(args: Args) -> Result<()> {
             let radiance = shading.radiance.to_f32();
             let what = format!(
                 "{}: {} {:.1} ms",
-                args.output.display(),
+                output.display(),
                 shading.description,
                 shading.timing.total_seconds() * 1e3
             );
@@ -399,7 +459,7 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     if gif {
-        write_gif(&gif_frames, &args.output, args.delay, args.force)?;
+        write_gif(&gif_frames, output, args.delay, args.force)?;
     }
     if let Some(out) = &args.vertices {
         match &path {
@@ -418,7 +478,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     text += &format!(
         "{}: {frame_count} frame(s) of {} x {}\n",
-        args.output.display(),
+        output.display(),
         args.camera.width,
         args.camera.height
     );

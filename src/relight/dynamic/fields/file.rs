@@ -12,6 +12,9 @@
 //! | `H` | header, JSON: [`FieldHeader`] |
 //! | | every sample's map: offsets `samples + 1` u64, indices `N` u32, values `N` f32 |
 //!
+//! Each array starts at a file offset that is a multiple of 8 (version 2; version 1 files are
+//! refused).
+//!
 //! **What decides the content**, all recorded in the header and all compared by
 //! [`OcclusionField::read_for`]: the shape (its mesh's [`scene_hash`] and its vertex and
 //! triangle counts: the mesh file or generator is recorded for the messages only, so that a
@@ -40,12 +43,12 @@ use crate::faces::{ParamKind, Parameterization};
 use crate::relight::dynamic::fields::{FieldFrame, FieldOptions, FieldReport, OcclusionField};
 use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::scene::cache::KeepRecord;
-use crate::relight::scene::framed::{Format, put_all};
+use crate::relight::scene::framed::Format;
 use crate::relight::{Generator, Mesh, SceneError, scene_hash};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
-pub const FIELD_VERSION: u32 = 1;
+pub const FIELD_VERSION: u32 = 2;
 
 const FORMAT: Format = Format {
     magic: b"HSOCCFLD",
@@ -215,9 +218,9 @@ impl OcclusionField {
             coefficients: indices.len(),
         };
         FORMAT.write(path, force, &header, self.maps.bytes(), |body| {
-            put_all(body, offsets);
-            put_all(body, indices);
-            put_all(body, values);
+            body.array(offsets);
+            body.array(indices);
+            body.array(values);
         })
     }
 
@@ -320,9 +323,9 @@ impl OcclusionField {
                 header.samples
             )));
         }
-        let offsets = r.u64s(header.samples + 1)?;
-        let indices = r.u32s(header.coefficients)?;
-        let values = r.f32s(header.coefficients)?;
+        let offsets = r.array(header.samples + 1)?;
+        let indices = r.array(header.coefficients)?;
+        let values = r.array::<f32>(header.coefficients)?;
         r.finish("maps")?;
         let texels = param.texels() as u32;
         let maps = SparseRows::from_parts(offsets, indices, values)

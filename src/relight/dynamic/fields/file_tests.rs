@@ -144,18 +144,19 @@ fn a_truncated_file_a_flipped_byte_and_a_wrong_magic_or_version_are_refused() {
         "not a haarshift occlusion field file"
     );
     let mut version = good.clone();
-    version[8..12].copy_from_slice(&2u32.to_le_bytes());
+    // Version 1 had unaligned arrays.
+    version[8..12].copy_from_slice(&1u32.to_le_bytes());
     assert_eq!(
         refusal(&version),
         SceneError::FieldVersion {
-            found: 2,
-            expected: 1
+            found: 1,
+            expected: 2
         }
     );
     assert!(
         refusal(&version)
             .to_string()
-            .contains("format version 2, this build reads version 1")
+            .contains("format version 1, this build reads version 2")
     );
 }
 

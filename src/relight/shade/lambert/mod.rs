@@ -49,6 +49,7 @@ use crate::product::selection::{Candidate, keep_largest};
 use crate::product::tree::mallat_detail;
 use crate::relight::light::lighting::Lighting;
 use crate::relight::material::brdf::check_albedo;
+use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::transport::TransportSet;
 use crate::{Error, Result, Sample};
 
@@ -97,15 +98,16 @@ pub struct ShadeOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PreparedTransport<T> {
     param: Parameterization,
-    offsets: Vec<usize>,
-    indices: Vec<u32>,
-    values: Vec<T>,
+    rows: SparseRows<T>,
     albedo: Vec<[f64; 3]>,
     depth: usize,
 }
 
 impl<T: Sample> PreparedTransport<T> {
     /// Prepares `set` for shading with per-vertex RGB `albedo` (`(V, 3)`) under `options`.
+    /// With nothing to re-truncate or limit and `T = f32`, the stored coefficients are used
+    /// as they are: a set read in place from a cache file stays in place
+    /// ([`TransportSet::is_mapped`]).
     pub fn new(
         set: &TransportSet,
         albedo: ArrayView2<'_, f32>,
@@ -152,30 +154,31 @@ impl<T: Sample> PreparedTransport<T> {
                 ),
             ));
         }
-        let per_vertex: Vec<(Vec<u32>, Vec<T>)> = (0..vertices)
-            .into_par_iter()
-            .map_init(Vec::new, |pool, v| {
-                let (indices, values) = set.coefficients(v);
-                retruncate(param, keep, depth, indices, values, pool)
-            })
-            .collect();
-        let mut offsets = Vec::with_capacity(vertices + 1);
-        offsets.push(0);
-        let total = per_vertex.iter().map(|(i, _)| i.len()).sum();
-        let (mut indices, mut values) = (Vec::with_capacity(total), Vec::with_capacity(total));
-        for (i, c) in per_vertex {
-            indices.extend_from_slice(&i);
-            values.extend_from_slice(&c);
-            offsets.push(indices.len());
-        }
+        let as_stored = keep == Selection::All && depth == levels;
+        let rows = match as_stored.then(|| set.rows().shared_as::<T>()).flatten() {
+            Some(rows) => rows,
+            None => {
+                let per_vertex: Vec<(Vec<u32>, Vec<T>)> = (0..vertices)
+                    .into_par_iter()
+                    .map_init(Vec::new, |pool, v| {
+                        let (indices, values) = set.coefficients(v);
+                        retruncate(param, keep, depth, indices, values, pool)
+                    })
+                    .collect();
+                per_vertex.iter().map(|(i, c)| (i, c)).collect()
+            }
+        };
         Ok(PreparedTransport {
             param,
-            offsets,
-            indices,
-            values,
+            rows,
             albedo,
             depth,
         })
+    }
+
+    /// Whether the coefficients are a mapped cache file's, read in place.
+    pub(crate) fn is_mapped(&self) -> bool {
+        self.rows.is_mapped()
     }
 
     /// The parameterisation of the transport.
@@ -190,13 +193,12 @@ impl<T: Sample> PreparedTransport<T> {
 
     /// Coefficients kept over all vertices (scaling coefficients included).
     pub fn coefficient_count(&self) -> usize {
-        self.indices.len()
+        self.rows.coefficient_count()
     }
 
     /// Vertex `v`'s coefficients as shaded: Mallat indices (ascending) and values.
     pub fn coefficients(&self, v: usize) -> (&[u32], &[T]) {
-        let (a, b) = (self.offsets[v], self.offsets[v + 1]);
-        (&self.indices[a..b], &self.values[a..b])
+        self.rows.row(v)
     }
 
     /// The detail levels taking part, `0..depth`.
@@ -212,8 +214,8 @@ impl<T: Sample> PreparedTransport<T> {
     /// `<T_v, f>` per channel for a function `f` given as dense RGB rows in Mallat order (the
     /// layout of [`Lighting`]'s coefficients).
     pub(crate) fn dot_rows(&self, v: usize, rows: &[[T; 3]]) -> [f64; 3] {
-        let (a, b) = (self.offsets[v], self.offsets[v + 1]);
-        dot(&self.indices[a..b], &self.values[a..b], rows)
+        let (indices, values) = self.rows.row(v);
+        dot(indices, values, rows)
     }
 
     /// Every vertex's outgoing radiance under `lighting`, `(V, 3)`.
@@ -247,13 +249,16 @@ impl<T: Sample> PreparedTransport<T> {
         let out = out.as_slice_mut().ok_or_else(|| {
             Error::shape(&[self.vertex_count(), 3], "the output must be contiguous")
         })?;
+        // The flat arrays once, not a row lookup per vertex: this loop runs at memory speed.
+        let (offsets, indices, values) = self.rows.parts();
         out.par_chunks_mut(3 * CHUNK)
             .enumerate()
             .for_each(|(chunk, rows)| {
                 let first = chunk * CHUNK;
                 for (k, row) in rows.chunks_exact_mut(3).enumerate() {
                     let v = first + k;
-                    let sum = self.dot_rows(v, &light);
+                    let (a, b) = (offsets[v] as usize, offsets[v + 1] as usize);
+                    let sum = dot(&indices[a..b], &values[a..b], &light);
                     let a = self.albedo[v];
                     for c in 0..3 {
                         row[c] = T::from_f64(sum[c] * a[c] * std::f64::consts::FRAC_1_PI);
@@ -435,10 +440,15 @@ where
             radiance: radiance.into(),
             timing: Timing::unrotated(encode_seconds, seconds(start)),
             description: format!(
-                "Haar, lighting kept {} detail coefficients, transport {} coefficients; \
+                "Haar, lighting kept {} detail coefficients, transport {} coefficients{}; \
                  transport prepared once in {:.1} ms",
                 lighting.kept(),
                 self.prepared.coefficient_count(),
+                if self.prepared.is_mapped() {
+                    " read in place from the cache file"
+                } else {
+                    ""
+                },
                 self.prepare_seconds * 1e3
             ),
             maps: None,

@@ -563,3 +563,61 @@ fn mismatches_are_one_line_errors() {
         "only 30 details"
     );
 }
+
+#[test]
+fn a_mapped_cache_shades_in_place_and_equal_to_the_transport_in_memory() {
+    use crate::relight::{CacheParams, KeepRecord, SceneCache};
+    let mesh = Generator::Sphere { cells: 3 }.mesh().unwrap();
+    let param = latlong(8);
+    let set = precompute(&mesh, param);
+    let albedo = varied_albedo(mesh.vertex_count());
+    let params = CacheParams {
+        param: "latlong".into(),
+        resolution: 8,
+        keep: KeepRecord::All,
+        samples: 1,
+        seed: 0,
+        order: "vertex".into(),
+        map_size: None,
+        ground_plane: false,
+        sh_bands: None,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ball.hsr");
+    SceneCache::new(params, mesh, albedo.clone(), set.clone())
+        .unwrap()
+        .write(&path, false)
+        .unwrap();
+    let read = SceneCache::read(&path).unwrap();
+    let sky = park()
+        .sphere_map(param, &SphereRotation::identity())
+        .unwrap();
+    let light = Lighting::from_map(&sky, Selection::All).unwrap();
+    let little = cfg!(target_endian = "little");
+    let in_place =
+        PreparedTransport::<f32>::new(&read.transport, albedo.view(), &ShadeOptions::default())
+            .unwrap();
+    assert_eq!(in_place.is_mapped(), little, "f32 as stored: no copy");
+    let in_memory =
+        PreparedTransport::<f32>::new(&set, albedo.view(), &ShadeOptions::default()).unwrap();
+    assert!(!in_memory.is_mapped());
+    assert_eq!(
+        in_place.shade(&light).unwrap(),
+        in_memory.shade(&light).unwrap()
+    );
+    // Anything that changes the coefficients makes its own copy.
+    let depth = ShadeOptions {
+        depth: Some(2),
+        ..ShadeOptions::default()
+    };
+    assert!(
+        !PreparedTransport::<f32>::new(&read.transport, albedo.view(), &depth)
+            .unwrap()
+            .is_mapped()
+    );
+    assert!(
+        !PreparedTransport::<f64>::new(&read.transport, albedo.view(), &ShadeOptions::default())
+            .unwrap()
+            .is_mapped()
+    );
+}
