@@ -24,7 +24,7 @@ cat >"$work/many_cubes.json" <<EOF
 EOF
 start_load=$(uptime)
 timed precompute relight precompute "$work/many_cubes.json" --param cube \
-    --resolution "$resolution" --keep-visibility all --memory-limit 64GiB \
+    --resolution "$resolution" --memory-limit 64GiB \
     -o "$work/many_cubes.hsr"
 bytes=$(stat -c %s "$work/many_cubes.hsr")
 # One render under the sampler: its JSON line, then what haarshift printed.
@@ -58,7 +58,7 @@ echo "Made by \`scripts/scale_render_memory.sh > results/scale/render_memory.md\
 echo "load when it started (\`uptime\`): \`$start_load\`"
 echo
 echo "The cubes generator with $count x $count cubes: $vertices vertices, $triangles triangles,"
-echo "precomputed with \`relight precompute SCENE --param cube --resolution $resolution --keep-visibility all\`"
+echo "precomputed with \`relight precompute SCENE --param cube --resolution $resolution\` (every coefficient kept)"
 echo "($(field precompute 'Elapsed (wall clock)') wall, $(cpu precompute) CPU s, peak resident $(peak_mib precompute) MiB). It printed:"
 echo
 echo '```text'

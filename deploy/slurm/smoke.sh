@@ -7,10 +7,12 @@
 # results/scale/slurm-smoke.txt:
 #   apt-get install slurm-wlm munge   # once, as root
 #   bash deploy/slurm/smoke.sh > results/scale/slurm-smoke.txt
-# HAARSHIFT names the binary (default: target/release/haarshift, built if missing).
+# HAARSHIFT names the binary (default: target/release/haarshift, built if missing);
+# WAIT_SECONDS (default 600) how long the jobs may take before the run counts as failed.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 shards=${SHARDS:-3}
+wait_seconds=${WAIT_SECONDS:-600}
 haarshift=$(realpath "${HAARSHIFT:-target/release/haarshift}")
 [ -x "$haarshift" ] || cargo build --release -p haarshift-cli >&2
 work=$(mktemp -d)
@@ -87,8 +89,8 @@ submitted=$(HAARSHIFT=$haarshift bash deploy/slurm/precompute.sbatch "$scene" "$
 echo "$submitted" | sed "s|$work/||g"
 merge=$(echo "$submitted" | sed -n 's/.*merge job \([0-9]*\).*/\1/p')
 while [ -n "$(squeue -h 2>/dev/null)" ]; do
-    if squeue -h -o %r | grep -q DependencyNeverSatisfied || ((SECONDS - start > 600)); then
-        echo "a shard failed (or 10 minutes passed); the queue:"
+    if squeue -h -o %r | grep -q DependencyNeverSatisfied || ((SECONDS - start > wait_seconds)); then
+        echo "a shard failed (or $wait_seconds s passed); the queue:"
         squeue
         cat "$work"/out/*.out
         exit 1

@@ -171,7 +171,8 @@ pub struct Cache {
 
 #[pymethods]
 impl Cache {
-    /// Reads a cache file (`.hsr`), refusing a damaged one or another format version.
+    /// Reads a cache file (`.hsr`), refusing a damaged one or another format version. The
+    /// file is memory-mapped and its transport read in place, not copied.
     #[staticmethod]
     fn read(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let cache = py.detach(|| SceneCache::read(&path)).or_raise()?;
