@@ -7,7 +7,8 @@
 //! at cube `6 x 64^2`, each vertex's transport keeping its 420 largest coefficients, a
 //! lighting keeping its 200 largest, Lambertian: the lighting's encoding (the 512 x 1024 map
 //! downsampled by solid-angle means, turned, converted to the cube, transformed, selected) and
-//! the shading (one sparse dot per vertex, f32) timed separately and together; the mapping
+//! the shading (one sparse dot per vertex, f32) timed separately and together, beside a plain
+//! parallel read of the same offsets, indices and values (the frame's floor); the mapping
 //! into the cube (its overlap table) is made once, as an animation makes it. The turn is a
 //! yaw by whole columns of the working map (the animation's step: a column permutation) or a
 //! general rotation (applied at the source's resolution). The transport is precomputed once
@@ -21,12 +22,14 @@
 //! Run: `cargo bench --bench relight -- --warm-up-time 1 --measurement-time 5`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use rayon::prelude::*;
 use std::sync::OnceLock;
 
 use haarshift::faces::param::SphereMap;
 use haarshift::faces::param::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::light::environment::{Environment, SphereMapping, downsample_solid_angle};
+use haarshift::relight::shade::lambert::CHUNK;
 use haarshift::relight::{
     Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,
     VisibilityOptions, shade_sh, vertex_major,
@@ -163,6 +166,22 @@ fn bench_relighting(c: &mut Criterion) {
         let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
         b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
+    });
+    // The floor of a frame: the same offsets, indices and values read once, in the same
+    // parallel chunks of vertices, summed (nothing gathered from the lighting).
+    group.bench_function("plain_read_of_the_shaded_bytes", |b| {
+        let t = prepared();
+        b.iter(|| {
+            (0..t.vertex_count())
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .map(|v| {
+                    let (indices, values) = t.coefficients(v);
+                    let i: u64 = indices.iter().map(|&i| u64::from(i)).sum();
+                    i as f64 + f64::from(values.iter().sum::<f32>())
+                })
+                .sum::<f64>()
+        })
     });
     group.bench_function("encode_and_shade/whole_column_yaw", |b| {
         let t = prepared();

@@ -35,7 +35,7 @@ for count in 1 2 4 8; do
     same=no
     cmp -s "$work/merged$count.hsr" "$work/whole.hsr" && same=yes
     rm -f "${parts[@]}" "$work/merged$count.hsr"
-    ratio=$(echo "scale=3; $cpu_sum / $(cpu whole)" | bc)
+    ratio=$(printf "%.3f" "$(echo "scale=3; $cpu_sum / $(cpu whole)" | bc)")
     rows+=("| $count | $cpu_sum | $ratio | $wall_sum | $peak | $(field "merge$count" 'Elapsed (wall clock)') | $(cpu "merge$count") | $(peak_mib "merge$count") | $same |")
 done
 bytes=$(stat -c %s "$work/whole.hsr")

@@ -144,6 +144,17 @@ impl Journal {
     /// Whether the unit `key`, the next in the run's order, is this journal's to measure or
     /// read back: every unit without a shard; with one, a unit already journaled or one of the
     /// shard's share. Call it once per unit, in the same order in every shard.
+    ///
+    /// ```
+    /// use haarshift::experiments::journal::Journal;
+    /// use haarshift::relight::precompute::shard::Shard;
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let run = dir.path().join("run.journal");
+    /// let mut last = Journal::create_shard(&run, Shard::new(2, 3).unwrap(), "o").unwrap();
+    /// let mine: Vec<bool> = (0..6).map(|k| last.assigned(&format!("unit {k}"))).collect();
+    /// assert_eq!(mine, [false, false, true, false, false, true]);
+    /// assert!(Journal::in_memory().assigned("anything"));
+    /// ```
     pub fn assigned(&mut self, key: &str) -> bool {
         let Some((shard, seen)) = &mut self.shard else {
             return true;
@@ -308,6 +319,16 @@ impl Journal {
 
     /// [`Journal::assigned`], then [`Journal::unit`] when the unit is this journal's; `None`
     /// when it is another shard's.
+    ///
+    /// ```
+    /// use haarshift::experiments::journal::Journal;
+    /// use haarshift::relight::precompute::shard::Shard;
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let run = dir.path().join("run.journal");
+    /// let mut first = Journal::create_shard(&run, Shard::new(0, 2).unwrap(), "o").unwrap();
+    /// assert_eq!(first.assigned_unit("a", || Ok(1)).unwrap(), Some(1));
+    /// assert_eq!(first.assigned_unit("b", || Ok(2)).unwrap(), None); // shard 1's
+    /// ```
     pub fn assigned_unit<T: Serialize + DeserializeOwned>(
         &mut self,
         key: &str,

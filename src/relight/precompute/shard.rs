@@ -75,6 +75,12 @@ impl Shard {
 
     /// This shard's share of `total` items (vertices, a scene's shapes, an experiment's
     /// settings): `[I x total / N, (I + 1) x total / N)`.
+    ///
+    /// ```
+    /// use haarshift::relight::precompute::shard::Shard;
+    /// assert_eq!(Shard::new(1, 4).unwrap().range(10), 2..5);
+    /// assert_eq!(Shard::new(3, 4).unwrap().range(2), 1..2);
+    /// ```
     pub fn range(&self, total: usize) -> Range<usize> {
         // In u128: I x V cannot overflow, and the quotient is at most V.
         let bound = |i: usize| (i as u128 * total as u128 / self.count as u128) as usize;
