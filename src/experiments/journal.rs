@@ -359,6 +359,21 @@ impl Journal {
         Ok(out.join(", "))
     }
 
+    /// The journal's file; `None` for a journal in memory.
+    ///
+    /// ```
+    /// use haarshift::experiments::journal::Journal;
+    /// use haarshift::relight::precompute::shard::Shard;
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let run = dir.path().join("run.journal");
+    /// let shard = Journal::create_shard(&run, Shard::new(1, 4).unwrap(), "o").unwrap();
+    /// assert_eq!(shard.path(), Some(dir.path().join("run.journal.shard-1-of-4").as_path()));
+    /// assert_eq!(Journal::in_memory().path(), None);
+    /// ```
+    pub fn path(&self) -> Option<&Path> {
+        self.file.as_ref().map(|(path, _)| path.as_path())
+    }
+
     /// How many units [`Journal::unit`] has taken from the journal instead of measuring.
     pub fn resumed(&self) -> usize {
         self.resumed

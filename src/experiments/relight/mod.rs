@@ -392,7 +392,9 @@ pub fn run(
         if let Some(seconds) = truth {
             results.truth_seconds.push((subject.name.clone(), seconds));
         }
-        let mut push = |records: Vec<RelightRecord>| {
+        // A unit's records; `None` for another shard's unit.
+        let mut push = |records: Option<Vec<RelightRecord>>| {
+            let records = records.unwrap_or_default();
             records.iter().for_each(&mut progress);
             results.records.extend(records);
         };
@@ -427,7 +429,7 @@ pub fn run(
             let Some((records, label)) = measured else {
                 continue;
             };
-            push(records);
+            push(Some(records));
             // Taken from the journal: the grid is read back from its sidecar.
             if let (None, Some(file), Some((name, caption))) = (&grid, &grid_file, label) {
                 grid = Some(PictureGrid {
@@ -439,42 +441,28 @@ pub fn run(
             results.grids.extend(grid);
         }
         let first = Condition::new(&lights[0], [0.0; 3], &protocol.coefficient_material, 0)?;
-        push(
-            journal
-                .assigned_unit(&unit("coefficients".into()), || {
-                    under_test(&mut slot, subject, protocol)?.coefficient_axis(&first)
-                })?
-                .unwrap_or_default(),
-        );
+        push(journal.assigned_unit(&unit("coefficients".into()), || {
+            under_test(&mut slot, subject, protocol)?.coefficient_axis(&first)
+        })?);
         for (m, brdf) in protocol.resolution_materials.iter().enumerate() {
             let condition = Condition::new(&lights[0], [0.0; 3], brdf, 0)?;
-            push(
-                journal
-                    .assigned_unit(&unit(format!("resolution {m}")), || {
-                        under_test(&mut slot, subject, protocol)?.resolution_axis(&condition)
-                    })?
-                    .unwrap_or_default(),
-            );
+            push(journal.assigned_unit(&unit(format!("resolution {m}")), || {
+                under_test(&mut slot, subject, protocol)?.resolution_axis(&condition)
+            })?);
         }
         for (m, brdf) in protocol.depth_materials.iter().enumerate() {
             let condition = Condition::new(&lights[0], [0.0; 3], brdf, 0)?;
-            push(
-                journal
-                    .assigned_unit(&unit(format!("depth {m}")), || {
-                        under_test(&mut slot, subject, protocol)?.depth_axis(&condition)
-                    })?
-                    .unwrap_or_default(),
-            );
+            push(journal.assigned_unit(&unit(format!("depth {m}")), || {
+                under_test(&mut slot, subject, protocol)?.depth_axis(&condition)
+            })?);
         }
         for (l, light) in maps.iter().enumerate() {
             for (m, brdf) in protocol.harmonics_materials.iter().enumerate() {
                 let condition = Condition::new(light, [0.0; 3], brdf, 0)?;
                 push(
-                    journal
-                        .assigned_unit(&unit(format!("harmonics {l} {m}")), || {
-                            under_test(&mut slot, subject, protocol)?.harmonics_axis(&condition)
-                        })?
-                        .unwrap_or_default(),
+                    journal.assigned_unit(&unit(format!("harmonics {l} {m}")), || {
+                        under_test(&mut slot, subject, protocol)?.harmonics_axis(&condition)
+                    })?,
                 );
             }
         }

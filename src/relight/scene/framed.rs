@@ -147,6 +147,11 @@ impl Format {
     }
 }
 
+/// The little-endian values of `raw`, copied.
+fn decode<T: LittleEndian>(raw: &[u8]) -> Vec<T> {
+    raw.chunks_exact(size_of::<T>()).map(T::from_le).collect()
+}
+
 /// Reads little-endian arrays off the front of a file's body: in place from a mapped file
 /// ([`Format::open_mapped`]) where they can be, copied otherwise.
 pub(crate) struct Reader<'a> {
@@ -184,7 +189,7 @@ impl<'a> Reader<'a> {
     /// The next array of `count` values, copied.
     pub fn values<T: LittleEndian>(&mut self, count: usize) -> Result<Vec<T>> {
         let (_, raw) = self.next_array::<T>(count)?;
-        Ok(raw.chunks_exact(size_of::<T>()).map(T::from_le).collect())
+        Ok(decode(raw))
     }
 
     /// The next array of `count` values, in place when the file is mapped.

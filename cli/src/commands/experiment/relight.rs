@@ -1,7 +1,7 @@
 //! `haarshift experiment relight`: every relighting method against the ray-cast ground truth,
 //! over the sources' axes, with picture grids.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use haarshift::Result;
 use haarshift::experiments::journal::Journal;
@@ -163,13 +163,11 @@ pub fn run_command(args: Args) -> Result<()> {
     bar.finish_and_clear();
     if let Some(shard) = shard {
         return print(&format!(
-            "shard {shard}: {} records ({} units taken from its journal) in {}.shard-{}-of-{}; \
+            "shard {shard}: {} records ({} units taken from its journal) in {}; \
              once every shard is done, --resume in the same directory writes the reports\n",
             results.records.len(),
             journal.resumed(),
-            reports.journal_path().display(),
-            shard.index(),
-            shard.count(),
+            journal.path().unwrap_or(Path::new("")).display(),
         ));
     }
     let text = report(&protocol, &results);
