@@ -137,7 +137,12 @@ impl Error {
     }
 
     /// Shorthand for [`Error::InvalidParameter`].
-    pub(crate) fn parameter(name: &'static str, reason: impl Into<String>) -> Self {
+    ///
+    /// ```
+    /// let e = haarshift::Error::parameter("port", "0 is taken");
+    /// assert_eq!(e.to_string(), "invalid port: 0 is taken");
+    /// ```
+    pub fn parameter(name: &'static str, reason: impl Into<String>) -> Self {
         Error::InvalidParameter {
             name,
             reason: reason.into(),

@@ -55,6 +55,15 @@ fn main() -> ExitCode {
         eprintln!("haarshift: internal error (please report it): {info}");
     }));
     let cli = Cli::parse();
+    if matches!(
+        &cli.command,
+        Command::Relight {
+            command: commands::relight::RelightCommand::View(_)
+        }
+    ) {
+        // The viewer's reference reports to the page that asked, not to the terminal.
+        haarshift_viewer::progress::PageProgress::install();
+    }
     progress::TerminalProgress::install();
     let result = match cli.command {
         Command::Transform(args) => commands::transform::run(args),

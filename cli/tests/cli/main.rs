@@ -23,3 +23,4 @@ mod sphere;
 mod sphere_integrate;
 mod sphere_product;
 mod transform;
+mod viewer;

@@ -15,9 +15,11 @@ pub mod precompute;
 pub mod reference;
 pub mod render;
 pub mod scene;
+pub mod view;
 
 /// Relight meshes under environment maps: precompute (whole or in shards, merged by merge), render, reference, animate, gallery,
-/// dynamic scenes of moving objects (scene), and the error of renders against a reference.
+/// dynamic scenes of moving objects (scene), the error of renders against a reference, and the
+/// interactive viewer in the browser (view).
 #[derive(Subcommand, Debug)]
 pub enum RelightCommand {
     Precompute(Box<precompute::Args>),
@@ -28,6 +30,7 @@ pub enum RelightCommand {
     Gallery(Box<gallery::Args>),
     Scene(Box<scene::Args>),
     Error(Box<error::Args>),
+    View(Box<view::Args>),
 }
 
 pub fn run(command: RelightCommand) -> Result<()> {
@@ -40,5 +43,6 @@ pub fn run(command: RelightCommand) -> Result<()> {
         RelightCommand::Gallery(args) => gallery::run(*args),
         RelightCommand::Scene(args) => scene::run(*args),
         RelightCommand::Error(args) => error::run(*args),
+        RelightCommand::View(args) => view::run(*args),
     }
 }

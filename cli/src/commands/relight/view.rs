@@ -1,0 +1,84 @@
+//! `haarshift relight view`: the scene in the browser, relit as the lighting is dragged.
+
+use std::net::{IpAddr, SocketAddr};
+use std::path::PathBuf;
+
+use haarshift::Result;
+use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
+
+use super::flags::LightFlags;
+use crate::commands::print;
+
+const HELP: &str = "\
+Starts a local server and prints the page's address: the page draws the scene (WebGL2) with
+the radiance computed by the same shaders as relight render, frame after frame, as the
+lighting is dragged (any angle), the camera orbited and zoomed, and the basis, material and
+budgets changed. The error view computes the reference (ray cast) in the background and
+shows each vertex's error in false colour. The page copies the relight render command of its
+view, saves it as PNG, and keeps its view in the URL. Nothing is fetched from the network;
+the server listens on 127.0.0.1 unless --host says otherwise, and serves each page (up to
+--max-sessions) a session of its own.
+
+Examples:
+  haarshift relight view bunny.hsr --env testdata/envmaps/rooitou_park_1k.hdr
+  haarshift relight view cubes.hsr --env park.hdr --port 9000 --open
+  haarshift relight view bunny.hsr --env park.hdr --yaw 120 --port 0   (any free port)";
+
+/// Serve a precomputed scene to the browser and relight it interactively.
+#[derive(clap::Args, Debug)]
+#[command(after_help = HELP)]
+pub struct Args {
+    /// The scene cache (`relight precompute ... -o SCENE.hsr`)
+    #[arg(value_name = "SCENE.hsr")]
+    pub cache: PathBuf,
+
+    #[command(flatten)]
+    pub light: LightFlags,
+
+    /// The port to listen on; 0 takes a free one
+    #[arg(long, value_name = "P", default_value_t = 8765)]
+    pub port: u16,
+
+    /// The address to listen on (another than 127.0.0.1 serves the network: the viewer has
+    /// no authentication)
+    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1")]
+    pub host: IpAddr,
+
+    /// Pages served at once, each a session of its own; one more is refused in one line
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub max_sessions: usize,
+
+    /// Open the page in the desktop's browser (xdg-open, open)
+    #[arg(long)]
+    pub open: bool,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let scene = ViewedScene::load(&args.cache, &args.light.spec())?;
+    let viewer = Viewer::bind(
+        scene,
+        ViewerOptions {
+            address: SocketAddr::new(args.host, args.port),
+            max_sessions: args.max_sessions,
+        },
+    )?;
+    let url = viewer.url();
+    print(&format!("haarshift viewer: {url} (Ctrl-C stops it)\n"))?;
+    if args.open {
+        open_in_browser(&url);
+    }
+    viewer.serve();
+    Ok(())
+}
+
+/// Asks the desktop to open `url`; a failure is said, not fatal (the address is printed).
+fn open_in_browser(url: &str) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else {
+        "xdg-open"
+    };
+    if std::process::Command::new(opener).arg(url).spawn().is_err() {
+        eprintln!("haarshift: could not run {opener}: open {url} by hand");
+    }
+}

@@ -1,0 +1,288 @@
+//! The local server: the page and its script over HTTP, one WebSocket session per page.
+//!
+//! Every connection gets a thread. Its request head is read (at most [`MAX_HEAD`] bytes within
+//! [`HEAD_WAIT`]) and parsed by `httparse`; `GET /` and `GET /viewer.js` are answered with the
+//! files embedded in the binary, `GET /ws` with the WebSocket handshake (RFC 6455, the accept
+//! key by `tungstenite`), after which the thread runs the page's [`Session`]. Every page gets
+//! a session of its own (its own shader, frames and reference) up to
+//! [`ViewerOptions::max_sessions`] at once; one more is told so in one line and closed. A
+//! WebSocket from a page of another origin is refused (403): any page the user opens could
+//! otherwise drive a server on the loopback.
+
+use std::io::{Read, Write};
+use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
+
+use tungstenite::protocol::{Role, WebSocket};
+use tungstenite::{Message, handshake::derive_accept_key};
+
+use haarshift::{Error, Result};
+
+use crate::protocol::Notice;
+use crate::scene::ViewedScene;
+use crate::session::Session;
+
+/// The longest request head read.
+pub const MAX_HEAD: usize = 16 * 1024;
+/// How long a connection may take to send its request head.
+pub const HEAD_WAIT: Duration = Duration::from_secs(10);
+
+const INDEX_HTML: &str = include_str!("../page/index.html");
+const VIEWER_JS: &str = include_str!("../page/viewer.js");
+
+/// Where and how the viewer serves.
+///
+/// ```
+/// use haarshift_viewer::ViewerOptions;
+/// let o = ViewerOptions::default();
+/// assert_eq!((o.address.ip().to_string(), o.address.port(), o.max_sessions), ("127.0.0.1".into(), 8765, 4));
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct ViewerOptions {
+    /// The address to listen on; port 0 takes a free one.
+    pub address: SocketAddr,
+    /// Pages served at once, each with its own session.
+    pub max_sessions: usize,
+}
+
+impl Default for ViewerOptions {
+    fn default() -> Self {
+        ViewerOptions {
+            address: SocketAddr::from(([127, 0, 0, 1], 8765)),
+            max_sessions: 4,
+        }
+    }
+}
+
+/// A viewer bound to its address, ready to [`serve`](Self::serve).
+///
+/// ```no_run
+/// use haarshift::relight::shade::LightSpec;
+/// use haarshift_viewer::{Viewer, ViewerOptions, ViewedScene};
+/// let light = LightSpec { env: Some("park.hdr".into()), ..LightSpec::default() };
+/// let scene = ViewedScene::load("bunny.hsr".as_ref(), &light).unwrap();
+/// let viewer = Viewer::bind(scene, ViewerOptions::default()).unwrap();
+/// println!("open {}", viewer.url());
+/// viewer.serve(); // until the process ends
+/// ```
+pub struct Viewer {
+    listener: TcpListener,
+    scene: Arc<ViewedScene>,
+    options: ViewerOptions,
+}
+
+impl Viewer {
+    /// Listens on `options.address` for pages of `scene`.
+    pub fn bind(scene: ViewedScene, options: ViewerOptions) -> Result<Viewer> {
+        if options.max_sessions == 0 {
+            return Err(Error::parameter(
+                "max sessions",
+                "0: at least one page must be served",
+            ));
+        }
+        let listener = TcpListener::bind(options.address).map_err(|e| {
+            Error::parameter(
+                "address",
+                format!("cannot listen on {}: {e}", options.address),
+            )
+        })?;
+        Ok(Viewer {
+            listener,
+            scene: Arc::new(scene),
+            options,
+        })
+    }
+
+    /// The address listened on (with the port taken when 0 was asked for).
+    pub fn address(&self) -> Result<SocketAddr> {
+        self.listener
+            .local_addr()
+            .map_err(|e| Error::parameter("address", e.to_string()))
+    }
+
+    /// The page's address, `http://HOST:PORT/`.
+    pub fn url(&self) -> String {
+        match self.address() {
+            Ok(a) => format!("http://{a}/"),
+            Err(_) => format!("http://{}/", self.options.address),
+        }
+    }
+
+    /// Serves pages until the process ends; each connection on its own thread.
+    pub fn serve(self) {
+        let sessions = Arc::new(AtomicUsize::new(0));
+        let port = self.address().map(|a| a.port()).unwrap_or(0);
+        for stream in self.listener.incoming().flatten() {
+            let scene = Arc::clone(&self.scene);
+            let sessions = Arc::clone(&sessions);
+            let options = self.options;
+            std::thread::spawn(move || connection(stream, scene, sessions, options, port));
+        }
+    }
+}
+
+/// One connection: the page, the script, or a session.
+fn connection(
+    mut stream: TcpStream,
+    scene: Arc<ViewedScene>,
+    sessions: Arc<AtomicUsize>,
+    options: ViewerOptions,
+    port: u16,
+) {
+    let _ = stream.set_read_timeout(Some(HEAD_WAIT));
+    let Some((head, rest)) = read_head(&mut stream) else {
+        return;
+    };
+    let mut headers = [httparse::EMPTY_HEADER; 32];
+    let mut request = httparse::Request::new(&mut headers);
+    if !matches!(request.parse(&head), Ok(httparse::Status::Complete(_))) {
+        let _ = respond(
+            &mut stream,
+            "400 Bad Request",
+            "text/plain",
+            b"bad request\n",
+        );
+        return;
+    }
+    let header = |name: &str| {
+        request
+            .headers
+            .iter()
+            .find(|h| h.name.eq_ignore_ascii_case(name))
+            .and_then(|h| std::str::from_utf8(h.value).ok())
+    };
+    let path = request.path.unwrap_or("/");
+    let path = path.split(['?', '#']).next().unwrap_or("/");
+    match (request.method, path) {
+        (Some("GET"), "/" | "/index.html") => {
+            let _ = respond(
+                &mut stream,
+                "200 OK",
+                "text/html; charset=utf-8",
+                INDEX_HTML.as_bytes(),
+            );
+        }
+        (Some("GET"), "/viewer.js") => {
+            let _ = respond(
+                &mut stream,
+                "200 OK",
+                "text/javascript; charset=utf-8",
+                VIEWER_JS.as_bytes(),
+            );
+        }
+        (Some("GET"), "/ws") => {
+            let origin_ok = header("origin").is_none_or(|o| same_origin(o, port));
+            let key = header("sec-websocket-key").map(str::to_owned);
+            let upgrade = header("upgrade").is_some_and(|u| u.eq_ignore_ascii_case("websocket"));
+            match (origin_ok, upgrade, key) {
+                (false, _, _) => {
+                    let _ = respond(
+                        &mut stream,
+                        "403 Forbidden",
+                        "text/plain",
+                        b"another origin\n",
+                    );
+                }
+                (true, true, Some(key)) => session(stream, rest, &key, scene, &sessions, options),
+                _ => {
+                    let _ = respond(
+                        &mut stream,
+                        "400 Bad Request",
+                        "text/plain",
+                        b"a WebSocket upgrade is expected\n",
+                    );
+                }
+            }
+        }
+        (Some("GET"), _) => {
+            let _ = respond(&mut stream, "404 Not Found", "text/plain", b"not found\n");
+        }
+        _ => {
+            let _ = respond(
+                &mut stream,
+                "405 Method Not Allowed",
+                "text/plain",
+                b"GET only\n",
+            );
+        }
+    }
+}
+
+/// The WebSocket handshake, then the page's session (or the refusal of one too many).
+fn session(
+    mut stream: TcpStream,
+    rest: Vec<u8>,
+    key: &str,
+    scene: Arc<ViewedScene>,
+    sessions: &AtomicUsize,
+    options: ViewerOptions,
+) {
+    let accept = format!(
+        "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+         Sec-WebSocket-Accept: {}\r\n\r\n",
+        derive_accept_key(key.as_bytes())
+    );
+    if stream.write_all(accept.as_bytes()).is_err() {
+        return;
+    }
+    let _ = stream.set_nodelay(true);
+    let mut ws = WebSocket::from_partially_read(stream, rest, Role::Server, None);
+    let open = sessions.fetch_add(1, Ordering::SeqCst);
+    if open >= options.max_sessions {
+        let message = Notice::Error {
+            message: format!(
+                "the viewer serves {} pages at once and all are open: close one and reload",
+                options.max_sessions
+            ),
+        };
+        let _ = ws.send(Message::text(
+            serde_json::to_string(&message).expect("a notice serialises"),
+        ));
+        let _ = ws.close(None);
+        let _ = ws.flush();
+    } else {
+        Session::new(scene).run(ws, options.max_sessions);
+    }
+    sessions.fetch_sub(1, Ordering::SeqCst);
+}
+
+/// Whether a page at `origin` is this server's own.
+fn same_origin(origin: &str, port: u16) -> bool {
+    ["127.0.0.1", "localhost", "[::1]"]
+        .iter()
+        .any(|host| origin == format!("http://{host}:{port}"))
+}
+
+/// The request head (through its blank line) and any bytes read after it, or `None` when the
+/// client sent no complete head within the limits.
+fn read_head(stream: &mut TcpStream) -> Option<(Vec<u8>, Vec<u8>)> {
+    let mut buffer = Vec::with_capacity(1024);
+    let mut chunk = [0u8; 1024];
+    loop {
+        if let Some(end) = buffer.windows(4).position(|w| w == b"\r\n\r\n") {
+            let rest = buffer.split_off(end + 4);
+            return Some((buffer, rest));
+        }
+        if buffer.len() >= MAX_HEAD {
+            return None;
+        }
+        match stream.read(&mut chunk) {
+            Ok(0) | Err(_) => return None,
+            Ok(n) => buffer.extend_from_slice(&chunk[..n]),
+        }
+    }
+}
+
+/// A complete response with `body`; the connection closes after it.
+fn respond(stream: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> std::io::Result<()> {
+    let head = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {}\r\n\
+         Cache-Control: no-store\r\nConnection: close\r\n\r\n",
+        body.len()
+    );
+    stream.write_all(head.as_bytes())?;
+    stream.write_all(body)?;
+    stream.flush()
+}

@@ -1,0 +1,403 @@
+//! One page's session: its shader, its frames and its reference in the background.
+//!
+//! The session reads every request queued on its socket before it starts a frame and keeps
+//! only the latest state, so a drag faster than the frames costs no backlog: the frame
+//! computed is always the newest view's. A state equal to the last one drawn (but for its
+//! number, or the eye when nothing depends on it) computes nothing.
+
+use std::io::ErrorKind;
+use std::net::TcpStream;
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, TryRecvError, channel};
+use std::time::{Duration, Instant};
+
+use serde_json::json;
+use tungstenite::{Message, WebSocket};
+
+use haarshift::product::Selection;
+use haarshift::relight::Brdf;
+use haarshift::relight::material::orient::BrdfRotation;
+use haarshift::relight::shade::glossy::GlossyOptions;
+use haarshift::relight::shade::{
+    FrameSpec, Method, ShadeOptions, Shader, ShaderSpec, Shading, ShadingInput,
+};
+use haarshift::sphere::SphereRotation;
+use haarshift::{Error, Result};
+
+use crate::progress::{Counter, watch};
+use crate::protocol::{Notice, Packet, PacketKind, Request, ViewState, sample_bytes};
+use crate::scene::ViewedScene;
+
+/// How long an idle session waits on its socket before it looks at its reference again.
+const IDLE_WAIT: Duration = Duration::from_millis(50);
+/// How long a busy session waits for one more queued request before it computes.
+const DRAIN_WAIT: Duration = Duration::from_millis(1);
+
+/// What the reference of a frame depends on: the lighting's rotation, the material and, for a
+/// view-dependent one, the eye.
+#[derive(Clone, Debug, PartialEq)]
+struct ReferenceKey {
+    angles: [f64; 3],
+    brdf: String,
+    eye: Option<[f64; 3]>,
+}
+
+/// A reference being computed on its own thread.
+struct ReferenceJob {
+    key: ReferenceKey,
+    counter: Arc<Counter>,
+    result: Receiver<Result<Shading>>,
+    start: Instant,
+}
+
+/// One page's state between frames.
+pub(crate) struct Session {
+    scene: Arc<ViewedScene>,
+    shader: Option<(ShaderSpec, Box<dyn Shader>)>,
+    /// The state of the last frame sent, its number cleared.
+    drawn: Option<ViewState>,
+    /// The reference sent last, or being computed.
+    reference: Option<ReferenceKey>,
+    job: Option<ReferenceJob>,
+    /// The latest state with the error view on: its reference starts once the running one
+    /// ends.
+    wanted: Option<ViewState>,
+    /// The progress last sent, so that only changes are.
+    progress_sent: (u64, u64),
+}
+
+impl Session {
+    pub(crate) fn new(scene: Arc<ViewedScene>) -> Session {
+        Session {
+            scene,
+            shader: None,
+            drawn: None,
+            reference: None,
+            job: None,
+            wanted: None,
+            progress_sent: (0, 0),
+        }
+    }
+
+    /// Serves the page on `ws` until it closes: the scene first, then a frame for every
+    /// latest state.
+    pub(crate) fn run(mut self, mut ws: WebSocket<TcpStream>, max_sessions: usize) {
+        let opening = self
+            .scene
+            .scene_packet(max_sessions)
+            .and_then(|scene| Ok([scene, self.scene.environment_packet()?]));
+        let Ok(packets) = opening else {
+            return;
+        };
+        for packet in packets {
+            if ws.send(Message::binary(packet)).is_err() {
+                return;
+            }
+        }
+        let mut latest: Option<ViewState> = None;
+        loop {
+            let wait = if latest.is_some() {
+                DRAIN_WAIT
+            } else {
+                IDLE_WAIT
+            };
+            if ws.get_ref().set_read_timeout(Some(wait)).is_err() {
+                return;
+            }
+            let outgoing = match ws.read() {
+                Ok(Message::Text(text)) => match self.request(&text) {
+                    Ok(state) => {
+                        latest = Some(state);
+                        continue;
+                    }
+                    Err(e) => vec![notice(&Notice::Error {
+                        message: e.to_string(),
+                    })],
+                },
+                Ok(Message::Binary(_)) => vec![notice(&Notice::Error {
+                    message: "binary requests are not understood: send JSON text".into(),
+                })],
+                Ok(_) => continue,
+                Err(tungstenite::Error::Io(e))
+                    if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) =>
+                {
+                    // Nothing more queued: draw the latest state, report the reference.
+                    let mut out = Vec::new();
+                    if let Some(state) = latest.take() {
+                        out.extend(self.answer(&state));
+                    }
+                    out.extend(self.poll_reference());
+                    out
+                }
+                Err(_) => return,
+            };
+            for message in outgoing {
+                if ws.send(message).is_err() {
+                    return;
+                }
+            }
+        }
+    }
+
+    /// A request's state, checked.
+    fn request(&self, text: &str) -> Result<ViewState> {
+        let Request::State(state) =
+            serde_json::from_str(text).map_err(|e| Error::parameter("request", format!("{e}")))?;
+        state.check()?;
+        Ok(state)
+    }
+
+    /// The messages answering `state`: its frame unless it was drawn already, and the start
+    /// of its reference when the error view is on. A state that cannot be served is an error
+    /// message; the session goes on.
+    fn answer(&mut self, state: &ViewState) -> Vec<Message> {
+        let mut out = Vec::new();
+        match self.frame(state) {
+            Ok(Some(packet)) => out.push(Message::binary(packet)),
+            Ok(None) => {}
+            Err(e) => {
+                out.push(notice(&Notice::Error {
+                    message: e.to_string(),
+                }));
+                return out;
+            }
+        }
+        self.wanted = state.error.then(|| state.clone());
+        out
+    }
+
+    /// The frame of `state`, or `None` when it is the one drawn last.
+    fn frame(&mut self, state: &ViewState) -> Result<Option<Vec<u8>>> {
+        let spec = self.spec(state)?;
+        let mut key = ViewState {
+            seq: 0,
+            error: false,
+            ..state.clone()
+        };
+        if !view_dependent(&spec) {
+            key.eye = None;
+        }
+        if self.drawn.as_ref() == Some(&key) {
+            return Ok(None);
+        }
+        let mut prepare_ms = 0.0;
+        if self.shader.as_ref().map(|(s, _)| s) != Some(&spec) {
+            let start = Instant::now();
+            self.shader = None; // the old shader's memory goes before the new one's comes
+            let input = ShadingInput::cache(&self.scene.cache).from_file(&self.scene.cache_path);
+            self.shader = Some((spec.clone(), spec.build(&input)?));
+            prepare_ms = start.elapsed().as_secs_f64() * 1e3;
+        }
+        let (_, shader) = self.shader.as_mut().expect("built above");
+        let rotation = SphereRotation::from_degrees(state.yaw, state.pitch, state.roll)?;
+        let eye = state.eye.unwrap_or(self.scene.camera.position());
+        let shading = shader.shade(&FrameSpec {
+            environment: &self.scene.environment,
+            rotation,
+            eye: Some(eye),
+        })?;
+        let radiance = shading.radiance.to_f32();
+        let header = json!({
+            "seq": state.seq,
+            "state": ViewState { eye: Some(eye), ..state.clone() },
+            "rotation": rotation.matrix(),
+            "format": state.format,
+            "vertices": radiance.nrows(),
+            "encode_ms": shading.timing.encode_seconds * 1e3,
+            "rotate_ms": shading.timing.rotate_seconds * 1e3,
+            "shade_ms": shading.timing.shade_seconds * 1e3,
+            "prepare_ms": prepare_ms,
+            "light_coefficients": shading.light_coefficients,
+            "maps": shading.maps.map(|m| json!({ "used": m.maps, "rotated": m.rotated, "cached": m.cached })),
+            "description": shading.description,
+        });
+        let values = radiance.as_standard_layout();
+        let payload = sample_bytes(values.as_slice().expect("standard layout"), state.format);
+        self.drawn = Some(key);
+        Packet::new(PacketKind::Frame, &header, &payload).map(Some)
+    }
+
+    /// The shader `state` asks for, its budgets checked against the scene's.
+    fn spec(&self, state: &ViewState) -> Result<ShaderSpec> {
+        let method: Method = state.basis.parse()?;
+        if method == Method::Reference {
+            return Err(Error::parameter(
+                "basis",
+                "the reference is computed in the background: turn on the error view",
+            ));
+        }
+        let brdf = page_brdf(&state.brdf)?;
+        let param = self.scene.cache.transport.param();
+        let texels = param.texels();
+        let levels = param.face_size().trailing_zeros() as usize;
+        for (name, budget) in [
+            ("keep_light", state.keep_light),
+            ("keep_visibility", state.keep_visibility),
+        ] {
+            if let Some(k) = budget.filter(|&k| k == 0 || k > texels) {
+                return Err(Error::parameter(
+                    name,
+                    format!("{k}: expected 1 to the {texels} coefficients of the scene's maps"),
+                ));
+            }
+        }
+        if let Some(d) = state.depth.filter(|&d| d > levels) {
+            return Err(Error::parameter(
+                "depth",
+                format!("{d}: the scene's maps have {levels} detail levels"),
+            ));
+        }
+        let material = GlossyOptions {
+            brdf: brdf.clone(),
+            rotation: state.brdf_rotation.parse::<BrdfRotation>()?,
+            cache_bins: state.rotation_cache,
+            ..GlossyOptions::default()
+        }
+        .for_brdf(&brdf);
+        Ok(ShaderSpec {
+            method,
+            material,
+            shade: ShadeOptions {
+                keep_visibility: state.keep_visibility.map(Selection::Largest),
+                depth: state.depth,
+            },
+            keep_light: state.keep_light.map_or(Selection::All, Selection::Largest),
+            ..ShaderSpec::default()
+        })
+    }
+
+    /// Starts the reference of `state`'s lighting and material unless it is the one sent or
+    /// being computed; one at a time (a newer one starts when the running one ends).
+    fn start_reference(&mut self, state: &ViewState) {
+        let Ok(brdf) = page_brdf(&state.brdf) else {
+            return;
+        };
+        let key = ReferenceKey {
+            angles: [state.yaw, state.pitch, state.roll],
+            brdf: state.brdf.clone(),
+            eye: (!brdf.is_lambert()).then(|| state.eye.unwrap_or(self.scene.camera.position())),
+        };
+        if self.reference.as_ref() == Some(&key) || self.job.is_some() {
+            return;
+        }
+        let Ok(rotation) =
+            SphereRotation::from_degrees(key.angles[0], key.angles[1], key.angles[2])
+        else {
+            return;
+        };
+        let spec = ShaderSpec {
+            method: Method::Reference,
+            material: GlossyOptions {
+                brdf,
+                ..GlossyOptions::default()
+            },
+            progress: true,
+            ..ShaderSpec::default()
+        };
+        let counter = Arc::new(Counter::default());
+        let (send, result) = channel();
+        let scene = Arc::clone(&self.scene);
+        let watched = Arc::clone(&counter);
+        let eye = key.eye.unwrap_or(self.scene.camera.position());
+        std::thread::spawn(move || {
+            watch(watched);
+            let input = ShadingInput::cache(&scene.cache).from_file(&scene.cache_path);
+            let shading = spec.build(&input).and_then(|mut shader| {
+                shader.shade(&FrameSpec {
+                    environment: &scene.environment,
+                    rotation,
+                    eye: Some(eye),
+                })
+            });
+            // The page may have gone: nobody to tell.
+            let _ = send.send(shading);
+        });
+        self.reference = Some(key.clone());
+        self.progress_sent = (0, 0);
+        self.job = Some(ReferenceJob {
+            key,
+            counter,
+            result,
+            start: Instant::now(),
+        });
+    }
+
+    /// The reference's news: its progress when it changed, the reference when it is ready.
+    fn poll_reference(&mut self) -> Vec<Message> {
+        if let Some(state) = self.wanted.clone() {
+            self.start_reference(&state);
+        }
+        let Some(job) = &self.job else {
+            return Vec::new();
+        };
+        match job.result.try_recv() {
+            Err(TryRecvError::Empty) => {
+                let (done, total) = job.counter.get();
+                if (done, total) == self.progress_sent {
+                    return Vec::new();
+                }
+                self.progress_sent = (done, total);
+                vec![notice(&Notice::Progress { done, total })]
+            }
+            Err(TryRecvError::Disconnected) => {
+                self.job = None;
+                self.reference = None;
+                vec![notice(&Notice::Error {
+                    message: "the reference's thread ended without a result".into(),
+                })]
+            }
+            Ok(result) => {
+                let job = self.job.take().expect("matched above");
+                let message = result.and_then(|shading| {
+                    let radiance = shading.radiance.to_f32();
+                    let values = radiance.as_standard_layout();
+                    let header = json!({
+                        "yaw": job.key.angles[0],
+                        "pitch": job.key.angles[1],
+                        "roll": job.key.angles[2],
+                        "brdf": job.key.brdf,
+                        "eye": job.key.eye,
+                        "seconds": job.start.elapsed().as_secs_f64(),
+                        "description": shading.description,
+                    });
+                    let payload = sample_bytes(
+                        values.as_slice().expect("standard layout"),
+                        crate::protocol::SampleFormat::F32,
+                    );
+                    Packet::new(PacketKind::Reference, &header, &payload)
+                });
+                match message {
+                    Ok(packet) => vec![Message::binary(packet)],
+                    Err(e) => {
+                        self.reference = None;
+                        vec![notice(&Notice::Error {
+                            message: format!("reference: {e}"),
+                        })]
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A BRDF the page may ask for: by name, never a file (a page must not make the server read
+/// files).
+fn page_brdf(name: &str) -> Result<Brdf> {
+    if name.starts_with("merl") {
+        return Err(Error::parameter(
+            "brdf",
+            "measured BRDFs are not offered by the viewer: lambert, phong:EXP or blinn:EXP",
+        ));
+    }
+    name.parse()
+}
+
+/// Whether frames of `spec` change with the eye.
+fn view_dependent(spec: &ShaderSpec) -> bool {
+    !spec.material.brdf.is_lambert()
+}
+
+/// A notice as a text message.
+fn notice(n: &Notice) -> Message {
+    Message::text(serde_json::to_string(n).expect("a notice serialises"))
+}
