@@ -9,7 +9,8 @@ const $ = (id) => document.getElementById(id);
 // Everything tests and the frame-rate script read over the DevTools protocol.
 const viewer = {
   framesReceived: 0,   // frame packets received
-  framesDrawn: 0,      // frames drawn (each received frame once)
+  framesDrawn: 0,      // frames drawn (a frame that arrives before the last is drawn is not)
+  drawnSeq: null,      // the state number of the frame drawn last
   frame: null,         // { header, radiance: Float32Array (V x 3) } of the last frame
   reference: null,     // { header, radiance } of the last reference
   scene: null,         // the scene's description
@@ -380,6 +381,7 @@ function draw() {
   gl.drawElements(gl.TRIANGLES, indexCount, gl.UNSIGNED_INT, 0);
   gl.bindVertexArray(null);
   viewer.framesDrawn += 1;
+  viewer.drawnSeq = viewer.frame.header.seq;
   recordRate();
   updateStats();
 }

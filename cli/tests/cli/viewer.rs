@@ -92,7 +92,7 @@ fn wait_for_latest(browser: &mut Browser) {
     let waited = browser.wait_for(
         "haarshiftViewer.frame !== null && haarshiftViewer.state !== null && \
              haarshiftViewer.frame.header.seq === haarshiftViewer.state.seq && \
-             haarshiftViewer.framesDrawn >= haarshiftViewer.framesReceived",
+             haarshiftViewer.drawnSeq === haarshiftViewer.state.seq",
         Duration::from_secs(120),
     );
     if let Err(e) = waited {
@@ -243,6 +243,204 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
     for (h, v) in radiance_h.iter().zip(&rendered_b) {
         assert_eq!(*h, half::f16::from_f32(*v).to_f32(), "{v} sent as {h}");
     }
+
+    // A state the server refuses is said on the page, and the next one is drawn.
+    browser.evaluate("haarshiftViewer.setState({ keep_light: 1e12 })").unwrap();
+    browser
+        .wait_for(
+            "haarshiftViewer.notices.some((n) => n.includes('keep_light')) && \
+             document.getElementById('message').style.display === 'block'",
+            Duration::from_secs(30),
+        )
+        .unwrap();
+
+    // The error view: the reference arrives in the background, equal to relight render's
+    // reference, and the page shows each vertex's error.
+    browser
+        .evaluate("haarshiftViewer.setState({ keep_light: 200, format: 'f32', error: true })")
+        .unwrap();
+    wait_for_latest(&mut browser);
+    browser
+        .wait_for("haarshiftViewer.reference !== null", Duration::from_secs(120))
+        .unwrap();
+    let yaw = state_b["yaw"].to_string();
+    let pitch = state_b["pitch"].to_string();
+    let truth = dir.path().join("truth.npy");
+    succeeds(&[
+        "relight", "render", p(&cache), "--env", p(&env), "--yaw", &yaw, "--pitch", &pitch,
+        "--basis", "reference", "--width", "16", "--height", "12",
+        "-o", p(&dir.path().join("truth.png")), "--vertices", p(&truth),
+    ]);
+    let truth: Array2<f32> = ndarray_npy::read_npy(&truth).unwrap();
+    let reference: Vec<f32> = browser
+        .evaluate("Array.from(haarshiftViewer.reference.radiance)")
+        .unwrap()
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap() as f32)
+        .collect();
+    assert_eq!(reference, truth.iter().copied().collect::<Vec<_>>());
+    browser
+        .wait_for(
+            "document.getElementById('stats').textContent.includes('error RMS')",
+            Duration::from_secs(30),
+        )
+        .unwrap();
+
     let errors = browser.console_errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
+}
+
+/// A WebSocket client of the viewer, as a page would be.
+struct Client(tungstenite::WebSocket<std::net::TcpStream>);
+
+impl Client {
+    /// Connects to `/ws`, with an `Origin` header when given.
+    fn connect(url: &str, origin: Option<&str>) -> Result<Client, tungstenite::Error> {
+        use tungstenite::client::IntoClientRequest;
+        let address = url.trim_start_matches("http://").trim_end_matches('/');
+        let stream = std::net::TcpStream::connect(address).unwrap();
+        stream.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+        let mut request = format!("ws://{address}/ws").into_client_request()?;
+        if let Some(origin) = origin {
+            request.headers_mut().insert("Origin", origin.parse().unwrap());
+        }
+        match tungstenite::client(request, stream) {
+            Ok((socket, _)) => Ok(Client(socket)),
+            Err(tungstenite::HandshakeError::Failure(e)) => Err(e),
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// Reads the scene and environment packets a session opens with.
+    fn opened(url: &str) -> Client {
+        let mut client = Client::connect(url, None).unwrap();
+        assert_eq!(client.packet_kind(), 1);
+        assert_eq!(client.packet_kind(), 2);
+        client
+    }
+
+    fn send(&mut self, text: &str) {
+        self.0.send(tungstenite::Message::text(text)).unwrap();
+    }
+
+    fn next(&mut self) -> tungstenite::Message {
+        loop {
+            match self.0.read().unwrap() {
+                m @ (tungstenite::Message::Text(_) | tungstenite::Message::Binary(_)) => return m,
+                _ => {}
+            }
+        }
+    }
+
+    /// The next message's packet kind (a binary message required).
+    fn packet_kind(&mut self) -> u32 {
+        match self.next() {
+            tungstenite::Message::Binary(b) => u32::from_le_bytes(b[0..4].try_into().unwrap()),
+            other => panic!("a packet expected, got {other:?}"),
+        }
+    }
+
+    /// The next message: an error notice whose message contains `needle`.
+    fn refused(&mut self, needle: &str) {
+        match self.next() {
+            tungstenite::Message::Text(t) => {
+                let notice: Value = serde_json::from_str(&t).unwrap();
+                assert_eq!(notice["type"], "error", "{t}");
+                let message = notice["message"].as_str().unwrap();
+                assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+                assert!(!message.contains('\n'), "{message:?} is not one line");
+            }
+            other => panic!("an error expected, got {other:?}"),
+        }
+    }
+
+    /// The next message: a frame answering state `seq`.
+    fn frame(&mut self, seq: u64) {
+        match self.next() {
+            tungstenite::Message::Binary(b) => {
+                assert_eq!(u32::from_le_bytes(b[0..4].try_into().unwrap()), 3);
+                let len = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
+                let header: Value = serde_json::from_slice(&b[8..8 + len]).unwrap();
+                assert_eq!(header["seq"], seq, "{header}");
+            }
+            other => panic!("a frame expected, got {other:?}"),
+        }
+    }
+}
+
+/// The answer to a raw HTTP request.
+fn http(url: &str, request: &[u8]) -> String {
+    use std::io::{Read, Write};
+    let address = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut stream = std::net::TcpStream::connect(address).unwrap();
+    stream.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+    let _ = stream.write_all(request);
+    let mut answer = String::new();
+    let _ = stream.read_to_string(&mut answer);
+    answer
+}
+
+#[test]
+fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = bunny_cache(dir.path());
+    let env = testdata("envmaps/rooitou_park_256x128.npy");
+    let view = ViewProcess::start(&[p(&cache), "--env", p(&env), "--max-sessions", "2"]);
+    let mut page = Client::opened(&view.url);
+    for (request, needle) in [
+        (r#"{"type": "state", "seq": 1, "yaw": 10, "colour": 1}"#, "unknown field `colour`"),
+        (r#"{"type": "state", "seq": 1, "yaw": NaN}"#, "invalid request"),
+        (r#"{"type": "state", "seq": 1, "yaw": 1e300}"#, "finite angle"),
+        (r#"{"type": "state", "seq": 1, "eye": [0, 1e999, 0]}"#, "invalid request"),
+        (r#"{"type": "state", "seq": 1, "keep_light": 1000000000000000}"#, "keep_light"),
+        (r#"{"type": "state", "seq": 1, "keep_visibility": 0}"#, "keep_visibility"),
+        (r#"{"type": "state", "seq": 1, "depth": 99}"#, "depth"),
+        (r#"{"type": "state", "seq": 1, "brdf": "phong:50", "rotation_cache": 100000000}"#, "rotation cache"),
+        (r#"{"type": "state", "seq": 1, "brdf": "merl:/etc/passwd"}"#, "measured BRDFs"),
+        (r#"{"type": "state", "seq": 1, "basis": "reference"}"#, "error view"),
+        (r#"{"type": "state", "seq": 1, "basis": "sh"}"#, "sh"),
+        (r#"{"type": "play"}"#, "unknown variant `play`"),
+        ("not json", "invalid request"),
+    ] {
+        page.send(request);
+        page.refused(needle);
+    }
+    page.0.send(tungstenite::Message::binary(vec![1u8, 2, 3])).unwrap();
+    page.refused("binary requests");
+    // After all that, a good state is drawn.
+    page.send(r#"{"type": "state", "seq": 7, "yaw": 12.5, "keep_light": 50}"#);
+    page.frame(7);
+
+    // A second page gets a session of its own; a third, beyond --max-sessions 2, one line.
+    let mut second = Client::opened(&view.url);
+    second.send(r#"{"type": "state", "seq": 1, "yaw": 80}"#);
+    second.frame(1);
+    let mut third = Client::connect(&view.url, None).unwrap();
+    third.refused("serves 2 pages at once");
+    drop(third);
+
+    // A page that leaves while its frame is computed ends its session only.
+    second.send(r#"{"type": "state", "seq": 2, "yaw": 81, "brdf": "phong:20"}"#);
+    drop(second);
+    page.send(r#"{"type": "state", "seq": 8, "yaw": 13}"#);
+    page.frame(8);
+    let mut again = Client::opened(&view.url);
+    again.send(r#"{"type": "state", "seq": 1, "pitch": 5}"#);
+    again.frame(1);
+
+    // Another site's page may not drive the viewer; plain HTTP gets its status lines.
+    assert!(Client::connect(&view.url, Some("http://example.com")).is_err());
+    assert!(http(&view.url, b"GET /ws HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 400"));
+    assert!(http(&view.url, b"GET /secret HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 404"));
+    assert!(http(&view.url, b"POST / HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 405"));
+    assert!(http(&view.url, b"\x00\x01garbage\r\n\r\n").starts_with("HTTP/1.1 400"));
+    let mut huge = b"GET / HTTP/1.1\r\nX: ".to_vec();
+    huge.extend(vec![b'a'; 64 * 1024]);
+    assert_eq!(http(&view.url, &huge), "");
+    let index = http(&view.url, b"GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+    assert!(index.starts_with("HTTP/1.1 200") && index.contains("viewer.js"), "{index}");
+    page.send(r#"{"type": "state", "seq": 9, "yaw": 14}"#);
+    page.frame(9);
 }
