@@ -3,7 +3,7 @@
 // described in viewer/src/protocol.rs.
 'use strict';
 
-const PACKET = { scene: 1, environment: 2, frame: 3, reference: 4 };
+const PACKET = { scene: 1, environment: 2, frame: 3, reference: 4, picture: 5 };
 const $ = (id) => document.getElementById(id);
 
 // Everything tests and the frame-rate script read over the DevTools protocol.
@@ -16,6 +16,7 @@ const viewer = {
   scene: null,         // the scene's description
   state: null,         // the view state last sent
   notices: [],         // error notices from the server, in order
+  timings: [],         // per frame received: the server's milliseconds and the round trip
   ready: false,        // the scene and the environment have arrived
   webgl2: false,
 };
@@ -83,8 +84,12 @@ function packet(buffer) {
     for (const seq of sentAt.keys()) if (seq <= header.seq) sentAt.delete(seq);
     viewer.frame = { header, radiance, roundTripMs: sent === undefined ? undefined : performance.now() - sent };
     viewer.framesReceived += 1;
+    viewer.timings.push({ encode: header.encode_ms, rotate: header.rotate_ms, shade: header.shade_ms, prepare: header.prepare_ms, roundTrip: viewer.frame.roundTripMs, at: performance.now() });
+    if (viewer.timings.length > 10000) viewer.timings.shift();
     hideMessage();
     frameDirty = true;
+  } else if (kind === PACKET.picture) {
+    download(new Blob([new Uint8Array(buffer, start)], { type: 'image/x-exr' }), 'haarshift-view.exr');
   } else if (kind === PACKET.reference) {
     viewer.reference = { header, radiance: new Float32Array(buffer, start) };
     referenceStatus = `reference ready (${header.seconds.toFixed(1)} s)`;
@@ -456,12 +461,16 @@ function setupControls(scene) {
     $('command').value = c;
     if (navigator.clipboard) navigator.clipboard.writeText(c).catch(() => {});
   };
-  $('save').onclick = () => canvas.toBlob((blob) => {
-    const a = document.createElement('a');
-    a.href = URL.createObjectURL(blob);
-    a.download = 'haarshift-view.png';
-    a.click();
-  });
+  $('save').onclick = () => canvas.toBlob((blob) => download(blob, 'haarshift-view.png'));
+  // The linear radiance, drawn by the server's rasteriser from the last frame.
+  $('exr').onclick = () => socket.send(JSON.stringify({ type: 'picture', look_at: orbit.target, fov: orbit.fov, width: canvas.width, height: canvas.height }));
+}
+
+function download(blob, name) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  a.click();
 }
 
 // Dragging: the lighting (left button), the camera (shift or right button); the wheel zooms.

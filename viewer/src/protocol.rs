@@ -31,7 +31,7 @@ pub const MAX_DEGREES: f64 = 36_000.0;
 /// ```
 /// use haarshift_viewer::protocol::Request;
 /// let r: Request = serde_json::from_str(r#"{"type": "state", "seq": 3, "yaw": 10}"#).unwrap();
-/// let Request::State(state) = r;
+/// let Request::State(state) = r else { unreachable!() };
 /// assert_eq!((state.seq, state.yaw, state.pitch), (3, 10.0, 0.0));
 /// assert!(serde_json::from_str::<Request>(r#"{"type": "state", "seq": 1, "yawn": 1}"#).is_err());
 /// ```
@@ -40,6 +40,48 @@ pub const MAX_DEGREES: f64 = 36_000.0;
 pub enum Request {
     /// The view as the page now shows it: compute its frame.
     State(ViewState),
+    /// The last frame drawn as a linear OpenEXR picture, by `relight render`'s rasteriser.
+    Picture(PictureRequest),
+}
+
+/// The largest picture side, in pixels.
+pub const MAX_PICTURE_SIDE: usize = 8192;
+
+/// The camera of a picture: the eye is the last frame's.
+///
+/// ```
+/// use haarshift_viewer::protocol::PictureRequest;
+/// let p = PictureRequest { look_at: [0.0; 3], fov: 40.0, width: 640, height: 480 };
+/// assert!(p.check().is_ok());
+/// assert!(PictureRequest { width: 100_000, ..p }.check().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PictureRequest {
+    /// The point looked at.
+    pub look_at: [f64; 3],
+    /// Vertical field of view, degrees.
+    pub fov: f64,
+    /// Pixels.
+    pub width: usize,
+    /// Pixels.
+    pub height: usize,
+}
+
+impl PictureRequest {
+    /// Refuses a picture of no pixels or more than [`MAX_PICTURE_SIDE`] a side (the camera is
+    /// checked when it is made).
+    pub fn check(&self) -> Result<()> {
+        for (name, side) in [("width", self.width), ("height", self.height)] {
+            if !(1..=MAX_PICTURE_SIDE).contains(&side) {
+                return Err(Error::parameter(
+                    name,
+                    format!("{side} pixels: expected 1 to {MAX_PICTURE_SIDE}"),
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Everything a frame depends on, as the page's controls set it.
@@ -186,6 +228,8 @@ pub enum PacketKind {
     /// The reference of a lighting and material: header the state, payload radiance
     /// `(V, 3)` f32.
     Reference = 4,
+    /// A picture: header its size, payload an OpenEXR file.
+    Picture = 5,
 }
 
 /// One binary message: a kind, a JSON header and a payload aligned to 4 bytes.

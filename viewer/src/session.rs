@@ -11,6 +11,7 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::time::{Duration, Instant};
 
+use ndarray::Array2;
 use serde_json::json;
 use tungstenite::{Message, WebSocket};
 
@@ -21,11 +22,15 @@ use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{
     FrameSpec, Method, ShadeOptions, Shader, ShaderSpec, Shading, ShadingInput,
 };
+use haarshift::render::output::write_render;
+use haarshift::render::view::{Backdrop, ViewSpec};
 use haarshift::sphere::SphereRotation;
 use haarshift::{Error, Result};
 
 use crate::progress::{Counter, watch};
-use crate::protocol::{Notice, Packet, PacketKind, Request, ViewState, sample_bytes};
+use crate::protocol::{
+    Notice, Packet, PacketKind, PictureRequest, Request, SampleFormat, ViewState, sample_bytes,
+};
 use crate::scene::ViewedScene;
 
 /// How long an idle session waits on its socket before it looks at its reference again.
@@ -56,6 +61,8 @@ pub(crate) struct Session {
     shader: Option<(ShaderSpec, Box<dyn Shader>)>,
     /// The state of the last frame sent, its number cleared.
     drawn: Option<ViewState>,
+    /// The last frame's radiance, rotation and eye, for a picture of it.
+    last: Option<(Array2<f32>, SphereRotation, [f64; 3])>,
     /// The reference sent last, or being computed.
     reference: Option<ReferenceKey>,
     job: Option<ReferenceJob>,
@@ -72,6 +79,7 @@ impl Session {
             scene,
             shader: None,
             drawn: None,
+            last: None,
             reference: None,
             job: None,
             wanted: None,
@@ -106,10 +114,11 @@ impl Session {
             }
             let outgoing = match ws.read() {
                 Ok(Message::Text(text)) => match self.request(&text) {
-                    Ok(state) => {
+                    Ok(Request::State(state)) => {
                         latest = Some(state);
                         continue;
                     }
+                    Ok(Request::Picture(picture)) => vec![self.picture(&picture)],
                     Err(e) => vec![notice(&Notice::Error {
                         message: e.to_string(),
                     })],
@@ -139,12 +148,56 @@ impl Session {
         }
     }
 
-    /// A request's state, checked.
-    fn request(&self, text: &str) -> Result<ViewState> {
-        let Request::State(state) =
+    /// A request, checked.
+    fn request(&self, text: &str) -> Result<Request> {
+        let request =
             serde_json::from_str(text).map_err(|e| Error::parameter("request", format!("{e}")))?;
-        state.check()?;
-        Ok(state)
+        match &request {
+            Request::State(state) => state.check()?,
+            Request::Picture(picture) => picture.check()?,
+        }
+        Ok(request)
+    }
+
+    /// The last frame as an OpenEXR picture (linear f32, the environment behind), or the
+    /// reason there is none.
+    fn picture(&self, request: &PictureRequest) -> Message {
+        let picture = || -> Result<Vec<u8>> {
+            let (radiance, rotation, eye) = self
+                .last
+                .as_ref()
+                .ok_or_else(|| Error::parameter("picture", "no frame has been drawn yet"))?;
+            let view = ViewSpec {
+                camera: Some((*eye, request.look_at)),
+                fov: Some(request.fov),
+                width: request.width,
+                height: request.height,
+                backdrop: Backdrop::Environment,
+            };
+            let mesh = &self.scene.cache.mesh;
+            let camera = view.camera(None, mesh)?;
+            let image = view.draw(
+                &camera,
+                mesh,
+                radiance.view(),
+                &self.scene.environment,
+                rotation,
+            )?;
+            let dir =
+                tempfile::tempdir().map_err(|e| Error::parameter("picture", e.to_string()))?;
+            let path = dir.path().join("view.exr");
+            write_render(&image, &path, 0.0, false)?;
+            let bytes = std::fs::read(&path).map_err(|source| Error::Io { path, source })?;
+            let header =
+                json!({ "width": request.width, "height": request.height, "format": "exr" });
+            Packet::new(PacketKind::Picture, &header, &bytes)
+        };
+        match picture() {
+            Ok(packet) => Message::binary(packet),
+            Err(e) => notice(&Notice::Error {
+                message: e.to_string(),
+            }),
+        }
     }
 
     /// The messages answering `state`: its frame unless it was drawn already, and the start
@@ -211,9 +264,12 @@ impl Session {
             "maps": shading.maps.map(|m| json!({ "used": m.maps, "rotated": m.rotated, "cached": m.cached })),
             "description": shading.description,
         });
-        let values = radiance.as_standard_layout();
-        let payload = sample_bytes(values.as_slice().expect("standard layout"), state.format);
+        let payload = {
+            let values = radiance.as_standard_layout();
+            sample_bytes(values.as_slice().expect("standard layout"), state.format)
+        };
         self.drawn = Some(key);
+        self.last = Some((radiance, rotation, eye));
         Packet::new(PacketKind::Frame, &header, &payload).map(Some)
     }
 
@@ -362,7 +418,7 @@ impl Session {
                     });
                     let payload = sample_bytes(
                         values.as_slice().expect("standard layout"),
-                        crate::protocol::SampleFormat::F32,
+                        SampleFormat::F32,
                     );
                     Packet::new(PacketKind::Reference, &header, &payload)
                 });

@@ -2,7 +2,8 @@
 //! runs, as written, in a copy of the repository's files (with `results/` as committed), twice,
 //! succeeds both times, prints its table and leaves `results/` alone; and every `haarshift`
 //! line of its other `sh` blocks runs in order from the root of a copy and succeeds (the few
-//! that take minutes as written at the smaller sizes of [`SMALLER`]).
+//! that take minutes as written at the smaller sizes of [`SMALLER`]); `relight view`, a server,
+//! on a free port until it serves its page.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -215,6 +216,10 @@ fn every_later_readme_command_runs_from_the_root_of_a_fresh_copy() {
         copy_tree(&repository().join(dir), &clone.join(dir));
     }
     for args in commands.iter().map(|args| smaller(args)) {
+        if args.starts_with(&["relight".to_owned(), "view".to_owned()]) {
+            serves_its_page(&args, &clone);
+            continue;
+        }
         let out = Command::new(env!("CARGO_BIN_EXE_haarshift"))
             .args(&args)
             .current_dir(&clone)
@@ -228,4 +233,17 @@ fn every_later_readme_command_runs_from_the_root_of_a_fresh_copy() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
+}
+
+/// `haarshift ARGS` (a `relight view`) on a free port in `dir`: it prints its address and serves
+/// the page there; it is stopped when dropped.
+fn serves_its_page(args: &[String], dir: &Path) {
+    let args: Vec<&str> = args[2..].iter().map(String::as_str).collect();
+    let view = crate::viewer::ViewProcess::start_in(Some(dir), &args);
+    let page = crate::viewer::http(&view.url, b"GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+    assert!(
+        page.starts_with("HTTP/1.1 200"),
+        "`relight view {}`: {page}",
+        args.join(" ")
+    );
 }

@@ -25,7 +25,16 @@ pub struct ViewProcess {
 impl ViewProcess {
     /// Starts `relight view ARGS --port 0` and reads the address it prints.
     pub fn start(args: &[&str]) -> ViewProcess {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_haarshift"))
+        ViewProcess::start_in(None, args)
+    }
+
+    /// [`start`](Self::start) in `dir`, when given.
+    pub fn start_in(dir: Option<&Path>, args: &[&str]) -> ViewProcess {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_haarshift"));
+        if let Some(dir) = dir {
+            command.current_dir(dir);
+        }
+        let mut child = command
             .args(["relight", "view"])
             .args(args)
             .args(["--port", "0"])
@@ -245,7 +254,9 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
     }
 
     // A state the server refuses is said on the page, and the next one is drawn.
-    browser.evaluate("haarshiftViewer.setState({ keep_light: 1e12 })").unwrap();
+    browser
+        .evaluate("haarshiftViewer.setState({ keep_light: 1e12 })")
+        .unwrap();
     browser
         .wait_for(
             "haarshiftViewer.notices.some((n) => n.includes('keep_light')) && \
@@ -261,15 +272,34 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
         .unwrap();
     wait_for_latest(&mut browser);
     browser
-        .wait_for("haarshiftViewer.reference !== null", Duration::from_secs(120))
+        .wait_for(
+            "haarshiftViewer.reference !== null",
+            Duration::from_secs(120),
+        )
         .unwrap();
     let yaw = state_b["yaw"].to_string();
     let pitch = state_b["pitch"].to_string();
     let truth = dir.path().join("truth.npy");
     succeeds(&[
-        "relight", "render", p(&cache), "--env", p(&env), "--yaw", &yaw, "--pitch", &pitch,
-        "--basis", "reference", "--width", "16", "--height", "12",
-        "-o", p(&dir.path().join("truth.png")), "--vertices", p(&truth),
+        "relight",
+        "render",
+        p(&cache),
+        "--env",
+        p(&env),
+        "--yaw",
+        &yaw,
+        "--pitch",
+        &pitch,
+        "--basis",
+        "reference",
+        "--width",
+        "16",
+        "--height",
+        "12",
+        "-o",
+        p(&dir.path().join("truth.png")),
+        "--vertices",
+        p(&truth),
     ]);
     let truth: Array2<f32> = ndarray_npy::read_npy(&truth).unwrap();
     let reference: Vec<f32> = browser
@@ -301,10 +331,14 @@ impl Client {
         use tungstenite::client::IntoClientRequest;
         let address = url.trim_start_matches("http://").trim_end_matches('/');
         let stream = std::net::TcpStream::connect(address).unwrap();
-        stream.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+        stream
+            .set_read_timeout(Some(Duration::from_secs(60)))
+            .unwrap();
         let mut request = format!("ws://{address}/ws").into_client_request()?;
         if let Some(origin) = origin {
-            request.headers_mut().insert("Origin", origin.parse().unwrap());
+            request
+                .headers_mut()
+                .insert("Origin", origin.parse().unwrap());
         }
         match tungstenite::client(request, stream) {
             Ok((socket, _)) => Ok(Client(socket)),
@@ -371,11 +405,13 @@ impl Client {
 }
 
 /// The answer to a raw HTTP request.
-fn http(url: &str, request: &[u8]) -> String {
+pub fn http(url: &str, request: &[u8]) -> String {
     use std::io::{Read, Write};
     let address = url.trim_start_matches("http://").trim_end_matches('/');
     let mut stream = std::net::TcpStream::connect(address).unwrap();
-    stream.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .unwrap();
     let _ = stream.write_all(request);
     let mut answer = String::new();
     let _ = stream.read_to_string(&mut answer);
@@ -390,16 +426,43 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
     let view = ViewProcess::start(&[p(&cache), "--env", p(&env), "--max-sessions", "2"]);
     let mut page = Client::opened(&view.url);
     for (request, needle) in [
-        (r#"{"type": "state", "seq": 1, "yaw": 10, "colour": 1}"#, "unknown field `colour`"),
-        (r#"{"type": "state", "seq": 1, "yaw": NaN}"#, "invalid request"),
-        (r#"{"type": "state", "seq": 1, "yaw": 1e300}"#, "finite angle"),
-        (r#"{"type": "state", "seq": 1, "eye": [0, 1e999, 0]}"#, "invalid request"),
-        (r#"{"type": "state", "seq": 1, "keep_light": 1000000000000000}"#, "keep_light"),
-        (r#"{"type": "state", "seq": 1, "keep_visibility": 0}"#, "keep_visibility"),
+        (
+            r#"{"type": "state", "seq": 1, "yaw": 10, "colour": 1}"#,
+            "unknown field `colour`",
+        ),
+        (
+            r#"{"type": "state", "seq": 1, "yaw": NaN}"#,
+            "invalid request",
+        ),
+        (
+            r#"{"type": "state", "seq": 1, "yaw": 1e300}"#,
+            "finite angle",
+        ),
+        (
+            r#"{"type": "state", "seq": 1, "eye": [0, 1e999, 0]}"#,
+            "invalid request",
+        ),
+        (
+            r#"{"type": "state", "seq": 1, "keep_light": 1000000000000000}"#,
+            "keep_light",
+        ),
+        (
+            r#"{"type": "state", "seq": 1, "keep_visibility": 0}"#,
+            "keep_visibility",
+        ),
         (r#"{"type": "state", "seq": 1, "depth": 99}"#, "depth"),
-        (r#"{"type": "state", "seq": 1, "brdf": "phong:50", "rotation_cache": 100000000}"#, "rotation cache"),
-        (r#"{"type": "state", "seq": 1, "brdf": "merl:/etc/passwd"}"#, "measured BRDFs"),
-        (r#"{"type": "state", "seq": 1, "basis": "reference"}"#, "error view"),
+        (
+            r#"{"type": "state", "seq": 1, "brdf": "phong:50", "rotation_cache": 100000000}"#,
+            "rotation cache",
+        ),
+        (
+            r#"{"type": "state", "seq": 1, "brdf": "merl:/etc/passwd"}"#,
+            "measured BRDFs",
+        ),
+        (
+            r#"{"type": "state", "seq": 1, "basis": "reference"}"#,
+            "error view",
+        ),
         (r#"{"type": "state", "seq": 1, "basis": "sh"}"#, "sh"),
         (r#"{"type": "play"}"#, "unknown variant `play`"),
         ("not json", "invalid request"),
@@ -407,11 +470,35 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
         page.send(request);
         page.refused(needle);
     }
-    page.0.send(tungstenite::Message::binary(vec![1u8, 2, 3])).unwrap();
+    page.0
+        .send(tungstenite::Message::binary(vec![1u8, 2, 3]))
+        .unwrap();
     page.refused("binary requests");
-    // After all that, a good state is drawn.
+    page.send(r#"{"type": "picture", "look_at": [0, 0, 0], "fov": 40, "width": 32, "height": 24}"#);
+    page.refused("no frame has been drawn yet");
+    // After all that, a good state is drawn, and pictured as OpenEXR.
     page.send(r#"{"type": "state", "seq": 7, "yaw": 12.5, "keep_light": 50}"#);
     page.frame(7);
+    page.send(r#"{"type": "picture", "look_at": [0, 0, 0], "fov": 40, "width": 32, "height": 0}"#);
+    page.refused("height");
+    page.send(
+        r#"{"type": "picture", "look_at": [0, 0, 0], "fov": 400, "width": 32, "height": 24}"#,
+    );
+    page.refused("fov");
+    page.send(r#"{"type": "picture", "look_at": [0, 0, 0], "fov": 40, "width": 32, "height": 24}"#);
+    match page.next() {
+        tungstenite::Message::Binary(b) => {
+            assert_eq!(u32::from_le_bytes(b[0..4].try_into().unwrap()), 5);
+            let len = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
+            let exr = &b[(8 + len).next_multiple_of(4)..];
+            assert_eq!(
+                &exr[0..4],
+                &[0x76, 0x2f, 0x31, 0x01],
+                "OpenEXR's magic number"
+            );
+        }
+        other => panic!("a picture expected, got {other:?}"),
+    }
 
     // A second page gets a session of its own; a third, beyond --max-sessions 2, one line.
     let mut second = Client::opened(&view.url);
@@ -433,14 +520,19 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
     // Another site's page may not drive the viewer; plain HTTP gets its status lines.
     assert!(Client::connect(&view.url, Some("http://example.com")).is_err());
     assert!(http(&view.url, b"GET /ws HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 400"));
-    assert!(http(&view.url, b"GET /secret HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 404"));
+    assert!(
+        http(&view.url, b"GET /secret HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 404")
+    );
     assert!(http(&view.url, b"POST / HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 405"));
     assert!(http(&view.url, b"\x00\x01garbage\r\n\r\n").starts_with("HTTP/1.1 400"));
     let mut huge = b"GET / HTTP/1.1\r\nX: ".to_vec();
     huge.extend(vec![b'a'; 64 * 1024]);
     assert_eq!(http(&view.url, &huge), "");
     let index = http(&view.url, b"GET / HTTP/1.1\r\nHost: x\r\n\r\n");
-    assert!(index.starts_with("HTTP/1.1 200") && index.contains("viewer.js"), "{index}");
+    assert!(
+        index.starts_with("HTTP/1.1 200") && index.contains("viewer.js"),
+        "{index}"
+    );
     page.send(r#"{"type": "state", "seq": 9, "yaw": 14}"#);
     page.frame(9);
 }

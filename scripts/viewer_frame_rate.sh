@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# The viewer's frame rates on this machine, in headless Chromium with software WebGL sharing
+# the cores with the server (viewer/examples/frame_rate.rs, one row per configuration):
+#   the 85,860-vertex cubes scene (cube 6 x 64^2, 200 lighting and 420 visibility coefficients:
+#   194 and 414 detail coefficients plus the 6 faces' scaling ones), Lambertian, the lighting
+#   dragged; the bunny on its ground plane at lat-long 64 with Phong 50 (rotation cache 64),
+#   the lighting dragged and the camera orbited. Prints a Markdown report:
+#   scripts/viewer_frame_rate.sh > results/viewer/frame_rate.md
+# The caches are precomputed in a temporary directory (minutes for the cubes); WORK=DIR keeps
+# and reuses them. ENV (first argument) is the lighting.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+env_map=${1:-testdata/envmaps/rooitou_park_1k.hdr}
+work=${WORK:-$(mktemp -d)}
+mkdir -p "$work" results/viewer
+cargo build --release -q -p haarshift-cli -p haarshift-viewer --example frame_rate
+bin=target/release/haarshift
+rate=target/release/examples/frame_rate
+[ -f "$work/cubes.hsr" ] || "$bin" relight precompute testdata/scenes/cubes.json --param cube \
+    --resolution 64 --keep-visibility 414 -o "$work/cubes.hsr" >&2
+[ -f "$work/bunny.hsr" ] || "$bin" relight precompute testdata/meshes/bunny.ply --ground-plane \
+    --resolution 64 -o "$work/bunny.hsr" >&2
+start_load=$(uptime)
+rows=(
+    "$("$rate" "$work/cubes.hsr" "$env_map" label=cubes keep_light=194)"
+    "$("$rate" "$work/bunny.hsr" "$env_map" label=bunny brdf=phong:50 rotation_cache=64)"
+    "$("$rate" "$work/bunny.hsr" "$env_map" label=bunny brdf=phong:50 rotation_cache=64 drag=orbit)"
+    "$("$rate" "$work/bunny.hsr" "$env_map" label=bunny)"
+    "$("$rate" "$work/cubes.hsr" "$env_map" label=cubes keep_light=194 screenshot=results/viewer/cubes.png)"
+)
+echo "# The viewer's frame rates"
+echo
+echo "Made by \`scripts/viewer_frame_rate.sh > results/viewer/frame_rate.md\` on $(nproc) cores"
+echo "with $(chromium --version 2>/dev/null || echo chromium) headless (SwiftShader WebGL2), 640 x 480;"
+echo "the lighting \`$env_map\`. Load when it started (\`uptime\`): \`$start_load\`"
+echo
+echo "Each row is one page and one drag of 50 mouse moves, one every 16 ms (a 60 Hz mouse),"
+echo "4 pixels each: 2 degrees of lighting yaw, or 1.6 degrees of camera orbit. *Server ms* are"
+echo "medians over the frames computed during the drag, from the frames' headers: the lighting"
+echo "rotated and encoded, the BRDF rotations, the shading (rotations included) and their sum."
+echo "*Received/s* and *drawn/s* are the page's own counters over the drag's wall time, read over"
+echo "the DevTools protocol; the server skips every state but the newest, so frames received"
+echo "are fewer than states sent when a frame takes longer than a mouse move. *First frame* is"
+echo "from opening the page to its first drawn frame (the shader's preparation and, for Phong,"
+echo "the first rotations), seconds."
+echo
+echo "| scene | vertices | maps | BRDF | dragged | encode ms | BRDF rotations ms | shading ms | server ms | frames | received/s | drawn/s | first frame s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+printf '%s\n' "${rows[@]}"

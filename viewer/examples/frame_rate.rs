@@ -1,0 +1,155 @@
+//! The viewer's frame rate in headless Chromium (software WebGL sharing the machine's cores
+//! with the server): one markdown row per run.
+//!
+//! ```sh
+//! cargo run --release -p haarshift-viewer --example frame_rate -- CACHE ENV [KEY=VALUE ...]
+//! ```
+//!
+//! Keys: `brdf` (`lambert`), `keep_light`, `keep_visibility`, `rotation_cache` (the page's
+//! state), `drag` (`light` or `orbit`), `moves` (50: mouse moves of the drag, one every
+//! 16 ms), `size` (`640x480`), `label`, `screenshot` (a PNG of the page after the drag).
+//!
+//! The server's time per frame is the median over the frames computed during the drag of
+//! their lighting encoding and shading (rotations included), from the frames' headers; frames
+//! received and drawn per second are the page's own counters over the drag's wall time, read
+//! over the DevTools protocol. `scripts/viewer_frame_rate.sh` runs the configurations of
+//! `results/viewer/frame_rate.md`.
+
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+use haarshift::relight::shade::LightSpec;
+use haarshift_viewer::browser::Browser;
+use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
+use serde_json::Value;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [cache, env, options @ ..] = args.as_slice() else {
+        return Err("usage: frame_rate CACHE ENV [KEY=VALUE ...]".into());
+    };
+    let options: HashMap<&str, &str> = options
+        .iter()
+        .map(|o| o.split_once('=').ok_or(format!("{o}: expected KEY=VALUE")))
+        .collect::<Result<_, _>>()?;
+    let get = |key: &str, default: &'static str| options.get(key).copied().unwrap_or(default);
+    let moves: usize = get("moves", "50").parse()?;
+    let (width, height) = get("size", "640x480")
+        .split_once('x')
+        .ok_or("size: expected WxH")?;
+    let (width, height): (usize, usize) = (width.parse()?, height.parse()?);
+    let orbit = get("drag", "light") == "orbit";
+
+    let light = LightSpec {
+        env: Some(env.into()),
+        ..LightSpec::default()
+    };
+    let scene = ViewedScene::load(cache.as_ref(), &light)?;
+    let vertices = scene.cache.mesh.vertex_count();
+    let param = scene.cache.transport.param();
+    let viewer = Viewer::bind(
+        scene,
+        ViewerOptions {
+            address: "127.0.0.1:0".parse()?,
+            max_sessions: 2,
+        },
+    )?;
+    let url = viewer.url();
+    std::thread::spawn(move || viewer.serve());
+
+    let mut hash = format!(
+        "width={width}&height={height}&panel=0&brdf={}",
+        get("brdf", "lambert")
+    );
+    for key in ["keep_light", "keep_visibility", "rotation_cache"] {
+        if let Some(v) = options.get(key) {
+            hash.push_str(&format!("&{key}={v}"));
+        }
+    }
+    let mut browser = Browser::launch(width, height)?;
+    browser.navigate(&format!("{url}#{hash}"))?;
+    let latest = "haarshiftViewer.frame !== null && haarshiftViewer.state !== null && \
+                  haarshiftViewer.drawnSeq === haarshiftViewer.state.seq";
+    let first = Instant::now();
+    browser.wait_for(latest, Duration::from_secs(1800))?;
+    let first_frame = first.elapsed().as_secs_f64();
+
+    let count = |b: &mut Browser, what: &str| -> Result<f64, Box<dyn std::error::Error>> {
+        Ok(b.evaluate(what)?.as_f64().ok_or(what.to_owned())?)
+    };
+    let received = count(&mut browser, "haarshiftViewer.framesReceived")?;
+    let drawn = count(&mut browser, "haarshiftViewer.framesDrawn")?;
+    let since = count(&mut browser, "performance.now()")?;
+    let modifiers = if orbit { 8 } else { 0 };
+    let (x0, y0) = (width as f64 / 2.0, height as f64 / 2.0);
+    let start = Instant::now();
+    browser.mouse("mousePressed", x0, y0, modifiers)?;
+    for k in 1..=moves {
+        // Back and forth, 4 pixels a move (2 degrees of yaw, 1.6 of orbit).
+        let x = x0
+            + 4.0
+                * (if (k / 40) % 2 == 0 {
+                    k % 40
+                } else {
+                    40 - k % 40
+                }) as f64;
+        browser.mouse("mouseMoved", x, y0, modifiers)?;
+        let next = Duration::from_millis(16 * k as u64);
+        if let Some(rest) = next.checked_sub(start.elapsed()) {
+            std::thread::sleep(rest);
+        }
+    }
+    browser.mouse("mouseReleased", x0, y0, modifiers)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let received = (count(&mut browser, "haarshiftViewer.framesReceived")? - received) / seconds;
+    let drawn = (count(&mut browser, "haarshiftViewer.framesDrawn")? - drawn) / seconds;
+    browser.wait_for(latest, Duration::from_secs(600))?;
+    let timings = browser.evaluate(&format!(
+        "haarshiftViewer.timings.filter((t) => t.at > {since}).map((t) => [t.encode, t.rotate, t.shade, t.prepare])"
+    ))?;
+    let mut server: Vec<[f64; 4]> = timings
+        .as_array()
+        .ok_or("no timings")?
+        .iter()
+        .map(|t| {
+            let v: Vec<f64> = t
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(Value::as_f64)
+                .collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect();
+    server.sort_by(|a, b| (a[0] + a[2]).total_cmp(&(b[0] + b[2])));
+    let median = server
+        .get(server.len() / 2)
+        .copied()
+        .unwrap_or([f64::NAN; 4]);
+    if let Some(path) = options.get("screenshot") {
+        // A new document (a hash change alone would not reload the page), controls shown.
+        browser.navigate("about:blank")?;
+        browser.navigate(&format!("{url}#{}", hash.replace("&panel=0", "")))?;
+        browser.wait_for(latest, Duration::from_secs(1800))?;
+        std::thread::sleep(Duration::from_millis(500));
+        std::fs::write(path, browser.screenshot()?)?;
+    }
+    let errors = browser.console_errors();
+    if !errors.is_empty() {
+        return Err(format!("the page logged errors: {errors:?}").into());
+    }
+    println!(
+        "| {} | {vertices} | {} {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {} | {received:.1} | {drawn:.1} | {first_frame:.1} |",
+        get("label", "-"),
+        param.kind(),
+        param.face_size(),
+        get("brdf", "lambert"),
+        if orbit { "camera" } else { "lighting" },
+        median[0],
+        median[1],
+        median[2],
+        median[0] + median[2],
+        server.len(),
+    );
+    Ok(())
+}
