@@ -68,7 +68,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut browser = Browser::launch(width, height)?;
     browser.navigate(&format!("{url}#{hash}"))?;
-    let latest = "haarshiftViewer.frame !== null && haarshiftViewer.state !== null && \
+    let latest = "window.haarshiftViewer !== undefined && haarshiftViewer.frame !== null && \
+                  haarshiftViewer.state !== null && \
                   haarshiftViewer.drawnSeq === haarshiftViewer.state.seq";
     let first = Instant::now();
     browser.wait_for(latest, Duration::from_secs(1800))?;

@@ -6,7 +6,7 @@
 //! read when it starts a frame, so a fast drag costs no queue.
 //!
 //! **Server to page**: JSON text messages ([`Notice`]: the scene's description, errors, the
-//! reference's progress) and binary messages, each one [`Packet`]: a kind, a JSON header and a
+//! reference's progress) and binary messages, each one [`packet`]: a kind, a JSON header and a
 //! little-endian payload starting at a multiple of 4 bytes, so the page reads it as a
 //! `Float32Array`, `Uint16Array` (f16) or `Uint32Array` view without a copy:
 //!
@@ -162,7 +162,7 @@ impl ViewState {
             ("pitch", self.pitch),
             ("roll", self.roll),
         ] {
-            if !(angle.abs() <= MAX_DEGREES) {
+            if !angle.is_finite() || angle.abs() > MAX_DEGREES {
                 return Err(Error::parameter(
                     name,
                     format!("{angle} degrees: expected a finite angle within {MAX_DEGREES}"),
@@ -214,7 +214,7 @@ pub enum Notice {
     },
 }
 
-/// The kinds of binary [`Packet`].
+/// The kinds of binary [`packet`]s.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
 pub enum PacketKind {
@@ -232,35 +232,31 @@ pub enum PacketKind {
     Picture = 5,
 }
 
-/// One binary message: a kind, a JSON header and a payload aligned to 4 bytes.
+/// The bytes of one binary message of `kind`: its JSON `header`, then `payload` aligned to 4
+/// bytes.
 ///
 /// ```
-/// use haarshift_viewer::protocol::{Packet, PacketKind};
-/// let bytes = Packet::new(PacketKind::Frame, &serde_json::json!({"seq": 1}), &[1.5f32.to_le_bytes()].concat()).unwrap();
+/// use haarshift_viewer::protocol::{PacketKind, packet};
+/// let bytes = packet(PacketKind::Frame, &serde_json::json!({"seq": 1}), &[1.5f32.to_le_bytes()].concat()).unwrap();
 /// assert_eq!(&bytes[0..4], &3u32.to_le_bytes());
 /// let header_len = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
 /// assert_eq!(&bytes[8..8 + header_len], br#"{"seq":1}"#);
 /// let payload = (8 + header_len).next_multiple_of(4);
 /// assert_eq!(&bytes[payload..], &1.5f32.to_le_bytes());
 /// ```
-pub struct Packet;
-
-impl Packet {
-    /// The bytes of a packet of `kind` with `header` and `payload`.
-    pub fn new(kind: PacketKind, header: &impl Serialize, payload: &[u8]) -> Result<Vec<u8>> {
-        let header = serde_json::to_vec(header)
-            .map_err(|e| Error::parameter("packet", format!("header: {e}")))?;
-        let start = (8 + header.len()).next_multiple_of(4);
-        let mut bytes = Vec::with_capacity(start + payload.len());
-        bytes.extend_from_slice(&(kind as u32).to_le_bytes());
-        let len = u32::try_from(header.len())
-            .map_err(|_| Error::parameter("packet", "a header of more than 4 GiB"))?;
-        bytes.extend_from_slice(&len.to_le_bytes());
-        bytes.extend_from_slice(&header);
-        bytes.resize(start, 0);
-        bytes.extend_from_slice(payload);
-        Ok(bytes)
-    }
+pub fn packet(kind: PacketKind, header: &impl Serialize, payload: &[u8]) -> Result<Vec<u8>> {
+    let header = serde_json::to_vec(header)
+        .map_err(|e| Error::parameter("packet", format!("header: {e}")))?;
+    let start = (8 + header.len()).next_multiple_of(4);
+    let mut bytes = Vec::with_capacity(start + payload.len());
+    bytes.extend_from_slice(&(kind as u32).to_le_bytes());
+    let len = u32::try_from(header.len())
+        .map_err(|_| Error::parameter("packet", "a header of more than 4 GiB"))?;
+    bytes.extend_from_slice(&len.to_le_bytes());
+    bytes.extend_from_slice(&header);
+    bytes.resize(start, 0);
+    bytes.extend_from_slice(payload);
+    Ok(bytes)
 }
 
 /// `values` as little-endian bytes in `format`.

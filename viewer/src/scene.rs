@@ -13,7 +13,7 @@ use haarshift::render::camera::Camera;
 use haarshift::render::view::ViewSpec;
 use haarshift::sphere::SphereRotation;
 
-use crate::protocol::{Packet, PacketKind, SampleFormat, sample_bytes};
+use crate::protocol::{PacketKind, SampleFormat, packet, sample_bytes};
 
 /// The background's lat-long height on the page: the environment brought down to at most this
 /// many rows by solid-angle-weighted means (sharper than a 640-pixel view needs of a 60-degree
@@ -98,7 +98,7 @@ impl ViewedScene {
                 .flatten()
                 .flat_map(|i| i.to_le_bytes()),
         );
-        Packet::new(PacketKind::Scene, &header, &payload)
+        packet(PacketKind::Scene, &header, &payload)
     }
 
     /// The environment packet: the unrotated map at most [`BACKGROUND_HEIGHT`] rows high,
@@ -115,7 +115,7 @@ impl ViewedScene {
             .map(|(k, ch)| a[[k / w, k % w, ch.min(c - 1)]] as f32)
             .collect();
         let header = json!({ "height": h, "width": w });
-        Packet::new(
+        packet(
             PacketKind::Environment,
             &header,
             &sample_bytes(&rgb, SampleFormat::F32),

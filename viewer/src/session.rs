@@ -29,7 +29,7 @@ use haarshift::{Error, Result};
 
 use crate::progress::{Counter, watch};
 use crate::protocol::{
-    Notice, Packet, PacketKind, PictureRequest, Request, SampleFormat, ViewState, sample_bytes,
+    Notice, PacketKind, PictureRequest, Request, SampleFormat, ViewState, packet, sample_bytes,
 };
 use crate::scene::ViewedScene;
 
@@ -190,7 +190,7 @@ impl Session {
             let bytes = std::fs::read(&path).map_err(|source| Error::Io { path, source })?;
             let header =
                 json!({ "width": request.width, "height": request.height, "format": "exr" });
-            Packet::new(PacketKind::Picture, &header, &bytes)
+            packet(PacketKind::Picture, &header, &bytes)
         };
         match picture() {
             Ok(packet) => Message::binary(packet),
@@ -270,7 +270,7 @@ impl Session {
         };
         self.drawn = Some(key);
         self.last = Some((radiance, rotation, eye));
-        Packet::new(PacketKind::Frame, &header, &payload).map(Some)
+        packet(PacketKind::Frame, &header, &payload).map(Some)
     }
 
     /// The shader `state` asks for, its budgets checked against the scene's.
@@ -420,7 +420,7 @@ impl Session {
                         values.as_slice().expect("standard layout"),
                         SampleFormat::F32,
                     );
-                    Packet::new(PacketKind::Reference, &header, &payload)
+                    packet(PacketKind::Reference, &header, &payload)
                 });
                 match message {
                     Ok(packet) => vec![Message::binary(packet)],

@@ -361,9 +361,9 @@ impl Client {
 
     fn next(&mut self) -> tungstenite::Message {
         loop {
-            match self.0.read().unwrap() {
-                m @ (tungstenite::Message::Text(_) | tungstenite::Message::Binary(_)) => return m,
-                _ => {}
+            let message = self.0.read().unwrap();
+            if message.is_text() || message.is_binary() {
+                return message;
             }
         }
     }
