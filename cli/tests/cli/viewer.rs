@@ -355,6 +355,25 @@ impl Client {
         client
     }
 
+    /// [`opened`](Self::opened) once a session is free: the page that left may still be
+    /// finishing its frame, and its session ends with it.
+    fn reopened(url: &str) -> Client {
+        for _ in 0..300 {
+            let mut client = Client::connect(url, None).unwrap();
+            match client.next() {
+                tungstenite::Message::Binary(b) if b[0] == 1 => {
+                    assert_eq!(client.packet_kind(), 2);
+                    return client;
+                }
+                tungstenite::Message::Text(t) if t.contains("pages at once") => {
+                    std::thread::sleep(Duration::from_millis(100));
+                }
+                other => panic!("a scene or a refusal expected, got {other:?}"),
+            }
+        }
+        panic!("no session was freed within 30 s");
+    }
+
     fn send(&mut self, text: &str) {
         self.0.send(tungstenite::Message::text(text)).unwrap();
     }
@@ -513,7 +532,7 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
     drop(second);
     page.send(r#"{"type": "state", "seq": 8, "yaw": 13}"#);
     page.frame(8);
-    let mut again = Client::opened(&view.url);
+    let mut again = Client::reopened(&view.url);
     again.send(r#"{"type": "state", "seq": 1, "pitch": 5}"#);
     again.frame(1);
 
@@ -535,4 +554,31 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
     );
     page.send(r#"{"type": "state", "seq": 9, "yaw": 14}"#);
     page.frame(9);
+}
+
+#[test]
+fn a_burst_of_states_is_answered_by_the_newest_state_s_frame_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = bunny_cache(dir.path());
+    let env = testdata("envmaps/rooitou_park_256x128.npy");
+    let view = ViewProcess::start(&[p(&cache), "--env", p(&env)]);
+    let mut page = Client::opened(&view.url);
+    // Twenty states in one write, as a fast drag queues them.
+    for seq in 1..=20 {
+        let state = format!(r#"{{"type": "state", "seq": {seq}, "yaw": {}}}"#, 3 * seq);
+        page.0.write(tungstenite::Message::text(state)).unwrap();
+    }
+    page.0.flush().unwrap();
+    let mut answered = Vec::new();
+    while answered.last() != Some(&20) {
+        match page.next() {
+            tungstenite::Message::Binary(b) => {
+                let len = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
+                let header: Value = serde_json::from_slice(&b[8..8 + len]).unwrap();
+                answered.push(header["seq"].as_u64().unwrap());
+            }
+            other => panic!("a frame expected, got {other:?}"),
+        }
+    }
+    assert!(answered.len() <= 2, "frames for states {answered:?}");
 }
