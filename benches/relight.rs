@@ -11,7 +11,8 @@
 //! parallel read of the same offsets, indices and values (the frame's floor); the mapping
 //! into the cube (its overlap table) is made once, as an animation makes it. The turn is a
 //! yaw by whole columns of the working map (the animation's step: a column permutation) or a
-//! general rotation (applied at the source's resolution). The transport is precomputed once
+//! general rotation (applied at the source's resolution, and, at lat-long 64, lat-long 128 and
+//! cube 64, to the copy prefiltered to twice the working lat-long height). The transport is precomputed once
 //! per run with the real ray caster ([`vertex_major`], a few minutes on two cores, with a
 //! progress bar) and only when one of these benchmarks is selected; nothing is synthetic.
 //!
@@ -28,7 +29,9 @@ use std::sync::OnceLock;
 use haarshift::faces::param::SphereMap;
 use haarshift::faces::param::{ParamKind, Parameterization};
 use haarshift::product::Selection;
-use haarshift::relight::light::environment::{Environment, SphereMapping, downsample_solid_angle};
+use haarshift::relight::light::environment::{
+    Environment, LightRotation, SphereMapping, downsample_solid_angle,
+};
 use haarshift::relight::shade::lambert::CHUNK;
 use haarshift::relight::{
     Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,
@@ -161,6 +164,23 @@ fn bench_relighting(c: &mut Criterion) {
     group.bench_function("encode_lighting_cube64_keep200/general_rotation", |b| {
         b.iter(|| Lighting::encode(&env, &mapping, &general, keep).expect("encodes"))
     });
+    // The same at lat-long 64, lat-long 128 and cube 64 with the general rotation applied to
+    // the copy prefiltered to twice the working lat-long height (made once, before timing).
+    for (kind, size) in [
+        (ParamKind::LatLong, 64),
+        (ParamKind::LatLong, 128),
+        (ParamKind::Cube, 64),
+    ] {
+        let param = Parameterization::new(kind, size).expect("param");
+        let fast = SphereMapping::new(env.map().height(), param)
+            .expect("mapping")
+            .with_rotation(LightRotation::Prefiltered);
+        Lighting::encode(&env, &fast, &general, keep).expect("prepares the copy");
+        let name = format!("encode_lighting_{kind}{size}_keep200/prefiltered_general_rotation");
+        group.bench_function(name, |b| {
+            b.iter(|| Lighting::encode(&env, &fast, &general, keep).expect("encodes"))
+        });
+    }
     group.bench_function("shade_keep420_f32", |b| {
         let t = prepared();
         let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");

@@ -112,6 +112,7 @@ class Shader:
         rotation_cache: Optional[int] = None,
         elevations: int = ...,
         fill_cache: bool = False,
+        light_rotation: Literal["source", "prefiltered"] = "source",
     ) -> None: ...
     def shade(
         self,

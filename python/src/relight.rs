@@ -416,7 +416,7 @@ type ShadeResult<'py> = (Bound<'py, PyAny>, HashMap<String, Py<PyAny>>);
 #[pymethods]
 impl Shader {
     #[new]
-    #[pyo3(signature = (cache, *, basis = "haar", brdf = "lambert", albedo = None, keep_light = None, keep_visibility = None, depth = None, brdf_rotation = "haar", level = None, keep_brdf = None, brdf_levels = None, rotation_cache = None, elevations = haarshift::relight::material::brdf::DEFAULT_ELEVATIONS, fill_cache = false))]
+    #[pyo3(signature = (cache, *, basis = "haar", brdf = "lambert", albedo = None, keep_light = None, keep_visibility = None, depth = None, brdf_rotation = "haar", level = None, keep_brdf = None, brdf_levels = None, rotation_cache = None, elevations = haarshift::relight::material::brdf::DEFAULT_ELEVATIONS, fill_cache = false, light_rotation = "source"))]
     #[allow(clippy::too_many_arguments)] // the keyword arguments of one Python class
     fn new(
         py: Python<'_>,
@@ -434,6 +434,7 @@ impl Shader {
         rotation_cache: Option<usize>,
         elevations: usize,
         fill_cache: bool,
+        light_rotation: &str,
     ) -> PyResult<Self> {
         let spec = ShaderSpec {
             method: parse::<Method>(basis)?,
@@ -452,6 +453,7 @@ impl Shader {
                 depth,
             },
             keep_light: keep_light.map_or(Selection::All, Selection::Largest),
+            light_rotation: parse(light_rotation)?,
             ..ShaderSpec::default()
         };
         let source = &cache.cache;

@@ -276,19 +276,28 @@ impl<T: Sample> LatLongMap<T> {
         }
         let step = std::f64::consts::PI / h as f64;
         let sub = step / samples as f64;
+        // The midpoints' sines and cosines, once per row and per column of midpoints (the
+        // values direction() would compute at each sample, so the means are the same).
+        check_size(h, channels)?;
+        let table = |pixels: usize| -> Vec<(f64, f64)> {
+            (0..pixels * samples)
+                .map(|m| {
+                    let (pixel, k) = (m / samples, m % samples);
+                    (pixel as f64 * step + (k as f64 + 0.5) * sub).sin_cos()
+                })
+                .collect()
+        };
+        let (rows, columns) = (table(h), table(2 * h));
         let data = fill_pixels(h, channels, |i, j, out| {
             let mut acc = [0.0f64; 64];
             let acc = &mut acc[..channels];
             let mut value = [T::zero(); 64];
             let value = &mut value[..channels];
             let mut total_weight = 0.0;
-            for a in 0..samples {
-                let theta = i as f64 * step + (a as f64 + 0.5) * sub;
-                let weight = theta.sin();
+            for &(weight, ct) in &rows[i * samples..][..samples] {
                 total_weight += weight * samples as f64;
-                for b in 0..samples {
-                    let phi = j as f64 * step + (b as f64 + 0.5) * sub;
-                    f(direction(theta, phi), value);
+                for &(sp, cp) in &columns[j * samples..][..samples] {
+                    f([weight * sp, ct, weight * cp], value);
                     for (s, v) in acc.iter_mut().zip(value.iter()) {
                         *s += weight * v.as_f64();
                     }

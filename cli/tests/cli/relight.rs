@@ -1033,3 +1033,75 @@ fn render_selects_the_reference_and_ambient_occlusion_by_name() {
         &["ambient occlusion is Lambertian"],
     );
 }
+
+#[test]
+fn render_with_the_prefiltered_light_rotation_is_the_librarys_prefiltered_path() {
+    use haarshift::product::Selection;
+    use haarshift::relight::SceneCache;
+    use haarshift::relight::light::environment::{Environment, LightRotation};
+    use haarshift::relight::shade::{FrameSpec, ShaderSpec, ShadingInput};
+    use haarshift::sphere::SphereRotation;
+    // A map 128 high and a working map 8 high: the prefiltered copy (16 high) is not the
+    // source, so the two rotations differ.
+    let dir = tempfile::tempdir().unwrap();
+    let cache = small_cache(dir.path());
+    let env = testdata("envmaps/rooitou_park_256x128.npy");
+    let render = |how: &str| {
+        let npy = dir.path().join(format!("{how}.npy"));
+        let png = dir.path().join(format!("{how}.png"));
+        let common = [
+            "--env",
+            p(&env),
+            "--yaw",
+            "33",
+            "--pitch",
+            "20",
+            "--keep-light",
+            "20",
+        ];
+        let mut args = render_args(&cache, &png, &common);
+        args.extend(["--light-rotation", how, "--vertices", p(&npy)]);
+        succeeds(&args);
+        read_vertices(&npy)
+    };
+    let (fast, source) = (render("prefiltered"), render("source"));
+    // The library's prefiltered path, bit for bit.
+    let scene = SceneCache::read(&cache).unwrap();
+    let spec = ShaderSpec {
+        keep_light: Selection::Largest(20),
+        light_rotation: LightRotation::Prefiltered,
+        ..ShaderSpec::default()
+    };
+    let mut shader = spec.build(&ShadingInput::cache(&scene)).unwrap();
+    let environment = Environment::load(&env).unwrap();
+    let frame = FrameSpec {
+        environment: &environment,
+        rotation: SphereRotation::from_degrees(33.0, 20.0, 0.0).unwrap(),
+        eye: None,
+    };
+    assert_eq!(fast, shader.shade(&frame).unwrap().radiance.to_f32());
+    // The default is the source's resolution, which the flag changes, slightly.
+    let off = relative_rms(&fast, &source);
+    assert!(off > 1e-6 && off < 0.05, "{off:e}");
+    // The ground truth and ambient occlusion refuse it; a bad name is a usage error.
+    let out = dir.path().join("x.png");
+    for basis in ["reference", "ambient"] {
+        let args = [
+            "--env",
+            p(&env),
+            "--basis",
+            basis,
+            "--light-rotation",
+            "prefiltered",
+        ];
+        fails_cleanly(
+            &render_args(&cache, &out, &args),
+            &["--light-rotation", basis],
+        );
+    }
+    let args = ["--env", p(&env), "--light-rotation", "fast"];
+    usage_error(
+        &render_args(&cache, &out, &args),
+        &["--light-rotation", "prefiltered"],
+    );
+}

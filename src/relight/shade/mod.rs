@@ -39,10 +39,10 @@ use std::time::Instant;
 use ndarray::Array2;
 
 use crate::Result;
-use crate::faces::Parameterization;
+use crate::faces::{Parameterization, SphereMap};
 use crate::product::Selection;
 use crate::relight::Lighting;
-use crate::relight::light::environment::SphereMapping;
+use crate::relight::light::environment::{LightRotation, SphereMapping};
 
 /// A way of computing every vertex's outgoing radiance, made once by [`ShaderSpec::build`]
 /// and asked for frame after frame (a glossy shader keeps its rotation cache between them).
@@ -231,36 +231,58 @@ pub struct Filled {
     pub seconds: f64,
 }
 
-/// The Haar lighting of frames: the environment rotated and brought to the transport's
-/// parameterisation, the mapping into it (a cube's conversion table) made once per
-/// environment height and reused from frame to frame.
+/// The lighting of frames in a shader's parameterisation: the environment rotated (as
+/// `rotation` says) and brought to it, the mapping into it (a cube's conversion table) made
+/// once per environment height and reused from frame to frame.
 #[derive(Debug)]
-pub(crate) struct HaarEncoder {
+pub(crate) struct FrameMapping {
     param: Parameterization,
-    keep: Selection,
+    rotation: LightRotation,
     mapping: Option<(usize, SphereMapping)>,
 }
 
-impl HaarEncoder {
-    pub(crate) fn new(param: Parameterization, keep: Selection) -> Self {
-        HaarEncoder {
+impl FrameMapping {
+    pub(crate) fn new(param: Parameterization, rotation: LightRotation) -> Self {
+        FrameMapping {
             param,
-            keep,
+            rotation,
             mapping: None,
+        }
+    }
+
+    /// `frame`'s environment, rotated, in the parameterisation.
+    pub(crate) fn apply(&mut self, frame: &FrameSpec<'_>) -> Result<SphereMap<f64>> {
+        let height = frame.environment.map().height();
+        let mapping = match self.mapping.take() {
+            Some((h, mapping)) if h == height => mapping,
+            _ => SphereMapping::new(height, self.param)?.with_rotation(self.rotation),
+        };
+        let map = mapping.apply(frame.environment, &frame.rotation);
+        self.mapping = Some((height, mapping));
+        map
+    }
+}
+
+/// The Haar lighting of frames ([`Lighting::encode`] with a [`FrameMapping`]).
+#[derive(Debug)]
+pub(crate) struct HaarEncoder {
+    mapping: FrameMapping,
+    keep: Selection,
+}
+
+impl HaarEncoder {
+    pub(crate) fn new(param: Parameterization, keep: Selection, rotation: LightRotation) -> Self {
+        HaarEncoder {
+            mapping: FrameMapping::new(param, rotation),
+            keep,
         }
     }
 
     /// `frame`'s lighting and the seconds encoding it took.
     pub(crate) fn encode(&mut self, frame: &FrameSpec<'_>) -> Result<(Lighting, f64)> {
         let start = Instant::now();
-        let height = frame.environment.map().height();
-        let mapping = match self.mapping.take() {
-            Some((h, mapping)) if h == height => mapping,
-            _ => SphereMapping::new(height, self.param)?,
-        };
-        let lighting = Lighting::encode(frame.environment, &mapping, &frame.rotation, self.keep);
-        self.mapping = Some((height, mapping));
-        Ok((lighting?, start.elapsed().as_secs_f64()))
+        let lighting = Lighting::from_map(&self.mapping.apply(frame)?, self.keep)?;
+        Ok((lighting, start.elapsed().as_secs_f64()))
     }
 }
 

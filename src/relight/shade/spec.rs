@@ -13,6 +13,7 @@ use super::lambert::{LambertShader, ShadeOptions};
 use super::reference::ReferenceShader;
 use crate::named::named_enum;
 use crate::product::Selection;
+use crate::relight::light::environment::LightRotation;
 use crate::relight::material::brdf::DEFAULT_ELEVATIONS;
 use crate::relight::material::orient::BrdfRotation;
 use crate::relight::{Mesh, Scene, SceneCache, TransportSet};
@@ -72,6 +73,9 @@ pub struct ShaderSpec {
     pub shade: ShadeOptions,
     /// The lighting's truncation, Haar only.
     pub keep_light: Selection,
+    /// How a general rotation of the lighting is applied, Haar and spherical harmonics
+    /// ([`LightRotation`]).
+    pub light_rotation: LightRotation,
     /// The Haar shaders' arithmetic.
     pub precision: Precision,
     /// Spherical harmonics: use the first `B` of the bands stored [default: all].
@@ -91,6 +95,7 @@ impl Default for ShaderSpec {
             fill_cache: false,
             shade: ShadeOptions::default(),
             keep_light: Selection::All,
+            light_rotation: LightRotation::Source,
             precision: Precision::F32,
             sh_bands: None,
             reference_resolution: None,
@@ -108,6 +113,11 @@ impl ShaderSpec {
     /// let mut spec = ShaderSpec::default(); // Lambertian
     /// spec.material.cache_bins = Some(16);
     /// assert!(spec.check().is_err()); // a rotation cache rotates glossy BRDFs only
+    /// use haarshift::relight::light::environment::LightRotation;
+    /// use haarshift::relight::shade::Method;
+    /// let fast = ShaderSpec { light_rotation: LightRotation::Prefiltered, ..ShaderSpec::default() };
+    /// assert!(fast.check().is_ok());
+    /// assert!(ShaderSpec { method: Method::Reference, ..fast }.check().is_err()); // the ground truth
     /// ```
     pub fn check(&self) -> Result<()> {
         let m = &self.material;
@@ -141,6 +151,18 @@ impl ShaderSpec {
                 reason: "--keep-light, --keep-visibility and --depth truncate the Haar \
                          basis; --basis sh uses every band stored"
                     .into(),
+            });
+        }
+        if self.light_rotation != LightRotation::Source
+            && matches!(self.method, Method::Reference | Method::Ambient)
+        {
+            return Err(Error::InvalidParameter {
+                name: "light-rotation",
+                reason: format!(
+                    "--light-rotation {} applies to the haar and sh bases; --basis {} rotates \
+                     the lighting at the source's resolution (reference) or not at all (ambient)",
+                    self.light_rotation, self.method
+                ),
             });
         }
         Ok(())

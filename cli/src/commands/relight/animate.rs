@@ -119,7 +119,9 @@ pub fn run(args: Args) -> Result<()> {
     // Lambertian: one sparse dot per vertex and frame. Glossy: with a rotation cache, a frame
     // rotates only the maps no earlier frame (or --fill-cache) rotated: with a fixed view,
     // the first frame's.
-    let spec = args.shading.spec(Method::Haar, &brdf, &args.glossy);
+    let spec = args
+        .shading
+        .spec(Method::Haar, &brdf, &args.glossy, &args.light);
     spec.check()?;
     let mut shader = spec.build(&ShadingInput::cache(&cache).from_file(&args.cache))?;
     let prepared = shader.preparation();

@@ -82,6 +82,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut spec = ShaderSpec {
         method: Method::Reference,
         reference_resolution: Some(args.resolution),
+        light_rotation: args.light.light_rotation,
         progress: true,
         ..ShaderSpec::default()
     };

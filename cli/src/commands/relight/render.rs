@@ -93,7 +93,9 @@ pub fn run(args: Args) -> Result<()> {
     let rotation = rotation(angles)?;
     let camera = view.camera(cache.camera.as_ref(), &cache.mesh)?;
     let brdf = args.material.brdf()?;
-    let spec = args.shading.spec(args.basis, &brdf, &args.glossy);
+    let spec = args
+        .shading
+        .spec(args.basis, &brdf, &args.glossy, &args.light);
     spec.check()?;
     let param = cache.transport.param();
     let mut shader = spec.build(&ShadingInput::cache(&cache).from_file(&args.cache))?;

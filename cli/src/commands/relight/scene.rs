@@ -9,6 +9,7 @@ use haarshift::product::Selection;
 use haarshift::relight::dynamic::fields::file::FieldStore;
 use haarshift::relight::dynamic::motion::{MotionPath, play};
 use haarshift::relight::dynamic::{Change, DynamicBudgets, DynamicOptions, DynamicScene};
+use haarshift::relight::light::environment::LightRotation;
 use haarshift::relight::precompute::shard::Shard;
 use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
 use haarshift::relight::shade::{FrameSpec, Shader, ShaderSpec};
@@ -292,6 +293,14 @@ pub fn run(args: Args) -> Result<()> {
             .map(Path::new),
     );
     refuse_outputs(&inputs, &outputs, args.force)?;
+    if args.light.light_rotation != LightRotation::Source {
+        return Err(Error::InvalidParameter {
+            name: "light-rotation",
+            reason: "--light-rotation prefiltered applies to relight render and animate; a \
+                     dynamic scene's lighting is rotated at the source's resolution"
+                .into(),
+        });
+    }
     let view = args.camera.view()?;
     let options = args.options()?;
     let mut store = args

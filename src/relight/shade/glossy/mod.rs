@@ -716,7 +716,7 @@ impl<T: Sample> GlossyHaarShader<T> {
         };
         Ok(GlossyHaarShader {
             shader,
-            encoder: HaarEncoder::new(set.param(), spec.keep_light),
+            encoder: HaarEncoder::new(set.param(), spec.keep_light, spec.light_rotation),
             options: spec.material.clone(),
             preparation: Preparation {
                 seconds: prepare_seconds,

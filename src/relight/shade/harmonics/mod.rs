@@ -43,9 +43,9 @@ use rayon::prelude::*;
 use std::time::Instant;
 
 use super::{
-    FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds,
+    FrameMapping, FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
+    Timing, seconds,
 };
-use crate::faces::Parameterization;
 use crate::relight::harmonics::{ShTransfer, check_bands};
 use crate::relight::material::orient::mirror_directions;
 use crate::relight::{Brdf, Mesh};
@@ -335,7 +335,7 @@ pub struct ShShader {
     albedo: Array2<f32>,
     mesh: Mesh,
     object_vertices: usize,
-    param: Parameterization,
+    mapping: FrameMapping,
     phong: Option<PhongSh>,
     prepare_seconds: f64,
 }
@@ -376,7 +376,7 @@ impl ShShader {
             albedo: input.albedo.to_owned(),
             mesh: input.mesh.clone(),
             object_vertices: input.object_vertices,
-            param: set.param(),
+            mapping: FrameMapping::new(set.param(), spec.light_rotation),
             phong,
             prepare_seconds: seconds(start),
         })
@@ -387,7 +387,7 @@ impl Shader for ShShader {
     fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
         let start = Instant::now();
         let bands = self.transfer.bands();
-        let map = frame.environment.sphere_map(self.param, &frame.rotation)?;
+        let map = self.mapping.apply(frame)?;
         let lighting = SphericalHarmonics::new(bands)?.project(&map);
         let encode_seconds = seconds(start);
         let start = Instant::now();

@@ -1,7 +1,7 @@
 use std::f64::consts::PI;
 
 use super::*;
-use crate::faces::ParamKind;
+use crate::faces::{ParamKind, Parameterization};
 
 #[test]
 fn shading_is_albedo_over_pi_times_the_dot_product() {

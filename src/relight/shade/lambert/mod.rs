@@ -421,7 +421,7 @@ impl<T: Sample> LambertShader<T> {
         let set = input.transport(spec.method)?;
         let prepared = PreparedTransport::new(set, input.albedo, &spec.shade)?;
         Ok(LambertShader {
-            encoder: HaarEncoder::new(set.param(), spec.keep_light),
+            encoder: HaarEncoder::new(set.param(), spec.keep_light, spec.light_rotation),
             prepared,
             prepare_seconds: seconds(start),
         })
