@@ -40,6 +40,7 @@ const state = {
   keep_visibility: params.has('keep_visibility') ? num('keep_visibility', null) : null,
   depth: params.has('depth') ? num('depth', null) : null,
   rotation_cache: params.has('rotation_cache') ? num('rotation_cache', null) : 64,
+  light_rotation: params.get('light_rotation') || 'prefiltered',
   eye: null,
   format: params.get('format') === 'f16' ? 'f16' : 'f32',
   error: params.get('error') === '1',
@@ -445,6 +446,8 @@ function setupControls(scene) {
   };
   $('material').onchange = material;
   $('exponent').onchange = material;
+  $('light_rotation').value = state.light_rotation;
+  $('light_rotation').onchange = () => { state.light_rotation = $('light_rotation').value; send(); };
   $('brdf_rotation').value = state.brdf_rotation;
   $('brdf_rotation').onchange = () => { state.brdf_rotation = $('brdf_rotation').value; send(); };
   $('rotation_cache').value = state.rotation_cache ?? 0;
@@ -513,6 +516,7 @@ function command() {
   const eye = eyePosition().map(round);
   const parts = ['haarshift relight render', quote(s.cache), '--env', quote(s.env), `--yaw ${round(state.yaw)}`, `--pitch ${round(state.pitch)}`, `--roll ${round(state.roll)}`];
   if (state.basis !== 'haar') parts.push(`--basis ${state.basis}`);
+  if (state.light_rotation !== 'source' && state.basis !== 'ambient') parts.push(`--light-rotation ${state.light_rotation}`);
   if (state.brdf !== 'lambert') {
     parts.push(`--brdf ${state.brdf}`);
     if (state.brdf_rotation !== 'haar') parts.push(`--brdf-rotation ${state.brdf_rotation}`);
@@ -536,7 +540,7 @@ function quote(path) {
 function writeHash() {
   const p = new URLSearchParams();
   for (const k of ['yaw', 'pitch', 'roll']) p.set(k, round(state[k]));
-  for (const k of ['basis', 'brdf', 'brdf_rotation', 'format']) p.set(k, state[k]);
+  for (const k of ['basis', 'brdf', 'brdf_rotation', 'light_rotation', 'format']) p.set(k, state[k]);
   for (const k of ['keep_light', 'keep_visibility', 'depth', 'rotation_cache']) if (state[k] !== null) p.set(k, state[k]);
   if (state.error) p.set('error', '1');
   for (const k of ['azimuth', 'elevation', 'distance', 'fov']) p.set(k, round(orbit[k]));

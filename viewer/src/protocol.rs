@@ -117,6 +117,9 @@ pub struct ViewState {
     /// A glossy BRDF's rotation cache, `N x 2N` bins (`--rotation-cache`); one rotation per
     /// vertex when absent.
     pub rotation_cache: Option<usize>,
+    /// How a general rotation of the lighting is applied (`--light-rotation`): `prefiltered`
+    /// (a few milliseconds, the viewer's default) or `source`.
+    pub light_rotation: String,
     /// The camera's position: the eye of view-dependent BRDFs.
     pub eye: Option<[f64; 3]>,
     /// The radiance's sample format in frames.
@@ -140,6 +143,7 @@ impl Default for ViewState {
             keep_visibility: None,
             depth: None,
             rotation_cache: None,
+            light_rotation: "prefiltered".into(),
             eye: None,
             format: SampleFormat::F32,
             error: false,

@@ -17,6 +17,7 @@ use tungstenite::{Message, WebSocket};
 
 use haarshift::product::Selection;
 use haarshift::relight::Brdf;
+use haarshift::relight::light::environment::LightRotation;
 use haarshift::relight::material::orient::BrdfRotation;
 use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{
@@ -318,6 +319,11 @@ impl Session {
                 depth: state.depth,
             },
             keep_light: state.keep_light.map_or(Selection::All, Selection::Largest),
+            // Ambient occlusion ignores the lighting: its rotation is not asked for.
+            light_rotation: match method {
+                Method::Ambient => LightRotation::Source,
+                _ => state.light_rotation.parse()?,
+            },
             ..ShaderSpec::default()
         })
     }
