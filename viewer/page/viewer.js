@@ -23,7 +23,7 @@ const viewer = {
 window.haarshiftViewer = viewer;
 
 const canvas = $('view');
-const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
+const gl = canvas.getContext('webgl2', { antialias: false });
 viewer.webgl2 = gl !== null;
 
 // ---- the view state, from the URL's hash --------------------------------------------------
@@ -358,6 +358,17 @@ function draw() {
   resize();
   if (!frameDirty || !viewer.frame || !envTexture) return;
   frameDirty = false;
+  render();
+  viewer.framesDrawn += 1;
+  viewer.drawnSeq = viewer.frame.header.seq;
+  recordRate();
+  updateStats();
+}
+if (gl) requestAnimationFrame(draw);
+
+// Draws the last frame (the drawing buffer is not preserved: a picture of it is taken in the
+// same task as the drawing).
+function render() {
   const { colours, display } = vertexColours();
   gl.bindBuffer(gl.ARRAY_BUFFER, radianceBuffer);
   gl.bufferSubData(gl.ARRAY_BUFFER, 0, colours);
@@ -386,12 +397,7 @@ function draw() {
   gl.bindVertexArray(vao);
   gl.drawElements(gl.TRIANGLES, indexCount, gl.UNSIGNED_INT, 0);
   gl.bindVertexArray(null);
-  viewer.framesDrawn += 1;
-  viewer.drawnSeq = viewer.frame.header.seq;
-  recordRate();
-  updateStats();
 }
-if (gl) requestAnimationFrame(draw);
 
 // Frames received and drawn per second over the last two seconds.
 const drawTimes = [];
@@ -464,7 +470,10 @@ function setupControls(scene) {
     $('command').value = c;
     if (navigator.clipboard) navigator.clipboard.writeText(c).catch(() => {});
   };
-  $('save').onclick = () => canvas.toBlob((blob) => download(blob, 'haarshift-view.png'));
+  $('save').onclick = () => {
+    if (viewer.frame && envTexture) render();
+    canvas.toBlob((blob) => download(blob, 'haarshift-view.png'));
+  };
   // The linear radiance, drawn by the server's rasteriser from the last frame.
   $('exr').onclick = () => socket.send(JSON.stringify({ type: 'picture', look_at: orbit.target, fov: orbit.fov, width: canvas.width, height: canvas.height }));
 }
