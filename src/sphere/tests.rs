@@ -724,8 +724,8 @@ fn the_reference_is_the_midpoint_rule_written_out_bit_for_bit() {
                     }
                 }
             }
-            for c in 0..3 {
-                assert_eq!(got.as_array()[[i, j, c]], acc[c] / total, "({i}, {j}, {c})");
+            for (c, s) in acc.iter().enumerate() {
+                assert_eq!(got.as_array()[[i, j, c]], s / total, "({i}, {j}, {c})");
             }
         }
     }
