@@ -220,7 +220,7 @@ fn main() -> Fallible<()> {
          Per frame: `Lighting::encode` end to end (rotation, resampling to the working \
          parameterisation, Haar transform, selection of {keep_text}), median of {count} \
          random rotations (yaw, pitch, roll uniform in degrees; none a whole-column yaw), \
-         {} threads. `source` rotates the map at its own resolution (the default); \
+         {} threads{}. `source` rotates the map at its own resolution (the default); \
          `prefiltered` rotates a copy brought down once to twice the working lat-long height \
          (its preparation, once per environment and parameterisation, in the last column); \
          `chain rule` rotates the working lat-long map in the Haar domain (`rotate_map`, \
@@ -231,6 +231,11 @@ fn main() -> Fallible<()> {
         args.get(2)
             .map_or("results/viewer/lighting_rotation.md", String::as_str),
         rayon::current_num_threads(),
+        // Other work on the machine moves the times: say how busy it was.
+        std::fs::read_to_string("/proc/loadavg").map_or(String::new(), |l| {
+            let one_minute = l.split_whitespace().next().unwrap_or("?").to_owned();
+            format!(" (load average {one_minute} as the run began)")
+        }),
     );
     for (name, env) in environments(&root.join("testdata/envmaps"), 128)? {
         let (h, w) = (env.map().height(), env.map().width());

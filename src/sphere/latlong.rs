@@ -376,7 +376,13 @@ impl<T: Sample> LatLongMap<T> {
     #[inline]
     fn pixel(&self, r: isize, c: isize) -> &[T] {
         let (h, w, ch) = self.data.dim();
-        let (r, c, _) = continue_index(r, c, h, w);
+        // Inside the map (nearly every lookup) the index is itself: no division.
+        let (r, c) = if (0..h as isize).contains(&r) && (0..w as isize).contains(&c) {
+            (r as usize, c as usize)
+        } else {
+            let (r, c, _) = continue_index(r, c, h, w);
+            (r, c)
+        };
         let flat = self.data.as_slice().expect("standard layout");
         &flat[(r * w + c) * ch..][..ch]
     }

@@ -250,7 +250,7 @@ impl Environment {
     /// let source = env.rotated(8, &tilt, LightRotation::Source).unwrap();
     /// assert_eq!(source, env.lat_long(8, &tilt).unwrap());
     /// let worst = (&fast.as_array() - &source.as_array()).fold(0.0f64, |m, d| m.max(d.abs()));
-    /// assert!(worst > 0.0 && worst < 1e-2, "{worst}");
+    /// assert!(worst > 0.0 && worst < 5e-2, "{worst}"); // the copy 16 high: O(copy texel^2)
     /// // a whole-column yaw is the same column shift in both
     /// let yaw = SphereRotation::from_degrees(45.0, 0.0, 0.0).unwrap();
     /// assert_eq!(env.rotated(8, &yaw, LightRotation::Prefiltered).unwrap(),
