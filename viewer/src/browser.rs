@@ -35,6 +35,17 @@ pub const FLAGS: [&str; 8] = [
 const WAIT: Duration = Duration::from_secs(60);
 
 /// A headless Chromium with one page attached.
+///
+/// ```no_run
+/// use haarshift_viewer::browser::Browser;
+/// use std::time::Duration;
+/// let mut browser = Browser::launch(640, 480).unwrap();
+/// browser.navigate("http://127.0.0.1:8765/").unwrap();
+/// browser.wait_for("window.haarshiftViewer?.framesDrawn > 0", Duration::from_secs(30)).unwrap();
+/// browser.drag([300.0, 240.0], [360.0, 240.0], 10, 0).unwrap(); // the lighting turns 30 degrees
+/// std::fs::write("view.png", browser.screenshot().unwrap()).unwrap();
+/// assert!(browser.console_errors().is_empty());
+/// ```
 pub struct Browser {
     child: Child,
     // Dropped after the child is killed: the profile lives as long as the browser.
@@ -46,6 +57,14 @@ pub struct Browser {
 }
 
 /// The browser to launch: `$CHROMIUM`, else `chromium` on the `PATH`.
+///
+/// ```
+/// // Either a path or a one-line reason saying how to install one.
+/// match haarshift_viewer::browser::chromium() {
+///     Ok(path) => assert!(path.ends_with("chromium") || std::env::var_os("CHROMIUM").is_some()),
+///     Err(e) => assert!(e.to_string().contains("apt-get install chromium")),
+/// }
+/// ```
 pub fn chromium() -> Result<PathBuf> {
     if let Some(path) = std::env::var_os("CHROMIUM") {
         return Ok(PathBuf::from(path));

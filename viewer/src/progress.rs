@@ -39,6 +39,20 @@ thread_local! {
 }
 
 /// Counts the tasks this thread begins from now on into `counter`.
+///
+/// ```
+/// use haarshift::progress::Progress;
+/// use haarshift_viewer::progress::{Counter, PageProgress, watch};
+/// use std::sync::Arc;
+/// let counter = Arc::new(Counter::default());
+/// watch(Arc::clone(&counter));
+/// let task = PageProgress.begin("rays", 10);
+/// task.advance(4);
+/// assert_eq!(counter.get(), (4, 10));
+/// // Another thread's tasks are not counted here.
+/// std::thread::spawn(|| PageProgress.begin("rays", 99).advance(99)).join().unwrap();
+/// assert_eq!(counter.get(), (4, 10));
+/// ```
 pub fn watch(counter: Arc<Counter>) {
     WATCHED.with(|w| *w.borrow_mut() = Some(counter));
 }
