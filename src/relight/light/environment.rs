@@ -35,14 +35,19 @@
 //! # Prefiltered rotation
 //!
 //! A rotation at the source's resolution costs what the source has texels (a 1024 x 512 map:
-//! hundreds of milliseconds), whatever the working resolution. [`LightRotation::Prefiltered`]
-//! instead rotates a copy of the map brought down once, by the same solid-angle-weighted
+//! about 0.1 s on two cores), whatever the working resolution. [`LightRotation::Prefiltered`]
+//! instead starts from a copy of the map brought down once, by the same solid-angle-weighted
 //! means, to `min(2N, H)` rows ([`Environment::downsampled`], kept with the environment), and
-//! downsamples the rotated copy to `N`: the cost is a few times the working map's texels. The
-//! rotated texel is then the mean of `4 x 4` samples of the bilinear interpolant of the
-//! prefiltered copy, so the result is a little blurrier than [`LightRotation::Source`]'s (the
-//! bilinear tent of one prefiltered texel, half a working texel); the measured difference is in
-//! `results/viewer/lighting_rotation.md`. Whole-column yaws take the exact column shift in
+//! samples the rotation at the working texels from it: each working texel is the
+//! `sin theta`-weighted mean of `2 x 2` stratum midpoints (one per texel of the copy) of the
+//! copy's bilinear interpolant, the ground truth's estimator
+//! ([`LatLongMap::from_fn_mean`]) on fewer, cheaper samples. The cost is four lookups per
+//! working texel; the result is blurrier than [`LightRotation::Source`]'s (the copy's texels
+//! and the bilinear tent over them are half a working texel), which moves a sun or a lamp
+//! partly into the neighbouring texels: measured in `results/viewer/lighting_rotation.md`.
+//! Under the identity the midpoints are the copy's texel centres and their `sin theta`
+//! weights are proportional to the copy's ring solid angles, so even this path keeps the
+//! map's energy to rounding. Whole-column yaws take the exact column shift in
 //! both, so the two agree bit for bit there, and whenever `2N >= H` (the prefiltered copy is
 //! the source).
 //!
@@ -67,9 +72,8 @@ use crate::sphere::latlong::angles;
 use crate::sphere::{LatLongMap, SphereRotation};
 use crate::{Error, Result, Sample};
 
-/// Samples per axis and texel when a general rotation is applied (the sphere module's
-/// [`reference`](crate::sphere::reference::reference)), at the source's resolution or the
-/// prefiltered copy's.
+/// Samples per axis and source texel when a general rotation is applied at the source's
+/// resolution (the sphere module's [`reference`](crate::sphere::reference::reference)).
 const ROTATION_SAMPLES: usize = 2;
 
 /// The prefiltered copy is this many times the working lat-long height (capped at the
@@ -95,10 +99,10 @@ named_enum! {
     pub enum LightRotation ("light-rotation") {
         #[default]
         /// At the source map's resolution, then downsampled: the sharpest, at a cost that
-        /// grows with the source (hundreds of milliseconds for a 1024 x 512 map).
+        /// grows with the source (about 0.1 s for a 1024 x 512 map on two cores).
         Source = "source",
-        /// On a copy prefiltered once to twice the working lat-long height, then downsampled:
-        /// a few milliseconds, a little blurrier.
+        /// From a copy prefiltered once to twice the working lat-long height, sampled at the
+        /// working texels: a few milliseconds, blurrier.
         Prefiltered = "prefiltered",
     }
 }

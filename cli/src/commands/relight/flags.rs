@@ -145,9 +145,10 @@ pub struct LightFlags {
 
     /// How a rotation other than a yaw by whole columns of the working map is applied (bases
     /// haar and sh): `source` rotates the map at its own resolution, then downsamples (the
-    /// sharpest; costs what the source has texels: 0.2 to 0.5 s per frame for a 1024 x 512
-    /// map); `prefiltered` rotates a copy brought down once (solid-angle means) to twice the
-    /// working lat-long height (a few ms per frame, a little blurrier)
+    /// sharpest; costs what the source has texels: about 0.1 s per frame for a 1024 x 512 map
+    /// on two cores); `prefiltered` rotates a copy brought down once (solid-angle means) to
+    /// twice the working lat-long height (2 to 8 ms per frame up to lat-long 128 or cube 64;
+    /// blurrier: a sun spreads into the neighbouring texels)
     #[arg(long, value_name = "HOW", default_value = "source",
           value_parser = choice::<LightRotation>(names!(LightRotation)))]
     pub light_rotation: LightRotation,
