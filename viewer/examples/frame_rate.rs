@@ -5,7 +5,7 @@
 //! cargo run --release -p haarshift-viewer --example frame_rate -- CACHE ENV [KEY=VALUE ...]
 //! ```
 //!
-//! Keys: `brdf` (`lambert`), `keep_light`, `keep_visibility`, `rotation_cache` (the page's
+//! Keys: `brdf` (`lambert`), `keep_light`, `keep_visibility`, `keep_brdf`, `rotation_cache` (the page's
 //! state), `drag` (`light` or `orbit`), `moves` (50: mouse moves of the drag, one every
 //! 16 ms), `size` (`640x480`), `label`, `screenshot` (a PNG of the page after the drag).
 //!
@@ -61,7 +61,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "width={width}&height={height}&panel=0&brdf={}",
         get("brdf", "lambert")
     );
-    for key in ["keep_light", "keep_visibility", "rotation_cache"] {
+    for key in [
+        "keep_light",
+        "keep_visibility",
+        "keep_brdf",
+        "rotation_cache",
+    ] {
         if let Some(v) = options.get(key) {
             hash.push_str(&format!("&{key}={v}"));
         }
@@ -140,11 +145,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err(format!("the page logged errors: {errors:?}").into());
     }
     println!(
-        "| {} | {vertices} | {} {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {} | {received:.1} | {drawn:.1} | {first_frame:.1} |",
+        "| {} | {vertices} | {} {} | {} | {} | {width} x {height} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {} | {received:.1} | {drawn:.1} | {first_frame:.1} |",
         get("label", "-"),
         param.kind(),
         param.face_size(),
         get("brdf", "lambert"),
+        ["keep_light", "keep_visibility", "keep_brdf"]
+            .iter()
+            .filter_map(|k| options.get(k).map(|v| format!("{k} {v}")))
+            .collect::<Vec<_>>()
+            .join(", "),
         if orbit { "camera" } else { "lighting" },
         median[0],
         median[1],

@@ -10,7 +10,7 @@ const $ = (id) => document.getElementById(id);
 const viewer = {
   framesReceived: 0,   // frame packets received
   framesDrawn: 0,      // frames drawn (a frame that arrives before the last is drawn is not)
-  drawnSeq: null,      // the state number of the frame drawn last
+  drawnSeq: null,      // the newest state number the frame drawn answers
   frame: null,         // { header, radiance: Float32Array (V x 3) } of the last frame
   reference: null,     // { header, radiance } of the last reference
   scene: null,         // the scene's description
@@ -39,6 +39,7 @@ const state = {
   keep_light: params.has('keep_light') ? num('keep_light', null) : null,
   keep_visibility: params.has('keep_visibility') ? num('keep_visibility', null) : null,
   depth: params.has('depth') ? num('depth', null) : null,
+  keep_brdf: params.has('keep_brdf') ? num('keep_brdf', null) : null,
   rotation_cache: params.has('rotation_cache') ? num('rotation_cache', null) : 64,
   light_rotation: params.get('light_rotation') || 'prefiltered',
   eye: null,
@@ -63,6 +64,9 @@ function notice(n) {
   if (n.type === 'error') {
     viewer.notices.push(n.message);
     showMessage(n.message);
+  } else if (n.type === 'unchanged') {
+    // The frame shown answers this state too.
+    if (viewer.frame && viewer.drawnSeq === viewer.frame.header.seq) viewer.drawnSeq = n.seq;
   } else if (n.type === 'progress') {
     referenceStatus = `reference ${n.total ? Math.floor((100 * n.done) / n.total) : 0}%`;
     updateStats();
@@ -430,7 +434,7 @@ function updateStats() {
 // ---- controls -----------------------------------------------------------------------------
 
 function setupControls(scene) {
-  for (const [id, max] of [['keep_light', scene.texels], ['keep_visibility', scene.texels]]) {
+  for (const [id, max] of [['keep_light', scene.texels], ['keep_visibility', scene.texels], ['keep_brdf', scene.texels]]) {
     const el = $(id);
     el.max = max;
     el.value = state[id] ?? max;
@@ -530,6 +534,7 @@ function command() {
     parts.push(`--brdf ${state.brdf}`);
     if (state.brdf_rotation !== 'haar') parts.push(`--brdf-rotation ${state.brdf_rotation}`);
     if (state.rotation_cache) parts.push(`--rotation-cache ${state.rotation_cache}`);
+    if (state.keep_brdf) parts.push(`--keep-brdf ${state.keep_brdf}`);
   }
   if (state.keep_light) parts.push(`--keep-light ${state.keep_light}`);
   if (state.keep_visibility) parts.push(`--keep-visibility ${state.keep_visibility}`);
@@ -550,7 +555,7 @@ function writeHash() {
   const p = new URLSearchParams();
   for (const k of ['yaw', 'pitch', 'roll']) p.set(k, round(state[k]));
   for (const k of ['basis', 'brdf', 'brdf_rotation', 'light_rotation', 'format']) p.set(k, state[k]);
-  for (const k of ['keep_light', 'keep_visibility', 'depth', 'rotation_cache']) if (state[k] !== null) p.set(k, state[k]);
+  for (const k of ['keep_light', 'keep_visibility', 'depth', 'keep_brdf', 'rotation_cache']) if (state[k] !== null) p.set(k, state[k]);
   if (state.error) p.set('error', '1');
   for (const k of ['azimuth', 'elevation', 'distance', 'fov']) p.set(k, round(orbit[k]));
   if (exposure) p.set('exposure', exposure);

@@ -114,6 +114,9 @@ pub struct ViewState {
     pub keep_visibility: Option<usize>,
     /// Traversal depth (`--depth`).
     pub depth: Option<usize>,
+    /// Detail coefficients of each rotated BRDF map kept, the largest (`--keep-brdf`); all
+    /// when absent.
+    pub keep_brdf: Option<usize>,
     /// A glossy BRDF's rotation cache, `N x 2N` bins (`--rotation-cache`); one rotation per
     /// vertex when absent.
     pub rotation_cache: Option<usize>,
@@ -142,6 +145,7 @@ impl Default for ViewState {
             keep_light: None,
             keep_visibility: None,
             depth: None,
+            keep_brdf: None,
             rotation_cache: None,
             light_rotation: "prefiltered".into(),
             eye: None,
@@ -208,6 +212,12 @@ pub enum Notice {
     Error {
         /// One line.
         message: String,
+    },
+    /// State `seq` changes nothing the last frame depends on (only the eye, say, under a
+    /// Lambertian material): that frame answers it.
+    Unchanged {
+        /// The state's number.
+        seq: u64,
     },
     /// The reference in the background: `done` of `total` units.
     Progress {

@@ -201,14 +201,14 @@ impl Session {
         }
     }
 
-    /// The messages answering `state`: its frame unless it was drawn already, and the start
-    /// of its reference when the error view is on. A state that cannot be served is an error
+    /// The messages answering `state`: its frame, or that the last frame answers it, and the
+    /// start of its reference when the error view is on. A state that cannot be served is an error
     /// message; the session goes on.
     fn answer(&mut self, state: &ViewState) -> Vec<Message> {
         let mut out = Vec::new();
         match self.frame(state) {
             Ok(Some(packet)) => out.push(Message::binary(packet)),
-            Ok(None) => {}
+            Ok(None) => out.push(notice(&Notice::Unchanged { seq: state.seq })),
             Err(e) => {
                 out.push(notice(&Notice::Error {
                     message: e.to_string(),
@@ -290,6 +290,7 @@ impl Session {
         for (name, budget) in [
             ("keep_light", state.keep_light),
             ("keep_visibility", state.keep_visibility),
+            ("keep_brdf", state.keep_brdf),
         ] {
             if let Some(k) = budget.filter(|&k| k == 0 || k > texels) {
                 return Err(Error::parameter(
@@ -307,6 +308,7 @@ impl Session {
         let material = GlossyOptions {
             brdf: brdf.clone(),
             rotation: state.brdf_rotation.parse::<BrdfRotation>()?,
+            keep_brdf: state.keep_brdf,
             cache_bins: state.rotation_cache,
             ..GlossyOptions::default()
         }
