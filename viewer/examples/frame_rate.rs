@@ -73,11 +73,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut browser = Browser::launch(width, height)?;
     browser.navigate(&format!("{url}#{hash}"))?;
-    let latest = "window.haarshiftViewer !== undefined && haarshiftViewer.frame !== null && \
-                  haarshiftViewer.state !== null && \
-                  haarshiftViewer.drawnSeq === haarshiftViewer.state.seq";
+    // The newest state's frame drawn, or a refusal (which ends the run).
+    let latest = "window.haarshiftViewer !== undefined && (haarshiftViewer.notices.length > 0 || \
+                  haarshiftViewer.frame !== null && haarshiftViewer.state !== null && \
+                  haarshiftViewer.drawnSeq === haarshiftViewer.state.seq)";
+    let refused = |b: &mut Browser| -> Result<(), Box<dyn std::error::Error>> {
+        match b.evaluate("haarshiftViewer.notices")?.as_array() {
+            Some(notices) if !notices.is_empty() => {
+                Err(format!("the server refused the page's state: {notices:?}").into())
+            }
+            _ => Ok(()),
+        }
+    };
     let first = Instant::now();
     browser.wait_for(latest, Duration::from_secs(1800))?;
+    refused(&mut browser)?;
     let first_frame = first.elapsed().as_secs_f64();
 
     let count = |b: &mut Browser, what: &str| -> Result<f64, Box<dyn std::error::Error>> {
@@ -110,6 +120,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let received = (count(&mut browser, "haarshiftViewer.framesReceived")? - received) / seconds;
     let drawn = (count(&mut browser, "haarshiftViewer.framesDrawn")? - drawn) / seconds;
     browser.wait_for(latest, Duration::from_secs(600))?;
+    refused(&mut browser)?;
     let timings = browser.evaluate(&format!(
         "haarshiftViewer.timings.filter((t) => t.at > {since}).map((t) => [t.encode, t.rotate, t.shade, t.prepare])"
     ))?;
