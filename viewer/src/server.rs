@@ -6,8 +6,8 @@
 //! key by `tungstenite`), after which the thread runs the page's [`Session`]. Every page gets
 //! a session of its own (its own shader, frames and reference) up to
 //! [`ViewerOptions::max_sessions`] at once; one more is told so in one line and closed. A
-//! WebSocket from a page of another origin is refused (403): any page the user opens could
-//! otherwise drive a server on the loopback.
+//! WebSocket from a page of another origin than the address asked for is refused (403): any
+//! page the user opens could otherwise drive a server on the loopback.
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -113,12 +113,11 @@ impl Viewer {
     /// Serves pages until the process ends; each connection on its own thread.
     pub fn serve(self) {
         let sessions = Arc::new(AtomicUsize::new(0));
-        let port = self.address().map(|a| a.port()).unwrap_or(0);
         for stream in self.listener.incoming().flatten() {
             let scene = Arc::clone(&self.scene);
             let sessions = Arc::clone(&sessions);
             let options = self.options;
-            std::thread::spawn(move || connection(stream, scene, sessions, options, port));
+            std::thread::spawn(move || connection(stream, scene, sessions, options));
         }
     }
 }
@@ -129,7 +128,6 @@ fn connection(
     scene: Arc<ViewedScene>,
     sessions: Arc<AtomicUsize>,
     options: ViewerOptions,
-    port: u16,
 ) {
     let _ = stream.set_read_timeout(Some(HEAD_WAIT));
     let Some((head, rest)) = read_head(&mut stream) else {
@@ -173,7 +171,7 @@ fn connection(
             );
         }
         (Some("GET"), "/ws") => {
-            let origin_ok = header("origin").is_none_or(|o| same_origin(o, port));
+            let origin_ok = header("origin").is_none_or(|o| same_origin(o, header("host")));
             let key = header("sec-websocket-key").map(str::to_owned);
             let upgrade = header("upgrade").is_some_and(|u| u.eq_ignore_ascii_case("websocket"));
             match (origin_ok, upgrade, key) {
@@ -248,11 +246,10 @@ fn session(
     sessions.fetch_sub(1, Ordering::SeqCst);
 }
 
-/// Whether a page at `origin` is this server's own.
-fn same_origin(origin: &str, port: u16) -> bool {
-    ["127.0.0.1", "localhost", "[::1]"]
-        .iter()
-        .any(|host| origin == format!("http://{host}:{port}"))
+/// Whether a page at `origin` is this server's own: the page's origin is the address the
+/// browser asked for (the `Host` header), whichever name or interface that is.
+fn same_origin(origin: &str, host: Option<&str>) -> bool {
+    host.is_some_and(|host| origin == format!("http://{host}"))
 }
 
 /// The request head (through its blank line) and any bytes read after it, or `None` when the
@@ -285,4 +282,21 @@ fn respond(stream: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> std
     stream.write_all(head.as_bytes())?;
     stream.write_all(body)?;
     stream.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::same_origin;
+
+    #[test]
+    fn only_the_page_of_the_address_asked_for_is_its_own() {
+        assert!(same_origin("http://127.0.0.1:8765", Some("127.0.0.1:8765")));
+        assert!(same_origin("http://viewer.lan:80", Some("viewer.lan:80")));
+        assert!(!same_origin("http://evil.example", Some("127.0.0.1:8765")));
+        assert!(!same_origin(
+            "http://127.0.0.1:9999",
+            Some("127.0.0.1:8765")
+        ));
+        assert!(!same_origin("http://127.0.0.1:8765", None));
+    }
 }
