@@ -52,6 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ViewerOptions {
             address: "127.0.0.1:0".parse()?,
             max_sessions: 2,
+            ..ViewerOptions::default()
         },
     )?;
     let url = viewer.url();

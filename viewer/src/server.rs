@@ -11,6 +11,7 @@
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
@@ -31,6 +32,7 @@ pub const HEAD_WAIT: Duration = Duration::from_secs(10);
 
 const INDEX_HTML: &str = include_str!("../page/index.html");
 const VIEWER_JS: &str = include_str!("../page/viewer.js");
+const RESULTS_HTML: &str = include_str!("../page/results.html");
 
 /// Where and how the viewer serves.
 ///
@@ -39,12 +41,15 @@ const VIEWER_JS: &str = include_str!("../page/viewer.js");
 /// let o = ViewerOptions::default();
 /// assert_eq!((o.address.ip().to_string(), o.address.port(), o.max_sessions), ("127.0.0.1".into(), 8765, 4));
 /// ```
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct ViewerOptions {
     /// The address to listen on; port 0 takes a free one.
     pub address: SocketAddr,
     /// Pages served at once, each with its own session.
     pub max_sessions: usize,
+    /// An `experiment relight` output directory, served at `/results`: its records
+    /// (`relight.json`) and pictures (`*.png`) side by side.
+    pub results: Option<PathBuf>,
 }
 
 impl Default for ViewerOptions {
@@ -52,6 +57,7 @@ impl Default for ViewerOptions {
         ViewerOptions {
             address: SocketAddr::from(([127, 0, 0, 1], 8765)),
             max_sessions: 4,
+            results: None,
         }
     }
 }
@@ -116,7 +122,7 @@ impl Viewer {
         for stream in self.listener.incoming().flatten() {
             let scene = Arc::clone(&self.scene);
             let sessions = Arc::clone(&sessions);
-            let options = self.options;
+            let options = self.options.clone();
             std::thread::spawn(move || connection(stream, scene, sessions, options));
         }
     }
@@ -194,6 +200,28 @@ fn connection(
                 }
             }
         }
+        (Some("GET"), "/results") if options.results.is_some() => {
+            let _ = respond(
+                &mut stream,
+                "200 OK",
+                "text/html; charset=utf-8",
+                RESULTS_HTML.as_bytes(),
+            );
+        }
+        (Some("GET"), path) if path.starts_with("/results/") => {
+            match options
+                .results
+                .as_deref()
+                .and_then(|dir| result_file(dir, &path[9..]))
+            {
+                Some((kind, bytes)) => {
+                    let _ = respond(&mut stream, "200 OK", kind, &bytes);
+                }
+                None => {
+                    let _ = respond(&mut stream, "404 Not Found", "text/plain", b"not found\n");
+                }
+            }
+        }
         (Some("GET"), _) => {
             let _ = respond(&mut stream, "404 Not Found", "text/plain", b"not found\n");
         }
@@ -246,6 +274,42 @@ fn session(
     sessions.fetch_sub(1, Ordering::SeqCst);
 }
 
+/// A file of the results directory, with its content type: `relight.json`, `files` (the names
+/// of its pictures, JSON) or `files/NAME.png` of a [`plain_png`] name.
+fn result_file(dir: &Path, name: &str) -> Option<(&'static str, Vec<u8>)> {
+    let (kind, file) = match name {
+        "relight.json" => ("application/json", name),
+        "files" => {
+            let mut names: Vec<String> = std::fs::read_dir(dir)
+                .ok()?
+                .flatten()
+                .filter_map(|e| e.file_name().into_string().ok())
+                .filter(|n| plain_png(n))
+                .collect();
+            names.sort();
+            return serde_json::to_vec(&names)
+                .ok()
+                .map(|b| ("application/json", b));
+        }
+        _ => {
+            let file = name.strip_prefix("files/").filter(|f| plain_png(f))?;
+            ("image/png", file)
+        }
+    };
+    std::fs::read(dir.join(file))
+        .ok()
+        .map(|bytes| (kind, bytes))
+}
+
+/// A `.png` file name of letters, digits, `.`, `-` and `_`, not starting with `.`: no path.
+fn plain_png(name: &str) -> bool {
+    !name.starts_with('.')
+        && name.ends_with(".png")
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_'))
+}
+
 /// Whether a page at `origin` is this server's own: the page's origin is the address the
 /// browser asked for (the `Host` header), whichever name or interface that is.
 fn same_origin(origin: &str, host: Option<&str>) -> bool {
@@ -287,6 +351,29 @@ fn respond(stream: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> std
 #[cfg(test)]
 mod tests {
     use super::same_origin;
+
+    #[test]
+    fn result_files_are_the_records_and_plain_png_names_only() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("relight.json"), b"[]").unwrap();
+        std::fs::write(dir.path().join("a-plot.png"), b"png").unwrap();
+        std::fs::write(dir.path().join("secret.txt"), b"no").unwrap();
+        let read = |name| super::result_file(dir.path(), name).map(|(_, b)| b);
+        assert_eq!(read("relight.json"), Some(b"[]".to_vec()));
+        assert_eq!(read("files/a-plot.png"), Some(b"png".to_vec()));
+        assert_eq!(read("files"), Some(br#"["a-plot.png"]"#.to_vec()));
+        for refused in [
+            "files/secret.txt",
+            "secret.txt",
+            "files/../a-plot.png",
+            "files/.png",
+            "files/sub/a.png",
+            "files/missing.png",
+            "relight.csv",
+        ] {
+            assert_eq!(read(refused), None, "{refused}");
+        }
+    }
 
     #[test]
     fn only_the_page_of_the_address_asked_for_is_its_own() {

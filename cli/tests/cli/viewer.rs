@@ -582,3 +582,60 @@ fn a_burst_of_states_is_answered_by_the_newest_state_s_frame_only() {
     }
     assert!(answered.len() <= 2, "frames for states {answered:?}");
 }
+
+#[test]
+fn the_results_page_shows_an_experiment_s_records_pictures_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = bunny_cache(dir.path());
+    let env = testdata("envmaps/rooitou_park_256x128.npy");
+    let results = testdata("../results/relight/experiments");
+    let view = ViewProcess::start(&[p(&cache), "--env", p(&env), "--results", p(&results)]);
+    let records: Vec<Value> =
+        serde_json::from_slice(&std::fs::read(results.join("relight.json")).unwrap()).unwrap();
+    let pictures = std::fs::read_dir(&results)
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension() == Some("png".as_ref()))
+        .count();
+    assert!(
+        http(
+            &view.url,
+            b"GET /results/files/../relight.csv HTTP/1.1\r\n\r\n"
+        )
+        .starts_with("HTTP/1.1 404")
+    );
+    let mut browser = Browser::launch(1000, 800).unwrap();
+    browser.navigate(&format!("{}results", view.url)).unwrap();
+    browser
+        .wait_for(
+            &format!(
+                "window.haarshiftResults !== undefined && haarshiftResults.records.length === {} && \
+                 [...document.images].filter((i) => i.complete && i.naturalWidth > 0).length === {pictures}",
+                records.len()
+            ),
+            Duration::from_secs(30),
+        )
+        .unwrap();
+    // A method's button marks its records in the table and the plot.
+    let method = browser
+        .evaluate("document.querySelector('#methods button').click(); haarshiftResults.selected")
+        .unwrap();
+    let marked = browser
+        .evaluate("[document.querySelectorAll('#records tr.on').length, document.querySelectorAll('#plot circle[r=\"6\"]').length]")
+        .unwrap();
+    let of_method = records
+        .iter()
+        .filter(|r| {
+            let key = format!(
+                "{} {}",
+                r["method"].as_str().unwrap(),
+                r["parameters"].as_str().unwrap_or("")
+            );
+            Value::from(key.trim()) == method
+        })
+        .count();
+    assert!(of_method > 0, "{method}");
+    assert_eq!(marked[0].as_u64(), Some(of_method as u64), "{marked}");
+    assert!(marked[1].as_u64().unwrap() > 0, "{marked}");
+    let errors = browser.console_errors();
+    assert!(errors.is_empty(), "console errors: {errors:?}");
+}

@@ -22,7 +22,8 @@ the server listens on 127.0.0.1 unless --host says otherwise, and serves each pa
 Examples:
   haarshift relight view bunny.hsr --env testdata/envmaps/rooitou_park_1k.hdr
   haarshift relight view cubes.hsr --env park.hdr --port 9000 --open
-  haarshift relight view bunny.hsr --env park.hdr --yaw 120 --port 0   (any free port)";
+  haarshift relight view bunny.hsr --env park.hdr --yaw 120 --port 0   (any free port)
+  haarshift relight view bunny.hsr --env park.hdr --results results/relight/experiments";
 
 /// Serve a precomputed scene to the browser and relight it interactively.
 #[derive(clap::Args, Debug)]
@@ -48,6 +49,11 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = 4)]
     pub max_sessions: usize,
 
+    /// An `experiment relight` output directory to serve at /results: its records, picture grids
+    /// and plots side by side, with an error/time plot marking the method clicked
+    #[arg(long, value_name = "DIR")]
+    pub results: Option<PathBuf>,
+
     /// Open the page in the desktop's browser (xdg-open, open)
     #[arg(long)]
     pub open: bool,
@@ -60,10 +66,14 @@ pub fn run(args: Args) -> Result<()> {
         ViewerOptions {
             address: SocketAddr::new(args.host, args.port),
             max_sessions: args.max_sessions,
+            results: args.results.clone(),
         },
     )?;
     let url = viewer.url();
     print(&format!("haarshift viewer: {url} (Ctrl-C stops it)\n"))?;
+    if args.results.is_some() {
+        print(&format!("the experiment's results: {url}results\n"))?;
+    }
     if args.open {
         open_in_browser(&url);
     }
