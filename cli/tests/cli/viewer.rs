@@ -630,7 +630,7 @@ fn the_results_page_shows_an_experiment_s_records_pictures_and_plot() {
                 r["method"].as_str().unwrap(),
                 r["parameters"].as_str().unwrap_or("")
             );
-            Value::from(key.trim()) == method
+            method.as_str() == Some(key.trim())
         })
         .count();
     assert!(of_method > 0, "{method}");
