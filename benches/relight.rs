@@ -29,9 +29,8 @@ use std::sync::OnceLock;
 use haarshift::faces::param::SphereMap;
 use haarshift::faces::param::{ParamKind, Parameterization};
 use haarshift::product::Selection;
-use haarshift::relight::light::environment::{
-    Environment, LightRotation, SphereMapping, downsample_solid_angle,
-};
+use haarshift::relight::light::downsample::downsample_solid_angle;
+use haarshift::relight::light::environment::{Environment, LightRotation, SphereMapping};
 use haarshift::relight::shade::lambert::CHUNK;
 use haarshift::relight::{
     Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,

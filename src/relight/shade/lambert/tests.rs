@@ -7,7 +7,8 @@ use crate::faces::integrate::layout;
 use crate::faces::param::{ParamKind, SphereMap};
 use crate::metrics::relative_rms_error;
 use crate::product::{HaarTree, IntegralOptions, product_integral, triple::triple_integral};
-use crate::relight::light::environment::{Environment, downsample_solid_angle};
+use crate::relight::light::downsample::downsample_solid_angle;
+use crate::relight::light::environment::Environment;
 use crate::relight::{
     Generator, Mesh, Occlusion, SceneBvh, VisibilityOptions, ray_offset, vertex_major,
 };
