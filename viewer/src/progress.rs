@@ -65,9 +65,10 @@ impl PageProgress {
     /// page then sees no counts, only when the reference is ready).
     ///
     /// ```
-    /// // A program installs one reporter; the first call wins.
-    /// let first = haarshift_viewer::progress::PageProgress::install();
-    /// assert!(!haarshift_viewer::progress::PageProgress::install() || !first);
+    /// use haarshift_viewer::progress::PageProgress;
+    /// // A program installs one reporter: the first call wins, a second is refused.
+    /// assert!(PageProgress::install());
+    /// assert!(!PageProgress::install());
     /// ```
     pub fn install() -> bool {
         set_reporter(Box::new(PageProgress)).is_ok()

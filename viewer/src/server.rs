@@ -160,21 +160,9 @@ fn connection(
     let path = request.path.unwrap_or("/");
     let path = path.split(['?', '#']).next().unwrap_or("/");
     match (request.method, path) {
-        (Some("GET"), "/" | "/index.html") => {
-            let _ = respond(
-                &mut stream,
-                "200 OK",
-                "text/html; charset=utf-8",
-                INDEX_HTML.as_bytes(),
-            );
-        }
-        (Some("GET"), "/viewer.js") => {
-            let _ = respond(
-                &mut stream,
-                "200 OK",
-                "text/javascript; charset=utf-8",
-                VIEWER_JS.as_bytes(),
-            );
+        (Some("GET"), path) if embedded(path).is_some() => {
+            let (kind, body) = embedded(path).expect("matched");
+            let _ = respond(&mut stream, "200 OK", kind, body.as_bytes());
         }
         (Some("GET"), "/ws") => {
             let origin_ok = header("origin").is_none_or(|o| same_origin(o, header("host")));
@@ -272,6 +260,15 @@ fn session(
         Session::new(scene).run(ws, options.max_sessions);
     }
     sessions.fetch_sub(1, Ordering::SeqCst);
+}
+
+/// The page's files embedded in the binary: the content type and the text at `path`.
+fn embedded(path: &str) -> Option<(&'static str, &'static str)> {
+    match path {
+        "/" | "/index.html" => Some(("text/html; charset=utf-8", INDEX_HTML)),
+        "/viewer.js" => Some(("text/javascript; charset=utf-8", VIEWER_JS)),
+        _ => None,
+    }
 }
 
 /// A file of the results directory, with its content type: `relight.json`, `files` (the names

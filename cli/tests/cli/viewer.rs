@@ -78,20 +78,25 @@ pub fn bunny_cache(dir: &Path) -> std::path::PathBuf {
     cache
 }
 
+/// The numbers of the JavaScript array `expression` evaluates to, as f32 (exactly: the page's
+/// values are f32).
+fn page_floats(browser: &mut Browser, expression: &str) -> Vec<f32> {
+    browser
+        .evaluate(expression)
+        .unwrap()
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap() as f32)
+        .collect()
+}
+
 /// The page's last frame: its state and its radiance `(V, 3)`.
 fn page_frame(browser: &mut Browser) -> (Value, Array2<f32>) {
     let state = browser
         .evaluate("haarshiftViewer.frame.header.state")
         .unwrap();
-    let values = browser
-        .evaluate("Array.from(haarshiftViewer.frame.radiance)")
-        .unwrap();
-    let values: Vec<f32> = values
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap() as f32)
-        .collect();
+    let values = page_floats(browser, "Array.from(haarshiftViewer.frame.radiance)");
     let rows = values.len() / 3;
     (state, Array2::from_shape_vec((rows, 3), values).unwrap())
 }
@@ -302,14 +307,10 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
         p(&truth),
     ]);
     let truth: Array2<f32> = ndarray_npy::read_npy(&truth).unwrap();
-    let reference: Vec<f32> = browser
-        .evaluate("Array.from(haarshiftViewer.reference.radiance)")
-        .unwrap()
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap() as f32)
-        .collect();
+    let reference = page_floats(
+        &mut browser,
+        "Array.from(haarshiftViewer.reference.radiance)",
+    );
     assert_eq!(reference, truth.iter().copied().collect::<Vec<_>>());
     browser
         .wait_for(
