@@ -33,6 +33,7 @@ pub trait Sample:
     + Display
     + Send
     + Sync
+    + lanes::Lanes
     + 'static
 {
     /// `"f32"` or `"f64"`.
@@ -43,6 +44,56 @@ pub trait Sample:
 
     /// Converts to f64 exactly.
     fn as_f64(self) -> f64;
+}
+
+/// Four samples in one SIMD register where the platform has one, sealed inside the crate.
+pub(crate) mod lanes {
+    use std::ops::{Add, AddAssign, Mul};
+
+    /// Four lanes of a sample type: glam's `Vec4` (one SSE register) for f32, `DVec4` for f64.
+    /// What the shading's sparse dot products gather an RGB row (and a zero) as, so that one
+    /// coefficient is one load and one multiply-add of four lanes; arrays of four would do the
+    /// same arithmetic, but the compiler drops the unused fourth lane and splits the load.
+    pub trait Lanes: Copy {
+        /// The four lanes.
+        type Quad: Copy
+            + Default
+            + Add<Output = Self::Quad>
+            + AddAssign
+            + Mul<Self, Output = Self::Quad>
+            + Send
+            + Sync;
+
+        /// `[r, g, b, 0]` as lanes.
+        fn rgb(rgb: [Self; 3]) -> Self::Quad;
+
+        /// The first three lanes.
+        fn first_three(quad: Self::Quad) -> [Self; 3];
+    }
+
+    impl Lanes for f32 {
+        type Quad = glam::Vec4;
+        #[inline(always)]
+        fn rgb([r, g, b]: [f32; 3]) -> glam::Vec4 {
+            glam::Vec4::new(r, g, b, 0.0)
+        }
+        #[inline(always)]
+        fn first_three(quad: glam::Vec4) -> [f32; 3] {
+            quad.truncate().to_array()
+        }
+    }
+
+    impl Lanes for f64 {
+        type Quad = glam::DVec4;
+        #[inline(always)]
+        fn rgb([r, g, b]: [f64; 3]) -> glam::DVec4 {
+            glam::DVec4::new(r, g, b, 0.0)
+        }
+        #[inline(always)]
+        fn first_three(quad: glam::DVec4) -> [f64; 3] {
+            quad.truncate().to_array()
+        }
+    }
 }
 
 impl Sample for f32 {

@@ -172,13 +172,18 @@ impl Lighting {
         self.coefficients.view()
     }
 
-    /// The coefficients as RGB rows in the sample type `T` (the shading's working copy).
-    pub(crate) fn rows<T: Sample>(&self) -> Vec<[T; 3]> {
-        self.coefficients
+    /// The coefficients as RGB rows in the sample type `T`, each in four SIMD lanes (the
+    /// shading's working copy), padded by
+    /// [`pad_to_power_of_two`](crate::relight::shade::lambert::pad_to_power_of_two).
+    pub(crate) fn quads<T: Sample>(&self) -> Vec<T::Quad> {
+        let mut rows: Vec<T::Quad> = self
+            .coefficients
             .rows()
             .into_iter()
-            .map(|r| [r[0], r[1], r[2]].map(T::from_f64))
-            .collect()
+            .map(|r| T::rgb([r[0], r[1], r[2]].map(T::from_f64)))
+            .collect();
+        crate::relight::shade::lambert::pad_to_power_of_two(&mut rows);
+        rows
     }
 
     /// The lighting's tree (all kept coefficients, RGB), for the general product integrals.

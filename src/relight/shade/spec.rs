@@ -43,14 +43,27 @@ named_enum! {
     }
 }
 
-/// The arithmetic of the Haar shaders (the other methods have their own).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Precision {
-    /// `f32`: the fast path.
-    #[default]
-    F32,
-    /// `f64`: for checks and committed tables.
-    F64,
+named_enum! {
+    /// The arithmetic of the Haar shaders (the other methods have their own): the names
+    /// `relight render --precision` takes.
+    ///
+    /// ```
+    /// use haarshift::relight::shade::Precision;
+    /// assert_eq!(Precision::default(), Precision::F32);
+    /// assert_eq!("q16".parse::<Precision>().unwrap(), Precision::Q16);
+    /// ```
+    #[derive(Default)]
+    pub enum Precision ("precision") {
+        #[default]
+        /// `f32`: the fast path.
+        F32 = "f32",
+        /// `f64`: for checks and committed tables.
+        F64 = "f64",
+        /// f32 arithmetic on a transport stored in 16 bits a coefficient with a scale per
+        /// vertex ([`QuantisedTransport`](crate::relight::shade::lambert::QuantisedTransport)):
+        /// half the bytes a frame streams; Lambertian materials only.
+        Q16 = "q16",
+    }
 }
 
 /// How per-vertex radiance is computed; [`build`](Self::build) makes the [`Shader`].
@@ -153,6 +166,17 @@ impl ShaderSpec {
                     .into(),
             });
         }
+        if self.precision == Precision::Q16 && (self.method != Method::Haar || !m.brdf.is_lambert())
+        {
+            return Err(Error::InvalidParameter {
+                name: "precision",
+                reason: format!(
+                    "--precision q16 quantises the Lambertian Haar transport; this is --basis {} \
+                     with --brdf {}",
+                    self.method, m.brdf
+                ),
+            });
+        }
         if self.light_rotation != LightRotation::Source
             && matches!(self.method, Method::Reference | Method::Ambient)
         {
@@ -196,11 +220,13 @@ impl ShaderSpec {
         self.check()?;
         Ok(match (self.method, self.precision) {
             (Method::Haar, precision) if self.material.brdf.is_lambert() => match precision {
-                Precision::F32 => Box::new(LambertShader::<f32>::new(self, input)?),
+                Precision::F32 | Precision::Q16 => {
+                    Box::new(LambertShader::<f32>::new(self, input)?)
+                }
                 Precision::F64 => Box::new(LambertShader::<f64>::new(self, input)?),
             },
-            (Method::Haar, Precision::F32) => Box::new(GlossyHaarShader::<f32>::new(self, input)?),
             (Method::Haar, Precision::F64) => Box::new(GlossyHaarShader::<f64>::new(self, input)?),
+            (Method::Haar, _) => Box::new(GlossyHaarShader::<f32>::new(self, input)?),
             (Method::Sh, _) => Box::new(ShShader::new(self, input)?),
             (Method::Reference, _) => Box::new(ReferenceShader::new(self, input)?),
             (Method::Ambient, _) => Box::new(AmbientShader::new(self, input)?),

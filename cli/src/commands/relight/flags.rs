@@ -10,7 +10,7 @@ use haarshift::relight::material::orient::BrdfRotation;
 use haarshift::relight::precompute::shard::{Shard, ShardSpec};
 use haarshift::relight::scene::validate::MemoryBudget;
 use haarshift::relight::shade::glossy::GlossyOptions;
-use haarshift::relight::shade::{LightSpec, Method, ShadeOptions, ShaderSpec};
+use haarshift::relight::shade::{LightSpec, Method, Precision, ShadeOptions, ShaderSpec};
 use haarshift::relight::{Brdf, EnvironmentSpec, Scene};
 use haarshift::render::view::{Backdrop, ViewSpec};
 use haarshift::{Error, Result};
@@ -385,6 +385,13 @@ pub struct ShadingFlags {
     /// level D, faces 2^D texels wide) [default: all]
     #[arg(long, value_name = "D")]
     pub depth: Option<usize>,
+
+    /// The Haar shading's arithmetic: `f32`; `f64` (slower, for checks); `q16`, f32 on the
+    /// Lambertian transport stored in 16 bits a coefficient with a scale per vertex (half the
+    /// bytes a frame reads; about 1e-5 of the radiance off, results/relight/quantised.md)
+    #[arg(long, value_name = "P", default_value = "f32",
+          value_parser = choice::<Precision>(names!(Precision)))]
+    pub precision: Precision,
 }
 
 impl ShadingFlags {
@@ -417,6 +424,7 @@ impl ShadingFlags {
             shade: self.options(),
             keep_light: self.light_selection(),
             light_rotation: light.light_rotation,
+            precision: self.precision,
             progress: true,
             ..ShaderSpec::default()
         }

@@ -45,7 +45,9 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use super::lambert::{PreparedTransport, ShadeOptions, select_kept, within_depth};
+use super::lambert::{
+    PreparedTransport, ShadeOptions, pad_to_power_of_two, select_kept, within_depth,
+};
 use super::{
     Filled, FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading,
     ShadingInput, Timing, seconds,
@@ -336,8 +338,8 @@ impl<T: Sample> GlossyShader<T> {
         let contributions: Vec<Vec<(u32, [f64; 3])>> = jobs
             .par_iter()
             .map_init(
-                || (Vec::new(), Vec::new(), Vec::new()),
-                |(product, rows, work), (key, users)| {
+                || (Vec::new(), (Vec::new(), Vec::new()), Vec::new()),
+                |(product, (rows, quads), work), (key, users)| {
                     let planes = match self.bins {
                         Some(_) => self
                             .cache
@@ -348,11 +350,11 @@ impl<T: Sample> GlossyShader<T> {
                             .expect("every used map was filled above"),
                         None => Arc::new(self.brdf_planes(&self.frame_of(*key, eye)?)?),
                     };
-                    product_rows(param, &light, &planes, product, rows, work)?;
+                    product_rows(param, &light, &planes, product, (rows, quads), work)?;
                     Ok(users
                         .iter()
                         .map(|&(v, w)| {
-                            let s = self.transport.dot_rows(v as usize, rows);
+                            let s = self.transport.dot_rows(v as usize, quads);
                             (v, s.map(|x| w * x))
                         })
                         .collect())
@@ -646,14 +648,15 @@ fn light_pixels<T: Sample>(lighting: &Lighting, depth: usize) -> Result<Vec<T>> 
 }
 
 /// `Q`, the orthonormal coefficients of `light x brdf` pixel by pixel, as RGB rows in Mallat
-/// order (the layout [`PreparedTransport::dot_rows`] reads). `brdf` has 1 or 3 planes; the
-/// buffers (`product`: a face's pixels and coefficients) are reused from call to call.
+/// order, in four lanes and padded (the layout [`PreparedTransport::dot_rows`] reads). `brdf` has 1 or 3
+/// planes; the buffers (`product`: a face's pixels and coefficients, `rows` the RGB rows) are
+/// reused from call to call.
 fn product_rows<T: Sample>(
     param: Parameterization,
     light: &[T],
     brdf: &[T],
     product: &mut Vec<T>,
-    rows: &mut Vec<[T; 3]>,
+    (rows, quads): (&mut Vec<[T; 3]>, &mut Vec<T::Quad>),
     work: &mut Vec<T>,
 ) -> Result<()> {
     let s = param.face_size();
@@ -676,6 +679,9 @@ fn product_rows<T: Sample>(
             }
         }
     }
+    quads.clear();
+    quads.extend(rows.iter().map(|&rgb| T::rgb(rgb)));
+    pad_to_power_of_two(quads);
     Ok(())
 }
 

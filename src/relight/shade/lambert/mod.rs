@@ -53,6 +53,9 @@ use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::transport::TransportSet;
 use crate::{Error, Result, Sample};
 
+mod quantised;
+pub use quantised::QuantisedTransport;
+
 /// Coefficients summed in the working precision before the sum is added in f64.
 pub const RUN: usize = 64;
 
@@ -212,8 +215,9 @@ impl<T: Sample> PreparedTransport<T> {
     }
 
     /// `<T_v, f>` per channel for a function `f` given as dense RGB rows in Mallat order (the
-    /// layout of [`Lighting`]'s coefficients).
-    pub(crate) fn dot_rows(&self, v: usize, rows: &[[T; 3]]) -> [f64; 3] {
+    /// layout of [`Lighting`]'s coefficients, padded by [`pad_to_power_of_two`]), each row in
+    /// four lanes ([`Lanes::rgb`](crate::sample::lanes::Lanes::rgb)).
+    pub(crate) fn dot_rows(&self, v: usize, rows: &[T::Quad]) -> [f64; 3] {
         let (indices, values) = self.rows.row(v);
         dot(indices, values, rows)
     }
@@ -227,28 +231,8 @@ impl<T: Sample> PreparedTransport<T> {
 
     /// [`shade`](Self::shade) into `out` (`(V, 3)`), reused from frame to frame.
     pub fn shade_into(&self, lighting: &Lighting, out: &mut Array2<T>) -> Result<()> {
-        if lighting.param() != self.param {
-            return Err(Error::parameter(
-                "lighting",
-                format!(
-                    "it is a {} {} map but the transport was precomputed at {} {}",
-                    lighting.param().kind(),
-                    lighting.param().face_size(),
-                    self.param.kind(),
-                    self.param.face_size()
-                ),
-            ));
-        }
-        if out.dim() != (self.vertex_count(), 3) {
-            return Err(Error::shape(
-                out.shape(),
-                format!("the output must be ({}, 3)", self.vertex_count()),
-            ));
-        }
-        let light = lighting.rows::<T>();
-        let out = out.as_slice_mut().ok_or_else(|| {
-            Error::shape(&[self.vertex_count(), 3], "the output must be contiguous")
-        })?;
+        let out = checked_output(self.param, self.vertex_count(), lighting, out)?;
+        let light = lighting.quads::<T>();
         // The flat arrays once, not a row lookup per vertex: this loop runs at memory speed.
         let (offsets, indices, values) = self.rows.parts();
         out.par_chunks_mut(3 * CHUNK)
@@ -269,20 +253,84 @@ impl<T: Sample> PreparedTransport<T> {
     }
 }
 
-/// `sum_i values_i light[indices_i]` per channel: runs of [`RUN`] in `T`, runs added in f64.
+/// `out` as a flat slice, once the lighting is of `param` and `out` is `(vertices, 3)` and
+/// contiguous.
+fn checked_output<'a, T: Sample>(
+    param: Parameterization,
+    vertices: usize,
+    lighting: &Lighting,
+    out: &'a mut Array2<T>,
+) -> Result<&'a mut [T]> {
+    if lighting.param() != param {
+        return Err(Error::parameter(
+            "lighting",
+            format!(
+                "it is a {} {} map but the transport was precomputed at {} {}",
+                lighting.param().kind(),
+                lighting.param().face_size(),
+                param.kind(),
+                param.face_size()
+            ),
+        ));
+    }
+    if out.dim() != (vertices, 3) {
+        return Err(Error::shape(
+            out.shape(),
+            format!("the output must be ({vertices}, 3)"),
+        ));
+    }
+    out.as_slice_mut()
+        .ok_or_else(|| Error::shape(&[vertices, 3], "the output must be contiguous"))
+}
+
+/// Zero rows appended up to a power of two: a valid index `i` equals `i & (len - 1)`, and
+/// reading `rows[i & (len - 1)]` in the hot loops ([`dot`]) needs no bounds check.
+pub(crate) fn pad_to_power_of_two<Q: Default + Clone>(rows: &mut Vec<Q>) {
+    rows.resize(rows.len().next_power_of_two(), Q::default());
+}
+
+/// `sum_i values_i light[indices_i]` per channel ([`sum_runs`]); `light` padded by
+/// [`pad_to_power_of_two`].
 #[inline]
-fn dot<T: Sample>(indices: &[u32], values: &[T], light: &[[T; 3]]) -> [f64; 3] {
+fn dot<T: Sample>(indices: &[u32], values: &[T], light: &[T::Quad]) -> [f64; 3] {
+    debug_assert!(light.len().is_power_of_two());
+    let mask = light.len() - 1;
+    sum_runs::<T, _, _>(indices, values, |i, t| light[i as usize & mask] * t)
+}
+
+/// `sum_k term(a_k, b_k)` per channel, in order (`a` and `b` of one length): runs of [`RUN`]
+/// in `T`, runs added in f64.
+///
+/// Within a run, term `k` goes to accumulator `k % LANES`: one chain of dependent additions
+/// would cost a floating-point add's latency per coefficient, four independent chains let the
+/// loads and multiplies of the next terms proceed meanwhile. A term is an RGB row and a zero
+/// in four SIMD lanes ([`Lanes`](crate::sample::lanes::Lanes)): one coefficient is one row
+/// load and one multiply-add. The accumulators are added in a fixed order, so the sum does
+/// not depend on the thread schedule.
+#[inline(always)]
+fn sum_runs<T: Sample, A: Copy, B: Copy>(
+    a: &[A],
+    b: &[B],
+    mut term: impl FnMut(A, B) -> T::Quad,
+) -> [f64; 3] {
+    const LANES: usize = 4;
+    debug_assert_eq!(a.len(), b.len());
     let mut total = [0.0f64; 3];
-    for (is, vs) in indices.chunks(RUN).zip(values.chunks(RUN)) {
-        let mut acc = [T::zero(); 3];
-        for (&i, &t) in is.iter().zip(vs) {
-            let l = light[i as usize];
-            acc[0] += t * l[0];
-            acc[1] += t * l[1];
-            acc[2] += t * l[2];
+    for (a, b) in a.chunks(RUN).zip(b.chunks(RUN)) {
+        let mut acc = [T::Quad::default(); LANES];
+        let (a_quads, a_rest) = a.as_chunks::<LANES>();
+        let (b_quads, b_rest) = b.as_chunks::<LANES>();
+        for (aq, bq) in a_quads.iter().zip(b_quads) {
+            for lane in 0..LANES {
+                acc[lane] += term(aq[lane], bq[lane]);
+            }
         }
+        for (lane, (&x, &y)) in a_rest.iter().zip(b_rest).enumerate() {
+            acc[lane] += term(x, y);
+        }
+        let run = T::first_three((acc[0] + acc[1]) + (acc[2] + acc[3]));
         for c in 0..3 {
-            total[c] += acc[c].as_f64();
+            total[c] += run[c].as_f64();
         }
     }
     total
@@ -406,25 +454,46 @@ fn retruncate<T: Sample>(
 }
 
 /// Lambertian Haar shading behind [`Shader`](super::Shader): the transport prepared once
-/// ([`PreparedTransport`]), each frame's lighting encoded and dotted with it.
+/// ([`PreparedTransport`], or with [`Precision::Q16`](super::Precision::Q16) a
+/// [`QuantisedTransport`]), each frame's lighting encoded and dotted with it.
 #[derive(Debug)]
 pub struct LambertShader<T> {
-    prepared: PreparedTransport<T>,
+    transport: Prepared<T>,
     encoder: HaarEncoder,
     prepare_seconds: f64,
 }
 
+/// The transport a [`LambertShader`] dots the lighting with.
+#[derive(Debug)]
+enum Prepared<T> {
+    Exact(PreparedTransport<T>),
+    Quantised(QuantisedTransport),
+}
+
 impl<T: Sample> LambertShader<T> {
-    /// `input`'s transport prepared with its albedo and `spec`'s truncation.
+    /// `input`'s transport prepared with its albedo and `spec`'s truncation (and quantised
+    /// for [`Precision::Q16`](super::Precision::Q16)).
     pub(crate) fn new(spec: &ShaderSpec, input: &ShadingInput<'_>) -> Result<Self> {
         let start = std::time::Instant::now();
         let set = input.transport(spec.method)?;
-        let prepared = PreparedTransport::new(set, input.albedo, &spec.shade)?;
+        let transport = match spec.precision {
+            super::Precision::Q16 => Prepared::Quantised(QuantisedTransport::new(
+                &PreparedTransport::<f32>::new(set, input.albedo, &spec.shade)?,
+            )),
+            _ => Prepared::Exact(PreparedTransport::new(set, input.albedo, &spec.shade)?),
+        };
         Ok(LambertShader {
             encoder: HaarEncoder::new(set.param(), spec.keep_light, spec.light_rotation),
-            prepared,
+            transport,
             prepare_seconds: seconds(start),
         })
+    }
+
+    fn vertex_count(&self) -> usize {
+        match &self.transport {
+            Prepared::Exact(t) => t.vertex_count(),
+            Prepared::Quantised(t) => t.vertex_count(),
+        }
     }
 }
 
@@ -435,20 +504,29 @@ where
     fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
         let (lighting, encode_seconds) = self.encoder.encode(frame)?;
         let start = std::time::Instant::now();
-        let radiance = self.prepared.shade(&lighting)?;
+        let mut radiance = Array2::zeros((self.vertex_count(), 3));
+        let stored = match &self.transport {
+            Prepared::Exact(t) => {
+                t.shade_into(&lighting, &mut radiance)?;
+                let place = if t.is_mapped() {
+                    " read in place from the cache file"
+                } else {
+                    ""
+                };
+                format!("transport {} coefficients{place}", t.coefficient_count())
+            }
+            Prepared::Quantised(t) => {
+                t.shade_into(&lighting, &mut radiance)?;
+                format!("transport {} entries of 16 bits", t.entry_count())
+            }
+        };
         Ok(Shading {
             radiance: radiance.into(),
             timing: Timing::unrotated(encode_seconds, seconds(start)),
             description: format!(
-                "Haar, lighting kept {} detail coefficients, transport {} coefficients{}; \
-                 transport prepared once in {:.1} ms",
+                "Haar, lighting kept {} detail coefficients, {stored}; transport prepared once \
+                 in {:.1} ms",
                 lighting.kept(),
-                self.prepared.coefficient_count(),
-                if self.prepared.is_mapped() {
-                    " read in place from the cache file"
-                } else {
-                    ""
-                },
                 self.prepare_seconds * 1e3
             ),
             maps: None,
