@@ -211,13 +211,6 @@ impl<T: Sample> PreparedTransport<T> {
         self.albedo[v]
     }
 
-    /// `<T_v, f>` per channel for a function `f` given as dense RGB rows in Mallat order (the
-    /// layout of [`Lighting`]'s coefficients).
-    pub(crate) fn dot_rows(&self, v: usize, rows: &[[T; 3]]) -> [f64; 3] {
-        let (indices, values) = self.rows.row(v);
-        dot(indices, values, rows)
-    }
-
     /// Every vertex's outgoing radiance under `lighting`, `(V, 3)`.
     pub fn shade(&self, lighting: &Lighting) -> Result<Array2<T>> {
         let mut out = Array2::zeros((self.vertex_count(), 3));
