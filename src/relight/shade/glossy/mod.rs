@@ -43,7 +43,7 @@
 //! nothing (`--fill-cache`).
 //!
 //! **Precision.** The sums run in `T` (f32 for speed, f64 for checks): eight lanes over runs
-//! of [`RUN`] texels in `T`, the runs added in f64. The BRDF maps are rotated in `T`
+//! of [`RUN`](super::lambert::RUN) texels in `T`, the runs added in f64. The BRDF maps are rotated in `T`
 //! ([`Orientation::in_f32`] for f32), laid out and truncated in f64, and stored in `T`.
 //! Against the f64 path's ancestor in f32 (a product per map, sparse dots) the radiance of the
 //! bunny at lat-long 64 moves by 2e-7 of its RMS (`results/relight/glossy/vertex.md`).
@@ -56,7 +56,7 @@ use std::time::Instant;
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use super::lambert::{PreparedTransport, RUN, ShadeOptions, select_kept, within_depth};
+use super::lambert::{PreparedTransport, ShadeOptions, select_kept, within_depth};
 use super::{
     Filled, FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading,
     ShadingInput, Timing, seconds,
@@ -66,11 +66,14 @@ use crate::product::Selection;
 use crate::relight::Mesh;
 use crate::relight::light::lighting::Lighting;
 use crate::relight::material::brdf::Brdf;
-use crate::relight::material::orient::{BrdfRotation, Frame, LobeWork, Orientation, to_pole, unit};
+use crate::relight::material::orient::{BrdfRotation, Frame, Orientation, to_pole, unit};
 use crate::relight::precompute::transport::TransportSet;
 use crate::sphere::latlong::{angles, direction};
 use crate::transform::{Normalization, pyramid};
 use crate::{Error, Result, Sample};
+use texels::{Blend, LobeBuffers, TransportWork, VertexWork, triple_sum};
+
+mod texels;
 
 /// The most bins per axis of the rotation cache (`N x 2N` bins).
 pub const MAX_CACHE_BINS: usize = 1024;
@@ -565,130 +568,6 @@ impl<T: Sample> GlossyShader<T> {
         )?;
         Ok(&work.pixels)
     }
-}
-
-/// The cache bins one vertex blends, with their weights: up to four (a Phong vertex's
-/// nearest bins), in no allocation.
-#[derive(Clone, Copy, Debug)]
-struct Blend {
-    bins: [(MapKey, f64); 4],
-    len: usize,
-}
-
-impl Blend {
-    /// No bins yet.
-    fn new() -> Blend {
-        Blend {
-            bins: [(MapKey::Mirror(0, 0), 0.0); 4],
-            len: 0,
-        }
-    }
-
-    /// Adds `weight` to `key`'s (a bin met twice, at a pole, counts once).
-    fn add(&mut self, key: MapKey, weight: f64) {
-        match self.bins[..self.len].iter_mut().find(|(k, _)| *k == key) {
-            Some((_, w)) => *w += weight,
-            None => {
-                self.bins[self.len] = (key, weight);
-                self.len += 1;
-            }
-        }
-    }
-
-    /// The bins.
-    fn keys(&self) -> impl Iterator<Item = MapKey> + '_ {
-        self.bins[..self.len].iter().map(|(k, _)| *k)
-    }
-
-    /// The blended map `sum_k w_k rho_k` (the triple product is linear in the BRDF): a bin of
-    /// weight 1 as it is, else written into `out`.
-    fn blend<'a, T: Sample>(
-        &self,
-        maps: &'a HashMap<MapKey, Arc<Vec<T>>>,
-        out: &'a mut Vec<T>,
-    ) -> &'a [T] {
-        let bins = &self.bins[..self.len];
-        if let [(key, w)] = bins
-            && *w == 1.0
-        {
-            return &maps[key];
-        }
-        out.clear();
-        for (k, (key, w)) in bins.iter().enumerate() {
-            let (map, w) = (&maps[key], T::from_f64(*w));
-            if k == 0 {
-                out.extend(map.iter().map(|&x| w * x));
-            } else {
-                for (o, &x) in out.iter_mut().zip(map.iter()) {
-                    *o += w * x;
-                }
-            }
-        }
-        out
-    }
-}
-
-/// One thread's buffers for the vertices it shades, reused from vertex to vertex.
-#[derive(Debug, Default)]
-struct VertexWork<T> {
-    lobe: LobeBuffers,
-    rho: Planes<T>,
-    transport: TransportWork<T>,
-}
-
-/// The BRDF's planes in f64 before truncation and conversion, and the rotation's scratch.
-#[derive(Debug, Default)]
-struct LobeBuffers {
-    planes: Vec<f64>,
-    work: LobeWork,
-}
-
-/// A vertex's transport coefficients (dense), its texel values and the inverse's scratch.
-#[derive(Debug, Default)]
-struct TransportWork<T> {
-    coefficients: Vec<T>,
-    pixels: Vec<T>,
-    scratch: Vec<T>,
-}
-
-/// Partial sums of a run kept side by side, so that the loop over a run vectorises.
-const LANES: usize = 8;
-
-/// `sum_p t(p) L_c(p) rho_c(p)` per channel over the texels, `light` three planes and `rho`
-/// one or three: over runs of [`RUN`] texels, `t rho` once per BRDF channel, then eight lanes
-/// in `T` per lighting channel (a loop that vectorises), the runs added in f64.
-fn triple_sum<T: Sample>(t: &[T], light: &[T], rho: &[T]) -> [f64; 3] {
-    let texels = t.len();
-    let channels = rho.len() / texels;
-    let mut total = [0.0f64; 3];
-    let mut weighted = [T::zero(); RUN];
-    for start in (0..texels).step_by(RUN) {
-        let len = RUN.min(texels - start);
-        let tw = &mut weighted[..len];
-        for (c, sum) in total.iter_mut().enumerate() {
-            if c < channels {
-                let r = &rho[c * texels + start..][..len];
-                for ((o, &t), &r) in tw.iter_mut().zip(&t[start..]).zip(r) {
-                    *o = t * r;
-                }
-            }
-            let l = &light[c * texels + start..][..len];
-            let mut lanes = [T::zero(); LANES];
-            let (w8, l8) = (tw.chunks_exact(LANES), l.chunks_exact(LANES));
-            let rest = (w8.remainder(), l8.remainder());
-            for (w, l) in w8.zip(l8) {
-                for k in 0..LANES {
-                    lanes[k] += w[k] * l[k];
-                }
-            }
-            let mut run = lanes.iter().fold(T::zero(), |a, &b| a + b);
-            for (&w, &l) in rest.0.iter().zip(rest.1) {
-                run += w * l;
-            }
-            *sum += run.as_f64();
-        }
-    }
-    total
 }
 
 /// The centre direction of bin `(i, j)` of an `n x 2n` lat-long grid.
