@@ -256,6 +256,9 @@ pub struct GlossyShader<T> {
 /// A BRDF map as the product needs it: `channels x texels`, channel-planar, face-major.
 type Planes<T> = Vec<T>;
 
+/// The cached bins a frame uses, by key.
+type Maps<T> = HashMap<MapKey, Arc<Planes<T>>>;
+
 impl<T: Sample> GlossyShader<T> {
     /// Prepares `set` (the transport of `mesh`'s vertices) with per-vertex RGB `albedo`
     /// (`(V, 3)`): vertices `0..object_vertices` carry `options.brdf`, the rest are Lambertian.
@@ -335,7 +338,7 @@ impl<T: Sample> GlossyShader<T> {
         let light = light_pixels::<T>(lighting, self.transport.depth())?;
         let mut report = GlossyReport::default();
         let start = Instant::now();
-        let blends: Option<(Vec<Blend>, HashMap<MapKey, Arc<Vec<T>>>)> = match self.bins {
+        let blends: Option<(Vec<Blend>, Maps<T>)> = match self.bins {
             Some(n) => {
                 let blends = (0..self.object_vertices)
                     .into_par_iter()

@@ -1,10 +1,7 @@
 //! The per-vertex side of the glossy shading ([module docs](super)): the cache bins a vertex
 //! blends, the buffers a thread reuses from vertex to vertex, and the dense sum over texels.
 
-use std::collections::HashMap;
-use std::sync::Arc;
-
-use super::{MapKey, Planes};
+use super::{MapKey, Maps, Planes};
 use crate::Sample;
 use crate::relight::material::orient::LobeWork;
 use crate::relight::shade::lambert::RUN;
@@ -44,11 +41,7 @@ impl Blend {
 
     /// The blended map `sum_k w_k rho_k` (the triple product is linear in the BRDF): a bin of
     /// weight 1 as it is, else written into `out`.
-    pub(super) fn blend<'a, T: Sample>(
-        &self,
-        maps: &'a HashMap<MapKey, Arc<Vec<T>>>,
-        out: &'a mut Vec<T>,
-    ) -> &'a [T] {
+    pub(super) fn blend<'a, T: Sample>(&self, maps: &'a Maps<T>, out: &'a mut Vec<T>) -> &'a [T] {
         let bins = &self.bins[..self.len];
         if let [(key, w)] = bins
             && *w == 1.0
