@@ -12,21 +12,28 @@
 //! from `object_vertices` on (the ground plane) stay Lambertian ([`fn@crate::relight::shade`]).
 //!
 //! **How.** The triple product of the three truncated functions is the integral of the
-//! product of their reconstructions, so `B_v = a_v <T_v, Q>` with `Q` the orthonormal Haar
-//! coefficients of the pixel-wise product `L~ x rho~_v`: one dense `O(N)` product and forward
-//! transform per distinct BRDF map, then one sparse dot product per vertex. This is Sun 2006's
-//! just-in-time radiance transfer (section 3.5) with the lighting and the BRDF as the fixed
-//! pair: the same number as [`triple_integral`](crate::product::triple::triple_integral) on the
-//! three trees (tested to 1e-12), and with a depth limit the same as the traversal stopped at
-//! that depth (all three functions are then constant on blocks of side `S >> depth`, and so is
-//! their product).
+//! product of their reconstructions, `B_v = a_v sum_p t_v(p) L~(p) rho~_v(p)` over the texels
+//! `p`, with `t_v` the transport's texel values (its sparse coefficients inverted face by
+//! face: the Haar basis is orthonormal, so this is Parseval's `<T_v, Q>` with `Q` the
+//! coefficients of `L~ x rho~_v`). Per frame the lighting's texels are made once; per vertex,
+//! one inverse transform of its transport, its BRDF's texels (rotated, or a blend of cached
+//! bins) and one dense sum of `3 N` products, in buffers each thread reuses from vertex to
+//! vertex. This is Sun 2006's just-in-time radiance transfer (section 3.5) with the lighting
+//! and the BRDF as the fixed pair: the same number as
+//! [`triple_integral`](crate::product::triple::triple_integral) on the three trees (tested to
+//! 1e-12), and with a depth limit the same as the traversal stopped at that depth (all three
+//! functions are then constant on blocks of side `S >> depth`, and so is their product).
+//! A product per BRDF map and a sparse dot per vertex and map (one forward transform of
+//! `L~ x rho~` per map) gives the same number; it costs more as soon as the vertices use as
+//! many maps as there are vertices (no cache: one each; a cache: four bins a vertex, 4,007
+//! distinct bins for the bunny's 1,839 glossy vertices at 64 x 128 bins).
 //!
 //! **Rotation cache** (`--rotation-cache N`, as Wang et al. 2006 precompute one rotation per
 //! sampled normal). Without it every vertex rotates its own BRDF map (exact frame). With it the
 //! key direction is quantised to the centres of an `N x 2N` lat-long grid of bins and each
 //! bin's map is rotated once and kept for every later view and lighting:
 //! * Phong: the key is the mirror direction; a vertex takes the bilinear blend of its four
-//!   nearest bins (four dot products; the triple product is linear in the BRDF), so the
+//!   nearest bins (blended texel by texel; the triple product is linear in the BRDF), so the
 //!   quantisation error is second order in the bin size;
 //! * view-dependent BRDFs: the nearest normal bin, with the viewer's elevation and azimuth
 //!   quantised as [`orient`](crate::relight::material::orient) does anyway (the key is the triple).
@@ -35,19 +42,21 @@
 //! [`GlossyShader::fill_cache`] rotates every Phong bin ahead, so that any later view rotates
 //! nothing (`--fill-cache`).
 //!
-//! **Precision.** The product and the dot products run in `T` (f32 for speed, f64 for checks);
-//! the BRDF maps are computed in f64 and stored in `T`.
+//! **Precision.** The sums run in `T` (f32 for speed, f64 for checks): eight lanes over runs
+//! of [`RUN`](super::lambert::RUN) texels in `T`, the runs added in f64. The BRDF maps are rotated in `T`
+//! ([`Orientation::in_f32`] for f32), laid out and truncated in f64, and stored in `T`.
+//! Against the f64 path's ancestor in f32 (a product per map, sparse dots) the radiance of the
+//! bunny at lat-long 64 moves by 2e-7 of its RMS (`results/relight/glossy/vertex.md`).
 
-use std::collections::HashMap;
+use std::any::TypeId;
+use std::collections::{BTreeSet, HashMap};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
 
-use super::lambert::{
-    PreparedTransport, ShadeOptions, pad_to_power_of_two, select_kept, within_depth,
-};
+use super::lambert::{PreparedTransport, ShadeOptions, select_kept, within_depth};
 use super::{
     Filled, FrameSpec, HaarEncoder, Preparation, Radiance, Shader, ShaderSpec, Shading,
     ShadingInput, Timing, seconds,
@@ -62,6 +71,9 @@ use crate::relight::precompute::transport::TransportSet;
 use crate::sphere::latlong::{angles, direction};
 use crate::transform::{Normalization, pyramid};
 use crate::{Error, Result, Sample};
+use texels::{Blend, LobeBuffers, TransportWork, VertexWork, triple_sum};
+
+mod texels;
 
 /// The most bins per axis of the rotation cache (`N x 2N` bins).
 pub const MAX_CACHE_BINS: usize = 1024;
@@ -171,11 +183,9 @@ impl Default for GlossyOptions {
     }
 }
 
-/// Which BRDF map a vertex uses: its own, or a bin of the cache.
+/// Which bin of the rotation cache a vertex uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 enum MapKey {
-    /// Vertex `v`'s exact frame (no cache).
-    Vertex(u32),
     /// A Phong bin: the mirror direction at bin `(row, col)`.
     Mirror(u32, u32),
     /// A view-dependent bin: the normal bin `(row, col)`, the table entry and the column turn.
@@ -246,6 +256,9 @@ pub struct GlossyShader<T> {
 /// A BRDF map as the product needs it: `channels x texels`, channel-planar, face-major.
 type Planes<T> = Vec<T>;
 
+/// The cached bins a frame uses, by key.
+type Maps<T> = HashMap<MapKey, Arc<Planes<T>>>;
+
 impl<T: Sample> GlossyShader<T> {
     /// Prepares `set` (the transport of `mesh`'s vertices) with per-vertex RGB `albedo`
     /// (`(V, 3)`): vertices `0..object_vertices` carry `options.brdf`, the rest are Lambertian.
@@ -276,6 +289,12 @@ impl<T: Sample> GlossyShader<T> {
             options.level,
             options.elevations,
         )?;
+        // An f32 shading rotates in f32 too: its lobes are rounded to f32 anyway.
+        let orientation = if TypeId::of::<T>() == TypeId::of::<f32>() {
+            orientation.in_f32()?
+        } else {
+            orientation
+        };
         options.check(param)?;
         let levels = param.face_size().trailing_zeros() as usize;
         let rows = |a: ArrayView2<'_, f64>| -> Vec<[f64; 3]> {
@@ -309,7 +328,6 @@ impl<T: Sample> GlossyShader<T> {
 
     /// Every vertex's outgoing radiance `(V, 3)` under `lighting`, seen from `eye`.
     pub fn shade(&self, lighting: &Lighting, eye: [f64; 3]) -> Result<(Array2<T>, GlossyReport)> {
-        let param = self.transport.param();
         if !eye.iter().all(|v| v.is_finite()) {
             return Err(Error::parameter(
                 "camera",
@@ -318,55 +336,45 @@ impl<T: Sample> GlossyShader<T> {
         }
         let mut out = self.transport.shade(lighting)?;
         let light = light_pixels::<T>(lighting, self.transport.depth())?;
-        let uses = self.map_uses(eye)?;
-        let mut report = GlossyReport {
-            maps: uses.len(),
-            ..GlossyReport::default()
+        let mut report = GlossyReport::default();
+        let start = Instant::now();
+        let blends: Option<(Vec<Blend>, Maps<T>)> = match self.bins {
+            Some(n) => {
+                let blends = (0..self.object_vertices)
+                    .into_par_iter()
+                    .map(|v| Ok(self.bin_keys(&self.vertex_frame(v, eye)?, n)))
+                    .collect::<Result<Vec<_>>>()?;
+                let used: BTreeSet<MapKey> = blends.iter().flat_map(|b| b.keys()).collect();
+                report.maps = used.len();
+                report.rotated = self.fill(used.iter().copied())?;
+                report.rotate_seconds = start.elapsed().as_secs_f64();
+                let cache = self.cache.lock().expect("the cache lock is never poisoned");
+                report.cached = cache.len();
+                let maps = used.iter().map(|k| (*k, Arc::clone(&cache[k]))).collect();
+                Some((blends, maps))
+            }
+            None => {
+                report.maps = self.object_vertices;
+                report.rotated = self.object_vertices;
+                None
+            }
         };
         let start = Instant::now();
-        if self.bins.is_some() {
-            report.rotated = self.fill(uses.keys().copied(), eye)?;
-            report.cached = self.cached();
-            report.rotate_seconds = start.elapsed().as_secs_f64();
-        } else {
-            report.rotated = uses.len();
-        }
-        let start = Instant::now();
-        // In key order, so that every vertex's sum is added up in the same order each time.
-        let mut jobs: Vec<(MapKey, Vec<(u32, f64)>)> = uses.into_iter().collect();
-        jobs.sort_unstable_by_key(|(key, _)| *key);
-        let contributions: Vec<Vec<(u32, [f64; 3])>> = jobs
-            .par_iter()
-            .map_init(
-                || (Vec::new(), (Vec::new(), Vec::new()), Vec::new()),
-                |(product, (rows, quads), work), (key, users)| {
-                    let planes = match self.bins {
-                        Some(_) => self
-                            .cache
-                            .lock()
-                            .expect("the cache lock is never poisoned")
-                            .get(key)
-                            .cloned()
-                            .expect("every used map was filled above"),
-                        None => Arc::new(self.brdf_planes(&self.frame_of(*key, eye)?)?),
-                    };
-                    product_rows(param, &light, &planes, product, (rows, quads), work)?;
-                    Ok(users
-                        .iter()
-                        .map(|&(v, w)| {
-                            let s = self.transport.dot_rows(v as usize, quads);
-                            (v, s.map(|x| w * x))
-                        })
-                        .collect())
-                },
-            )
+        let sums: Vec<[f64; 3]> = (0..self.object_vertices)
+            .into_par_iter()
+            .map_init(VertexWork::default, |work, v| {
+                let rho = match &blends {
+                    Some((blends, maps)) => blends[v].blend(maps, &mut work.rho),
+                    None => {
+                        let frame = self.vertex_frame(v, eye)?;
+                        self.brdf_planes(&frame, &mut work.lobe, &mut work.rho)?;
+                        &work.rho[..]
+                    }
+                };
+                let t = self.transport_pixels(v, &mut work.transport)?;
+                Ok(triple_sum(t, &light, rho))
+            })
             .collect::<Result<_>>()?;
-        let mut sums = vec![[0.0f64; 3]; self.object_vertices];
-        for (v, s) in contributions.into_iter().flatten() {
-            for c in 0..3 {
-                sums[v as usize][c] += s[c];
-            }
-        }
         for (v, s) in sums.iter().enumerate() {
             let a = self.transport.albedo(v);
             for c in 0..3 {
@@ -420,19 +428,22 @@ impl<T: Sample> GlossyShader<T> {
         }
         let (rows, columns) = (n as u32, 2 * n as u32);
         let keys = (0..rows).flat_map(|i| (0..columns).map(move |j| MapKey::Mirror(i, j)));
-        // Mirror bins do not depend on the eye.
-        self.fill(keys, [0.0; 3])
+        self.fill(keys)
     }
 
     /// Rotates the maps of `keys` the cache lacks and adds them; returns how many.
-    fn fill(&self, keys: impl Iterator<Item = MapKey>, eye: [f64; 3]) -> Result<usize> {
+    fn fill(&self, keys: impl Iterator<Item = MapKey>) -> Result<usize> {
         let missing: Vec<MapKey> = {
             let cache = self.cache.lock().expect("the cache lock is never poisoned");
             keys.filter(|k| !cache.contains_key(k)).collect()
         };
         let filled: Vec<(MapKey, Arc<Vec<T>>)> = missing
             .par_iter()
-            .map(|&key| Ok((key, Arc::new(self.brdf_planes(&self.frame_of(key, eye)?)?))))
+            .map_init(LobeBuffers::default, |lobe, &key| {
+                let mut planes = Vec::new();
+                self.brdf_planes(&self.frame_of(key), lobe, &mut planes)?;
+                Ok((key, Arc::new(planes)))
+            })
             .collect::<Result<_>>()?;
         let rotated = filled.len();
         self.cache
@@ -454,36 +465,15 @@ impl<T: Sample> GlossyShader<T> {
         })
     }
 
-    /// The BRDF maps every glossy vertex uses, with the vertices and their weights.
-    fn map_uses(&self, eye: [f64; 3]) -> Result<HashMap<MapKey, Vec<(u32, f64)>>> {
-        let keyed: Vec<Vec<(MapKey, f64)>> = (0..self.object_vertices)
-            .into_par_iter()
-            .map(|v| {
-                let frame = self.vertex_frame(v, eye)?;
-                Ok(match self.bins {
-                    None => vec![(MapKey::Vertex(v as u32), 1.0)],
-                    Some(n) => self.bin_keys(&frame, n),
-                })
-            })
-            .collect::<Result<_>>()?;
-        let mut uses: HashMap<MapKey, Vec<(u32, f64)>> = HashMap::new();
-        for (v, keys) in keyed.into_iter().enumerate() {
-            for (key, w) in keys {
-                uses.entry(key).or_default().push((v as u32, w));
-            }
-        }
-        Ok(uses)
-    }
-
     /// The cache bins of `frame` with their weights (see the [module docs](self)).
-    fn bin_keys(&self, frame: &Frame, n: usize) -> Vec<(MapKey, f64)> {
+    fn bin_keys(&self, frame: &Frame, n: usize) -> Blend {
         let step = std::f64::consts::PI / n as f64;
         if self.orientation.brdf().is_mirror_symmetric() {
             let (theta, phi) = angles(unit(frame.mirror()).unwrap_or(frame.normal));
             let (fi, fj) = (theta / step - 0.5, phi / step - 0.5);
             let (i0, j0) = (fi.floor(), fj.floor());
             let (ti, tj) = (fi - i0, fj - j0);
-            let mut keys: Vec<(MapKey, f64)> = Vec::with_capacity(4);
+            let mut keys = Blend::new();
             for (di, wi) in [(0, 1.0 - ti), (1, ti)] {
                 for (dj, wj) in [(0, 1.0 - tj), (1, tj)] {
                     let w = wi * wj;
@@ -493,10 +483,7 @@ impl<T: Sample> GlossyShader<T> {
                     // Rows clamp at the poles, columns wrap at the seam.
                     let i = (i0 as i64 + di).clamp(0, n as i64 - 1) as u32;
                     let j = (j0 as i64 + dj).rem_euclid(2 * n as i64) as u32;
-                    match keys.iter_mut().find(|(k, _)| *k == MapKey::Mirror(i, j)) {
-                        Some((_, acc)) => *acc += w,
-                        None => keys.push((MapKey::Mirror(i, j), w)),
-                    }
+                    keys.add(MapKey::Mirror(i, j), w);
                 }
             }
             return keys;
@@ -512,50 +499,77 @@ impl<T: Sample> GlossyShader<T> {
                 outgoing: frame.outgoing,
             })
             .unwrap_or((0, 0));
-        vec![(
+        let mut keys = Blend::new();
+        keys.add(
             MapKey::View(i as u32, j as u32, entry as u32, turn as u32),
             1.0,
-        )]
+        );
+        keys
     }
 
     /// The frame a map key stands for.
-    fn frame_of(&self, key: MapKey, eye: [f64; 3]) -> Result<Frame> {
+    fn frame_of(&self, key: MapKey) -> Frame {
         let n = self.bins.unwrap_or(1);
         match key {
-            MapKey::Vertex(v) => self.vertex_frame(v as usize, eye),
             MapKey::Mirror(i, j) => {
                 let r = bin_centre(n, i, j);
-                Ok(Frame {
+                Frame {
                     normal: r,
                     outgoing: r,
-                })
+                }
             }
             MapKey::View(i, j, entry, turn) => {
                 let normal = bin_centre(n, i, j);
                 let local = self.orientation.outgoing_of(entry as usize, turn as usize);
                 let outgoing = to_pole(normal).inverse().apply(local);
-                Ok(Frame { normal, outgoing })
+                Frame { normal, outgoing }
             }
         }
     }
 
     /// The BRDF in `frame`, truncated to `--keep-brdf`, `--brdf-levels` and the depth, as
-    /// channel planes in `T`.
-    fn brdf_planes(&self, frame: &Frame) -> Result<Planes<T>> {
-        let map = self.orientation.lobe(frame)?;
-        let param = map.param();
-        let (faces, s, _, channels) = map.as_array().dim();
-        let texels = faces * s * s;
-        let mut planes = vec![0.0f64; channels * texels];
-        for ((f, i, j, c), v) in map.as_array().indexed_iter() {
-            planes[c * texels + (f * s + i) * s + j] = *v;
-        }
+    /// channel planes in `T` ([`Planes`]) written into `out`.
+    fn brdf_planes(
+        &self,
+        frame: &Frame,
+        lobe: &mut LobeBuffers,
+        out: &mut Planes<T>,
+    ) -> Result<()> {
+        let planes = &mut lobe.planes;
+        self.orientation
+            .lobe_planes(frame, planes, &mut lobe.work)?;
+        let param = self.orientation.param();
+        let channels = planes.len() / param.texels();
         let depth = self.transport.depth().min(self.brdf_levels);
-        let levels = s.trailing_zeros() as usize;
+        let levels = param.face_size().trailing_zeros() as usize;
         if self.keep_brdf.is_some() || depth < levels {
-            truncate_planes(param, &mut planes, channels, self.keep_brdf, depth)?;
+            truncate_planes(param, planes, channels, self.keep_brdf, depth)?;
         }
-        Ok(planes.into_iter().map(T::from_f64).collect())
+        out.clear();
+        out.extend(planes.iter().map(|&v| T::from_f64(v)));
+        Ok(())
+    }
+
+    /// Vertex `v`'s transport as texel values (face by face, row by row): its sparse
+    /// coefficients scattered and inverted face by face into `work`.
+    fn transport_pixels<'w>(&self, v: usize, work: &'w mut TransportWork<T>) -> Result<&'w [T]> {
+        let param = self.transport.param();
+        let texels = param.texels();
+        let (indices, values) = self.transport.coefficients(v);
+        work.coefficients.clear();
+        work.coefficients.resize(texels, T::zero());
+        for (&i, &c) in indices.iter().zip(values) {
+            work.coefficients[i as usize] = c;
+        }
+        work.pixels.resize(texels, T::zero());
+        transform_faces(
+            &work.coefficients,
+            &mut work.pixels,
+            param.face_size(),
+            false,
+            &mut work.scratch,
+        )?;
+        Ok(&work.pixels)
     }
 }
 
@@ -645,44 +659,6 @@ fn light_pixels<T: Sample>(lighting: &Lighting, depth: usize) -> Result<Vec<T>> 
     let mut pixels = vec![0.0f64; 3 * texels];
     transform_faces(&coefficients, &mut pixels, s, false, &mut Vec::new())?;
     Ok(pixels.into_iter().map(T::from_f64).collect())
-}
-
-/// `Q`, the orthonormal coefficients of `light x brdf` pixel by pixel, as RGB rows in Mallat
-/// order, in four lanes and padded (the layout [`PreparedTransport::dot_rows`] reads). `brdf` has 1 or 3
-/// planes; the buffers (`product`: a face's pixels and coefficients, `rows` the RGB rows) are
-/// reused from call to call.
-fn product_rows<T: Sample>(
-    param: Parameterization,
-    light: &[T],
-    brdf: &[T],
-    product: &mut Vec<T>,
-    (rows, quads): (&mut Vec<[T; 3]>, &mut Vec<T::Quad>),
-    work: &mut Vec<T>,
-) -> Result<()> {
-    let s = param.face_size();
-    let texels = param.texels();
-    let channels = brdf.len() / texels;
-    product.resize(2 * s * s, T::zero());
-    rows.resize(texels, [T::zero(); 3]);
-    let (pixels, coefficients) = product.split_at_mut(s * s);
-    for c in 0..3 {
-        let b = &brdf[(c.min(channels - 1)) * texels..][..texels];
-        let l = &light[c * texels..][..texels];
-        for face in 0..param.faces() {
-            let at = face * s * s;
-            for (t, p) in pixels.iter_mut().enumerate() {
-                *p = l[at + t] * b[at + t];
-            }
-            transform_faces(pixels, coefficients, s, true, work)?;
-            for (t, &q) in coefficients.iter().enumerate() {
-                rows[at + t][c] = q;
-            }
-        }
-    }
-    quads.clear();
-    quads.extend(rows.iter().map(|&rgb| T::rgb(rgb)));
-    pad_to_power_of_two(quads);
-    Ok(())
 }
 
 /// Glossy Haar shading behind [`Shader`](super::Shader): a [`GlossyShader`] made once (and

@@ -192,6 +192,83 @@ fn the_shading_is_the_pixel_domain_triple_product_of_the_truncated_factors() {
     }
 }
 
+#[test]
+fn a_cached_vertex_is_the_weighted_triple_product_of_its_bins() {
+    // Each vertex against the pixel-domain oracle of every bin it blends, weighted: the blend
+    // of the bins' texels is the blend of their triple products.
+    let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
+    let (mesh, set, albedo) = scene(param, 6);
+    let light = lighting(param, Selection::Largest(50));
+    let eye = [0.5, 2.0, 3.0];
+    for (brdf, bins) in [
+        (Brdf::Phong { exponent: 12.0 }, 8),
+        (Brdf::BlinnPhong { exponent: 8.0 }, 4),
+    ] {
+        // Phong blends four bins; a view-dependent BRDF takes one.
+        let phong = brdf.is_mirror_symmetric();
+        let options = GlossyOptions {
+            brdf,
+            cache_bins: Some(bins),
+            ..GlossyOptions::default()
+        };
+        let shade = ShadeOptions::default();
+        let shader =
+            GlossyShader::<f64>::new(&set, &mesh, albedo.view(), &shade, &options, 6).unwrap();
+        let (b, _) = shader.shade(&light, eye).unwrap();
+        let mut blended = 0;
+        for v in 0..6 {
+            let blend = shader.bin_keys(&shader.vertex_frame(v, eye).unwrap(), bins);
+            blended += usize::from(blend.len > 1);
+            let mut want = [0.0; 3];
+            for &(key, w) in &blend.bins[..blend.len] {
+                let rho = shader.orientation.lobe(&shader.frame_of(key)).unwrap();
+                let stored = shader.transport().coefficients(v);
+                let sum = pixel_domain(param, stored, &light, &rho, Selection::All, (4, 4));
+                for c in 0..3 {
+                    want[c] += w * sum[c];
+                }
+            }
+            for c in 0..3 {
+                let w = f64::from(albedo[[v, c]]) * want[c];
+                assert!(
+                    (b[[v, c]] - w).abs() < 1e-12 * w.abs().max(1.0),
+                    "vertex {v} channel {c}: {} vs {w}",
+                    b[[v, c]]
+                );
+            }
+        }
+        assert_eq!(blended > 0, phong, "{blended} vertices blend bins");
+    }
+}
+
+#[test]
+fn the_f32_shading_stays_within_its_rounding_of_the_f64_one() {
+    // f32 everywhere: the rotation, the texels, the sums in runs. Measured 5.4e-7 of the RMS
+    // without a cache, 4.5e-7 with one.
+    let param = Parameterization::new(ParamKind::LatLong, 32).unwrap();
+    let (mesh, set, albedo) = scene(param, 8);
+    let light = lighting(param, Selection::All);
+    let shade = ShadeOptions::default();
+    for bins in [None, Some(16)] {
+        let options = GlossyOptions {
+            brdf: Brdf::Phong { exponent: 30.0 },
+            cache_bins: bins,
+            ..GlossyOptions::default()
+        };
+        let wide =
+            GlossyShader::<f64>::new(&set, &mesh, albedo.view(), &shade, &options, 8).unwrap();
+        let narrow =
+            GlossyShader::<f32>::new(&set, &mesh, albedo.view(), &shade, &options, 8).unwrap();
+        let (want, _) = wide.shade(&light, [1.0, 3.0, 2.0]).unwrap();
+        let (got, _) = narrow.shade(&light, [1.0, 3.0, 2.0]).unwrap();
+        let rms = (want.iter().map(|x| x * x).sum::<f64>() / want.len() as f64).sqrt();
+        let worst = (&got.mapv(f64::from) - &want)
+            .iter()
+            .fold(0.0f64, |a, d| a.max(d.abs()));
+        assert!(worst < 2e-6 * rms, "{bins:?}: {worst:e} of RMS {rms}");
+    }
+}
+
 /// A strip, its transport and albedo, for the tests below.
 fn scene(param: Parameterization, n: usize) -> (Mesh, TransportSet, Array2<f32>) {
     let mesh = strip(n);

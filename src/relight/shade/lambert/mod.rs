@@ -214,14 +214,6 @@ impl<T: Sample> PreparedTransport<T> {
         self.albedo[v]
     }
 
-    /// `<T_v, f>` per channel for a function `f` given as dense RGB rows in Mallat order (the
-    /// layout of [`Lighting`]'s coefficients, padded by [`pad_to_power_of_two`]), each row in
-    /// four lanes ([`Lanes::rgb`](crate::sample::lanes::Lanes::rgb)).
-    pub(crate) fn dot_rows(&self, v: usize, rows: &[T::Quad]) -> [f64; 3] {
-        let (indices, values) = self.rows.row(v);
-        dot(indices, values, rows)
-    }
-
     /// Every vertex's outgoing radiance under `lighting`, `(V, 3)`.
     pub fn shade(&self, lighting: &Lighting) -> Result<Array2<T>> {
         let mut out = Array2::zeros((self.vertex_count(), 3));
