@@ -35,23 +35,46 @@
 use std::collections::HashSet;
 
 use glam::Vec3A;
-use obvhs::BvhBuildParams;
-use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh_from_tris;
-use obvhs::ray::Ray;
-use obvhs::rt_triangle::RtTriangle;
 use obvhs::triangle::Triangle;
 
 use crate::relight::Mesh;
+use crate::relight::precompute::packet::{LANES, PacketBvh};
 use crate::relight::scene::mesh::{cross, sub};
 
 /// Answers "does this ray hit anything before `t_max`?"; see the [module docs](self).
 pub trait Occlusion: Sync {
-    /// Whether the ray `origin + t direction`, `0 <= t <= t_max`, hits a triangle.
+    /// Whether the ray `origin + t direction`, `0 <= t < t_max`, hits a triangle.
     fn occluded(&self, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool;
+
+    /// `blocked[i] = self.occluded(origin, directions[i], t_max)` for the rays of one origin
+    /// (the first `directions.len().min(blocked.len())`); an implementation may trace them
+    /// together, as [`SceneBvh`] does in packets.
+    ///
+    /// ```
+    /// use haarshift::relight::{Mesh, Occlusion, SceneBvh};
+    /// use ndarray::array;
+    /// let roof = Mesh::new(array![[-1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.0, -1.0]],
+    ///                      vec![[0, 1, 2]], None).unwrap();
+    /// let mut blocked = [false; 3];
+    /// let up = [[0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.6, 0.8, 0.0]];
+    /// SceneBvh::new(&roof).occluded_from([0.0; 3], &up, f32::INFINITY, &mut blocked);
+    /// assert_eq!(blocked, [true, false, true]);
+    /// ```
+    fn occluded_from(
+        &self,
+        origin: [f32; 3],
+        directions: &[[f32; 3]],
+        t_max: f32,
+        blocked: &mut [bool],
+    ) {
+        for (b, &d) in blocked.iter_mut().zip(directions) {
+            *b = self.occluded(origin, d, t_max);
+        }
+    }
 }
 
-/// The scene's triangles in an `obvhs` compressed wide BVH.
+/// The scene's triangles in a BVH traced by packets of rays that share their origin
+/// ([`packet`](super::packet)).
 ///
 /// ```
 /// use haarshift::relight::{Mesh, Occlusion, SceneBvh};
@@ -64,11 +87,9 @@ pub trait Occlusion: Sync {
 /// assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.5)); // stops short of it
 /// ```
 pub struct SceneBvh {
-    bvh: Option<CwBvh>,
+    bvh: Option<PacketBvh>,
     /// The power of two the positions were scaled by (1 unless the scene is tiny).
     scale: f32,
-    /// Triangles in the BVH's primitive order (no index indirection when tracing).
-    triangles: Vec<RtTriangle>,
 }
 
 /// The extent (largest side of the bounding box, in f32) below which [`SceneBvh`] scales a
@@ -124,45 +145,40 @@ impl SceneBvh {
             })
             .collect();
         drop(seen);
-        if triangles.is_empty() {
-            return SceneBvh {
-                bvh: None,
-                scale,
-                triangles: Vec::new(),
-            };
-        }
-        let bvh = build_cwbvh_from_tris(
-            &triangles,
-            BvhBuildParams::medium_build(),
-            &mut std::time::Duration::default(),
-        );
-        let ordered = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| RtTriangle::from(&triangles[i as usize]))
-            .collect();
         SceneBvh {
-            bvh: Some(bvh),
+            bvh: (!triangles.is_empty()).then(|| PacketBvh::new(&triangles)),
             scale,
-            triangles: ordered,
         }
     }
 }
 
 impl Occlusion for SceneBvh {
-    #[inline]
     fn occluded(&self, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
+        let mut blocked = [false];
+        if let Some(bvh) = &self.bvh {
+            // In the BVH's scaled space: origin + t d becomes s origin + (s t) d.
+            let o = origin.map(|x| x * self.scale);
+            bvh.occluded_packet::<1>(o, &[direction], t_max * self.scale, &mut blocked);
+        }
+        blocked[0]
+    }
+
+    fn occluded_from(
+        &self,
+        origin: [f32; 3],
+        directions: &[[f32; 3]],
+        t_max: f32,
+        blocked: &mut [bool],
+    ) {
+        let n = directions.len().min(blocked.len());
         let Some(bvh) = &self.bvh else {
-            return false;
+            blocked[..n].fill(false);
+            return;
         };
-        // In the BVH's scaled space: origin + t d becomes s origin + (s t) d.
-        let ray = Ray::new(
-            Vec3A::from_array(origin) * self.scale,
-            Vec3A::from_array(direction),
-            0.0,
-            t_max * self.scale,
-        );
-        !bvh.ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
+        let o = origin.map(|x| x * self.scale);
+        for (d, b) in directions[..n].chunks(LANES).zip(blocked[..n].chunks_mut(LANES)) {
+            bvh.occluded_packet::<LANES>(o, d, t_max * self.scale, b);
+        }
     }
 }
 
