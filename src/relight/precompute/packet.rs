@@ -85,6 +85,9 @@ struct Rays<const N: usize> {
     /// The axis along which the first ray moves fastest, and whether it moves up it.
     axis: usize,
     up: bool,
+    /// Per axis, the least and greatest reciprocal over the packet's rays, when all of them
+    /// have the same sign (`None` when they do not: the packet is not tested as a whole).
+    span: Option<[[f32; 2]; 3]>,
 }
 
 impl PacketBvh {
@@ -162,13 +165,18 @@ impl PacketBvh {
             t_max: [t_max; N],
             axis,
             up: lead[axis] > 0.0,
+            span: None,
         };
+        let mut span = [[f32::INFINITY, f32::NEG_INFINITY]; 3];
         for (i, d) in directions.iter().enumerate() {
             for k in 0..3 {
                 rays.d[k][i] = d[k];
                 rays.inv[k][i] = 1.0 / d[k];
+                span[k] = [span[k][0].min(rays.inv[k][i]), span[k][1].max(rays.inv[k][i])];
             }
         }
+        let one_sign = |[lo, hi]: [f32; 2]| lo.is_finite() && hi.is_finite() && (lo > 0.0) == (hi > 0.0);
+        rays.span = (N > 1 && span.iter().all(|&k| one_sign(k))).then_some(span);
         let all = if directions.len() == 32 {
             u32::MAX
         } else {
@@ -267,6 +275,24 @@ fn corners(bvh2: &Bvh2, id: usize) -> ([f32; 3], [f32; 3]) {
 fn box_lanes<const N: usize>(lo: [f32; 3], hi: [f32; 3], o: [f32; 3], rays: &Rays<N>) -> u32 {
     let a = [lo[0] - o[0], lo[1] - o[1], lo[2] - o[2]];
     let b = [hi[0] - o[0], hi[1] - o[1], hi[2] - o[2]];
+    if let Some(span) = &rays.span {
+        // The whole packet first, by interval arithmetic on the reciprocals (Boulos et al.
+        // 2007): with one sign per axis, each ray's entry distance along an axis is its
+        // reciprocal times the near slab, so it lies between the products with the least
+        // and the greatest reciprocal (rounding is monotonic: these bound the lanes' own
+        // products exactly), and likewise its exit. No ray meets a box that the bounds miss.
+        let mut near = 0.0f32;
+        let mut far = rays.t_max[0];
+        for k in 0..3 {
+            let [p, q] = span[k];
+            let (n, f) = if p > 0.0 { (a[k], b[k]) } else { (b[k], a[k]) };
+            near = near.max((n * p).min(n * q));
+            far = far.min((f * p).max(f * q));
+        }
+        if near > far * ROUND_UP {
+            return 0;
+        }
+    }
     let mut near = [0.0f32; N];
     let mut far = rays.t_max;
     for k in 0..3 {
