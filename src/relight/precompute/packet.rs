@@ -88,6 +88,8 @@ struct Rays<const N: usize> {
     /// Per axis, the least and greatest reciprocal over the packet's rays, when all of them
     /// have the same sign (`None` when they do not: the packet is not tested as a whole).
     span: Option<[[f32; 2]; 3]>,
+    /// Whether a ray has a zero component (the slab test then guards against NaN).
+    parallel: bool,
 }
 
 impl PacketBvh {
@@ -166,6 +168,7 @@ impl PacketBvh {
             axis,
             up: lead[axis] > 0.0,
             span: None,
+            parallel: directions.iter().flatten().any(|&x| x == 0.0),
         };
         let mut span = [[f32::INFINITY, f32::NEG_INFINITY]; 3];
         for (i, d) in directions.iter().enumerate() {
@@ -297,10 +300,14 @@ fn box_lanes<const N: usize>(lo: [f32; 3], hi: [f32; 3], o: [f32; 3], rays: &Ray
     let mut far = rays.t_max;
     for k in 0..3 {
         for i in 0..N {
-            let (t0, t1) = (a[k] * rays.inv[k][i], b[k] * rays.inv[k][i]);
-            // `x < y ? x : y` (one SSE instruction): a NaN slab distance (a zero direction
-            // component from exactly on the slab's plane) yields the other, and a ray
-            // parallel to a slab outside it gets an empty interval.
+            let (mut t0, mut t1) = (a[k] * rays.inv[k][i], b[k] * rays.inv[k][i]);
+            if rays.parallel {
+                // A zero component and an origin on the slab's plane give `0 x inf = NaN`:
+                // the ray runs in that plane, inside the slab for every t. With the other
+                // distance (then infinite) negated, the slab is (-inf, inf); both NaN (a flat
+                // slab) stay NaN, which the comparisons below pass over.
+                (t0, t1) = (if t0.is_nan() { -t1 } else { t0 }, if t1.is_nan() { -t0 } else { t1 });
+            }
             let (t_near, t_far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
             near[i] = if t_near > near[i] { t_near } else { near[i] };
             far[i] = if t_far < far[i] { t_far } else { far[i] };

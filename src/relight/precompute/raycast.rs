@@ -56,7 +56,7 @@ pub trait Occlusion: Sync {
     /// let roof = Mesh::new(array![[-1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.0, -1.0]],
     ///                      vec![[0, 1, 2]], None).unwrap();
     /// let mut blocked = [false; 3];
-    /// let up = [[0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.6, 0.8, 0.0]];
+    /// let up = [[0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.8, 0.6]];
     /// SceneBvh::new(&roof).occluded_from([0.0; 3], &up, f32::INFINITY, &mut blocked);
     /// assert_eq!(blocked, [true, false, true]);
     /// ```
