@@ -12,7 +12,8 @@
 //!   --repeat    time the precomputation (rays and Haar encoding, `vertex_range`) R times
 //!               on the rayon pool (RAYON_NUM_THREADS) and print the fastest as JSON
 //!   --baseline  also time it through the single-ray path the packets replaced
-//!               (benches/single_ray.rs), in the same process
+//!               (benches/single_ray.rs), in the same process, and say whether the two
+//!               transports are equal
 //! ```
 //!
 //! The rays exported are those the precomputation asks its [`Occlusion`] about, recorded as
@@ -24,7 +25,9 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use haarshift::faces::{ParamKind, Parameterization};
-use haarshift::relight::{Occlusion, Scene, SceneBvh, VisibilityOptions, vertex_range};
+use haarshift::relight::{
+    Occlusion, Scene, SceneBvh, TransportSet, VisibilityOptions, vertex_range,
+};
 use ndarray::{Array1, Array2};
 
 #[path = "../benches/single_ray.rs"]
@@ -57,18 +60,19 @@ fn rows(v: Vec<[f32; 3]>) -> Array2<f32> {
     Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect()).expect("n x 3")
 }
 
-/// The fastest of `repeat` precomputations of `vertices` through `occlusion`: rays, seconds.
+/// The fastest of `repeat` precomputations of `vertices` through `occlusion`: rays, seconds
+/// and the transport.
 fn fastest(
     scene: &Scene,
     occlusion: &impl Occlusion,
     options: &VisibilityOptions,
     vertices: &Range<usize>,
     repeat: usize,
-) -> haarshift::Result<(u64, f64)> {
-    let mut best = (0, f64::INFINITY);
+) -> haarshift::Result<(u64, f64, Option<TransportSet>)> {
+    let mut best = (0, f64::INFINITY, None);
     for _ in 0..repeat {
-        let (_, report) = vertex_range(&scene.mesh, occlusion, options, vertices.clone())?;
-        best = (report.rays, best.1.min(report.seconds));
+        let (set, report) = vertex_range(&scene.mesh, occlusion, options, vertices.clone())?;
+        best = (report.rays, best.1.min(report.seconds), Some(set));
     }
     Ok(best)
 }
@@ -116,7 +120,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ndarray_npy::write_npy(dir.join("blocked.npy"), &Array1::from(blocked))?;
     }
     if repeat > 0 {
-        let (rays, seconds) = fastest(&scene, &bvh, &options, &vertices, repeat)?;
+        let (rays, seconds, set) = fastest(&scene, &bvh, &options, &vertices, repeat)?;
         let mut line = format!(
             "{{\"triangles\": {}, \"vertices\": {}, \"threads\": {}, \"build_seconds\": {build}, \
              \"rays\": {rays}, \"seconds\": {seconds}",
@@ -125,8 +129,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             rayon::current_num_threads()
         );
         if baseline {
-            let (_, before) = fastest(&scene, &single_ray::SingleRay::new(mesh), &options, &vertices, repeat)?;
-            line += &format!(", \"baseline_seconds\": {before}");
+            let old = single_ray::SingleRay::new(mesh);
+            let (_, before, old) = fastest(&scene, &old, &options, &vertices, repeat)?;
+            line += &format!(
+                ", \"baseline_seconds\": {before}, \"baseline_equal\": {}",
+                old == set
+            );
         }
         println!("{line}}}");
     }

@@ -579,7 +579,11 @@ impl<T: Sample, const C: usize> HaarTree<T, C> {
 
 /// The most details `selection` keeps of `faces` faces of side `s` ([`Selection::limit`]),
 /// refusing more per face than a face has.
-pub(crate) fn selection_limit(faces: usize, s: usize, selection: Selection) -> Result<Option<usize>> {
+pub(crate) fn selection_limit(
+    faces: usize,
+    s: usize,
+    selection: Selection,
+) -> Result<Option<usize>> {
     let details_per_face = s * s - 1;
     let limit = selection.limit(faces * details_per_face)?;
     if let Selection::LargestPerFace(k) = selection

@@ -401,9 +401,8 @@ fn kept_coefficients_are_the_trees_non_zero_coefficients() {
         ] {
             let (indices, values) =
                 crate::product::kept::kept_coefficients(map, layout, selection).unwrap();
-            let tree =
-                HaarTree::<f32, 1>::from_pixels(map.insert_axis(Axis(3)), layout, selection)
-                    .unwrap();
+            let tree = HaarTree::<f32, 1>::from_pixels(map.insert_axis(Axis(3)), layout, selection)
+                .unwrap();
             let flat = tree.to_coefficients();
             let (want_i, want_v): (Vec<u32>, Vec<f32>) = (flat.iter().enumerate())
                 .filter(|(_, c)| **c != 0.0)
@@ -414,7 +413,11 @@ fn kept_coefficients_are_the_trees_non_zero_coefficients() {
                 values.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
                 want_v.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
             );
-            assert!(indices.len() > faces * 4, "{selection:?}: {}", indices.len());
+            assert!(
+                indices.len() > faces * 4,
+                "{selection:?}: {}",
+                indices.len()
+            );
         }
     }
 }

@@ -175,10 +175,14 @@ impl PacketBvh {
             for k in 0..3 {
                 rays.d[k][i] = d[k];
                 rays.inv[k][i] = 1.0 / d[k];
-                span[k] = [span[k][0].min(rays.inv[k][i]), span[k][1].max(rays.inv[k][i])];
+                span[k] = [
+                    span[k][0].min(rays.inv[k][i]),
+                    span[k][1].max(rays.inv[k][i]),
+                ];
             }
         }
-        let one_sign = |[lo, hi]: [f32; 2]| lo.is_finite() && hi.is_finite() && (lo > 0.0) == (hi > 0.0);
+        let one_sign =
+            |[lo, hi]: [f32; 2]| lo.is_finite() && hi.is_finite() && (lo > 0.0) == (hi > 0.0);
         rays.span = (N > 1 && span.iter().all(|&k| one_sign(k))).then_some(span);
         let all = if directions.len() == 32 {
             u32::MAX
@@ -306,7 +310,10 @@ fn box_lanes<const N: usize>(lo: [f32; 3], hi: [f32; 3], o: [f32; 3], rays: &Ray
                 // the ray runs in that plane, inside the slab for every t. With the other
                 // distance (then infinite) negated, the slab is (-inf, inf); both NaN (a flat
                 // slab) stay NaN, which the comparisons below pass over.
-                (t0, t1) = (if t0.is_nan() { -t1 } else { t0 }, if t1.is_nan() { -t0 } else { t1 });
+                (t0, t1) = (
+                    if t0.is_nan() { -t1 } else { t0 },
+                    if t1.is_nan() { -t0 } else { t1 },
+                );
             }
             let (t_near, t_far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
             near[i] = if t_near > near[i] { t_near } else { near[i] };

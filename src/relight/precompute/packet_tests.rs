@@ -51,15 +51,18 @@ fn scene(grid: bool) -> impl Strategy<Value = Vec<Triangle>> {
 /// Up to 32 directions around a random one (a packet's cone) or anywhere, some with zero
 /// components.
 fn directions(grid: bool) -> impl Strategy<Value = Vec<[f32; 3]>> {
-    (point(false), 0.0f32..1.5, prop::collection::vec(point(grid), 1..=32)).prop_map(
-        |(axis, spread, offsets)| {
+    (
+        point(false),
+        0.0f32..1.5,
+        prop::collection::vec(point(grid), 1..=32),
+    )
+        .prop_map(|(axis, spread, offsets)| {
             offsets
                 .into_iter()
                 .map(|o| std::array::from_fn(|k| axis[k] + spread * o[k]))
                 .filter(|d: &[f32; 3]| d.iter().any(|&x| x != 0.0))
                 .collect()
-        },
-    )
+        })
 }
 
 /// Every packet of `rays` answered by [`PacketBvh::occluded_packet`] with `N` lanes, against the
@@ -69,7 +72,11 @@ fn check<const N: usize>(bvh: &PacketBvh, origin: [f32; 3], rays: &[[f32; 3]], t
         let mut blocked = vec![false; packet.len()];
         bvh.occluded_packet::<N>(origin, packet, t_max, &mut blocked);
         for (d, &b) in packet.iter().zip(&blocked) {
-            assert_eq!(b, brute_force(bvh, origin, *d, t_max), "{origin:?} {d:?} {t_max}");
+            assert_eq!(
+                b,
+                brute_force(bvh, origin, *d, t_max),
+                "{origin:?} {d:?} {t_max}"
+            );
             let mut one = [false];
             bvh.occluded_packet::<1>(origin, &[*d], t_max, &mut one);
             assert_eq!(one[0], b, "{origin:?} {d:?}");
@@ -102,11 +109,24 @@ fn a_ray_from_a_corner_along_an_edge_and_rays_along_a_flat_box() {
     // direction components and NaN distances.
     let corner = |x: f32, z: f32| Vec3A::new(x, 0.0, z);
     let triangles = [
-        Triangle { v0: corner(0.0, 0.0), v1: corner(1.0, 0.0), v2: corner(1.0, 1.0) },
-        Triangle { v0: corner(0.0, 0.0), v1: corner(1.0, 1.0), v2: corner(0.0, 1.0) },
+        Triangle {
+            v0: corner(0.0, 0.0),
+            v1: corner(1.0, 0.0),
+            v2: corner(1.0, 1.0),
+        },
+        Triangle {
+            v0: corner(0.0, 0.0),
+            v1: corner(1.0, 1.0),
+            v2: corner(0.0, 1.0),
+        },
     ];
     let bvh = PacketBvh::new(&triangles);
-    let origins = [[0.5, 1.0, 0.5], [0.0, 0.0, 0.0], [-1.0, 0.0, 0.5], [0.5, -1.0, 0.0]];
+    let origins = [
+        [0.5, 1.0, 0.5],
+        [0.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.5],
+        [0.5, -1.0, 0.0],
+    ];
     let rays = [
         [0.0, -1.0, 0.0],
         [0.0, 1.0, 0.0],
@@ -119,7 +139,10 @@ fn a_ray_from_a_corner_along_an_edge_and_rays_along_a_flat_box() {
     let mut hits = 0;
     for o in origins {
         check::<LANES>(&bvh, o, &rays, f32::INFINITY);
-        hits += rays.iter().filter(|&&d| brute_force(&bvh, o, d, f32::INFINITY)).count();
+        hits += rays
+            .iter()
+            .filter(|&&d| brute_force(&bvh, o, d, f32::INFINITY))
+            .count();
     }
     assert!(hits >= 3, "{hits}");
 }

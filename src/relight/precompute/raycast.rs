@@ -1,19 +1,24 @@
 //! Occlusion queries: does a ray from a point hit any triangle of the scene?
 //!
-//! Visibility needs only the *any-hit* query ("stop at the first hit"), so the interface is one
-//! method, [`Occlusion::occluded`], and the rest of the crate never sees the BVH library.
+//! Visibility needs only the *any-hit* query ("stop at the first hit"), so the interface is
+//! [`Occlusion::occluded`] for one ray and [`Occlusion::occluded_from`] for many rays of one
+//! origin (a vertex's rays), and the rest of the crate never sees the BVH.
 //!
-//! **The BVH: [`obvhs`].** It builds a compressed 8-wide BVH (CWBVH, Ylitie et al. 2017) with
-//! PLOC and reinsertion, traverses four children at a time with SIMD and has an any-hit
-//! traversal (`ray_traverse_miss`) that returns at the first hit, which is the whole query
-//! here; its dependencies are small (`glam`, `bytemuck`, a radix sort), it is dual MIT/Apache
-//! licensed. The alternatives: `bvh` 0.12 (binary SAH BVH, nalgebra)
-//! only yields the candidate shapes whose boxes a ray crosses, and its triangle test culls back
-//! faces; `parry3d` 0.31 is a whole collision library (glamx, rkyv, spade and more) whose
-//! `TriMesh` answers rays through its general `RayCast` trait. `tools/bvh-compare` (its own workspace, so the
-//! candidates never enter this crate's build) traces the same occlusion rays through all three
-//! on the bunny with its ground plane and on the 85,860-vertex cubes scene and prints rays per
-//! second: `cd tools/bvh-compare && cargo run --release`.
+//! **The BVH: [`obvhs`] builds, our packets trace ([`packet`](super::packet)).** `obvhs`
+//! builds a binary BVH with PLOC, reinsertion and leaf collapsing (small dependencies: `glam`,
+//! `bytemuck`, a radix sort; dual MIT/Apache); it is laid out with both children's boxes in each
+//! node and traced by packets of up to 16 rays that share their origin, which is every query
+//! visibility makes. Before, the rays went one by one through `obvhs`'s own compressed 8-wide
+//! BVH (CWBVH, Ylitie et al. 2017; its any-hit `ray_traverse_miss`); on the same rays the whole
+//! precomputation (rays and encoding) is about 2x faster so (`cargo bench --bench rays`, the
+//! old path as baseline), and faster than Intel Embree 4.4's single-ray `rtcOccluded1` on them
+//! (`benches/compare_rays.py`, `benches/rays_results.md`). Embree itself was not bound: the
+//! packets match or beat its single-ray query without a C++ library to install and build
+//! against, and its answers need no scaling of tiny scenes. Of the crates `tools/bvh-compare`
+//! measured (its own workspace, so the candidates never enter this crate's build: `cd
+//! tools/bvh-compare && cargo run --release`), `obvhs`'s single-ray query was the fastest, 1.5-2x
+//! faster than `bvh` 0.12 (binary SAH BVH, nalgebra, a back-face-culling triangle test) and
+//! `parry3d` 0.31 (a whole collision library).
 //!
 //! Rays are f32 (the BVH's precision). What the BVH is given is cleaned in f32, after the
 //! conversion: triangles of zero area there are left out (no ray can hit one) and repeated
@@ -25,11 +30,12 @@
 //! two, to an extent between 1 and 2, before the build (and rays with it): PLOC ranks merges by
 //! box surface areas in f32, which underflow to zero below about `1e-19`, and a scene whose
 //! areas all tie builds in time quadratic in its triangles (a scene of extent `1e-23` took a
-//! minute for 12,000 under the fuzzer); and the wide BVH's traversal skips a child box the ray
-//! leaves before `t = 1e-4` (an absolute epsilon in `obvhs` 0.4), so such a scene would occlude
-//! nothing. Scaling by `2^k` is exact in floating point: the answers are those of the same
-//! scene at that size. (The epsilon is absolute at every size: in a scene of extent `1e-2`, an
-//! occluder within `1e-4` of a ray's origin is missed too.) A ray hits a triangle when the Moller-Trumbore test finds `0 <= t <= t_max`
+//! minute for 12,000 under the fuzzer). Scaling by `2^k` is exact in floating point: the
+//! answers are those of the same scene at that size. (The traversal itself has no absolute
+//! epsilon: `obvhs`'s CWBVH skipped a box the ray left before `t = 1e-4`, so an occluder that
+//! near the origin was missed; none is now. On the bunny, its ground and the cubes scene no
+//! visibility bit changed by it: see the [packet](super::packet) docs.) A ray hits a triangle
+//! when the Moller-Trumbore test finds `0 <= t < t_max`
 //! ([`obvhs::rt_triangle::RtTriangle::intersect`]); the caller offsets origins off surfaces.
 
 use std::collections::HashSet;
@@ -176,7 +182,10 @@ impl Occlusion for SceneBvh {
             return;
         };
         let o = origin.map(|x| x * self.scale);
-        for (d, b) in directions[..n].chunks(LANES).zip(blocked[..n].chunks_mut(LANES)) {
+        for (d, b) in directions[..n]
+            .chunks(LANES)
+            .zip(blocked[..n].chunks_mut(LANES))
+        {
             bvh.occluded_packet::<LANES>(o, d, t_max * self.scale, b);
         }
     }

@@ -143,17 +143,26 @@ fn packets_from_vertices_answer_as_testing_every_triangle() {
     let bvh = SceneBvh::new(&mesh);
     let param = crate::faces::Parameterization::new(crate::faces::ParamKind::Cube, 8).unwrap();
     let directions: Vec<[f32; 3]> = (0..param.texels())
-        .map(|t| param.texel_direction(t / 64, (t / 8) % 8, t % 8).map(|x| x as f32))
+        .map(|t| {
+            param
+                .texel_direction(t / 64, (t / 8) % 8, t % 8)
+                .map(|x| x as f32)
+        })
         .collect();
     let eps = crate::relight::ray_offset(&mesh);
     let mut blocked = vec![false; directions.len()];
     let mut hits = 0;
     for v in (0..mesh.vertex_count()).step_by(97) {
-        let origin: [f32; 3] =
-            std::array::from_fn(|k| (mesh.positions()[[v, k]] + eps * mesh.normals()[[v, k]]) as f32);
+        let origin: [f32; 3] = std::array::from_fn(|k| {
+            (mesh.positions()[[v, k]] + eps * mesh.normals()[[v, k]]) as f32
+        });
         bvh.occluded_from(origin, &directions, f32::INFINITY, &mut blocked);
         for (d, &b) in directions.iter().zip(&blocked) {
-            assert_eq!(b, brute_force(&bvh, origin, *d, f32::INFINITY), "vertex {v} {d:?}");
+            assert_eq!(
+                b,
+                brute_force(&bvh, origin, *d, f32::INFINITY),
+                "vertex {v} {d:?}"
+            );
             hits += usize::from(b);
         }
     }

@@ -317,7 +317,10 @@ pub(crate) fn encode(
     keep: Selection,
 ) -> Result<(Vec<u32>, Vec<f32>)> {
     if values.dim() != weights.dim() {
-        return Err(Error::shape(values.shape(), "values must be shaped as the weights"));
+        return Err(Error::shape(
+            values.shape(),
+            "values must be shaped as the weights",
+        ));
     }
     kept_coefficients((&values * &weights).view(), layout(param), keep)
 }
