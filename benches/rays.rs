@@ -64,7 +64,7 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("cast/single_ray", |b| b.iter(|| cast(&baseline, &work)));
     group.bench_function("cast/packets", |b| b.iter(|| cast(&packets, &work)));
-    let precompute = |o: &dyn Fn() -> usize| one.install(o);
+    let precompute = |o: &(dyn Fn() -> usize + Sync)| one.install(o);
     group.bench_function("precompute/single_ray", |b| {
         b.iter(|| {
             precompute(&|| {

@@ -33,10 +33,13 @@ use ndarray::{Array1, Array2};
 #[path = "../benches/single_ray.rs"]
 mod single_ray;
 
+/// Every ray asked: origins, directions, answers (1: blocked).
+type Recorded = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u8>);
+
 /// Answers through `inner` and records every ray and answer.
 struct Recorder<'a> {
     inner: &'a SceneBvh,
-    rays: Mutex<(Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u8>)>,
+    rays: Mutex<Recorded>,
 }
 
 impl Occlusion for Recorder<'_> {

@@ -333,7 +333,7 @@ fn triangle_lanes<const N: usize>(tri: &RtTriangle, o: [f32; 3], rays: &Rays<N>)
     let ng_c = ng.dot(c);
     let (c, e1, e2, ng) = (c.to_array(), e1.to_array(), e2.to_array(), ng.to_array());
     let mut hit = [false; N];
-    for i in 0..N {
+    for (i, hit) in hit.iter_mut().enumerate() {
         let d = [rays.d[0][i], rays.d[1][i], rays.d[2][i]];
         // r = d x c, glam's component order.
         let r = [
@@ -347,7 +347,7 @@ fn triangle_lanes<const N: usize>(tri: &RtTriangle, o: [f32; 3], rays: &Rays<N>)
         let w = 1.0 - u - v;
         let signs = u.to_bits() | v.to_bits() | w.to_bits();
         let t = ng_c * inv_det;
-        hit[i] = inv_det != 0.0 && signs & 0x8000_0000 == 0 && t >= 0.0 && t < rays.t_max[i];
+        *hit = inv_det != 0.0 && signs & 0x8000_0000 == 0 && t >= 0.0 && t < rays.t_max[i];
     }
     mask(hit)
 }

@@ -9,12 +9,13 @@
 //! `bytemuck`, a radix sort; dual MIT/Apache); it is laid out with both children's boxes in each
 //! node and traced by packets of up to 16 rays that share their origin, which is every query
 //! visibility makes. Before, the rays went one by one through `obvhs`'s own compressed 8-wide
-//! BVH (CWBVH, Ylitie et al. 2017; its any-hit `ray_traverse_miss`); on the same rays the whole
-//! precomputation (rays and encoding) is about 2x faster so (`cargo bench --bench rays`, the
-//! old path as baseline), and faster than Intel Embree 4.4's single-ray `rtcOccluded1` on them
-//! (`benches/compare_rays.py`, `benches/rays_results.md`). Embree itself was not bound: the
-//! packets match or beat its single-ray query without a C++ library to install and build
-//! against, and its answers need no scaling of tiny scenes. Of the crates `tools/bvh-compare`
+//! BVH (CWBVH, Ylitie et al. 2017; its any-hit `ray_traverse_miss`). On the same rays, one
+//! thread, the whole precomputation (rays and encoding) is 2.1x faster than through that path
+//! on the bunny, 1.2x on the cubes scene and 1.1x on a 600,000-triangle scene, and against
+//! Intel Embree 4.4's single-ray `rtcOccluded1` (rays only) it is 1.1x faster on the bunny but
+//! 0.71x and 0.22x on the two larger scenes (`benches/compare_rays.py`,
+//! `benches/rays_results.md`; `cargo bench --bench rays`). Embree is not bound (yet): on large
+//! scenes it is the faster tracer. Of the crates `tools/bvh-compare`
 //! measured (its own workspace, so the candidates never enter this crate's build: `cd
 //! tools/bvh-compare && cargo run --release`), `obvhs`'s single-ray query was the fastest, 1.5-2x
 //! faster than `bvh` 0.12 (binary SAH BVH, nalgebra, a back-face-culling triangle test) and
@@ -33,8 +34,9 @@
 //! minute for 12,000 under the fuzzer). Scaling by `2^k` is exact in floating point: the
 //! answers are those of the same scene at that size. (The traversal itself has no absolute
 //! epsilon: `obvhs`'s CWBVH skipped a box the ray left before `t = 1e-4`, so an occluder that
-//! near the origin was missed; none is now. On the bunny, its ground and the cubes scene no
-//! visibility bit changed by it: see the [packet](super::packet) docs.) A ray hits a triangle
+//! near the origin was missed; none is now. On the bunny every visibility bit is the old
+//! path's; on the cubes scene some rays differ from it, see `benches/rays_results.md`.) A ray
+//! hits a triangle
 //! when the Moller-Trumbore test finds `0 <= t < t_max`
 //! ([`obvhs::rt_triangle::RtTriangle::intersect`]); the caller offsets origins off surfaces.
 

@@ -14,8 +14,10 @@
 //!
 //! **Two loop orders.**
 //! * [`vertex_major`]: vertices outer (rayon), directions inner, rays through a BVH
-//!   ([`Occlusion`]); each vertex is encoded as soon as it is done, so the working memory is one
-//!   `(faces, S, S)` array per thread.
+//!   ([`Occlusion`]), a vertex's rays asked together ([`Occlusion::occluded_from`]) in 4 x 4
+//!   texel blocks, so that a packet of them is a narrow cone; each vertex is encoded as soon as
+//!   it is done, so the working memory is one `(faces, S, S)` array per thread and a buffer of
+//!   1,024 rays. The order the rays are cast in changes no answer.
 //! * [`direction_major`]: Microsoft 2003's order: directions outer, vertices inner, a software shadow
 //!   buffer per direction ([`ShadowMap`]) instead of rays. Visibility of all (vertex, direction)
 //!   pairs is held as bits, one column of `V` bits per direction (`V x D / 8` bytes: 352 MB for
@@ -159,6 +161,7 @@ pub(crate) fn origin_and_normal(mesh: &Mesh, v: usize, eps: f64) -> ([f64; 3], [
     (std::array::from_fn(|k| p[[v, k]] + eps * n[k]), n)
 }
 
+#[inline]
 pub(crate) fn f32x3(a: [f64; 3]) -> [f32; 3] {
     a.map(|x| x as f32)
 }
