@@ -74,6 +74,7 @@ pub mod baseline;
 pub mod basis;
 pub mod coefficient;
 pub mod integral;
+pub mod kept;
 pub mod multiply;
 pub mod selection;
 pub mod texel;

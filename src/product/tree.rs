@@ -193,16 +193,7 @@ impl<T: Sample, const C: usize> HaarTree<T, C> {
         selection: Selection,
     ) -> Result<Self> {
         let n = s.trailing_zeros();
-        let details_per_face = s * s - 1;
-        let limit = selection.limit(faces * details_per_face)?;
-        if let Selection::LargestPerFace(k) = selection
-            && k > details_per_face
-        {
-            return Err(Error::parameter(
-                "keep",
-                format!("{k} coefficients per face asked for but a face has {details_per_face}"),
-            ));
-        }
+        let limit = selection_limit(faces, s, selection)?;
         let kept = kept_mask::<T, C>(coeffs, faces, s, layout, selection, limit);
         let mut tree = HaarTree {
             faces,
@@ -586,9 +577,29 @@ impl<T: Sample, const C: usize> HaarTree<T, C> {
     }
 }
 
+/// The most details `selection` keeps of `faces` faces of side `s` ([`Selection::limit`]),
+/// refusing more per face than a face has.
+pub(crate) fn selection_limit(
+    faces: usize,
+    s: usize,
+    selection: Selection,
+) -> Result<Option<usize>> {
+    let details_per_face = s * s - 1;
+    let limit = selection.limit(faces * details_per_face)?;
+    if let Selection::LargestPerFace(k) = selection
+        && k > details_per_face
+    {
+        return Err(Error::parameter(
+            "keep",
+            format!("{k} coefficients per face asked for but a face has {details_per_face}"),
+        ));
+    }
+    Ok(limit)
+}
+
 /// Which Mallat positions (per face, `S x S`, row-major, faces concatenated) hold a kept
 /// detail coefficient.
-fn kept_mask<T: Sample, const C: usize>(
+pub(crate) fn kept_mask<T: Sample, const C: usize>(
     coeffs: ArrayView4<'_, T>,
     faces: usize,
     s: usize,

@@ -382,3 +382,42 @@ fn sparse_coefficients_out_of_range_or_not_finite_are_refused() {
         "S a power of two"
     );
 }
+
+#[test]
+fn kept_coefficients_are_the_trees_non_zero_coefficients() {
+    // Every selection on f32 faces with exact zeros among them (as visibility has): the flat
+    // list equals the tree's coefficients array scanned for non-zeros, to the bit.
+    let map = random_faces(61, 6, 16, 1, -1.0, 1.0)
+        .mapv(|x| if x.abs() < 0.3 { 0.0 } else { x as f32 })
+        .index_axis_move(Axis(3), 0);
+    for layout in [FaceLayout::Stacked, FaceLayout::SideBySide] {
+        let faces = if layout == FaceLayout::Stacked { 6 } else { 2 };
+        let map = map.slice(s![..faces, .., ..]);
+        for selection in [
+            Selection::All,
+            Selection::Largest(100),
+            Selection::LargestPerFace(7),
+            Selection::Threshold(0.5),
+        ] {
+            let (indices, values) =
+                crate::product::kept::kept_coefficients(map, layout, selection).unwrap();
+            let tree = HaarTree::<f32, 1>::from_pixels(map.insert_axis(Axis(3)), layout, selection)
+                .unwrap();
+            let flat = tree.to_coefficients();
+            let (want_i, want_v): (Vec<u32>, Vec<f32>) = (flat.iter().enumerate())
+                .filter(|(_, c)| **c != 0.0)
+                .map(|(i, &c)| (i as u32, c))
+                .unzip();
+            assert_eq!(indices, want_i, "{layout:?} {selection:?}");
+            assert_eq!(
+                values.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                want_v.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            );
+            assert!(
+                indices.len() > faces * 4,
+                "{selection:?}: {}",
+                indices.len()
+            );
+        }
+    }
+}

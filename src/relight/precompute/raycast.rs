@@ -1,19 +1,25 @@
 //! Occlusion queries: does a ray from a point hit any triangle of the scene?
 //!
-//! Visibility needs only the *any-hit* query ("stop at the first hit"), so the interface is one
-//! method, [`Occlusion::occluded`], and the rest of the crate never sees the BVH library.
+//! Visibility needs only the *any-hit* query ("stop at the first hit"), so the interface is
+//! [`Occlusion::occluded`] for one ray and [`Occlusion::occluded_from`] for many rays of one
+//! origin (a vertex's rays), and the rest of the crate never sees the BVH.
 //!
-//! **The BVH: [`obvhs`].** It builds a compressed 8-wide BVH (CWBVH, Ylitie et al. 2017) with
-//! PLOC and reinsertion, traverses four children at a time with SIMD and has an any-hit
-//! traversal (`ray_traverse_miss`) that returns at the first hit, which is the whole query
-//! here; its dependencies are small (`glam`, `bytemuck`, a radix sort), it is dual MIT/Apache
-//! licensed. The alternatives: `bvh` 0.12 (binary SAH BVH, nalgebra)
-//! only yields the candidate shapes whose boxes a ray crosses, and its triangle test culls back
-//! faces; `parry3d` 0.31 is a whole collision library (glamx, rkyv, spade and more) whose
-//! `TriMesh` answers rays through its general `RayCast` trait. `tools/bvh-compare` (its own workspace, so the
-//! candidates never enter this crate's build) traces the same occlusion rays through all three
-//! on the bunny with its ground plane and on the 85,860-vertex cubes scene and prints rays per
-//! second: `cd tools/bvh-compare && cargo run --release`.
+//! **The BVH: [`obvhs`] builds, our packets trace ([`packet`](super::packet)).** `obvhs`
+//! builds a binary BVH with PLOC, reinsertion and leaf collapsing (small dependencies: `glam`,
+//! `bytemuck`, a radix sort; dual MIT/Apache); it is laid out with both children's boxes in each
+//! node and traced by packets of up to 16 rays that share their origin, which is every query
+//! visibility makes. Before, the rays went one by one through `obvhs`'s own compressed 8-wide
+//! BVH (CWBVH, Ylitie et al. 2017; its any-hit `ray_traverse_miss`). On the same rays, one
+//! thread, the whole precomputation (rays and encoding) is 2.1x faster than through that path
+//! on the bunny, 1.2x on the cubes scene and 1.1x on a 600,000-triangle scene, and against
+//! Intel Embree 4.4's single-ray `rtcOccluded1` (rays only) it is 1.1x faster on the bunny but
+//! 0.71x and 0.22x on the two larger scenes (`benches/compare_rays.py`,
+//! `benches/rays_results.md`; `cargo bench --bench rays`). Embree is not bound (yet): on large
+//! scenes it is the faster tracer. Of the crates `tools/bvh-compare`
+//! measured (its own workspace, so the candidates never enter this crate's build: `cd
+//! tools/bvh-compare && cargo run --release`), `obvhs`'s single-ray query was the fastest, 1.5-2x
+//! faster than `bvh` 0.12 (binary SAH BVH, nalgebra, a back-face-culling triangle test) and
+//! `parry3d` 0.31 (a whole collision library).
 //!
 //! Rays are f32 (the BVH's precision). What the BVH is given is cleaned in f32, after the
 //! conversion: triangles of zero area there are left out (no ray can hit one) and repeated
@@ -25,33 +31,58 @@
 //! two, to an extent between 1 and 2, before the build (and rays with it): PLOC ranks merges by
 //! box surface areas in f32, which underflow to zero below about `1e-19`, and a scene whose
 //! areas all tie builds in time quadratic in its triangles (a scene of extent `1e-23` took a
-//! minute for 12,000 under the fuzzer); and the wide BVH's traversal skips a child box the ray
-//! leaves before `t = 1e-4` (an absolute epsilon in `obvhs` 0.4), so such a scene would occlude
-//! nothing. Scaling by `2^k` is exact in floating point: the answers are those of the same
-//! scene at that size. (The epsilon is absolute at every size: in a scene of extent `1e-2`, an
-//! occluder within `1e-4` of a ray's origin is missed too.) A ray hits a triangle when the Moller-Trumbore test finds `0 <= t <= t_max`
+//! minute for 12,000 under the fuzzer). Scaling by `2^k` is exact in floating point: the
+//! answers are those of the same scene at that size. (The traversal itself has no absolute
+//! epsilon: `obvhs`'s CWBVH skipped a box the ray left before `t = 1e-4`, so an occluder that
+//! near the origin was missed; none is now. On the bunny every visibility bit is the old
+//! path's; on the cubes scene some rays differ from it, see `benches/rays_results.md`.) A ray
+//! hits a triangle
+//! when the Moller-Trumbore test finds `0 <= t < t_max`
 //! ([`obvhs::rt_triangle::RtTriangle::intersect`]); the caller offsets origins off surfaces.
 
 use std::collections::HashSet;
 
 use glam::Vec3A;
-use obvhs::BvhBuildParams;
-use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh_from_tris;
-use obvhs::ray::Ray;
-use obvhs::rt_triangle::RtTriangle;
 use obvhs::triangle::Triangle;
 
 use crate::relight::Mesh;
+use crate::relight::precompute::packet::{LANES, PacketBvh};
 use crate::relight::scene::mesh::{cross, sub};
 
 /// Answers "does this ray hit anything before `t_max`?"; see the [module docs](self).
 pub trait Occlusion: Sync {
-    /// Whether the ray `origin + t direction`, `0 <= t <= t_max`, hits a triangle.
+    /// Whether the ray `origin + t direction`, `0 <= t < t_max`, hits a triangle.
     fn occluded(&self, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool;
+
+    /// `blocked[i] = self.occluded(origin, directions[i], t_max)` for the rays of one origin
+    /// (the first `directions.len().min(blocked.len())`); an implementation may trace them
+    /// together, as [`SceneBvh`] does in packets.
+    ///
+    /// ```
+    /// use haarshift::relight::{Mesh, Occlusion, SceneBvh};
+    /// use ndarray::array;
+    /// let roof = Mesh::new(array![[-1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.0, -1.0]],
+    ///                      vec![[0, 1, 2]], None).unwrap();
+    /// let mut blocked = [false; 3];
+    /// let up = [[0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.8, 0.6]];
+    /// SceneBvh::new(&roof).occluded_from([0.0; 3], &up, f32::INFINITY, &mut blocked);
+    /// assert_eq!(blocked, [true, false, true]);
+    /// ```
+    fn occluded_from(
+        &self,
+        origin: [f32; 3],
+        directions: &[[f32; 3]],
+        t_max: f32,
+        blocked: &mut [bool],
+    ) {
+        for (b, &d) in blocked.iter_mut().zip(directions) {
+            *b = self.occluded(origin, d, t_max);
+        }
+    }
 }
 
-/// The scene's triangles in an `obvhs` compressed wide BVH.
+/// The scene's triangles in a BVH traced by packets of rays that share their origin
+/// ([`packet`](super::packet)).
 ///
 /// ```
 /// use haarshift::relight::{Mesh, Occlusion, SceneBvh};
@@ -64,11 +95,9 @@ pub trait Occlusion: Sync {
 /// assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.5)); // stops short of it
 /// ```
 pub struct SceneBvh {
-    bvh: Option<CwBvh>,
+    bvh: Option<PacketBvh>,
     /// The power of two the positions were scaled by (1 unless the scene is tiny).
     scale: f32,
-    /// Triangles in the BVH's primitive order (no index indirection when tracing).
-    triangles: Vec<RtTriangle>,
 }
 
 /// The extent (largest side of the bounding box, in f32) below which [`SceneBvh`] scales a
@@ -124,45 +153,43 @@ impl SceneBvh {
             })
             .collect();
         drop(seen);
-        if triangles.is_empty() {
-            return SceneBvh {
-                bvh: None,
-                scale,
-                triangles: Vec::new(),
-            };
-        }
-        let bvh = build_cwbvh_from_tris(
-            &triangles,
-            BvhBuildParams::medium_build(),
-            &mut std::time::Duration::default(),
-        );
-        let ordered = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| RtTriangle::from(&triangles[i as usize]))
-            .collect();
         SceneBvh {
-            bvh: Some(bvh),
+            bvh: (!triangles.is_empty()).then(|| PacketBvh::new(&triangles)),
             scale,
-            triangles: ordered,
         }
     }
 }
 
 impl Occlusion for SceneBvh {
-    #[inline]
     fn occluded(&self, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
+        let mut blocked = [false];
+        if let Some(bvh) = &self.bvh {
+            // In the BVH's scaled space: origin + t d becomes s origin + (s t) d.
+            let o = origin.map(|x| x * self.scale);
+            bvh.occluded_packet::<1>(o, &[direction], t_max * self.scale, &mut blocked);
+        }
+        blocked[0]
+    }
+
+    fn occluded_from(
+        &self,
+        origin: [f32; 3],
+        directions: &[[f32; 3]],
+        t_max: f32,
+        blocked: &mut [bool],
+    ) {
+        let n = directions.len().min(blocked.len());
         let Some(bvh) = &self.bvh else {
-            return false;
+            blocked[..n].fill(false);
+            return;
         };
-        // In the BVH's scaled space: origin + t d becomes s origin + (s t) d.
-        let ray = Ray::new(
-            Vec3A::from_array(origin) * self.scale,
-            Vec3A::from_array(direction),
-            0.0,
-            t_max * self.scale,
-        );
-        !bvh.ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
+        let o = origin.map(|x| x * self.scale);
+        for (d, b) in directions[..n]
+            .chunks(LANES)
+            .zip(blocked[..n].chunks_mut(LANES))
+        {
+            bvh.occluded_packet::<LANES>(o, d, t_max * self.scale, b);
+        }
     }
 }
 

@@ -1,6 +1,8 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
+use obvhs::ray::Ray;
+
 use super::*;
 use crate::relight::{Scene, add_ground_plane};
 
@@ -11,6 +13,10 @@ fn bunny_on_ground() -> Mesh {
     mesh
 }
 
+fn traced(bvh: &SceneBvh) -> &[obvhs::rt_triangle::RtTriangle] {
+    bvh.bvh.as_ref().map_or(&[], |b| &b.triangles)
+}
+
 /// The oracle: every triangle tested, the same intersection routine.
 fn brute_force(bvh: &SceneBvh, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
     let ray = Ray::new(
@@ -19,17 +25,14 @@ fn brute_force(bvh: &SceneBvh, origin: [f32; 3], direction: [f32; 3], t_max: f32
         0.0,
         t_max,
     );
-    bvh.triangles.iter().any(|t| {
-        let hit = t.intersect(&ray);
-        hit.is_finite() && hit <= t_max
-    })
+    traced(bvh).iter().any(|t| t.intersect(&ray) < t_max)
 }
 
 #[test]
 fn bvh_answers_as_testing_every_triangle() {
     let mesh = bunny_on_ground();
     let bvh = SceneBvh::new(&mesh);
-    assert_eq!(bvh.triangles.len(), mesh.triangles().len()); // none degenerate here
+    assert_eq!(traced(&bvh).len(), mesh.triangles().len()); // none degenerate here
     let b = mesh.bounds();
     let mut rng = StdRng::seed_from_u64(11);
     let mut hits = 0;
@@ -60,7 +63,7 @@ fn degenerate_triangles_never_occlude() {
     let positions = ndarray::array![[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]];
     let mesh = Mesh::new(positions, vec![[0, 1, 2], [0, 0, 1]], None).unwrap();
     let bvh = SceneBvh::new(&mesh);
-    assert!(bvh.triangles.is_empty());
+    assert!(traced(&bvh).is_empty());
     assert!(!bvh.occluded([0.5, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
     // A scene built the usual way is unaffected by such triangles.
     let scene = Scene::from_mesh(mesh, true).unwrap();
@@ -82,7 +85,7 @@ fn repeated_and_f32_degenerate_triangles_are_kept_once_and_dropped() {
     let triangles = vec![[0, 1, 2], [1, 2, 0], [0, 2, 1], [3, 4, 5], [0, 0, 1]];
     let mesh = Mesh::new(positions, triangles.clone(), None).unwrap();
     let bvh = SceneBvh::new(&mesh);
-    assert_eq!(bvh.triangles.len(), 1);
+    assert_eq!(traced(&bvh).len(), 1);
     assert!(bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
     assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, -1.0, 0.0], f32::INFINITY));
     // The mesh keeps every triangle as read: cleaning feeds only the BVH.
@@ -121,7 +124,48 @@ fn a_tiny_scene_answers_as_the_same_scene_at_an_extent_between_one_and_two() {
         let answer = near.occluded(o, d, t_max);
         let t = (2f64.powi(-76) / unit) as f32;
         assert_eq!(tiny.occluded(o.map(|x| x * t), d, t_max * t), answer);
+        // And as a packet of rays around it.
+        let around: Vec<[f32; 3]> = (0..16).map(|k| d.map(|x| x + 0.01 * k as f32)).collect();
+        let (mut a, mut b) = ([false; 16], [false; 16]);
+        near.occluded_from(o, &around, t_max, &mut a);
+        tiny.occluded_from(o.map(|x| x * t), &around, t_max * t, &mut b);
+        assert_eq!((a, a[0]), (b, answer));
         hits += usize::from(answer);
     }
     assert!((1_000..19_000).contains(&hits), "{hits}");
+}
+
+#[test]
+fn packets_from_vertices_answer_as_testing_every_triangle() {
+    // The visibility case: from just above vertices of the bunny on its ground, one ray to
+    // every cube 8 x 8 texel centre, in the order and packets precomputation casts them.
+    let mesh = bunny_on_ground();
+    let bvh = SceneBvh::new(&mesh);
+    let param = crate::faces::Parameterization::new(crate::faces::ParamKind::Cube, 8).unwrap();
+    let directions: Vec<[f32; 3]> = (0..param.texels())
+        .map(|t| {
+            param
+                .texel_direction(t / 64, (t / 8) % 8, t % 8)
+                .map(|x| x as f32)
+        })
+        .collect();
+    let eps = crate::relight::ray_offset(&mesh);
+    let mut blocked = vec![false; directions.len()];
+    let mut hits = 0;
+    for v in (0..mesh.vertex_count()).step_by(97) {
+        let origin: [f32; 3] = std::array::from_fn(|k| {
+            (mesh.positions()[[v, k]] + eps * mesh.normals()[[v, k]]) as f32
+        });
+        bvh.occluded_from(origin, &directions, f32::INFINITY, &mut blocked);
+        for (d, &b) in directions.iter().zip(&blocked) {
+            assert_eq!(
+                b,
+                brute_force(&bvh, origin, *d, f32::INFINITY),
+                "vertex {v} {d:?}"
+            );
+            hits += usize::from(b);
+        }
+    }
+    let rays = directions.len() * mesh.vertex_count().div_ceil(97);
+    assert!((rays / 5..rays * 4 / 5).contains(&hits), "{hits} of {rays}");
 }

@@ -15,12 +15,13 @@
 //! ([`ShTransfer`], Microsoft 2003's low-frequency transfer), made from the same values by the same
 //! precomputation, for the comparison method.
 
-use ndarray::{Array3, Array4, ArrayView3, Axis};
+use ndarray::{Array3, Array4, ArrayView3};
 
 use crate::faces::Parameterization;
 use crate::faces::integrate::layout;
 use crate::io::mapped::Buffer;
-use crate::product::{HaarTree, Selection, Transport, WeightedPixels};
+use crate::product::kept::kept_coefficients;
+use crate::product::{HaarTree, Selection, Transport};
 use crate::relight::harmonics::{ShProjector, ShTransfer};
 use crate::relight::precompute::sparse::SparseRows;
 use crate::{Error, Result};
@@ -315,16 +316,11 @@ pub(crate) fn encode(
     param: Parameterization,
     keep: Selection,
 ) -> Result<(Vec<u32>, Vec<f32>)> {
-    let pixels = WeightedPixels::<f32, 1>::new(values.insert_axis(Axis(3)), weights)?;
-    let transport = Transport::new(&pixels, layout(param), keep)?;
-    let coefficients = transport.tree().to_coefficients();
-    let mut indices = Vec::new();
-    let mut kept = Vec::new();
-    for (i, &c) in coefficients.iter().enumerate() {
-        if c != 0.0 {
-            indices.push(i as u32);
-            kept.push(c);
-        }
+    if values.dim() != weights.dim() {
+        return Err(Error::shape(
+            values.shape(),
+            "values must be shaped as the weights",
+        ));
     }
-    Ok((indices, kept))
+    kept_coefficients((&values * &weights).view(), layout(param), keep)
 }
