@@ -372,9 +372,11 @@ impl<T: Sample> LatLongMap<T> {
     }
 
     /// The channels of pixel `(r, c)` after continuing `r` over the poles and `c` around the
-    /// seam (see the [module docs](self)).
+    /// seam (see the [module docs](self)), in the map with its columns rolled by `roll`
+    /// (`< W`, as [`roll_columns`](Self::roll_columns) rolls them: its column `c` is this
+    /// map's `c + roll`).
     #[inline]
-    fn pixel(&self, r: isize, c: isize) -> &[T] {
+    fn pixel(&self, r: isize, c: isize, roll: usize) -> &[T] {
         let (h, w, ch) = self.data.dim();
         // Inside the map (nearly every lookup) the index is itself: no division.
         let (r, c) = if (0..h as isize).contains(&r) && (0..w as isize).contains(&c) {
@@ -383,6 +385,8 @@ impl<T: Sample> LatLongMap<T> {
             let (r, c, _) = continue_index(r, c, h, w);
             (r, c)
         };
+        let c = c + roll;
+        let c = if c >= w { c - w } else { c };
         let flat = self.data.as_slice().expect("standard layout");
         &flat[(r * w + c) * ch..][..ch]
     }
@@ -391,6 +395,13 @@ impl<T: Sample> LatLongMap<T> {
     /// nearest pixel centres, continued over the seam and the poles.
     pub fn bilinear(&self, theta: f64, phi: f64, out: &mut [T]) {
         let (y, x) = self.grid_position(theta, phi);
+        self.bilinear_grid(y, x, 0, out);
+    }
+
+    /// [`bilinear`](Self::bilinear) at the continuous grid position `(y, x)` of
+    /// [`grid_position`](Self::grid_position), in the map with its columns rolled by `roll`
+    /// (`< W`): the values of `self.roll_columns(roll)` without the copy.
+    pub(crate) fn bilinear_grid(&self, y: f64, x: f64, roll: usize, out: &mut [T]) {
         let (r0, c0) = (y.floor(), x.floor());
         let (fy, fx) = (y - r0, x - c0);
         let (r0, c0) = (r0 as isize, c0 as isize);
@@ -398,7 +409,7 @@ impl<T: Sample> LatLongMap<T> {
         for (dr, wy) in [(0, 1.0 - fy), (1, fy)] {
             for (dc, wx) in [(0, 1.0 - fx), (1, fx)] {
                 let weight = T::from_f64(wy * wx);
-                for (o, &v) in out.iter_mut().zip(self.pixel(r0 + dr, c0 + dc)) {
+                for (o, &v) in out.iter_mut().zip(self.pixel(r0 + dr, c0 + dc, roll)) {
                     *o += weight * v;
                 }
             }
@@ -417,7 +428,7 @@ impl<T: Sample> LatLongMap<T> {
         for (dr, &wr) in wy.iter().enumerate() {
             for (dc, &wc) in wx.iter().enumerate() {
                 let weight = T::from_f64(wr * wc);
-                let px = self.pixel(r0 + dr as isize, c0 + dc as isize);
+                let px = self.pixel(r0 + dr as isize, c0 + dc as isize, 0);
                 for (o, &v) in out.iter_mut().zip(px) {
                     *o += weight * v;
                 }
@@ -428,7 +439,7 @@ impl<T: Sample> LatLongMap<T> {
     /// Continuous pixel coordinates `(row, column)` of `(theta, phi)`: pixel centres sit at
     /// whole numbers.
     #[inline]
-    fn grid_position(&self, theta: f64, phi: f64) -> (f64, f64) {
+    pub(crate) fn grid_position(&self, theta: f64, phi: f64) -> (f64, f64) {
         let h = self.height() as f64;
         let step = std::f64::consts::PI / h;
         (theta / step - 0.5, phi / step - 0.5)
