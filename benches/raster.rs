@@ -4,8 +4,10 @@
 //! `relight precompute --ground-plane` builds it) and of Vollick and Lessig's cubes scene
 //! (`testdata/scenes/cubes.json`, its own camera), the environment behind
 //! (`rooitou_park_256x128.npy`, and the 1024 x 512 `rooitou_park_1k.hdr`), turned by a yaw of
-//! whole columns (an animation's frame) or by a general rotation (yaw 30, pitch 20); and the
-//! triangles alone in front of a colour. The radiance is a smooth function of position (the
+//! whole columns (an animation's frame) or by a general rotation (yaw 30, pitch 20), as one
+//! frame on its own (`relight render`) and as an animation's later frame (`next_frame`:
+//! [`Frames`] keeping what its first frame prepared); and the triangles alone in front of a
+//! colour. The radiance is a smooth function of position (the
 //! rasteriser's cost does not depend on it).
 //!
 //! Run: `cargo bench --bench raster -- --warm-up-time 1 --measurement-time 5`; the figures
@@ -17,7 +19,7 @@ use std::path::Path;
 use haarshift::io::read_image;
 use haarshift::relight::light::environment::Environment;
 use haarshift::relight::{Mesh, Scene};
-use haarshift::render::view::{Backdrop, ViewSpec};
+use haarshift::render::view::{Backdrop, Frames, ViewSpec};
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use ndarray::{Array2, Array3};
 
@@ -79,6 +81,21 @@ fn bench(c: &mut Criterion) {
                             .expect("draws")
                     })
                 });
+                // An animation's later frame: what the first prepared, kept.
+                let mut frames = Frames::new(view);
+                frames
+                    .draw(&camera, mesh, radiance.view(), env, rotation)
+                    .expect("draws");
+                group.bench_function(
+                    format!("{name}/{env_name}/{turn_name}/next_frame"),
+                    |bench| {
+                        bench.iter(|| {
+                            frames
+                                .draw(&camera, mesh, radiance.view(), env, rotation)
+                                .expect("draws")
+                        })
+                    },
+                );
             }
         }
         let colour = ViewSpec {

@@ -253,12 +253,13 @@ fn setup_triangles(camera: &Camera, width: usize, height: usize, mesh: &LitMesh<
         .flat_map_iter(|chunk| {
             let mut out = Vec::with_capacity(chunk.len());
             for tri in chunk {
-                let corners = tri.map(|i| vertices[i as usize]);
-                if corners.iter().all(|v| v[2] >= near && !outside(v)) {
+                let [a, b, c] = [0, 1, 2].map(|k| &vertices[tri[k] as usize]);
+                if [a, b, c].iter().all(|v| v[2] >= near && !outside(v)) {
                     // Nearly every triangle: nothing to clip, no allocation.
-                    out.extend(setup(corners.map(|v| project(&v)), width, height));
+                    out.extend(setup([project(a), project(b), project(c)], width, height));
                     continue;
                 }
+                let corners = [*a, *b, *c];
                 let mut poly = corners.to_vec();
                 if poly.iter().any(|v| v[2] < near) {
                     poly = clip(&poly, |v| v[2] - near);
@@ -375,7 +376,11 @@ impl Setup {
     fn radiance(&self, i: usize, j: usize, w: f64) -> [f32; 3] {
         let (x, y) = (j as f64 + 0.5, i as f64 + 0.5);
         let z = 1.0 / w;
-        [1, 2, 3].map(|q| (self.at(q, x, y) * z) as f32)
+        [
+            (self.at(1, x, y) * z) as f32,
+            (self.at(2, x, y) * z) as f32,
+            (self.at(3, x, y) * z) as f32,
+        ]
     }
 
     /// Plane `q` (0: `1/z`; 1 to 3: `radiance / z`) at pixel coordinates `(x, y)`, evaluated

@@ -39,7 +39,7 @@ use rayon::prelude::*;
 /// let (positions, radiance) = (Array2::<f64>::zeros((0, 3)), Array2::<f32>::zeros((0, 3)));
 /// let mesh = LitMesh { positions: positions.view(), triangles: &[], radiance: radiance.view() };
 /// let turn = SphereRotation::from_degrees(90.0, 0.0, 0.0).unwrap(); // 8 of 32 columns
-/// let sky = Sky { map: &map, rotation: &turn, lookup: &lookup };
+/// let sky = Sky { map: &map, rotation: &turn, lookup: Some(&lookup) };
 /// let image = render(&camera, 24, 16, &mesh, Background::Sky(sky)).unwrap();
 /// let rolled = map.roll_columns(8);
 /// assert_eq!(image, render(&camera, 24, 16, &mesh, Background::Environment(&rolled)).unwrap());
@@ -99,32 +99,38 @@ impl SkyLookup {
     }
 }
 
-/// The environment `map` turned by `rotation` behind the image, looked up through `lookup`
-/// (made for the render's camera, image size and `map`'s height): see the
-/// [module docs](self).
+/// The environment `map` turned by `rotation` behind the image, each pixel's place in it read
+/// from `lookup` (made for the render's camera, image size and `map`'s height) or, without
+/// one, found from its ray: see the [module docs](self).
 #[derive(Clone, Copy, Debug)]
 pub struct Sky<'a> {
     /// The environment (1 channel: gray; 3 or more: the first three).
     pub map: &'a LatLongMap<f64>,
     /// How it is turned: the pixel with ray `d` shows `map` at `rotation.apply(d)`.
     pub rotation: &'a SphereRotation,
-    /// Each pixel's place in a map as high as `map`.
-    pub lookup: &'a SkyLookup,
+    /// Each pixel's place in a map as high as `map` (none: found from its ray, for one
+    /// frame). A turn other than a whole-column yaw finds it from the ray in any case.
+    pub lookup: Option<&'a SkyLookup>,
 }
 
 /// How a render finds the background of a pixel, checked and ready.
 pub(super) enum Behind<'a> {
     /// A constant colour.
     Colour([f32; 3]),
-    /// The pixel's place read from a lookup, in `map` with its columns rolled by `roll`.
-    Grid {
+    /// `map` with its columns rolled by `roll`, at each pixel's `place`.
+    Map {
         map: &'a LatLongMap<f64>,
-        grid: &'a [[f64; 2]],
         roll: usize,
+        place: Place<'a>,
     },
-    /// The pixel's ray found anew, turned by `rotation` (none: as it is).
-    Rays {
-        map: &'a LatLongMap<f64>,
+}
+
+/// Where a pixel's ray meets the map.
+pub(super) enum Place<'a> {
+    /// Read from a lookup.
+    Lookup(&'a [[f64; 2]]),
+    /// Found anew from the pixel's ray, turned by `rotation` (none: as it is).
+    Ray {
         camera: &'a Camera,
         focal: f64,
         rotation: Option<&'a SphereRotation>,
@@ -140,10 +146,10 @@ impl<'a> Behind<'a> {
         height: usize,
     ) -> Result<Self> {
         use super::Background;
-        let map = match background {
+        let (map, rotation, lookup) = match background {
             Background::Colour(c) => return Ok(Behind::Colour(c)),
-            Background::Environment(map) => map,
-            Background::Sky(sky) => sky.map,
+            Background::Environment(map) => (map, None, None),
+            Background::Sky(sky) => (sky.map, Some(sky.rotation), sky.lookup),
         };
         if !matches!(map.channels(), 1 | 3..=64) {
             return Err(Error::parameter(
@@ -154,76 +160,68 @@ impl<'a> Behind<'a> {
                 ),
             ));
         }
-        let focal = camera.focal(height);
-        let sky = match background {
-            Background::Sky(sky) => sky,
-            _ => {
-                return Ok(Behind::Rays {
-                    map,
-                    camera,
-                    focal,
-                    rotation: None,
-                });
-            }
-        };
-        if !sky.lookup.fits(camera, width, height, map) {
+        if let Some(lookup) = lookup
+            && !lookup.fits(camera, width, height, map)
+        {
             return Err(Error::parameter(
                 "background",
                 format!(
                     "a sky lookup made for a {} x {} image into maps {} high, another camera or \
                      both, drawn at {width} x {height} into a map {} high",
-                    sky.lookup.width,
-                    sky.lookup.height,
-                    sky.lookup.map_height,
+                    lookup.width,
+                    lookup.height,
+                    lookup.map_height,
                     map.height()
                 ),
             ));
         }
-        Ok(match sky.rotation.whole_column_yaw(map.width()) {
-            Some(roll) => Behind::Grid {
-                map,
-                grid: &sky.lookup.grid,
-                roll,
-            },
-            None => Behind::Rays {
-                map,
-                camera,
-                focal,
-                rotation: Some(sky.rotation),
-            },
+        let ray = |rotation| Place::Ray {
+            camera,
+            focal: camera.focal(height),
+            rotation,
+        };
+        // A whole-column yaw (or none) moves the unturned ray's place by whole columns.
+        let roll = rotation.map_or(Some(0), |r| r.whole_column_yaw(map.width()));
+        let place = match (roll, lookup) {
+            (Some(_), Some(lookup)) => Place::Lookup(&lookup.grid),
+            (Some(_), None) => ray(None),
+            (None, _) => ray(rotation),
+        };
+        Ok(Behind::Map {
+            map,
+            roll: roll.unwrap_or(0),
+            place,
         })
     }
 
     /// The background of pixel `(i, j)` of a `width x height` image.
     #[inline]
     pub(super) fn at(&self, i: usize, j: usize, width: usize, height: usize) -> [f32; 3] {
-        let mut v = [0.0f64; 3];
-        let map = match *self {
-            Behind::Colour(c) => return c,
-            Behind::Grid { map, grid, roll } => {
+        let (map, roll, place) = match self {
+            Behind::Colour(c) => return *c,
+            Behind::Map { map, roll, place } => (map, *roll, place),
+        };
+        let (y, x) = match *place {
+            Place::Lookup(grid) => {
                 let [y, x] = grid[i * width + j];
-                let ch = map.channels().min(3);
-                map.bilinear_grid(y, x, roll, &mut v[..ch]);
-                map
+                (y, x)
             }
-            Behind::Rays {
-                map,
+            Place::Ray {
                 camera,
                 focal,
                 rotation,
             } => {
                 let d = camera.ray_at_focal(focal, j as f64 + 0.5, i as f64 + 0.5, width, height);
-                let d = rotation.map_or(d, |r| r.apply(d));
-                let (theta, phi) = angles(d);
-                let ch = map.channels().min(3);
-                map.bilinear(theta, phi, &mut v[..ch]);
-                map
+                let (theta, phi) = angles(rotation.map_or(d, |r| r.apply(d)));
+                map.grid_position(theta, phi)
             }
         };
         if map.channels() < 3 {
-            [v[0] as f32; 3]
+            let [v] = map.bilinear_grid::<1>(y, x, roll);
+            [v as f32; 3]
         } else {
-            [v[0] as f32, v[1] as f32, v[2] as f32]
+            let [r, g, b] = map.bilinear_grid::<3>(y, x, roll);
+            [r as f32, g as f32, b as f32]
         }
     }
 }

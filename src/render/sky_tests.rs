@@ -70,7 +70,7 @@ fn a_whole_column_yaw_is_the_rolled_map_and_any_turn_is_the_oracle_bit_for_bit()
                 let sky = Sky {
                     map: &map,
                     rotation: &turn,
-                    lookup: &lookup,
+                    lookup: Some(&lookup),
                 };
                 let got = backdrop(camera, w, h, Background::Sky(sky));
                 let rolled = map.roll_columns(k);
@@ -87,7 +87,7 @@ fn a_whole_column_yaw_is_the_rolled_map_and_any_turn_is_the_oracle_bit_for_bit()
                 let sky = Sky {
                     map: &map,
                     rotation: &turn,
-                    lookup: &lookup,
+                    lookup: Some(&lookup),
                 };
                 let got = backdrop(camera, w, h, Background::Sky(sky));
                 assert_eq!(
@@ -118,7 +118,7 @@ fn a_lookup_serves_only_its_camera_size_and_map_height() {
         let sky = Sky {
             map,
             rotation: &identity,
-            lookup: &lookup,
+            lookup: Some(&lookup),
         };
         let (positions, radiance) = (Array2::<f64>::zeros((0, 3)), Array2::<f32>::zeros((0, 3)));
         let mesh = LitMesh {

@@ -107,14 +107,61 @@ impl ViewSpec {
         env: &Environment,
         rotation: &SphereRotation,
     ) -> Result<PlanarImage<f32>> {
-        Frames::new(*self).draw(camera, mesh, radiance, env, rotation)
+        self.draw_keeping(camera, mesh, radiance, env, rotation, None)
+    }
+
+    /// [`draw`](Self::draw), each pixel's place in the environment read from the lookup in
+    /// `kept` when there is one and the lighting turns by whole columns (the lookup made
+    /// first, or anew for another camera, image size or map height, and left there), else
+    /// found from its ray.
+    fn draw_keeping(
+        &self,
+        camera: &Camera,
+        mesh: &Mesh,
+        radiance: ArrayView2<'_, f32>,
+        env: &Environment,
+        rotation: &SphereRotation,
+        kept: Option<&mut Option<SkyLookup>>,
+    ) -> Result<PlanarImage<f32>> {
+        let (width, height) = (self.width, self.height);
+        let drawn = LitMesh {
+            positions: mesh.positions(),
+            triangles: mesh.triangles(),
+            radiance,
+        };
+        let colour = match self.backdrop {
+            Backdrop::Colour(c) => c,
+            Backdrop::Environment => {
+                let map = env.downsampled(env.map().height().min(BACKGROUND_HEIGHT))?;
+                // Only a whole-column yaw reads a lookup (see `sky`).
+                let whole = rotation.whole_column_yaw(map.width()).is_some();
+                let lookup = match kept {
+                    Some(kept) if whole => {
+                        let lookup = match kept.take() {
+                            Some(lookup) if lookup.fits(camera, width, height, &map) => lookup,
+                            _ => SkyLookup::new(camera, width, height, &map)?,
+                        };
+                        Some(&*kept.insert(lookup))
+                    }
+                    _ => None,
+                };
+                let sky = Sky {
+                    map: &map,
+                    rotation,
+                    lookup,
+                };
+                return render(camera, width, height, &drawn, Background::Sky(sky));
+            }
+        };
+        render(camera, width, height, &drawn, Background::Colour(colour))
     }
 }
 
 /// A view drawn frame after frame: [`ViewSpec::draw`], with each pixel's place in the
-/// environment ([`SkyLookup`]) prepared for the first frame and kept while the camera, the
-/// image size and the backdrop's height stay (an animation's frames turn the lighting, or
-/// move the camera and prepare it anew).
+/// environment ([`SkyLookup`]) prepared for the first frame the lighting turns by whole
+/// columns (or not at all) and kept while the camera, the image size and the backdrop's
+/// height stay (an animation's frames turn the lighting, or move the camera and prepare it
+/// anew).
 ///
 /// ```
 /// use haarshift::relight::light::environment::Environment;
@@ -154,28 +201,14 @@ impl Frames {
         env: &Environment,
         rotation: &SphereRotation,
     ) -> Result<PlanarImage<f32>> {
-        let (width, height) = (self.view.width, self.view.height);
-        let drawn = LitMesh {
-            positions: mesh.positions(),
-            triangles: mesh.triangles(),
+        let view = self.view;
+        view.draw_keeping(
+            camera,
+            mesh,
             radiance,
-        };
-        match self.view.backdrop {
-            Backdrop::Colour(c) => render(camera, width, height, &drawn, Background::Colour(c)),
-            Backdrop::Environment => {
-                let map = env.downsampled(env.map().height().min(BACKGROUND_HEIGHT))?;
-                let lookup = match self.lookup.take() {
-                    Some(kept) if kept.fits(camera, width, height, &map) => kept,
-                    _ => SkyLookup::new(camera, width, height, &map)?,
-                };
-                let lookup = self.lookup.insert(lookup);
-                let sky = Sky {
-                    map: &map,
-                    rotation,
-                    lookup,
-                };
-                render(camera, width, height, &drawn, Background::Sky(sky))
-            }
-        }
+            env,
+            rotation,
+            Some(&mut self.lookup),
+        )
     }
 }
