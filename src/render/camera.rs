@@ -188,7 +188,20 @@ impl Camera {
 
     /// The unit direction (world) of the ray through pixel coordinates `(x, y)`.
     pub fn ray(&self, x: f64, y: f64, width: usize, height: usize) -> [f64; 3] {
-        let f = self.focal(height);
+        self.ray_at_focal(self.focal(height), x, y, width, height)
+    }
+
+    /// [`ray`](Self::ray) with the focal length `f` ([`focal`](Self::focal)) computed once
+    /// for a whole image.
+    #[inline]
+    pub(super) fn ray_at_focal(
+        &self,
+        f: f64,
+        x: f64,
+        y: f64,
+        width: usize,
+        height: usize,
+    ) -> [f64; 3] {
         let (a, b) = ((x - 0.5 * width as f64) / f, (0.5 * height as f64 - y) / f);
         let d = self.forward + a * self.right + b * self.up;
         // At least as long as the unit forward axis, which it is perpendicular to the rest of.

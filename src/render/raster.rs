@@ -17,20 +17,31 @@
 //! at every pixel centre. Both faces of a triangle are drawn. The z-buffer keeps the nearest
 //! fragment; of two at the same depth, the earlier triangle.
 //!
-//! The image is cut into bands of rows rendered in parallel with rayon, each band going over
-//! the triangles whose bounding box reaches it, in the mesh's order (so the result does not
-//! depend on the thread count). Pixels no triangle covers show the [`Background`]: a colour,
-//! or the environment seen along the pixel centre's ray (bilinear lookup in the lat-long map,
-//! the sphere module's direction convention).
+//! # Tiles and threads
+//!
+//! Vertices are taken to camera space once, then triangles are set up in parallel (no
+//! allocation unless one must be clipped). The image is cut into bands of [`BAND_ROWS`] full
+//! rows (tiles as wide as the image, so that each writes whole rows of the three output
+//! planes), rendered in parallel with rayon. A band first keeps, per pixel, only the depth and
+//! the index of the nearest triangle, going over the triangles whose bounding box reaches it
+//! in the mesh's order (so the result does not depend on the thread count); then it fills
+//! each pixel once: the winner's radiance, interpolated at the pixel centre, or the
+//! background. A pixel hidden behind others is never shaded, and its value is the same
+//! arithmetic on the same numbers as if every fragment had been shaded as it came.
+//!
+//! Pixels no triangle covers show the [`Background`]: a colour, or the environment seen along
+//! the pixel centre's ray (bilinear lookup in the lat-long map, the sphere module's direction
+//! convention), turned and looked up through a prepared table with [`Background::Sky`] (see
+//! [`sky`](super::sky)).
 
 use std::ops::Range;
 
-use ndarray::{Array3, ArrayView2, Axis};
+use ndarray::{Array3, ArrayView2};
 use rayon::prelude::*;
 
 use super::camera::Camera;
+use super::sky::{Behind, Sky};
 use crate::sphere::LatLongMap;
-use crate::sphere::latlong::angles;
 use crate::{Channels, Error, PlanarImage, Result, SampleDepth};
 
 /// The near plane's distance as a fraction of the camera's distance to the point looked at.
@@ -43,8 +54,12 @@ const SUBPIXEL: f64 = 256.0;
 /// first, which keeps the integer edge functions far from overflow.
 const GUARD: f64 = (1u64 << 21) as f64;
 
-/// Rows per band of parallel work.
-const BAND_ROWS: usize = 16;
+/// Rows per band of parallel work: a band's depths and winners (12 bytes a pixel) stay in a
+/// core's L2 at any width up to a few thousand pixels.
+pub const BAND_ROWS: usize = 16;
+
+/// No triangle covers the pixel (yet).
+const NONE: u32 = u32::MAX;
 
 /// What pixels that no triangle covers show.
 #[derive(Clone, Copy, Debug)]
@@ -53,6 +68,9 @@ pub enum Background<'a> {
     Colour([f32; 3]),
     /// The environment along each pixel's ray (1 channel: gray; 3 or more: the first three).
     Environment(&'a LatLongMap<f64>),
+    /// The environment turned, each pixel's place in it prepared once for the camera
+    /// ([`Sky`]).
+    Sky(Sky<'a>),
 }
 
 /// A mesh to draw: `positions` `(V, 3)`, triangles indexing them, and the linear RGB radiance
@@ -120,23 +138,8 @@ pub fn render(
     mesh: &LitMesh<'_>,
     background: Background<'_>,
 ) -> Result<PlanarImage<f32>> {
-    if width == 0 || height == 0 || width > 1 << 15 || height > 1 << 15 {
-        return Err(Error::shape(
-            &[height, width],
-            "an image is 1 to 32768 pixels wide and high",
-        ));
-    }
-    if let Background::Environment(env) = background
-        && !matches!(env.channels(), 1 | 3..=64)
-    {
-        return Err(Error::parameter(
-            "background",
-            format!(
-                "an environment of {} channels (expected 1 for gray, or 3 to 64)",
-                env.channels()
-            ),
-        ));
-    }
+    check_size(width, height)?;
+    let behind = Behind::new(background, camera, width, height)?;
     mesh.check()?;
     let setups = setup_triangles(camera, width, height, mesh);
     let bands = height.div_ceil(BAND_ROWS);
@@ -146,66 +149,57 @@ pub fn render(
             list.push(k as u32);
         }
     }
-    // (row, column, channel) radiance; rows in bands.
-    let mut pixels = Array3::<f32>::zeros((height, width, 3));
-    pixels
-        .axis_chunks_iter_mut(Axis(0), BAND_ROWS)
-        .into_par_iter()
+    let mut planes = Array3::<f32>::zeros((3, height, width));
+    let flat = planes.as_slice_mut().expect("standard layout");
+    let (red, rest) = flat.split_at_mut(width * height);
+    let (green, blue) = rest.split_at_mut(width * height);
+    let band = BAND_ROWS * width;
+    red.par_chunks_mut(band)
+        .zip(green.par_chunks_mut(band))
+        .zip(blue.par_chunks_mut(band))
         .zip(binned)
         .enumerate()
-        .for_each(|(b, (mut band, list))| {
-            let rows = b * BAND_ROWS..(b * BAND_ROWS + band.dim().0);
-            let out = band.as_slice_mut().expect("standard layout");
-            let mut depth = vec![0.0f64; rows.len() * width];
-            let mut covered = vec![false; rows.len() * width];
-            for &k in &list {
-                rasterize(&setups[k as usize], rows.clone(), width, |i, j, w, rgb| {
-                    let p = (i - rows.start) * width + j;
-                    if !covered[p] || w > depth[p] {
-                        covered[p] = true;
-                        depth[p] = w;
-                        out[3 * p..3 * p + 3].copy_from_slice(&rgb);
-                    }
-                });
-            }
-            for (p, px) in out.chunks_exact_mut(3).enumerate() {
-                if !covered[p] {
-                    let (i, j) = (rows.start + p / width, p % width);
-                    px.copy_from_slice(&background_at(camera, width, height, i, j, background));
+        .for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(depth, winner), (b, (((red, green), blue), list))| {
+                let rows = b * BAND_ROWS..b * BAND_ROWS + red.len() / width;
+                depth.clear();
+                depth.resize(red.len(), 0.0f64);
+                winner.clear();
+                winner.resize(red.len(), NONE);
+                for &k in &list {
+                    rasterize(&setups[k as usize], rows.clone(), width, |i, j, w| {
+                        let p = (i - rows.start) * width + j;
+                        if winner[p] == NONE || w > depth[p] {
+                            winner[p] = k;
+                            depth[p] = w;
+                        }
+                    });
                 }
-            }
-        });
-    let planes = pixels
-        .permuted_axes([2, 0, 1])
-        .as_standard_layout()
-        .into_owned();
+                for (p, i) in rows.clone().enumerate() {
+                    for j in 0..width {
+                        let q = p * width + j;
+                        let rgb = match winner[q] {
+                            NONE => behind.at(i, j, width, height),
+                            k => setups[k as usize].radiance(i, j, depth[q]),
+                        };
+                        (red[q], green[q], blue[q]) = (rgb[0], rgb[1], rgb[2]);
+                    }
+                }
+            },
+        );
     PlanarImage::new(planes, Channels::Rgb, SampleDepth::F32)
 }
 
-/// The background seen through the centre of pixel `(i, j)`.
-fn background_at(
-    camera: &Camera,
-    width: usize,
-    height: usize,
-    i: usize,
-    j: usize,
-    background: Background<'_>,
-) -> [f32; 3] {
-    match background {
-        Background::Colour(c) => c,
-        Background::Environment(env) => {
-            let d = camera.ray(j as f64 + 0.5, i as f64 + 0.5, width, height);
-            let (theta, phi) = angles(d);
-            let mut v = [0.0f64; 64];
-            let v = &mut v[..env.channels()];
-            env.bilinear(theta, phi, v);
-            if v.len() < 3 {
-                [v[0] as f32; 3]
-            } else {
-                [v[0] as f32, v[1] as f32, v[2] as f32]
-            }
-        }
+/// Refuses an image size [`render`] cannot draw.
+pub(super) fn check_size(width: usize, height: usize) -> Result<()> {
+    if width == 0 || height == 0 || width > 1 << 15 || height > 1 << 15 {
+        return Err(Error::shape(
+            &[height, width],
+            "an image is 1 to 32768 pixels wide and high",
+        ));
     }
+    Ok(())
 }
 
 /// A triangle ready to rasterise: snapped vertices, interpolation planes, the rows it spans.
@@ -223,56 +217,67 @@ struct Setup {
 /// A vertex in camera space with its radiance: `(x, y, z, r, g, b)`.
 type ClipVertex = [f64; 6];
 
+/// Triangles set up per parallel task: enough to amortise the task, few enough to balance.
+const SETUP_CHUNK: usize = 2048;
+
 /// Every triangle of `mesh` clipped, projected, snapped and set up, in the mesh's order.
 fn setup_triangles(camera: &Camera, width: usize, height: usize, mesh: &LitMesh<'_>) -> Vec<Setup> {
     let near = camera.near(NEAR_FRACTION);
     let f = camera.focal(height);
     let (cx, cy) = (0.5 * width as f64, 0.5 * height as f64);
-    let vertex = |i: u32| -> ClipVertex {
-        let i = i as usize;
-        let p = [0, 1, 2].map(|k| mesh.positions[[i, k]]);
-        let [x, y, z] = camera.camera_coordinates(p);
-        let r = mesh.radiance.row(i);
-        [x, y, z, r[0] as f64, r[1] as f64, r[2] as f64]
+    // Each vertex taken to camera space once, not once per triangle using it.
+    let vertices: Vec<ClipVertex> = (0..mesh.positions.nrows())
+        .into_par_iter()
+        .map(|i| {
+            let p = [0, 1, 2].map(|k| mesh.positions[[i, k]]);
+            let [x, y, z] = camera.camera_coordinates(p);
+            let r = mesh.radiance.row(i);
+            [x, y, z, r[0] as f64, r[1] as f64, r[2] as f64]
+        })
+        .collect();
+    let project = |v: &ClipVertex| -> [f64; 6] {
+        let w = 1.0 / v[2];
+        [
+            cx + f * v[0] * w,
+            cy - f * v[1] * w,
+            w,
+            v[3] * w,
+            v[4] * w,
+            v[5] * w,
+        ]
     };
+    let outside =
+        |v: &ClipVertex| (f * v[0]).abs() > GUARD * v[2] || (f * v[1]).abs() > GUARD * v[2];
     mesh.triangles
-        .par_iter()
-        .fold(Vec::new, |mut out, tri| {
-            let mut poly = vec![vertex(tri[0]), vertex(tri[1]), vertex(tri[2])];
-            if poly.iter().any(|v| v[2] < near) {
-                poly = clip(&poly, |v| v[2] - near);
-            }
-            let outside =
-                |v: &ClipVertex| (f * v[0]).abs() > GUARD * v[2] || (f * v[1]).abs() > GUARD * v[2];
-            if poly.iter().any(outside) {
-                let g = GUARD / f;
-                poly = clip(&poly, |v| g * v[2] - v[0]);
-                poly = clip(&poly, |v| g * v[2] + v[0]);
-                poly = clip(&poly, |v| g * v[2] - v[1]);
-                poly = clip(&poly, |v| g * v[2] + v[1]);
-            }
-            let screen: Vec<[f64; 6]> = poly
-                .iter()
-                .map(|v| {
-                    let w = 1.0 / v[2];
-                    [
-                        cx + f * v[0] * w,
-                        cy - f * v[1] * w,
-                        w,
-                        v[3] * w,
-                        v[4] * w,
-                        v[5] * w,
-                    ]
-                })
-                .collect();
-            for k in 1..screen.len().saturating_sub(1) {
-                if let Some(s) = setup([screen[0], screen[k], screen[k + 1]], width, height) {
-                    out.push(s);
+        .par_chunks(SETUP_CHUNK)
+        .flat_map_iter(|chunk| {
+            let mut out = Vec::with_capacity(chunk.len());
+            for tri in chunk {
+                let [a, b, c] = [0, 1, 2].map(|k| &vertices[tri[k] as usize]);
+                if [a, b, c].iter().all(|v| v[2] >= near && !outside(v)) {
+                    // Nearly every triangle: nothing to clip, no allocation.
+                    out.extend(setup([project(a), project(b), project(c)], width, height));
+                    continue;
+                }
+                let corners = [*a, *b, *c];
+                let mut poly = corners.to_vec();
+                if poly.iter().any(|v| v[2] < near) {
+                    poly = clip(&poly, |v| v[2] - near);
+                }
+                if poly.iter().any(outside) {
+                    let g = GUARD / f;
+                    poly = clip(&poly, |v| g * v[2] - v[0]);
+                    poly = clip(&poly, |v| g * v[2] + v[0]);
+                    poly = clip(&poly, |v| g * v[2] - v[1]);
+                    poly = clip(&poly, |v| g * v[2] + v[1]);
+                }
+                let screen: Vec<[f64; 6]> = poly.iter().map(project).collect();
+                for k in 1..screen.len().saturating_sub(1) {
+                    out.extend(setup([screen[0], screen[k], screen[k + 1]], width, height));
                 }
             }
             out
         })
-        .flatten()
         .collect()
 }
 
@@ -364,13 +369,36 @@ fn top_left(a: [i64; 2], b: [i64; 2]) -> bool {
     dy < 0 || (dy == 0 && dx > 0)
 }
 
-/// Calls `fragment(row, column, 1/z, radiance)` for every pixel centre in `rows` that the
-/// triangle covers, by the top-left rule.
+impl Setup {
+    /// The radiance at the centre of pixel `(i, j)`, where `1/z` is `w` (the value of
+    /// [`rasterize`]'s fragment there).
+    #[inline]
+    fn radiance(&self, i: usize, j: usize, w: f64) -> [f32; 3] {
+        let (x, y) = (j as f64 + 0.5, i as f64 + 0.5);
+        let z = 1.0 / w;
+        [
+            (self.at(1, x, y) * z) as f32,
+            (self.at(2, x, y) * z) as f32,
+            (self.at(3, x, y) * z) as f32,
+        ]
+    }
+
+    /// Plane `q` (0: `1/z`; 1 to 3: `radiance / z`) at pixel coordinates `(x, y)`, evaluated
+    /// afresh at every pixel (not stepped) so that a value does not depend on where a
+    /// triangle's span began.
+    #[inline]
+    fn at(&self, q: usize, x: f64, y: f64) -> f64 {
+        self.planes[q][0] * x + self.planes[q][1] * y + self.planes[q][2]
+    }
+}
+
+/// Calls `fragment(row, column, 1/z)` for every pixel centre in `rows` that the triangle
+/// covers, by the top-left rule.
 fn rasterize(
     s: &Setup,
     rows: Range<usize>,
     width: usize,
-    mut fragment: impl FnMut(usize, usize, f64, [f32; 3]),
+    mut fragment: impl FnMut(usize, usize, f64),
 ) {
     let rows = rows.start.max(s.rows.start)..rows.end.min(s.rows.end);
     let cols = s.cols.start..s.cols.end.min(width);
@@ -391,16 +419,7 @@ fn rasterize(
         let y = i as f64 + 0.5;
         for j in cols.clone() {
             if e[0] >= 0 && e[1] >= 0 && e[2] >= 0 {
-                let x = j as f64 + 0.5;
-                let at = |q: usize| s.planes[q][0] * x + s.planes[q][1] * y + s.planes[q][2];
-                let w = at(0);
-                let z = 1.0 / w;
-                fragment(
-                    i,
-                    j,
-                    w,
-                    [(at(1) * z) as f32, (at(2) * z) as f32, (at(3) * z) as f32],
-                );
+                fragment(i, j, s.at(0, j as f64 + 0.5, y));
             }
             for k in 0..3 {
                 e[k] += dx[k];

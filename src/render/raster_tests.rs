@@ -2,8 +2,11 @@
 
 use super::*;
 use crate::render::{srgb_encode, write_render};
+use crate::sphere::latlong::angles;
 use glam::DVec3;
-use ndarray::{Array2, array};
+use ndarray::{Array2, Array3, array};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
 
 fn front_camera() -> Camera {
     Camera::new([0.0, 0.0, 5.0], [0.0, 0.0, 0.0], 60.0).unwrap()
@@ -36,7 +39,7 @@ fn coverage(
 ) -> Array2<u32> {
     let mut count = Array2::<u32>::zeros((h, w));
     for s in setups(camera, w, h, positions, tris) {
-        rasterize(&s, 0..h, w, |i, j, _, _| count[[i, j]] += 1);
+        rasterize(&s, 0..h, w, |i, j, _| count[[i, j]] += 1);
     }
     count
 }
@@ -404,5 +407,136 @@ fn triangles_through_the_near_plane_are_clipped_not_dropped() {
                 assert_eq!(count[[i, j]], 0, "({i}, {j})");
             }
         }
+    }
+}
+
+/// The image by brute force: every pixel centre against every set-up triangle in the mesh's
+/// order, coverage from the edge functions evaluated at the centre itself (top-left rule), the
+/// nearest fragment kept (the earlier of two at the same depth), its radiance interpolated
+/// there; `background(i, j)` elsewhere. No bands, no bounding boxes, no stepping, no threads.
+fn brute_force(
+    camera: &Camera,
+    w: usize,
+    h: usize,
+    mesh: &LitMesh<'_>,
+    background: impl Fn(usize, usize) -> [f32; 3],
+) -> Array3<f32> {
+    let setups = setup_triangles(camera, w, h, mesh);
+    let mut image = Array3::<f32>::zeros((3, h, w));
+    for i in 0..h {
+        for j in 0..w {
+            let p = [256 * j as i64 + 128, 256 * i as i64 + 128];
+            let (x, y) = (j as f64 + 0.5, i as f64 + 0.5);
+            let mut nearest: Option<(f64, [f32; 3])> = None;
+            for s in &setups {
+                let [a, b, c] = s.snapped;
+                let inside = [(b, c), (c, a), (a, b)].iter().all(|&(u, v)| {
+                    let e = (v[0] - u[0]) * (p[1] - u[1]) - (v[1] - u[1]) * (p[0] - u[0]);
+                    let (dx, dy) = (v[0] - u[0], v[1] - u[1]);
+                    e > 0 || (e == 0 && (dy < 0 || (dy == 0 && dx > 0)))
+                });
+                if !inside {
+                    continue;
+                }
+                let plane = |q: usize| s.planes[q][0] * x + s.planes[q][1] * y + s.planes[q][2];
+                let depth = plane(0);
+                if nearest.is_none_or(|(d, _)| depth > d) {
+                    let z = 1.0 / depth;
+                    let rgb = [1, 2, 3].map(|q| (plane(q) * z) as f32);
+                    nearest = Some((depth, rgb));
+                }
+            }
+            let rgb = nearest.map_or_else(|| background(i, j), |(_, rgb)| rgb);
+            for c in 0..3 {
+                image[[c, i, j]] = rgb[c];
+            }
+        }
+    }
+    image
+}
+
+/// A random scene in front of (and around, and behind) `camera`'s view: small and large
+/// triangles, many crossing the bands' borders, some off screen or behind the camera, some
+/// through the near plane, some degenerate (a repeated vertex, three collinear points), and
+/// exact duplicates of others (equal depths: the earlier wins).
+fn random_scene(rng: &mut StdRng) -> (Array2<f64>, Vec<[u32; 3]>, Array2<f32>) {
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let mut tris = Vec::new();
+    for t in 0..40 {
+        let centre = [
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-4.0..4.5),
+        ];
+        let size = if t % 5 == 0 { 4.0 } else { 0.6 };
+        let k = points.len() as u32;
+        for _ in 0..3 {
+            points.push(std::array::from_fn(|c| {
+                centre[c] + size * rng.random_range(-1.0..1.0)
+            }));
+        }
+        match t % 10 {
+            3 => points[k as usize + 2] = points[k as usize], // a repeated vertex
+            4 => {
+                let (a, b) = (points[k as usize], points[k as usize + 1]);
+                points[k as usize + 2] = std::array::from_fn(|c| 0.5 * (a[c] + b[c]));
+            }
+            _ => {}
+        }
+        tris.push([k, k + 1, k + 2]);
+        if t % 7 == 2 {
+            tris.push([k + 1, k + 2, k]); // the same triangle again, later
+        }
+    }
+    let positions = Array2::from_shape_fn((points.len(), 3), |(v, c)| points[v][c]);
+    let radiance = Array2::from_shape_fn((points.len(), 3), |_| rng.random_range(0.0..2.0f32));
+    (positions, tris, radiance)
+}
+
+#[test]
+fn the_banded_parallel_image_equals_brute_force_bit_for_bit() {
+    let mut rng = StdRng::seed_from_u64(34);
+    let env = LatLongMap::<f64>::from_fn(16, 3, |d, o| {
+        o.copy_from_slice(&[1.0 + d[0], 2.0 - d[1], 1.5 + d[0] * d[2]])
+    })
+    .unwrap();
+    // 37 x 43: the last band is partial and no border falls on a multiple of 8.
+    let (w, h) = (37, 43);
+    for scene in 0..12 {
+        let camera =
+            Camera::new([0.3, 0.2, 5.0], [0.0, 0.0, 0.0], 40.0 + 5.0 * scene as f64).unwrap();
+        let (positions, tris, radiance) = random_scene(&mut rng);
+        let mesh = LitMesh {
+            positions: positions.view(),
+            triangles: &tris,
+            radiance: radiance.view(),
+        };
+        let colour = [0.25, 0.5, 0.75];
+        let got = render(&camera, w, h, &mesh, Background::Colour(colour)).unwrap();
+        let want = brute_force(&camera, w, h, &mesh, |_, _| colour);
+        assert_eq!(got.planes(), want, "scene {scene}");
+        // Some pixels drawn, some left to the background.
+        let background = (0..h * w)
+            .filter(|&p| want[[0, p / w, p % w]] == 0.25)
+            .count();
+        assert!(
+            background > 0 && background < w * h,
+            "scene {scene}: {background}"
+        );
+        let got = render(&camera, w, h, &mesh, Background::Environment(&env)).unwrap();
+        let want = brute_force(&camera, w, h, &mesh, |i, j| {
+            let (theta, phi) = angles(camera.ray(j as f64 + 0.5, i as f64 + 0.5, w, h));
+            let mut v = [0.0; 3];
+            env.bilinear(theta, phi, &mut v);
+            v.map(|x| x as f32)
+        });
+        assert_eq!(got.planes(), want, "scene {scene}, environment");
+        // Threads do not change a bit.
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let alone = one.install(|| render(&camera, w, h, &mesh, Background::Environment(&env)));
+        assert_eq!(alone.unwrap(), got, "scene {scene}, one thread");
     }
 }

@@ -1,12 +1,13 @@
 //! How a relit scene is seen: the camera a caller asked for resolved against the scene file's
-//! and the scene's framing, and the frame drawn ([`ViewSpec`]).
+//! and the scene's framing, and the frame drawn ([`ViewSpec`]), or frame after frame
+//! ([`Frames`]).
 
 use ndarray::ArrayView2;
 
-use super::{Background, Camera, DEFAULT_FOV, LitMesh, render};
+use super::{Background, Camera, DEFAULT_FOV, LitMesh, Sky, SkyLookup, render};
 use crate::relight::light::environment::Environment;
 use crate::relight::{CameraSpec, Mesh};
-use crate::sphere::{LatLongMap, SphereRotation};
+use crate::sphere::SphereRotation;
 use crate::{PlanarImage, Result};
 
 /// What uncovered pixels show.
@@ -81,8 +82,9 @@ impl ViewSpec {
     }
 
     /// `mesh` with per-vertex `radiance` as `camera` sees it, `width x height`, in front of
-    /// the backdrop: the lighting `env` rotated by `rotation` (at most
-    /// [`BACKGROUND_HEIGHT`] rows), or a colour.
+    /// the backdrop: the lighting `env` turned by `rotation` (its copy at most
+    /// [`BACKGROUND_HEIGHT`] rows high, seen along each pixel's ray: see
+    /// [`sky`](super::sky)), or a colour. One frame of [`Frames`].
     ///
     /// ```
     /// use haarshift::relight::light::environment::Environment;
@@ -105,19 +107,108 @@ impl ViewSpec {
         env: &Environment,
         rotation: &SphereRotation,
     ) -> Result<PlanarImage<f32>> {
-        let backdrop: LatLongMap<f64>;
-        let background = match self.backdrop {
-            Backdrop::Environment => {
-                backdrop = env.lat_long(env.map().height().min(BACKGROUND_HEIGHT), rotation)?;
-                Background::Environment(&backdrop)
-            }
-            Backdrop::Colour(c) => Background::Colour(c),
-        };
+        self.draw_keeping(camera, mesh, radiance, env, rotation, None)
+    }
+
+    /// [`draw`](Self::draw), each pixel's place in the environment read from the lookup in
+    /// `kept` when there is one and the lighting turns by whole columns (the lookup made
+    /// first, or anew for another camera, image size or map height, and left there), else
+    /// found from its ray.
+    fn draw_keeping(
+        &self,
+        camera: &Camera,
+        mesh: &Mesh,
+        radiance: ArrayView2<'_, f32>,
+        env: &Environment,
+        rotation: &SphereRotation,
+        kept: Option<&mut Option<SkyLookup>>,
+    ) -> Result<PlanarImage<f32>> {
+        let (width, height) = (self.width, self.height);
         let drawn = LitMesh {
             positions: mesh.positions(),
             triangles: mesh.triangles(),
             radiance,
         };
-        render(camera, self.width, self.height, &drawn, background)
+        let colour = match self.backdrop {
+            Backdrop::Colour(c) => c,
+            Backdrop::Environment => {
+                let map = env.downsampled(env.map().height().min(BACKGROUND_HEIGHT))?;
+                // Only a whole-column yaw reads a lookup (see `sky`).
+                let whole = rotation.whole_column_yaw(map.width()).is_some();
+                let lookup = match kept {
+                    Some(kept) if whole => {
+                        let lookup = match kept.take() {
+                            Some(lookup) if lookup.fits(camera, width, height, &map) => lookup,
+                            _ => SkyLookup::new(camera, width, height, &map)?,
+                        };
+                        Some(&*kept.insert(lookup))
+                    }
+                    _ => None,
+                };
+                let sky = Sky {
+                    map: &map,
+                    rotation,
+                    lookup,
+                };
+                return render(camera, width, height, &drawn, Background::Sky(sky));
+            }
+        };
+        render(camera, width, height, &drawn, Background::Colour(colour))
+    }
+}
+
+/// A view drawn frame after frame: [`ViewSpec::draw`], with each pixel's place in the
+/// environment ([`SkyLookup`]) prepared for the first frame the lighting turns by whole
+/// columns (or not at all) and kept while the camera, the image size and the backdrop's
+/// height stay (an animation's frames turn the lighting, or move the camera and prepare it
+/// anew).
+///
+/// ```
+/// use haarshift::relight::light::environment::Environment;
+/// use haarshift::render::view::{Frames, ViewSpec};
+/// use haarshift::relight::Generator;
+/// use haarshift::sphere::{LatLongMap, SphereRotation};
+/// let mesh = Generator::Sphere { cells: 2 }.mesh().unwrap();
+/// let view = ViewSpec { width: 32, height: 24, ..ViewSpec::default() };
+/// let camera = view.camera(None, &mesh).unwrap();
+/// let radiance = ndarray::Array2::<f32>::ones((mesh.vertex_count(), 3));
+/// let env = Environment::new(LatLongMap::<f64>::from_fn(8, 3, |d, o| o.fill(1.0 + d[0])).unwrap());
+/// let mut frames = Frames::new(view);
+/// for yaw in [0.0, 45.0, 10.0] {
+///     let turn = SphereRotation::from_degrees(yaw, 0.0, 0.0).unwrap();
+///     let image = frames.draw(&camera, &mesh, radiance.view(), &env, &turn).unwrap();
+///     assert_eq!(image, view.draw(&camera, &mesh, radiance.view(), &env, &turn).unwrap());
+/// }
+/// ```
+#[derive(Clone, Debug)]
+pub struct Frames {
+    view: ViewSpec,
+    lookup: Option<SkyLookup>,
+}
+
+impl Frames {
+    /// Frames of `view`, nothing prepared yet.
+    pub fn new(view: ViewSpec) -> Self {
+        Frames { view, lookup: None }
+    }
+
+    /// One frame, as [`ViewSpec::draw`] draws it.
+    pub fn draw(
+        &mut self,
+        camera: &Camera,
+        mesh: &Mesh,
+        radiance: ArrayView2<'_, f32>,
+        env: &Environment,
+        rotation: &SphereRotation,
+    ) -> Result<PlanarImage<f32>> {
+        let view = self.view;
+        view.draw_keeping(
+            camera,
+            mesh,
+            radiance,
+            env,
+            rotation,
+            Some(&mut self.lookup),
+        )
     }
 }

@@ -187,6 +187,26 @@ pub(crate) fn continue_index(r: isize, c: isize, h: usize, w: usize) -> (usize, 
     )
 }
 
+/// Channel `k` of four taps (offsets into `flat`) times their weights, summed in their order
+/// from zero.
+#[inline]
+fn weighted<T: Sample>(flat: &[T], taps: &[usize; 4], weights: &[T; 4], k: usize) -> T {
+    let mut sum = T::zero();
+    for (&tap, &weight) in taps.iter().zip(weights) {
+        sum += weight * flat[tap + k];
+    }
+    sum
+}
+
+/// `v.floor()` for a grid coordinate (`|v| < 2^63`; NaN gives 0, whose difference with `v`
+/// is NaN as `floor`'s is): without SSE4.1 in the baseline x86-64 target, `f64::floor` is a
+/// call into libm, which a bilinear lookup made twice per pixel.
+#[inline]
+fn floor(v: f64) -> f64 {
+    let t = v as i64 as f64;
+    if t > v { t - 1.0 } else { t }
+}
+
 /// A lat-long map: `H` rows of elevation by `W = 2 H` columns of azimuth by `C` channels.
 ///
 /// ```
@@ -375,6 +395,16 @@ impl<T: Sample> LatLongMap<T> {
     /// seam (see the [module docs](self)).
     #[inline]
     fn pixel(&self, r: isize, c: isize) -> &[T] {
+        let flat = self.data.as_slice().expect("standard layout");
+        &flat[self.offset(r, c, 0)..][..self.channels()]
+    }
+
+    /// Where pixel `(r, c)` starts in the flat data, after continuing `r` over the poles and
+    /// `c` around the seam, in the map with its columns rolled by `roll` (`< W`, as
+    /// [`roll_columns`](Self::roll_columns) rolls them: its column `c` is this map's
+    /// `c + roll`).
+    #[inline]
+    fn offset(&self, r: isize, c: isize, roll: usize) -> usize {
         let (h, w, ch) = self.data.dim();
         // Inside the map (nearly every lookup) the index is itself: no division.
         let (r, c) = if (0..h as isize).contains(&r) && (0..w as isize).contains(&c) {
@@ -383,26 +413,61 @@ impl<T: Sample> LatLongMap<T> {
             let (r, c, _) = continue_index(r, c, h, w);
             (r, c)
         };
-        let flat = self.data.as_slice().expect("standard layout");
-        &flat[(r * w + c) * ch..][..ch]
+        let c = c + roll;
+        let c = if c >= w { c - w } else { c };
+        (r * w + c) * ch
     }
 
     /// Bilinear lookup at `(theta, phi)` into `out` (one value per channel), between the four
     /// nearest pixel centres, continued over the seam and the poles.
     pub fn bilinear(&self, theta: f64, phi: f64, out: &mut [T]) {
         let (y, x) = self.grid_position(theta, phi);
-        let (r0, c0) = (y.floor(), x.floor());
+        let (taps, weights) = self.bilinear_taps(y, x, 0);
+        let flat = self.data.as_slice().expect("standard layout");
+        // Channels beyond the map's (if `out` has more) stay zero.
+        out.fill(T::zero());
+        for (k, o) in out.iter_mut().take(self.channels()).enumerate() {
+            *o = weighted(flat, &taps, &weights, k);
+        }
+    }
+
+    /// [`bilinear`](Self::bilinear) of the first `N` channels (at most the map's) at the
+    /// continuous grid position `(y, x)` of [`grid_position`](Self::grid_position), in the map
+    /// with its columns rolled by `roll` (`< W`): the values of `self.roll_columns(roll)`
+    /// without the copy.
+    #[inline]
+    pub(crate) fn bilinear_grid<const N: usize>(&self, y: f64, x: f64, roll: usize) -> [T; N] {
+        let (taps, weights) = self.bilinear_taps(y, x, roll);
+        let flat = self.data.as_slice().expect("standard layout");
+        let mut out = [T::zero(); N];
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = weighted(flat, &taps, &weights, k);
+        }
+        out
+    }
+
+    /// The four pixel centres around the grid position `(y, x)` (their offsets in the flat
+    /// data, continued and rolled as [`offset`](Self::offset) does; the upper row first, each
+    /// row left to right) and their bilinear weights.
+    #[inline]
+    fn bilinear_taps(&self, y: f64, x: f64, roll: usize) -> ([usize; 4], [T; 4]) {
+        let (r0, c0) = (floor(y), floor(x));
         let (fy, fx) = (y - r0, x - c0);
         let (r0, c0) = (r0 as isize, c0 as isize);
-        out.fill(T::zero());
-        for (dr, wy) in [(0, 1.0 - fy), (1, fy)] {
-            for (dc, wx) in [(0, 1.0 - fx), (1, fx)] {
-                let weight = T::from_f64(wy * wx);
-                for (o, &v) in out.iter_mut().zip(self.pixel(r0 + dr, c0 + dc)) {
-                    *o += weight * v;
-                }
-            }
-        }
+        let taps = [
+            self.offset(r0, c0, roll),
+            self.offset(r0, c0 + 1, roll),
+            self.offset(r0 + 1, c0, roll),
+            self.offset(r0 + 1, c0 + 1, roll),
+        ];
+        let (gy, gx) = (1.0 - fy, 1.0 - fx);
+        let weights = [
+            T::from_f64(gy * gx),
+            T::from_f64(gy * fx),
+            T::from_f64(fy * gx),
+            T::from_f64(fy * fx),
+        ];
+        (taps, weights)
     }
 
     /// Bicubic (Catmull-Rom) lookup at `(theta, phi)` over the 4 x 4 nearest pixel centres,
@@ -428,7 +493,7 @@ impl<T: Sample> LatLongMap<T> {
     /// Continuous pixel coordinates `(row, column)` of `(theta, phi)`: pixel centres sit at
     /// whole numbers.
     #[inline]
-    fn grid_position(&self, theta: f64, phi: f64) -> (f64, f64) {
+    pub(crate) fn grid_position(&self, theta: f64, phi: f64) -> (f64, f64) {
         let h = self.height() as f64;
         let step = std::f64::consts::PI / h;
         (theta / step - 0.5, phi / step - 0.5)

@@ -6,6 +6,7 @@ use std::time::Instant;
 use haarshift::relight::SceneCache;
 use haarshift::relight::shade::{FrameSpec, Method, ShadingInput};
 use haarshift::render::animation::{numbered_path, write_gif};
+use haarshift::render::view::Frames;
 use haarshift::render::{to_srgb8, write_render};
 use haarshift::{Error, Result};
 
@@ -135,6 +136,9 @@ pub fn run(args: Args) -> Result<()> {
         prepared.seconds * 1e3
     );
     let mut frames = Vec::with_capacity(if gif { args.frames } else { 0 });
+    // Each pixel's place in the environment is prepared with the first frame and kept while
+    // the camera stays.
+    let mut drawing = Frames::new(view);
     for k in 0..args.frames {
         let step = 360.0 * k as f64 / args.frames as f64;
         let (frame_yaw, orbit) = if args.orbit {
@@ -160,7 +164,7 @@ pub fn run(args: Args) -> Result<()> {
         let shade_ms = shading.timing.total_seconds() * 1e3;
         let radiance = shading.radiance.to_f32();
         let start = Instant::now();
-        let image = view.draw(&view_camera, &cache.mesh, radiance.view(), &env, &turn)?;
+        let image = drawing.draw(&view_camera, &cache.mesh, radiance.view(), &env, &turn)?;
         let raster_ms = ms(start);
         match frame_paths.get(k) {
             Some(path) => write_render(&image, path, args.camera.exposure, args.force)?,

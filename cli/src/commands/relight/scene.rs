@@ -15,6 +15,7 @@ use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_ma
 use haarshift::relight::shade::{FrameSpec, Shader, ShaderSpec};
 use haarshift::relight::{Brdf, CameraSpec};
 use haarshift::render::animation::{numbered_path, write_gif};
+use haarshift::render::view::Frames;
 use haarshift::render::{Camera, render_format, to_srgb8, write_render};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
@@ -368,6 +369,9 @@ pub fn run(args: Args) -> Result<()> {
     let keep_light = args.keep_light.map_or(Selection::All, Selection::Largest);
     let mut all_radiance: Vec<Array2<f32>> = Vec::new();
     let mut gif_frames = Vec::new();
+    // Each pixel's place in the environment, prepared with the first frame and kept while
+    // the camera stays.
+    let mut frames = Frames::new(view);
     let mut draw = |scene: &DynamicScene,
                     camera: &Camera,
                     radiance: &Array2<f32>,
@@ -377,7 +381,7 @@ pub fn run(args: Args) -> Result<()> {
                     what: String|
      -> Result<()> {
         let start = Instant::now();
-        let image = view.draw(camera, &scene.mesh(), radiance.view(), &env, turn)?;
+        let image = frames.draw(camera, &scene.mesh(), radiance.view(), &env, turn)?;
         let raster_ms = ms(start);
         match (frame_paths.get(index), gif) {
             (Some(p), _) => write_render(&image, p, args.camera.exposure, args.force)?,
