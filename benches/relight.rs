@@ -31,7 +31,7 @@ use haarshift::faces::param::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::light::downsample::downsample_solid_angle;
 use haarshift::relight::light::environment::{Environment, LightRotation, SphereMapping};
-use haarshift::relight::shade::lambert::CHUNK;
+use haarshift::relight::shade::lambert::{CHUNK, QuantisedTransport};
 use haarshift::relight::{
     Generator, Lighting, PhongSh, PreparedTransport, SceneBvh, ShTransfer, ShadeOptions,
     VisibilityOptions, shade_sh, vertex_major,
@@ -187,7 +187,8 @@ fn bench_relighting(c: &mut Criterion) {
         b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
     });
     // The floor of a frame: the same offsets, indices and values read once, in the same
-    // parallel chunks of vertices, summed (nothing gathered from the lighting).
+    // parallel chunks of vertices, their bits summed (integer sums, which the compiler
+    // vectorises: nothing gathered, nothing waiting on a floating-point add).
     group.bench_function("plain_read_of_the_shaded_bytes", |b| {
         let t = prepared();
         b.iter(|| {
@@ -196,10 +197,35 @@ fn bench_relighting(c: &mut Criterion) {
                 .with_min_len(CHUNK)
                 .map(|v| {
                     let (indices, values) = t.coefficients(v);
-                    let i: u64 = indices.iter().map(|&i| u64::from(i)).sum();
-                    i as f64 + f64::from(values.iter().sum::<f32>())
+                    let i = indices.iter().fold(0u32, |s, &i| s.wrapping_add(i));
+                    let w = values.iter().fold(0u32, |s, x| s.wrapping_add(x.to_bits()));
+                    u64::from(i ^ w)
                 })
-                .sum::<f64>()
+                .sum::<u64>()
+        })
+    });
+    // The same transport in 16 bits a coefficient (--precision q16), and its own floor.
+    let quantised = OnceLock::new();
+    let packed = || quantised.get_or_init(|| QuantisedTransport::new(prepared()));
+    group.bench_function("shade_keep420_q16", |b| {
+        let q = packed();
+        let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
+        let mut out = ndarray::Array2::<f32>::zeros((q.vertex_count(), 3));
+        b.iter(|| q.shade_into(&light, &mut out).expect("shades"))
+    });
+    group.bench_function("plain_read_of_the_q16_bytes", |b| {
+        let q = packed();
+        b.iter(|| {
+            (0..q.vertex_count())
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .map(|v| {
+                    let (gaps, values) = q.entries(v);
+                    let g = gaps.iter().fold(0u16, |s, &g| s.wrapping_add(g));
+                    let w = values.iter().fold(0i16, |s, &x| s.wrapping_add(x));
+                    u64::from(g) ^ w as u64
+                })
+                .sum::<u64>()
         })
     });
     group.bench_function("encode_and_shade/whole_column_yaw", |b| {

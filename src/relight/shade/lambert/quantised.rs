@@ -122,7 +122,14 @@ impl QuantisedTransport {
         self.gaps.len() * 4 + self.offsets.len() * 8
     }
 
-    /// Vertex `v`'s entries as stored: Mallat indices (ascending) and the values `q s_v`
+    /// Vertex `v`'s entries as they are stored: the gaps between indices and the values in
+    /// steps (what a frame reads).
+    pub fn entries(&self, v: usize) -> (&[u16], &[i16]) {
+        let entries = self.offsets[v] as usize..self.offsets[v + 1] as usize;
+        (&self.gaps[entries.clone()], &self.values[entries])
+    }
+
+    /// Vertex `v`'s entries decoded: Mallat indices (ascending) and the values `q s_v`
     /// (the entries that bridge gaps over 65,535 are there too, with value 0).
     pub fn coefficients(&self, v: usize) -> (Vec<u32>, Vec<f32>) {
         let entries = self.offsets[v] as usize..self.offsets[v + 1] as usize;
@@ -156,8 +163,7 @@ impl QuantisedTransport {
                 let (light, mask) = (quads.as_slice(), quads.len() - 1);
                 for (k, row) in rows.chunks_exact_mut(3).enumerate() {
                     let v = first + k;
-                    let entries = self.offsets[v] as usize..self.offsets[v + 1] as usize;
-                    let (gaps, values) = (&self.gaps[entries.clone()], &self.values[entries]);
+                    let (gaps, values) = self.entries(v);
                     let mut index = 0usize;
                     let sum = sum_runs::<f32, _, _>(gaps, values, move |gap, q| {
                         index += usize::from(gap);
