@@ -22,14 +22,14 @@ for param in "latlong 64" "cube 32"; do
     for map in "${maps[@]}"; do
         env_map="testdata/envmaps/${map}_1k.hdr"
         view=(--env "$env_map" --width 64 --height 48)
-        timed reference relight render "$cache" "${view[@]}" --basis reference \
+        timed reference relight render "$cache" "${view[@]}" --basis reference --force \
             --vertices "$work/reference.npy" -o "$work/reference.png"
         for budget in "${budgets[@]}"; do
             label=${budget%%|*}
             read -r -a flags <<<"${budget#*|}"
             for precision in f32 q16; do
                 timed "$precision" relight render "$cache" "${view[@]}" "${flags[@]}" \
-                    --precision "$precision" --vertices "$work/$precision.npy" \
+                    --precision "$precision" --force --vertices "$work/$precision.npy" \
                     -o "$work/$precision.png"
             done
             errors=($("$hs" relight error "$work/reference.npy" "$work/f32.npy" "$work/q16.npy" |
