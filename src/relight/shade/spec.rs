@@ -131,6 +131,13 @@ impl ShaderSpec {
     /// let fast = ShaderSpec { light_rotation: LightRotation::Prefiltered, ..ShaderSpec::default() };
     /// assert!(fast.check().is_ok());
     /// assert!(ShaderSpec { method: Method::Reference, ..fast }.check().is_err()); // the ground truth
+    /// use haarshift::relight::shade::Precision;
+    /// let q16 = ShaderSpec { precision: Precision::Q16, ..ShaderSpec::default() };
+    /// assert!(q16.check().is_ok()); // Lambertian Haar
+    /// let mut glossy = q16.clone();
+    /// glossy.material.brdf = "phong:20".parse().unwrap();
+    /// assert!(glossy.check().unwrap_err().to_string().contains("q16"));
+    /// assert!(ShaderSpec { method: Method::Sh, ..q16 }.check().is_err());
     /// ```
     pub fn check(&self) -> Result<()> {
         let m = &self.material;
