@@ -1,4 +1,4 @@
-use ndarray::{Array2, Array3, Axis};
+use ndarray::{Array2, Array3, ArrayView2, Axis};
 
 use super::*;
 use crate::faces::integrate::layout;
@@ -180,14 +180,7 @@ fn the_shading_is_the_pixel_domain_triple_product_of_the_truncated_factors() {
             let stored = shader.transport().coefficients(v);
             let depths = (depth.unwrap_or(4), brdf_levels.unwrap_or(4));
             let want = pixel_domain(param, stored, &light, &rho, keep, depths);
-            for c in 0..3 {
-                let w = f64::from(albedo[[v, c]]) * want[c];
-                assert!(
-                    (b[[v, c]] - w).abs() < 1e-12 * w.abs().max(1.0),
-                    "vertex {v} channel {c}: {} vs {w}",
-                    b[[v, c]]
-                );
-            }
+            assert_radiance(b.view(), albedo.view(), v, want);
         }
     }
 }
@@ -228,14 +221,7 @@ fn a_cached_vertex_is_the_weighted_triple_product_of_its_bins() {
                     want[c] += w * sum[c];
                 }
             }
-            for c in 0..3 {
-                let w = f64::from(albedo[[v, c]]) * want[c];
-                assert!(
-                    (b[[v, c]] - w).abs() < 1e-12 * w.abs().max(1.0),
-                    "vertex {v} channel {c}: {} vs {w}",
-                    b[[v, c]]
-                );
-            }
+            assert_radiance(b.view(), albedo.view(), v, want);
         }
         assert_eq!(blended > 0, phong, "{blended} vertices blend bins");
     }
@@ -543,5 +529,18 @@ fn full_coefficients_and_direct_evaluation_equal_the_reference() {
             .iter()
             .fold(0.0f64, |a, d| a.max(d.abs()));
         assert!(apart > 0.1 * rms, "{brdf}: {apart} of {rms}");
+    }
+}
+
+/// Vertex `v`'s radiance in `b` is its albedo times `want`, to 1e-12 (relative, or absolute
+/// below 1).
+fn assert_radiance(b: ArrayView2<'_, f64>, albedo: ArrayView2<'_, f32>, v: usize, want: [f64; 3]) {
+    for c in 0..3 {
+        let w = f64::from(albedo[[v, c]]) * want[c];
+        assert!(
+            (b[[v, c]] - w).abs() < 1e-12 * w.abs().max(1.0),
+            "vertex {v} channel {c}: {} vs {w}",
+            b[[v, c]]
+        );
     }
 }
