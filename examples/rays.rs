@@ -8,7 +8,8 @@
 //!   --vertices  precompute these vertices only (all by default)
 //!   --export    write the mesh as Embree takes it (vertices.npy f32 (V, 3), triangles.npy
 //!               i32 (T, 3)) and every ray cast, in casting order: origins.npy and
-//!               directions.npy f32 (N, 3), blocked.npy u8 (N,)
+//!               directions.npy f32 (N, 3), blocked.npy u8 (N,), and the same rays' answers
+//!               through the single-ray path the packets replaced, single_ray.npy u8 (N,)
 //!   --repeat    time the precomputation (rays and Haar encoding, `vertex_range`) R times
 //!               on the rayon pool (RAYON_NUM_THREADS) and print the fastest as JSON
 //!   --baseline  also time it through the single-ray path the packets replaced
@@ -37,12 +38,30 @@ mod single_ray;
 type Recorded = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u8>);
 
 /// Answers through `inner` and records every ray and answer.
-struct Recorder<'a> {
-    inner: &'a SceneBvh,
+struct Recorder<'a, O> {
+    inner: &'a O,
     rays: Mutex<Recorded>,
 }
 
-impl Occlusion for Recorder<'_> {
+impl<O: Occlusion> Recorder<'_, O> {
+    /// Every ray `vertex_range` casts for `vertices`, on one thread (so in vertex order).
+    fn record(
+        inner: &O,
+        mesh: &haarshift::relight::Mesh,
+        options: &VisibilityOptions,
+        vertices: Range<usize>,
+    ) -> Result<Recorded, Box<dyn std::error::Error>> {
+        let recorder = Recorder {
+            inner,
+            rays: Mutex::default(),
+        };
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+        one.install(|| vertex_range(mesh, &recorder, options, vertices))?;
+        Ok(recorder.rays.into_inner()?)
+    }
+}
+
+impl<O: Occlusion> Occlusion for Recorder<'_, O> {
     fn occluded(&self, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
         let mut blocked = [false];
         self.occluded_from(origin, &[direction], t_max, &mut blocked);
@@ -106,13 +125,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let build = start.elapsed().as_secs_f64();
     if let Some(dir) = export {
         std::fs::create_dir_all(&dir)?;
-        let recorder = Recorder {
-            inner: &bvh,
-            rays: Mutex::default(),
-        };
-        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-        one.install(|| vertex_range(mesh, &recorder, &options, vertices.clone()))?;
-        let (origins, directions, blocked) = recorder.rays.into_inner()?;
+        let (origins, directions, blocked) =
+            Recorder::record(&bvh, mesh, &options, vertices.clone())?;
+        let old = single_ray::SingleRay::new(mesh);
+        let (_, old_directions, single_ray) =
+            Recorder::record(&old, mesh, &options, vertices.clone())?;
+        assert_eq!(
+            old_directions, directions,
+            "both paths are asked the same rays"
+        );
         let positions = mesh.positions().mapv(|x| x as f32);
         let triangles = mesh.triangles().iter().flatten().map(|&i| i as i32);
         let triangles = Array2::from_shape_vec((mesh.triangles().len(), 3), triangles.collect())?;
@@ -121,6 +142,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ndarray_npy::write_npy(dir.join("origins.npy"), &rows(origins))?;
         ndarray_npy::write_npy(dir.join("directions.npy"), &rows(directions))?;
         ndarray_npy::write_npy(dir.join("blocked.npy"), &Array1::from(blocked))?;
+        ndarray_npy::write_npy(dir.join("single_ray.npy"), &Array1::from(single_ray))?;
     }
     if repeat > 0 {
         let (rays, seconds, set) = fastest(&scene, &bvh, &options, &vertices, repeat)?;
