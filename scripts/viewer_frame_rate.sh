@@ -5,7 +5,9 @@
 #   194 and 414 detail coefficients plus the 6 faces' scaling ones), Lambertian, the lighting
 #   dragged and the camera orbited, and at 320 x 240; the bunny on its ground plane at lat-long
 #   64, Lambertian and with Phong 50 (rotation cache 64; every coefficient, or 200 and 420), the
-#   lighting dragged and the camera orbited; the bunny at cube 6 x 64^2, Lambertian. Prints a Markdown report:
+#   lighting dragged and the camera orbited; the bunny at cube 6 x 64^2, Lambertian; the bunny and
+#   the ball (testdata/scenes/bunny_and_ball.json, a dynamic scene at lat-long 32: occlusion
+#   fields), the ball dragged across the ground and the lighting dragged. Prints a Markdown report:
 #   scripts/viewer_frame_rate.sh > results/viewer/frame_rate.md
 # The caches are precomputed in a temporary directory (minutes for the cubes); WORK=DIR keeps
 # and reuses them. ENV (first argument) is the lighting.
@@ -35,6 +37,8 @@ rows=(
     "$("$rate" "$work/bunny.hsr" "$env_map" label=bunny "${phong[@]}" "${budgets[@]}")"
     "$("$rate" "$work/bunny.hsr" "$env_map" label=bunny "${phong[@]}" drag=orbit)"
     "$("$rate" "$work/bunny-cube.hsr" "$env_map" label=bunny "${budgets[@]}")"
+    "$("$rate" testdata/scenes/bunny_and_ball.json "$env_map" label=bunny-and-ball drag=object:1)"
+    "$("$rate" testdata/scenes/bunny_and_ball.json "$env_map" label=bunny-and-ball)"
     "$("$rate" "$work/cubes.hsr" "$env_map" label=cubes keep_light=194 screenshot=results/viewer/cubes.png)"
 )
 echo "# The viewer's frame rates"
@@ -45,7 +49,9 @@ echo "unless the row says otherwise;"
 echo "the lighting \`$env_map\`. Load when it started (\`uptime\`): \`$start_load\`"
 echo
 echo "Each row is one page and one drag of 50 mouse moves, one every 16 ms (a 60 Hz mouse),"
-echo "4 pixels each: 2 degrees of lighting yaw, or 1.6 degrees of camera orbit. *Server ms* are"
+echo "4 pixels each: 2 degrees of lighting yaw, 1.6 degrees of camera orbit, or a dynamic scene's"
+echo "object slid across the ground by 4 pixels' worth at the point looked at (the server then"
+echo "sends the mesh's positions with the frame; *prepare* is placing the objects). *Server ms* are"
 echo "medians over the frames computed during the drag, from the frames' headers: the lighting"
 echo "rotated and encoded, the BRDF rotations, the shading (rotations included) and their sum."
 echo "*Received/s* and *drawn/s* are the page's own counters over the drag's wall time, read over"

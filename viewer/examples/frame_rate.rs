@@ -2,12 +2,15 @@
 //! with the server): one markdown row per run.
 //!
 //! ```sh
-//! cargo run --release -p haarshift-viewer --example frame_rate -- CACHE ENV [KEY=VALUE ...]
+//! cargo run --release -p haarshift-viewer --example frame_rate -- SCENE ENV [KEY=VALUE ...]
 //! ```
 //!
-//! Keys: `brdf` (`lambert`), `keep_light`, `keep_visibility`, `keep_brdf`, `rotation_cache` (the page's
-//! state), `drag` (`light` or `orbit`), `moves` (50: mouse moves of the drag, one every
-//! 16 ms), `size` (`640x480`), `label`, `screenshot` (a PNG of the page after the drag).
+//! SCENE is a scene cache (`.hsr`) or a scene file (`.json`, built as `relight scene` builds
+//! it at lat-long `resolution`, 32 by default). Keys: `brdf` (`lambert`), `keep_light`,
+//! `keep_visibility`, `keep_brdf`, `rotation_cache` (the page's state), `drag` (`light`,
+//! `orbit` or `object:K`, a dynamic scene's object K), `moves` (50: mouse moves of the drag,
+//! one every 16 ms), `size` (`640x480`), `label`, `screenshot` (a PNG of the page after the
+//! drag).
 //!
 //! The server's time per frame is the median over the frames computed during the drag of
 //! their lighting encoding and shading (rotations included), from the frames' headers; frames
@@ -18,6 +21,8 @@
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
+use haarshift::faces::{ParamKind, Parameterization};
+use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
 use haarshift::relight::shade::LightSpec;
 use haarshift_viewer::browser::Browser;
 use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
@@ -25,8 +30,8 @@ use serde_json::Value;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let [cache, env, options @ ..] = args.as_slice() else {
-        return Err("usage: frame_rate CACHE ENV [KEY=VALUE ...]".into());
+    let [path, env, options @ ..] = args.as_slice() else {
+        return Err("usage: frame_rate SCENE ENV [KEY=VALUE ...]".into());
     };
     let options: HashMap<&str, &str> = options
         .iter()
@@ -38,15 +43,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .split_once('x')
         .ok_or("size: expected WxH")?;
     let (width, height): (usize, usize) = (width.parse()?, height.parse()?);
-    let orbit = get("drag", "light") == "orbit";
+    let drag = get("drag", "light");
+    let orbit = drag == "orbit";
+    let object = drag
+        .strip_prefix("object:")
+        .map(str::parse::<usize>)
+        .transpose()?;
 
     let light = LightSpec {
         env: Some(env.into()),
         ..LightSpec::default()
     };
-    let scene = ViewedScene::load(cache.as_ref(), &light)?;
-    let vertices = scene.cache.mesh.vertex_count();
-    let param = scene.cache.transport.param();
+    let scene = if path.ends_with(".json") {
+        let resolution = get("resolution", "32").parse()?;
+        let options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, resolution)?);
+        let built = DynamicScene::load_with(path.as_ref(), &options, None)?;
+        ViewedScene::dynamic(built, path.as_ref(), None, &light)?
+    } else {
+        ViewedScene::load(path.as_ref(), &light)?
+    };
+    let vertices = scene.mesh().vertex_count();
+    let param = scene.param();
     let viewer = Viewer::bind(
         scene,
         ViewerOptions {
@@ -94,6 +111,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let count = |b: &mut Browser, what: &str| -> Result<f64, Box<dyn std::error::Error>> {
         Ok(b.evaluate(what)?.as_f64().ok_or(what.to_owned())?)
     };
+    if let Some(k) = object {
+        browser.evaluate(&format!(
+            "const s = document.getElementById('drag_target'); s.value = '{k}'; \
+             s.dispatchEvent(new Event('change')); true"
+        ))?;
+    }
     let received = count(&mut browser, "haarshiftViewer.framesReceived")?;
     let drawn = count(&mut browser, "haarshiftViewer.framesDrawn")?;
     let since = count(&mut browser, "performance.now()")?;
@@ -167,7 +190,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .filter_map(|k| options.get(k).map(|v| format!("{k} {v}")))
             .collect::<Vec<_>>()
             .join(", "),
-        if orbit { "camera" } else { "lighting" },
+        match object {
+            Some(k) => format!("object {k}"),
+            None if orbit => "camera".into(),
+            None => "lighting".into(),
+        },
         median[0],
         median[1],
         median[2],

@@ -3,7 +3,7 @@
 // described in viewer/src/protocol.rs.
 'use strict';
 
-const PACKET = { scene: 1, environment: 2, frame: 3, reference: 4, picture: 5 };
+const PACKET = { scene: 1, environment: 2, frame: 3, reference: 4, picture: 5, positions: 6 };
 const $ = (id) => document.getElementById(id);
 
 // Everything tests and the frame-rate script read over the DevTools protocol.
@@ -18,6 +18,7 @@ const viewer = {
   notices: [],         // error notices from the server, in order
   timings: [],         // per frame received: the server's milliseconds and the round trip
   ready: false,        // the scene and the environment have arrived
+  positionsReceived: 0, // a dynamic scene's position packets (its objects moved)
   webgl2: false,
 };
 window.haarshiftViewer = viewer;
@@ -45,7 +46,16 @@ const state = {
   eye: null,
   format: params.get('format') === 'f16' ? 'f16' : 'f32',
   error: params.get('error') === '1',
+  // A dynamic scene's motion path frame and its objects' translations (x,y,z;x,y,z in the URL).
+  path_frame: params.has('path_frame') ? num('path_frame', null) : null,
+  objects: translationsFromUrl(params.get('objects')),
 };
+
+function translationsFromUrl(text) {
+  if (!text) return null;
+  const t = text.split(';').map((o) => o.split(',').map(Number));
+  return t.every((o) => o.length === 3 && o.every(isFinite)) ? t : null;
+}
 // The camera, orbiting the point looked at: azimuth and elevation in degrees, distance.
 const orbit = { azimuth: num('azimuth', NaN), elevation: num('elevation', NaN), distance: num('distance', NaN), target: null, fov: num('fov', NaN) };
 let exposure = num('exposure', 0);
@@ -89,10 +99,16 @@ function packet(buffer) {
     for (const seq of sentAt.keys()) if (seq <= header.seq) sentAt.delete(seq);
     viewer.frame = { header, radiance, roundTripMs: sent === undefined ? undefined : performance.now() - sent };
     viewer.framesReceived += 1;
+    if (playing && header.seq === state.seq) setTimeout(stepPath, PATH_FRAME_MS);
     viewer.timings.push({ encode: header.encode_ms, rotate: header.rotate_ms, shade: header.shade_ms, prepare: header.prepare_ms, roundTrip: viewer.frame.roundTripMs, at: performance.now() });
     if (viewer.timings.length > 10000) viewer.timings.shift();
     hideMessage();
     frameDirty = true;
+  } else if (kind === PACKET.positions) {
+    // A dynamic scene's objects moved: the frame that follows is shaded where they now are.
+    gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
+    gl.bufferSubData(gl.ARRAY_BUFFER, 0, new Float32Array(buffer, start, 3 * header.vertices));
+    viewer.positionsReceived += 1;
   } else if (kind === PACKET.picture) {
     download(new Blob([new Uint8Array(buffer, start)], { type: 'image/x-exr' }), 'haarshift-view.exr');
   } else if (kind === PACKET.reference) {
@@ -193,7 +209,7 @@ function program(vs, fs) {
   return p;
 }
 
-let meshProgram, skyProgram, vao, radianceBuffer, indexCount = 0, envTexture = null;
+let meshProgram, skyProgram, vao, positionBuffer, radianceBuffer, indexCount = 0, envTexture = null;
 if (gl) {
   meshProgram = program(MESH_VS, MESH_FS);
   skyProgram = program(SKY_VS, SKY_FS);
@@ -208,9 +224,9 @@ function sceneArrived(header, buffer, start) {
   const triangles = new Uint32Array(buffer, start + 12 * v, 3 * header.triangles);
   vao = gl.createVertexArray();
   gl.bindVertexArray(vao);
-  const positionBuffer = gl.createBuffer();
+  positionBuffer = gl.createBuffer();
   gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
-  gl.bufferData(gl.ARRAY_BUFFER, positions, gl.STATIC_DRAW);
+  gl.bufferData(gl.ARRAY_BUFFER, positions, header.dynamic ? gl.DYNAMIC_DRAW : gl.STATIC_DRAW);
   let loc = gl.getAttribLocation(meshProgram, 'position');
   gl.enableVertexAttribArray(loc);
   gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0);
@@ -335,8 +351,10 @@ function vertexColours() {
   if (!state.error) return { colours: frame.radiance, display: false };
   const ref = viewer.reference;
   const sent = frame.header.state;
-  const same = ref && sent && ref.header.yaw === sent.yaw && ref.header.pitch === sent.pitch && ref.header.roll === sent.roll && ref.header.brdf === sent.brdf &&
-    (ref.header.eye === null || (sent.eye && ref.header.eye.every((x, i) => x === sent.eye[i])));
+  // (A dynamic scene's path frame adds its yaw; its objects must be where the frame has them.)
+  const same = ref && sent && ref.header.yaw === sent.yaw + (frame.header.path_yaw ?? 0) && ref.header.pitch === sent.pitch && ref.header.roll === sent.roll && ref.header.brdf === sent.brdf &&
+    (ref.header.eye === null || (sent.eye && ref.header.eye.every((x, i) => x === sent.eye[i]))) &&
+    JSON.stringify(ref.header.translations) === JSON.stringify(frame.header.translations ?? []);
   if (!same) {
     if (!referenceStatus.startsWith('reference ') || referenceStatus.startsWith('reference ready')) referenceStatus = 'reference: waiting for this view';
     return { colours: frame.radiance, display: false };
@@ -469,6 +487,7 @@ function setupControls(scene) {
   $('error').checked = state.error;
   $('error').onchange = () => { state.error = $('error').checked; $('legend').style.display = state.error ? 'block' : 'none'; frameDirty = true; send(); };
   $('legend').style.display = state.error ? 'block' : 'none';
+  if (scene.dynamic) setupDynamic(scene.dynamic);
   $('copy').onclick = () => {
     const c = command();
     $('command').value = c;
@@ -480,6 +499,46 @@ function setupControls(scene) {
   };
   // The linear radiance, drawn by the server's rasteriser from the last frame.
   $('exr').onclick = () => socket.send(JSON.stringify({ type: 'picture', look_at: orbit.target, fov: orbit.fov, width: canvas.width, height: canvas.height }));
+}
+
+// A dynamic scene: its objects are dragged (the one chosen) and its motion path played; the
+// controls of what it does not offer (other bases, the page's materials) are hidden.
+let dragTarget = -1;
+let playing = false;
+const PATH_FRAME_MS = 40; // at most 25 path frames a second, at most one ahead of the server
+function setupDynamic(dynamic) {
+  for (const id of ['basis', 'material', 'exponent', 'brdf_rotation', 'keep_brdf', 'rotation_cache', 'depth']) $(id).parentElement.style.display = 'none';
+  $('dynamic').style.display = 'block';
+  dynamic.objects.forEach((o, k) => $('drag_target').add(new Option(o.name ?? `object ${k}`, k)));
+  $('drag_target').onchange = () => { dragTarget = +$('drag_target').value; };
+  const frames = dynamic.path_frames;
+  if (!frames) {
+    for (const id of ['path_frame', 'play']) ($(id).parentElement.tagName === 'LABEL' ? $(id).parentElement : $(id)).style.display = 'none';
+    return;
+  }
+  $('path_frame').max = frames - 1;
+  $('path_frame').value = state.path_frame ?? 0;
+  $('path_frame').oninput = () => { state.path_frame = +$('path_frame').value; state.objects = null; send(); };
+  $('play').onclick = () => {
+    playing = !playing;
+    $('play').textContent = playing ? 'stop' : 'play the path';
+    if (playing) stepPath();
+  };
+}
+
+function stepPath() {
+  if (!playing) return;
+  const frames = viewer.scene.dynamic.path_frames;
+  state.path_frame = ((state.path_frame ?? -1) + 1) % frames;
+  state.objects = null;
+  $('path_frame').value = state.path_frame;
+  send();
+}
+
+// The translations drawn now: the last frame's (a path frame's placements), else the scene's.
+function translations() {
+  const t = state.objects ?? viewer.frame?.header.translations ?? viewer.scene.dynamic.objects.map((o) => o.translate);
+  return t.map((x) => x.slice());
 }
 
 function download(blob, name) {
@@ -506,6 +565,16 @@ canvas.addEventListener('pointermove', (e) => {
     orbit.azimuth -= 0.4 * dx;
     orbit.elevation = Math.min(89, Math.max(-89, orbit.elevation + 0.4 * dy));
     frameDirty = true;
+  } else if (dragTarget >= 0) {
+    // The object slides on the ground: right with the camera's right, up the screen away from
+    // the eye, a pixel the size of one at the point looked at.
+    const a = (orbit.azimuth * Math.PI) / 180;
+    const perPixel = (2 * orbit.distance * Math.tan((orbit.fov * Math.PI) / 360)) / canvas.height;
+    const t = translations();
+    t[dragTarget][0] += perPixel * (dx * Math.cos(a) + dy * Math.sin(a));
+    t[dragTarget][2] += perPixel * (-dx * Math.sin(a) + dy * Math.cos(a));
+    state.objects = t;
+    state.path_frame = null;
   } else {
     state.yaw = (state.yaw + 0.5 * dx) % 360;
     state.pitch = Math.min(90, Math.max(-90, state.pitch + 0.5 * dy));
@@ -523,10 +592,25 @@ canvas.addEventListener('wheel', (e) => {
 
 const round = (x) => +x.toFixed(6);
 
-// The relight render command that computes this view's frame and picture.
+// The relight render command that computes this view's frame and picture (relight scene for a
+// dynamic scene: objects the page moved are said in a comment, the scene file holds where).
 function command() {
   const s = viewer.scene;
   const eye = eyePosition().map(round);
+  if (s.dynamic) {
+    const yaw = round(state.yaw + (viewer.frame?.header.path_yaw ?? 0));
+    const parts = ['haarshift relight scene', quote(s.cache), '--env', quote(s.env), `--yaw ${yaw}`, `--pitch ${round(state.pitch)}`, `--roll ${round(state.roll)}`, ...s.dynamic.build_flags];
+    if (state.light_rotation !== 'source') parts.push(`--light-rotation ${state.light_rotation}`);
+    if (state.keep_light) parts.push(`--keep-light ${state.keep_light}`);
+    if (state.keep_visibility) parts.push(`--keep-visibility ${state.keep_visibility}`);
+    parts.push(`--camera ${eye.join(',')}`, `--look-at ${orbit.target.map(round).join(',')}`, `--fov ${round(orbit.fov)}`);
+    parts.push(`--width ${canvas.width} --height ${canvas.height}`);
+    if (exposure) parts.push(`--exposure ${exposure}`);
+    parts.push('-o view.png --vertices view.npy');
+    const moved = viewer.frame?.header.translations?.map((t, k) => [t, s.dynamic.objects[k]]).filter(([t, o]) => t.some((x, i) => x !== o.translate[i]));
+    if (moved?.length) parts.push(`  # with ${moved.map(([t, o]) => `${o.name ?? 'an object'} translated to ${t.map(round).join(',')}`).join(', ')} in the scene file`);
+    return parts.join(' ');
+  }
   const parts = ['haarshift relight render', quote(s.cache), '--env', quote(s.env), `--yaw ${round(state.yaw)}`, `--pitch ${round(state.pitch)}`, `--roll ${round(state.roll)}`];
   if (state.basis !== 'haar') parts.push(`--basis ${state.basis}`);
   if (state.light_rotation !== 'source' && state.basis !== 'ambient') parts.push(`--light-rotation ${state.light_rotation}`);
@@ -557,6 +641,8 @@ function writeHash() {
   for (const k of ['basis', 'brdf', 'brdf_rotation', 'light_rotation', 'format']) p.set(k, state[k]);
   for (const k of ['keep_light', 'keep_visibility', 'depth', 'keep_brdf', 'rotation_cache']) if (state[k] !== null) p.set(k, state[k]);
   if (state.error) p.set('error', '1');
+  if (state.path_frame !== null) p.set('path_frame', state.path_frame);
+  if (state.objects) p.set('objects', state.objects.map((t) => t.map(round).join(',')).join(';'));
   for (const k of ['azimuth', 'elevation', 'distance', 'fov']) p.set(k, round(orbit[k]));
   if (exposure) p.set('exposure', exposure);
   if (fixedSize) { p.set('width', fixedSize[0]); p.set('height', fixedSize[1]); }

@@ -26,6 +26,10 @@ use haarshift::{Error, Result};
 /// request is refused rather than reduced, since no drag produces it.
 pub const MAX_DEGREES: f64 = 36_000.0;
 
+/// The most object translations a state may carry (the scene's own count is checked by the
+/// session).
+pub const MAX_OBJECTS: usize = 4096;
+
 /// One message from the page.
 ///
 /// ```
@@ -39,7 +43,7 @@ pub const MAX_DEGREES: f64 = 36_000.0;
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Request {
     /// The view as the page now shows it: compute its frame.
-    State(ViewState),
+    State(Box<ViewState>),
     /// The last frame drawn as a linear OpenEXR picture, by `relight render`'s rasteriser.
     Picture(PictureRequest),
 }
@@ -130,6 +134,13 @@ pub struct ViewState {
     /// Compute the reference for this lighting and material in the background, and send it
     /// when ready, so the page can show the frame's error.
     pub error: bool,
+    /// A dynamic scene's motion path frame (`relight view --animate`): every object where
+    /// the path has put it by then, and the lighting turned by the path's yaw on top of `yaw`.
+    pub path_frame: Option<usize>,
+    /// A dynamic scene's objects' translations, one per object in the scene's order (their
+    /// scale and turn stay): where the page has dragged them. Absent: the scene file's (or
+    /// the path frame's) placements.
+    pub objects: Option<Vec<[f64; 3]>>,
 }
 
 impl Default for ViewState {
@@ -151,6 +162,8 @@ impl Default for ViewState {
             eye: None,
             format: SampleFormat::F32,
             error: false,
+            path_frame: None,
+            objects: None,
         }
     }
 }
@@ -162,6 +175,8 @@ impl ViewState {
     /// use haarshift_viewer::protocol::ViewState;
     /// assert!(ViewState { yaw: 1e9, ..ViewState::default() }.check().is_err());
     /// assert!(ViewState { eye: Some([0.0, f64::INFINITY, 0.0]), ..ViewState::default() }.check().is_err());
+    /// assert!(ViewState { objects: Some(vec![[0.0, f64::NAN, 1.0]]), ..ViewState::default() }.check().is_err());
+    /// assert!(ViewState { objects: Some(vec![[1.0; 3]; 5000]), ..ViewState::default() }.check().is_err());
     /// assert!(ViewState::default().check().is_ok());
     /// ```
     pub fn check(&self) -> Result<()> {
@@ -181,6 +196,19 @@ impl ViewState {
             return Err(Error::parameter(
                 "eye",
                 format!("{eye:?}: expected three finite numbers"),
+            ));
+        }
+        let objects = self.objects.as_deref().unwrap_or_default();
+        if objects.len() > MAX_OBJECTS {
+            return Err(Error::parameter(
+                "objects",
+                format!("{} translations: at most {MAX_OBJECTS}", objects.len()),
+            ));
+        }
+        if let Some(t) = objects.iter().find(|t| t.iter().any(|v| !v.is_finite())) {
+            return Err(Error::parameter(
+                "objects",
+                format!("{t:?}: expected three finite numbers"),
             ));
         }
         Ok(())
@@ -244,6 +272,9 @@ pub enum PacketKind {
     Reference = 4,
     /// A picture: header its size, payload an OpenEXR file.
     Picture = 5,
+    /// A dynamic scene's mesh as the next frame places its objects: header the vertex count,
+    /// payload positions `(V, 3)` f32 (the triangles stay the scene packet's).
+    Positions = 6,
 }
 
 /// The bytes of one binary message of `kind`: its JSON `header`, then `payload` aligned to 4

@@ -17,8 +17,10 @@ use tungstenite::{Message, WebSocket};
 
 use haarshift::product::Selection;
 use haarshift::relight::Brdf;
+use haarshift::relight::dynamic::{Change, DynamicScene, Placement};
 use haarshift::relight::light::environment::LightRotation;
 use haarshift::relight::material::orient::BrdfRotation;
+use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
 use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{
     FrameSpec, Method, ShadeOptions, Shader, ShaderSpec, Shading, ShadingInput,
@@ -32,7 +34,7 @@ use crate::progress::{Counter, watch};
 use crate::protocol::{
     Notice, PacketKind, PictureRequest, Request, SampleFormat, ViewState, packet, sample_bytes,
 };
-use crate::scene::ViewedScene;
+use crate::scene::{Source, ViewedScene};
 
 /// How long an idle session waits on its socket before it looks at its reference again.
 const IDLE_WAIT: Duration = Duration::from_millis(50);
@@ -46,6 +48,8 @@ struct ReferenceKey {
     angles: [f64; 3],
     brdf: String,
     eye: Option<[f64; 3]>,
+    /// A dynamic scene's placements (none for a scene cache).
+    placements: Vec<Placement>,
 }
 
 /// A reference being computed on its own thread.
@@ -64,6 +68,8 @@ pub(crate) struct Session {
     drawn: Option<ViewState>,
     /// The last frame's radiance, rotation and eye, for a picture of it.
     last: Option<(Array2<f32>, SphereRotation, [f64; 3])>,
+    /// A dynamic scene's copy, placed as the last frame asked: each page moves its own.
+    placed: Option<Placed>,
     /// The reference sent last, or being computed.
     reference: Option<ReferenceKey>,
     job: Option<ReferenceJob>,
@@ -81,6 +87,7 @@ impl Session {
             shader: None,
             drawn: None,
             last: None,
+            placed: None,
             reference: None,
             job: None,
             wanted: None,
@@ -116,7 +123,7 @@ impl Session {
             let outgoing = match ws.read() {
                 Ok(Message::Text(text)) => match self.request(&text) {
                     Ok(Request::State(state)) => {
-                        latest = Some(state);
+                        latest = Some(*state);
                         continue;
                     }
                     Ok(Request::Picture(picture)) => vec![self.picture(&picture)],
@@ -175,11 +182,14 @@ impl Session {
                 height: request.height,
                 backdrop: Backdrop::Environment,
             };
-            let mesh = &self.scene.cache.mesh;
-            let camera = view.camera(None, mesh)?;
+            let mesh = match &self.placed {
+                Some(placed) => std::borrow::Cow::Owned(placed.scene.mesh()),
+                None => self.scene.mesh(),
+            };
+            let camera = view.camera(None, &mesh)?;
             let image = view.draw(
                 &camera,
-                mesh,
+                &mesh,
                 radiance.view(),
                 &self.scene.environment,
                 rotation,
@@ -206,8 +216,13 @@ impl Session {
     /// message; the session goes on.
     fn answer(&mut self, state: &ViewState) -> Vec<Message> {
         let mut out = Vec::new();
-        match self.frame(state) {
-            Ok(Some(packet)) => out.push(Message::binary(packet)),
+        let scene = Arc::clone(&self.scene);
+        let frame = match &scene.source {
+            Source::Cache(_) => self.frame(state).map(|f| f.map(|f| vec![f])),
+            Source::Dynamic(base) => self.dynamic_frame(base, state),
+        };
+        match frame {
+            Ok(Some(packets)) => out.extend(packets.into_iter().map(Message::binary)),
             Ok(None) => out.push(notice(&Notice::Unchanged { seq: state.seq })),
             Err(e) => {
                 out.push(notice(&Notice::Error {
@@ -238,7 +253,8 @@ impl Session {
         if self.shader.as_ref().map(|(s, _)| s) != Some(&spec) {
             let start = Instant::now();
             self.shader = None; // the old shader's memory goes before the new one's comes
-            let input = ShadingInput::cache(&self.scene.cache).from_file(&self.scene.cache_path);
+            let cache = self.scene.cache("a shader")?;
+            let input = ShadingInput::cache(cache).from_file(&self.scene.path);
             self.shader = Some((spec.clone(), spec.build(&input)?));
             prepare_ms = start.elapsed().as_secs_f64() * 1e3;
         }
@@ -250,8 +266,27 @@ impl Session {
             rotation,
             eye: Some(eye),
         })?;
+        self.drawn = Some(key);
+        self.frame_packet(
+            state,
+            (rotation, eye),
+            &shading,
+            json!({ "prepare_ms": prepare_ms }),
+        )
+        .map(Some)
+    }
+
+    /// The frame packet of `state`, shaded by `shading` under `rotation` seen from `eye`, with
+    /// `more` in its header; kept as the last frame.
+    fn frame_packet(
+        &mut self,
+        state: &ViewState,
+        (rotation, eye): (SphereRotation, [f64; 3]),
+        shading: &Shading,
+        more: serde_json::Value,
+    ) -> Result<Vec<u8>> {
         let radiance = shading.radiance.to_f32();
-        let header = json!({
+        let mut header = json!({
             "seq": state.seq,
             "state": ViewState { eye: Some(eye), ..state.clone() },
             "rotation": rotation.matrix(),
@@ -260,18 +295,102 @@ impl Session {
             "encode_ms": shading.timing.encode_seconds * 1e3,
             "rotate_ms": shading.timing.rotate_seconds * 1e3,
             "shade_ms": shading.timing.shade_seconds * 1e3,
-            "prepare_ms": prepare_ms,
+            "prepare_ms": 0.0,
             "light_coefficients": shading.light_coefficients,
-            "maps": shading.maps.map(|m| json!({ "used": m.maps, "rotated": m.rotated, "cached": m.cached })),
+            "maps": shading.maps.as_ref().map(|m| json!({ "used": m.maps, "rotated": m.rotated, "cached": m.cached })),
             "description": shading.description,
         });
+        if let (Some(header), serde_json::Value::Object(more)) = (header.as_object_mut(), more) {
+            header.extend(more);
+        }
         let payload = {
             let values = radiance.as_standard_layout();
             sample_bytes(values.as_slice().expect("standard layout"), state.format)
         };
-        self.drawn = Some(key);
         self.last = Some((radiance, rotation, eye));
-        packet(PacketKind::Frame, &header, &payload).map(Some)
+        packet(PacketKind::Frame, &header, &payload)
+    }
+
+    /// The packets answering `state` in a dynamic scene built as `base`: the mesh's positions
+    /// when an object moved since they were last sent, then the frame; `None` when the last
+    /// frame answers it. Frames are `relight scene`'s: occlusion fields and Haar product
+    /// integrals through [`DynamicShader`].
+    fn dynamic_frame(
+        &mut self,
+        base: &DynamicScene,
+        state: &ViewState,
+    ) -> Result<Option<Vec<Vec<u8>>>> {
+        check_dynamic(state)?;
+        let glossy = !glossy_material(base)?.is_lambert();
+        let mut key = ViewState {
+            seq: 0,
+            error: false,
+            ..state.clone()
+        };
+        if !glossy {
+            key.eye = None;
+        }
+        if self.drawn.as_ref() == Some(&key) {
+            return Ok(None);
+        }
+        let (placements, path_yaw) = placements(base, self.scene.motion.as_deref(), state)?;
+        let start = Instant::now();
+        let placed = match self.placed.take() {
+            Some(placed) if placed.keep_visibility == state.keep_visibility => placed,
+            _ => Placed {
+                scene: match state.keep_visibility {
+                    Some(k) => base.truncated(Selection::Largest(k), Selection::All)?,
+                    None => base.clone(),
+                },
+                keep_visibility: state.keep_visibility,
+                sent: (0..base.object_count())
+                    .map(|k| base.placement(k))
+                    .collect(),
+            },
+        };
+        let placed = self.placed.insert(placed);
+        for (k, &p) in placements.iter().enumerate() {
+            if placed.scene.placement(k) != p {
+                placed.scene.place(k, p)?;
+            }
+        }
+        let eye = state.eye.unwrap_or(self.scene.camera.position());
+        if glossy {
+            placed.scene.set_eye(eye)?;
+        }
+        let prepare_ms = start.elapsed().as_secs_f64() * 1e3;
+        let rotation = SphereRotation::from_degrees(state.yaw + path_yaw, state.pitch, state.roll)?;
+        let keep_light = state.keep_light.map_or(Selection::All, Selection::Largest);
+        let shading = DynamicShader::new(&placed.scene, DynamicMethod::Haar, keep_light)
+            .with_light_rotation(state.light_rotation.parse()?)
+            .shade(&FrameSpec {
+                environment: &self.scene.environment,
+                rotation,
+                eye: Some(eye),
+            })?;
+        let mut packets = Vec::new();
+        if placed.sent != placements {
+            let positions: Vec<f32> = placed
+                .scene
+                .mesh()
+                .positions()
+                .iter()
+                .map(|&v| v as f32)
+                .collect();
+            let header = json!({ "vertices": positions.len() / 3 });
+            packets.push(packet(
+                PacketKind::Positions,
+                &header,
+                &sample_bytes(&positions, SampleFormat::F32),
+            )?);
+            placed.sent.clone_from(&placements);
+        }
+        let translations: Vec<[f64; 3]> = placements.iter().map(|p| p.translate).collect();
+        let more =
+            json!({ "prepare_ms": prepare_ms, "translations": translations, "path_yaw": path_yaw });
+        packets.push(self.frame_packet(state, (rotation, eye), &shading, more)?);
+        self.drawn = Some(key);
+        Ok(Some(packets))
     }
 
     /// The shader `state` asks for, its budgets checked against the scene's.
@@ -284,7 +403,7 @@ impl Session {
             ));
         }
         let brdf = page_brdf(&state.brdf)?;
-        let param = self.scene.cache.transport.param();
+        let param = self.scene.param();
         let texels = param.texels();
         let levels = param.face_size().trailing_zeros() as usize;
         for (name, budget) in [
@@ -336,10 +455,25 @@ impl Session {
         let Ok(brdf) = page_brdf(&state.brdf) else {
             return;
         };
+        let placed = self.placed.as_ref().map(|p| p.scene.clone());
+        let path_yaw = match &self.scene.source {
+            Source::Cache(_) => 0.0,
+            Source::Dynamic(base) => match placements(base, self.scene.motion.as_deref(), state) {
+                Ok((_, yaw)) => yaw,
+                Err(_) => return,
+            },
+        };
+        let glossy = match &placed {
+            Some(scene) => glossy_material(scene).is_ok_and(|b| !b.is_lambert()),
+            None => !brdf.is_lambert(),
+        };
         let key = ReferenceKey {
-            angles: [state.yaw, state.pitch, state.roll],
+            angles: [state.yaw + path_yaw, state.pitch, state.roll],
             brdf: state.brdf.clone(),
-            eye: (!brdf.is_lambert()).then(|| state.eye.unwrap_or(self.scene.camera.position())),
+            eye: glossy.then(|| state.eye.unwrap_or(self.scene.camera.position())),
+            placements: placed.as_ref().map_or_else(Vec::new, |s| {
+                (0..s.object_count()).map(|k| s.placement(k)).collect()
+            }),
         };
         if self.reference.as_ref() == Some(&key) || self.job.is_some() {
             return;
@@ -365,14 +499,21 @@ impl Session {
         let eye = key.eye.unwrap_or(self.scene.camera.position());
         std::thread::spawn(move || {
             watch(watched);
-            let input = ShadingInput::cache(&scene.cache).from_file(&scene.cache_path);
-            let shading = spec.build(&input).and_then(|mut shader| {
-                shader.shade(&FrameSpec {
-                    environment: &scene.environment,
-                    rotation,
-                    eye: Some(eye),
-                })
-            });
+            let frame = FrameSpec {
+                environment: &scene.environment,
+                rotation,
+                eye: Some(eye),
+            };
+            let shading = match &placed {
+                Some(placed) => {
+                    DynamicShader::new(placed, DynamicMethod::Reference, Selection::All)
+                        .shade(&frame)
+                }
+                None => scene.cache("the reference").and_then(|cache| {
+                    let input = ShadingInput::cache(cache).from_file(&scene.path);
+                    spec.build(&input)?.shade(&frame)
+                }),
+            };
             // The page may have gone: nobody to tell.
             let _ = send.send(shading);
         });
@@ -421,6 +562,7 @@ impl Session {
                         "roll": job.key.angles[2],
                         "brdf": job.key.brdf,
                         "eye": job.key.eye,
+                        "translations": job.key.placements.iter().map(|p| p.translate).collect::<Vec<_>>(),
                         "seconds": job.start.elapsed().as_secs_f64(),
                         "description": shading.description,
                     });
@@ -442,6 +584,90 @@ impl Session {
             }
         }
     }
+}
+
+/// A dynamic scene's copy in one session.
+struct Placed {
+    /// The scene, its own transport truncated to `keep_visibility`, placed as the last frame
+    /// asked.
+    scene: DynamicScene,
+    keep_visibility: Option<usize>,
+    /// The placements whose positions the page has.
+    sent: Vec<Placement>,
+}
+
+/// Refuses what a dynamic scene does not offer: it is shaded by Haar product integrals with
+/// its file's materials.
+fn check_dynamic(state: &ViewState) -> Result<()> {
+    let refuse = |name: &'static str, what: &str| {
+        Err(Error::parameter(
+            name,
+            format!(
+                "{what}: a dynamic scene is shaded by Haar product integrals with its scene file's materials"
+            ),
+        ))
+    };
+    if state.basis != "haar" {
+        return refuse("basis", &state.basis);
+    }
+    if state.brdf != "lambert" {
+        return refuse("brdf", &state.brdf);
+    }
+    if let Some(d) = state.depth {
+        return refuse("depth", &d.to_string());
+    }
+    if let Some(k) = state.keep_brdf {
+        return refuse("keep_brdf", &k.to_string());
+    }
+    Ok(())
+}
+
+/// Every object's placement in `state` and the lighting's yaw that its motion path frame
+/// adds: the scene's placements, then the path's moves up to its frame, then the page's
+/// translations.
+fn placements(
+    scene: &DynamicScene,
+    motion: Option<&[haarshift::relight::dynamic::motion::FrameState]>,
+    state: &ViewState,
+) -> Result<(Vec<Placement>, f64)> {
+    let n = scene.object_count();
+    let mut placements: Vec<Placement> = (0..n).map(|k| scene.placement(k)).collect();
+    let mut yaw = 0.0;
+    if let Some(f) = state.path_frame {
+        let frames = motion.ok_or_else(|| {
+            Error::parameter(
+                "path_frame",
+                "the viewer has no motion path: start it with --animate PATH.json",
+            )
+        })?;
+        let Some(last) = frames.get(f) else {
+            return Err(Error::parameter(
+                "path_frame",
+                format!("{f}: the motion path has {} frames", frames.len()),
+            ));
+        };
+        for frame in &frames[..=f] {
+            if let (Change::Object(k), Some(p)) = (frame.change, frame.placement) {
+                placements[k] = p;
+            }
+        }
+        yaw = last.light_yaw;
+    }
+    if let Some(translations) = &state.objects {
+        if translations.len() != n {
+            return Err(Error::parameter(
+                "objects",
+                format!(
+                    "{} translations: the scene has {n} objects",
+                    translations.len()
+                ),
+            ));
+        }
+        for (p, &t) in placements.iter_mut().zip(translations) {
+            p.translate = t;
+        }
+    }
+    Ok((placements, yaw))
 }
 
 /// A BRDF the page may ask for: by name, never a file (a page must not make the server read

@@ -24,3 +24,4 @@ mod sphere_integrate;
 mod sphere_product;
 mod transform;
 mod viewer;
+mod viewer_dynamic;

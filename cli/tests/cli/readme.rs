@@ -135,8 +135,8 @@ const SMALLER: &[(&str, &str)] = &[
     ("--rotation-cache", "8"),
 ];
 
-/// Flags the test adds to `relight scene` (its occlusion fields' sampling, 29,720 points a shape
-/// by default), so that each scene command takes seconds.
+/// Flags the test adds to `relight scene` and `relight view SCENE.json` (the occlusion fields'
+/// sampling, 29,720 points a shape by default), so that each scene command takes seconds.
 const SPARSER_FIELDS: &[&str] = &["--circles", "10", "--circle-points", "20", "--shells", "4"];
 
 /// The arguments of every `haarshift` line in the README's `sh` blocks after the first, in
@@ -166,7 +166,14 @@ fn smaller(args: &[String]) -> Vec<String> {
             out[i] = (*value).to_owned();
         }
     }
-    if out.len() > 1 && out[0] == "relight" && out[1] == "scene" {
+    let builds_fields = match out.as_slice() {
+        [relight, scene, ..] if relight == "relight" && scene == "scene" => true,
+        [relight, view, file, ..] if relight == "relight" && view == "view" => {
+            file.ends_with(".json")
+        }
+        _ => false,
+    };
+    if builds_fields {
         out.extend(SPARSER_FIELDS.iter().map(|s| (*s).to_owned()));
     }
     out

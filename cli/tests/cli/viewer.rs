@@ -101,8 +101,19 @@ fn page_frame(browser: &mut Browser) -> (Value, Array2<f32>) {
     (state, Array2::from_shape_vec((rows, 3), values).unwrap())
 }
 
+/// Opens `url` and waits until the page has loaded.
+pub fn load_page(browser: &mut Browser, url: &str) {
+    browser.navigate(url).unwrap();
+    browser
+        .wait_for(
+            "document.readyState === 'complete'",
+            Duration::from_secs(30),
+        )
+        .unwrap();
+}
+
 /// Waits until the page has drawn the frame of the last state it sent.
-fn wait_for_latest(browser: &mut Browser) {
+pub fn wait_for_latest(browser: &mut Browser) {
     let waited = browser.wait_for(
         "haarshiftViewer.frame !== null && haarshiftViewer.state !== null && \
              haarshiftViewer.frame.header.seq === haarshiftViewer.state.seq && \
@@ -179,18 +190,13 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
     let env = testdata("envmaps/rooitou_park_256x128.npy");
     let view = ViewProcess::start(&[p(&cache), "--env", p(&env)]);
     let mut browser = Browser::launch(SIZE[0], SIZE[1]).unwrap();
-    browser
-        .navigate(&format!(
+    load_page(
+        &mut browser,
+        &format!(
             "{}#width={}&height={}&panel=0&yaw=30&pitch=10&keep_light=200",
             view.url, SIZE[0], SIZE[1]
-        ))
-        .unwrap();
-    browser
-        .wait_for(
-            "document.readyState === 'complete'",
-            Duration::from_secs(30),
-        )
-        .unwrap();
+        ),
+    );
     assert_eq!(
         browser.evaluate("haarshiftViewer.webgl2").unwrap(),
         Value::Bool(true),
@@ -324,7 +330,7 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
 }
 
 /// A WebSocket client of the viewer, as a page would be.
-struct Client(tungstenite::WebSocket<std::net::TcpStream>);
+pub struct Client(tungstenite::WebSocket<std::net::TcpStream>);
 
 impl Client {
     /// Connects to `/ws`, with an `Origin` header when given.
@@ -349,7 +355,7 @@ impl Client {
     }
 
     /// Reads the scene and environment packets a session opens with.
-    fn opened(url: &str) -> Client {
+    pub fn opened(url: &str) -> Client {
         let mut client = Client::connect(url, None).unwrap();
         assert_eq!(client.packet_kind(), 1);
         assert_eq!(client.packet_kind(), 2);
@@ -375,11 +381,11 @@ impl Client {
         panic!("no session was freed within 30 s");
     }
 
-    fn send(&mut self, text: &str) {
+    pub fn send(&mut self, text: &str) {
         self.0.send(tungstenite::Message::text(text)).unwrap();
     }
 
-    fn next(&mut self) -> tungstenite::Message {
+    pub fn next(&mut self) -> tungstenite::Message {
         loop {
             let message = self.0.read().unwrap();
             if message.is_text() || message.is_binary() {
@@ -397,7 +403,7 @@ impl Client {
     }
 
     /// The next message: an error notice whose message contains `needle`.
-    fn refused(&mut self, needle: &str) {
+    pub fn refused(&mut self, needle: &str) {
         match self.next() {
             tungstenite::Message::Text(t) => {
                 let notice: Value = serde_json::from_str(&t).unwrap();

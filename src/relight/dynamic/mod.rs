@@ -122,6 +122,7 @@ pub struct BuildReport {
 /// assert_eq!((scene.object_count(), scene.shape_count()), (2, 1)); // one shape, two instances
 /// assert_eq!(scene.vertex_count(), 2 * 54 + 33 * 33);
 /// assert_eq!(scene.object_index("b"), Some(1));
+/// assert_eq!((scene.object_name(0), scene.object_name(1)), (Some("a"), Some("b")));
 /// ```
 #[derive(Clone, Debug)]
 pub struct DynamicScene {
@@ -233,6 +234,11 @@ impl DynamicScene {
         self.objects
             .iter()
             .position(|o| o.name.as_deref() == Some(name))
+    }
+
+    /// Object `k`'s name in the scene file, if it has one.
+    pub fn object_name(&self, k: usize) -> Option<&str> {
+        self.objects.get(k).and_then(|o| o.name.as_deref())
     }
 
     /// Object `k`'s placement.

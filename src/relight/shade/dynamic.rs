@@ -7,13 +7,13 @@ use std::time::Instant;
 
 use ndarray::Array2;
 
-use super::{FrameSpec, Preparation, Radiance, Shader, Shading, Timing, seconds};
+use super::{FrameSpec, HaarEncoder, Preparation, Radiance, Shader, Shading, Timing, seconds};
 use crate::Result;
 use crate::named::named_enum;
 use crate::product::Selection;
+use crate::relight::Brdf;
 use crate::relight::dynamic::DynamicScene;
-use crate::relight::light::environment::Environment;
-use crate::relight::{Brdf, Lighting};
+use crate::relight::light::environment::{Environment, LightRotation};
 use crate::sphere::SphereRotation;
 
 named_enum! {
@@ -32,7 +32,8 @@ named_enum! {
 }
 
 /// A [`DynamicScene`] as it is placed now, shaded by a [`DynamicMethod`] with the lighting
-/// truncated to `keep_light` (Haar).
+/// truncated to `keep_light` (Haar) and rotated at the source map's resolution (or as
+/// [`with_light_rotation`](Self::with_light_rotation) says).
 ///
 /// ```
 /// use haarshift::product::Selection;
@@ -59,7 +60,7 @@ named_enum! {
 pub struct DynamicShader<'a> {
     scene: &'a DynamicScene,
     method: DynamicMethod,
-    keep_light: Selection,
+    encoder: HaarEncoder,
 }
 
 impl<'a> DynamicShader<'a> {
@@ -68,7 +69,46 @@ impl<'a> DynamicShader<'a> {
         DynamicShader {
             scene,
             method,
-            keep_light,
+            encoder: HaarEncoder::new(scene.param(), keep_light, LightRotation::Source),
+        }
+    }
+
+    /// The shader with the Haar lighting rotated as `how` says: [`LightRotation::Prefiltered`]
+    /// is what an interactive drag needs (milliseconds at any angle, against a tenth of a
+    /// second at a 1k map's resolution). The reference always rotates the source.
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::SceneFile;
+    /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
+    /// use haarshift::relight::light::environment::{Environment, LightRotation};
+    /// use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader};
+    /// use haarshift::relight::shade::{FrameSpec, Shader};
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
+    /// use haarshift::sphere::{LatLongMap, SphereRotation};
+    /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
+    ///     {"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();
+    /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
+    /// (options.field.circles, options.field.circle_points) = (8, 16);
+    /// (options.field.shells, options.field.shell_grid) = (4, 3);
+    /// let scene = DynamicScene::build(&file, std::path::Path::new("."), &options).unwrap();
+    /// let sky = Environment::new(LatLongMap::<f64>::from_fn(64, 3, |d, o| o.fill(1.0 + d[1])).unwrap());
+    /// let tilt = SphereRotation::from_degrees(10.0, 30.0, 0.0).unwrap();
+    /// let frame = FrameSpec { environment: &sky, rotation: tilt, eye: None };
+    /// let haar = |how| {
+    ///     let mut shader = DynamicShader::new(&scene, DynamicMethod::Haar, Selection::All)
+    ///         .with_light_rotation(how);
+    ///     shader.shade(&frame).unwrap().radiance.to_f64()
+    /// };
+    /// let (source, fast) = (haar(LightRotation::Source), haar(LightRotation::Prefiltered));
+    /// assert_ne!(source, fast);
+    /// assert!((&source - &fast).iter().all(|d| d.abs() < 0.02 * source[[0, 0]]));
+    /// ```
+    pub fn with_light_rotation(self, how: LightRotation) -> Self {
+        let keep = self.encoder.keep();
+        DynamicShader {
+            encoder: HaarEncoder::new(self.scene.param(), keep, how),
+            ..self
         }
     }
 
@@ -93,14 +133,7 @@ impl Shader for DynamicShader<'_> {
         let (radiance, encode_seconds, shade_seconds, description, coefficients) = match self.method
         {
             DynamicMethod::Haar => {
-                let start = Instant::now();
-                let lighting = Lighting::new(
-                    frame.environment,
-                    self.scene.param(),
-                    &frame.rotation,
-                    self.keep_light,
-                )?;
-                let encode = seconds(start);
+                let (lighting, encode) = self.encoder.encode(frame)?;
                 let start = Instant::now();
                 let radiance = Radiance::F32(self.scene.shade::<f32>(&lighting)?);
                 let coefficients = lighting.kept() + param.faces();

@@ -278,6 +278,11 @@ impl HaarEncoder {
         }
     }
 
+    /// The lighting's truncation.
+    pub(crate) fn keep(&self) -> Selection {
+        self.keep
+    }
+
     /// `frame`'s lighting and the seconds encoding it took.
     pub(crate) fn encode(&mut self, frame: &FrameSpec<'_>) -> Result<(Lighting, f64)> {
         let start = Instant::now();

@@ -3,7 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
+use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
+use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions};
 use haarshift::relight::light::environment::{Environment, LightRotation};
 use haarshift::relight::material::brdf::DEFAULT_ELEVATIONS;
 use haarshift::relight::material::orient::BrdfRotation;
@@ -121,6 +123,88 @@ impl ShardFlags {
 /// `--shard`, parsed by the library.
 fn shard_spec(s: &str) -> std::result::Result<ShardSpec, String> {
     s.parse().map_err(|e: haarshift::Error| e.to_string())
+}
+
+/// When a looked-up occlusion map is truncated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TruncateWhen {
+    /// Each sample's map is stored truncated; the lookup blends them.
+    Before,
+    /// The stored maps are blended, then the blend is truncated to --keep-field.
+    After,
+}
+
+/// How a dynamic scene (objects with occlusion fields) is built: `relight scene` and
+/// `relight view SCENE.json`.
+#[derive(clap::Args, Debug)]
+#[command(next_help_heading = "Building a scene file's fields (SCENE.json)")]
+pub struct DynamicFlags {
+    /// Parameterisation of every map: `latlong` N x 2N (objects can turn) or `cube` 6 x N x N
+    #[arg(long, default_value = "latlong", value_parser = choice::<ParamKind>(names!(ParamKind)))]
+    pub param: ParamKind,
+
+    /// Resolution N: lat-long N x 2N, cube 6 x N x N
+    #[arg(long, value_name = "N", default_value_t = 32)]
+    pub resolution: usize,
+
+    /// Detail coefficients of each vertex's own transport kept [default: all]
+    #[arg(long, value_name = "K")]
+    pub keep_visibility: Option<usize>,
+
+    /// Detail coefficients of each occlusion map kept [default: all]
+    #[arg(long, value_name = "K")]
+    pub keep_field: Option<usize>,
+
+    /// Detail coefficients of each vertex's fixed product kept (animations) [default: all]
+    #[arg(long, value_name = "K")]
+    pub keep_product: Option<usize>,
+
+    /// When looked-up occlusion maps are truncated
+    #[arg(long, value_enum, default_value = "before")]
+    pub truncate: TruncateWhen,
+
+    /// Traversal depth: detail levels 0..D-1 only [default: all]
+    #[arg(long, value_name = "D")]
+    pub depth: Option<usize>,
+
+    /// Circles of the planar field
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    pub circles: usize,
+
+    /// Points per circle
+    #[arg(long, value_name = "N", default_value_t = 200)]
+    pub circle_points: usize,
+
+    /// Shells of the spherical field
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub shells: usize,
+
+    /// Points per face edge of each shell's cube grid
+    #[arg(long, value_name = "N", default_value_t = 9)]
+    pub shell_grid: usize,
+
+    /// Load each shape's fields from DIR when its file matches; build and write absent ones
+    #[arg(long, value_name = "DIR")]
+    pub fields_dir: Option<PathBuf>,
+}
+
+impl DynamicFlags {
+    /// The build options the flags say (progress bars on).
+    pub fn options(&self) -> Result<DynamicOptions> {
+        Ok(DynamicOptions::from_budgets(&DynamicBudgets {
+            param: Parameterization::new(self.param, self.resolution)?,
+            keep_visibility: self.keep_visibility,
+            keep_field: self.keep_field,
+            keep_product: self.keep_product,
+            truncate_after: self.truncate == TruncateWhen::After,
+            depth: self.depth,
+            circles: self.circles,
+            circle_points: self.circle_points,
+            shells: self.shells,
+            shell_grid: self.shell_grid,
+            progress: true,
+        }))
+    }
 }
 
 /// The lighting: the environment map and its rotation.

@@ -4,11 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift::relight::dynamic::fields::file::FieldStore;
 use haarshift::relight::dynamic::motion::{MotionPath, play};
-use haarshift::relight::dynamic::{Change, DynamicBudgets, DynamicOptions, DynamicScene};
+use haarshift::relight::dynamic::{Change, DynamicScene};
 use haarshift::relight::light::environment::LightRotation;
 use haarshift::relight::precompute::shard::Shard;
 use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
@@ -20,7 +19,9 @@ use haarshift::render::{Camera, render_format, to_srgb8, write_render};
 use haarshift::{Error, Result, SampleDepth};
 use ndarray::{Array2, Array3};
 
-use super::flags::{CameraFlags, GlossyFlags, LightFlags, ShardFlags, brdf, bytes, ms, rotation};
+use super::flags::{
+    CameraFlags, DynamicFlags, GlossyFlags, LightFlags, ShardFlags, brdf, bytes, ms, rotation,
+};
 use crate::commands::{choice, names, print, refuse_outputs};
 
 const HELP: &str = "\
@@ -74,15 +75,6 @@ Examples:
   haarshift relight scene testdata/scenes/table_and_chair.json --fields-dir fields --shard 1/2
       (builds the chair's fields only: shape 1 of the table and the chair)";
 
-/// When a looked-up occlusion map is truncated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum TruncateWhen {
-    /// Each sample's map is stored truncated; the lookup blends them.
-    Before,
-    /// The stored maps are blended, then the blend is truncated to --keep-field.
-    After,
-}
-
 /// Render a dynamic scene of objects shadowing each other through occlusion fields.
 #[derive(clap::Args, Debug)]
 #[command(after_help = HELP)]
@@ -117,57 +109,12 @@ pub struct Args {
           value_parser = choice::<DynamicMethod>(names!(DynamicMethod)))]
     pub method: DynamicMethod,
 
-    /// Parameterisation of every map: `latlong` N x 2N (objects can turn) or `cube` 6 x N x N
-    #[arg(long, default_value = "latlong", value_parser = choice::<ParamKind>(names!(ParamKind)))]
-    pub param: ParamKind,
-
-    /// Resolution N: lat-long N x 2N, cube 6 x N x N
-    #[arg(long, value_name = "N", default_value_t = 32)]
-    pub resolution: usize,
-
     /// Detail coefficients of the lighting kept [default: all]
     #[arg(long, value_name = "K")]
     pub keep_light: Option<usize>,
 
-    /// Detail coefficients of each vertex's own transport kept [default: all]
-    #[arg(long, value_name = "K")]
-    pub keep_visibility: Option<usize>,
-
-    /// Detail coefficients of each occlusion map kept [default: all]
-    #[arg(long, value_name = "K")]
-    pub keep_field: Option<usize>,
-
-    /// Detail coefficients of each vertex's fixed product kept (animations) [default: all]
-    #[arg(long, value_name = "K")]
-    pub keep_product: Option<usize>,
-
-    /// When looked-up occlusion maps are truncated
-    #[arg(long, value_enum, default_value = "before")]
-    pub truncate: TruncateWhen,
-
-    /// Traversal depth: detail levels 0..D-1 only [default: all]
-    #[arg(long, value_name = "D")]
-    pub depth: Option<usize>,
-
-    /// Circles of the planar field
-    #[arg(long, value_name = "N", default_value_t = 100)]
-    pub circles: usize,
-
-    /// Points per circle
-    #[arg(long, value_name = "N", default_value_t = 200)]
-    pub circle_points: usize,
-
-    /// Shells of the spherical field
-    #[arg(long, value_name = "N", default_value_t = 20)]
-    pub shells: usize,
-
-    /// Points per face edge of each shell's cube grid
-    #[arg(long, value_name = "N", default_value_t = 9)]
-    pub shell_grid: usize,
-
-    /// Load each shape's fields from DIR when its file matches; build and write absent ones
-    #[arg(long, value_name = "DIR")]
-    pub fields_dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub dynamic: DynamicFlags,
 
     /// With --fields-dir: build (or find) the fields of this shard's share of the shapes
     /// only, and render nothing
@@ -197,34 +144,17 @@ pub struct Args {
     pub force: bool,
 }
 
-impl Args {
-    fn options(&self) -> Result<DynamicOptions> {
-        Ok(DynamicOptions::from_budgets(&DynamicBudgets {
-            param: Parameterization::new(self.param, self.resolution)?,
-            keep_visibility: self.keep_visibility,
-            keep_field: self.keep_field,
-            keep_product: self.keep_product,
-            truncate_after: self.truncate == TruncateWhen::After,
-            depth: self.depth,
-            circles: self.circles,
-            circle_points: self.circle_points,
-            shells: self.shells,
-            shell_grid: self.shell_grid,
-            progress: true,
-        }))
-    }
-}
-
 /// `--shard`: this machine's share of the shapes' fields, built (or found) in --fields-dir.
 fn build_fields(args: &Args, shard: Shard) -> Result<()> {
     let dir = args
+        .dynamic
         .fields_dir
         .as_ref()
         .ok_or_else(|| Error::InvalidParameter {
             name: "shard",
             reason: "--shard builds fields into a directory: add --fields-dir DIR".into(),
         })?;
-    let options = args.options()?;
+    let options = args.dynamic.options()?;
     let mut store = FieldStore::new(dir, args.force);
     store.prepare()?;
     let start = Instant::now();
@@ -294,17 +224,18 @@ pub fn run(args: Args) -> Result<()> {
             .map(Path::new),
     );
     refuse_outputs(&inputs, &outputs, args.force)?;
-    if args.light.light_rotation != LightRotation::Source {
+    if args.light.light_rotation != LightRotation::Source && args.animate.is_some() {
         return Err(Error::InvalidParameter {
             name: "light-rotation",
-            reason: "--light-rotation prefiltered applies to relight render and animate; a \
-                     dynamic scene's lighting is rotated at the source's resolution"
+            reason: "--light-rotation prefiltered applies to one frame; an animation's lighting \
+                     is rotated at the source's resolution"
                 .into(),
         });
     }
     let view = args.camera.view()?;
-    let options = args.options()?;
+    let options = args.dynamic.options()?;
     let mut store = args
+        .dynamic
         .fields_dir
         .as_ref()
         .map(|dir| FieldStore::new(dir, args.force));
@@ -397,8 +328,9 @@ pub fn run(args: Args) -> Result<()> {
     match &path {
         None => {
             let turn = rotation(angles)?;
-            let shading =
-                DynamicShader::new(&scene, args.method, keep_light).shade(&FrameSpec {
+            let shading = DynamicShader::new(&scene, args.method, keep_light)
+                .with_light_rotation(args.light.light_rotation)
+                .shade(&FrameSpec {
                     environment: &env,
                     rotation: turn,
                     eye: None,

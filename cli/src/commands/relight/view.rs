@@ -3,10 +3,12 @@
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
-use haarshift::Result;
+use haarshift::relight::dynamic::DynamicScene;
+use haarshift::relight::dynamic::fields::file::FieldStore;
+use haarshift::{Error, Result};
 use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
 
-use super::flags::LightFlags;
+use super::flags::{DynamicFlags, LightFlags};
 use crate::commands::print;
 
 const HELP: &str = "\
@@ -19,19 +21,33 @@ view, saves it as PNG, and keeps its view in the URL. Nothing is fetched from th
 the server listens on 127.0.0.1 unless --host says otherwise, and serves each page (up to
 --max-sessions) a session of its own.
 
+A scene file (SCENE.json, as relight scene takes it) is built into occlusion fields first
+(or its fields loaded from --fields-dir): the page then moves its objects (drag with the
+object chosen) and plays --animate's motion path, each frame occlusion fields and Haar
+product integrals as relight scene computes them; the error view ray-casts the placed scene.
+
 Examples:
   haarshift relight view bunny.hsr --env testdata/envmaps/rooitou_park_1k.hdr
   haarshift relight view cubes.hsr --env park.hdr --port 9000 --open
   haarshift relight view bunny.hsr --env park.hdr --yaw 120 --port 0   (any free port)
-  haarshift relight view bunny.hsr --env park.hdr --results results/relight/experiments";
+  haarshift relight view bunny.hsr --env park.hdr --results results/relight/experiments
+  haarshift relight view testdata/scenes/bunny_and_ball.json --animate testdata/scenes/ball_path.json";
 
-/// Serve a precomputed scene to the browser and relight it interactively.
+/// Serve a precomputed or dynamic scene to the browser and relight it interactively.
 #[derive(clap::Args, Debug)]
 #[command(after_help = HELP)]
 pub struct Args {
-    /// The scene cache (`relight precompute ... -o SCENE.hsr`)
-    #[arg(value_name = "SCENE.hsr")]
-    pub cache: PathBuf,
+    /// The scene cache (`relight precompute ... -o SCENE.hsr`), or a scene file whose objects
+    /// the page moves (SCENE.json, built as `relight scene` builds it)
+    #[arg(value_name = "SCENE.hsr|SCENE.json")]
+    pub scene: PathBuf,
+
+    /// A scene file's motion path (`relight scene --animate`'s), played by the page
+    #[arg(long, value_name = "PATH.json")]
+    pub animate: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub dynamic: DynamicFlags,
 
     #[command(flatten)]
     pub light: LightFlags,
@@ -60,7 +76,42 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let scene = ViewedScene::load(&args.cache, &args.light.spec())?;
+    let is_json = args
+        .scene
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let scene = if is_json {
+        let options = args.dynamic.options()?;
+        let mut store = args
+            .dynamic
+            .fields_dir
+            .as_ref()
+            .map(|dir| FieldStore::new(dir, false));
+        store.as_ref().map(FieldStore::prepare).transpose()?;
+        let built = DynamicScene::load_with(&args.scene, &options, store.as_mut())?;
+        ViewedScene::dynamic(
+            built,
+            &args.scene,
+            args.animate.as_deref(),
+            &args.light.spec(),
+        )?
+    } else {
+        for (flag, given) in [
+            ("animate", args.animate.is_some()),
+            ("fields-dir", args.dynamic.fields_dir.is_some()),
+        ] {
+            if given {
+                return Err(Error::InvalidParameter {
+                    name: flag,
+                    reason: format!(
+                        "--{flag} applies to a scene file (SCENE.json); {} is a scene cache",
+                        args.scene.display()
+                    ),
+                });
+            }
+        }
+        ViewedScene::load(&args.scene, &args.light.spec())?
+    };
     let viewer = Viewer::bind(
         scene,
         ViewerOptions {
