@@ -7,7 +7,8 @@
 #   64, Lambertian and with Phong 50 (rotation cache 64; every coefficient, or 200 and 420), the
 #   lighting dragged and the camera orbited; the bunny at cube 6 x 64^2, Lambertian; the bunny and
 #   the ball (testdata/scenes/bunny_and_ball.json, a dynamic scene at lat-long 32: occlusion
-#   fields), the ball dragged across the ground and the lighting dragged. Prints a Markdown report:
+#   fields; every coefficient, and scripts/dynamic.sh's budgets), the ball dragged across the
+#   ground and the lighting dragged. Prints a Markdown report:
 #   scripts/viewer_frame_rate.sh > results/viewer/frame_rate.md
 # The caches are precomputed in a temporary directory (minutes for the cubes); WORK=DIR keeps
 # and reuses them. ENV (first argument) is the lighting.
@@ -28,6 +29,7 @@ rate=target/release/examples/frame_rate
 start_load=$(uptime)
 phong=(brdf=phong:50 rotation_cache=64)
 budgets=(keep_light=194 keep_visibility=414)
+fields=(keep_light=200 keep_visibility=70 keep_field=70)  # scripts/dynamic.sh's budgets
 rows=(
     "$("$rate" "$work/cubes.hsr" "$env_map" label=cubes keep_light=194)"
     "$("$rate" "$work/cubes.hsr" "$env_map" label=cubes keep_light=194 drag=orbit)"
@@ -38,7 +40,8 @@ rows=(
     "$("$rate" "$work/bunny.hsr" "$env_map" label=bunny "${phong[@]}" drag=orbit)"
     "$("$rate" "$work/bunny-cube.hsr" "$env_map" label=bunny "${budgets[@]}")"
     "$("$rate" testdata/scenes/bunny_and_ball.json "$env_map" label=bunny-and-ball drag=object:1)"
-    "$("$rate" testdata/scenes/bunny_and_ball.json "$env_map" label=bunny-and-ball)"
+    "$("$rate" testdata/scenes/bunny_and_ball.json "$env_map" label=bunny-and-ball "${fields[@]}" drag=object:1)"
+    "$("$rate" testdata/scenes/bunny_and_ball.json "$env_map" label=bunny-and-ball "${fields[@]}")"
     "$("$rate" "$work/cubes.hsr" "$env_map" label=cubes keep_light=194 screenshot=results/viewer/cubes.png)"
 )
 echo "# The viewer's frame rates"

@@ -6,7 +6,8 @@
 //! ```
 //!
 //! SCENE is a scene cache (`.hsr`) or a scene file (`.json`, built as `relight scene` builds
-//! it at lat-long `resolution`, 32 by default). Keys: `brdf` (`lambert`), `keep_light`,
+//! it at lat-long `resolution`, 32 by default, its occlusion maps kept to `keep_field`
+//! detail coefficients, all by default). Keys: `brdf` (`lambert`), `keep_light`,
 //! `keep_visibility`, `keep_brdf`, `rotation_cache` (the page's state), `drag` (`light`,
 //! `orbit` or `object:K`, a dynamic scene's object K), `moves` (50: mouse moves of the drag,
 //! one every 16 ms), `size` (`640x480`), `label`, `screenshot` (a PNG of the page after the
@@ -22,6 +23,7 @@ use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 use haarshift::faces::{ParamKind, Parameterization};
+use haarshift::product::Selection;
 use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
 use haarshift::relight::shade::LightSpec;
 use haarshift_viewer::browser::Browser;
@@ -56,8 +58,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let scene = if path.ends_with(".json") {
         let resolution = get("resolution", "32").parse()?;
-        let options = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, resolution)?);
-        let built = DynamicScene::load_with(path.as_ref(), &options, None)?;
+        let mut build = DynamicOptions::new(Parameterization::new(ParamKind::LatLong, resolution)?);
+        if let Some(k) = options.get("keep_field") {
+            build.field.keep = Selection::Largest(k.parse()?);
+        }
+        let built = DynamicScene::load_with(path.as_ref(), &build, None)?;
         ViewedScene::dynamic(built, path.as_ref(), None, &light)?
     } else {
         ViewedScene::load(path.as_ref(), &light)?
@@ -185,7 +190,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         param.kind(),
         param.face_size(),
         get("brdf", "lambert"),
-        ["keep_light", "keep_visibility", "keep_brdf"]
+        ["keep_light", "keep_visibility", "keep_field", "keep_brdf"]
             .iter()
             .filter_map(|k| options.get(k).map(|v| format!("{k} {v}")))
             .collect::<Vec<_>>()
