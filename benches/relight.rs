@@ -186,6 +186,14 @@ fn bench_relighting(c: &mut Criterion) {
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
         b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
     });
+    // Every lighting coefficient kept: its 24,576 rows gathered from the dense table (a
+    // truncated lighting's few non-zero rows go through a byte table that stays in L1).
+    group.bench_function("shade_keep420_f32_every_light_coefficient", |b| {
+        let t = prepared();
+        let light = Lighting::encode(&env, &mapping, &whole, Selection::All).expect("encodes");
+        let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
+        b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
+    });
     // The floor of a frame: the same offsets, indices and values read once, in the same
     // parallel chunks of vertices, their bits summed (integer sums, which the compiler
     // vectorises: nothing gathered, nothing waiting on a floating-point add).

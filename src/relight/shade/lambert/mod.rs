@@ -32,8 +32,9 @@
 //! rounding. The output is `T`.
 //!
 //! **Speed.** Vertices in parallel (rayon) in chunks of [`CHUNK`]; the hot loop allocates
-//! nothing and reads the lighting rows (`texels x 3 x size_of T`, 295 KB for a `6 x 64^2`
-//! cube in f32) at the vertex's indices, which are ascending.
+//! nothing and reads the lighting rows at the vertex's indices, which are ascending: the
+//! dense rows (`texels x 4 x size_of T`, 393 KB for a `6 x 64^2` cube in f32), or for a
+//! truncated lighting its few non-zero rows through a byte table (`LightRows`).
 
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
@@ -54,7 +55,9 @@ use crate::relight::precompute::transport::TransportSet;
 use crate::{Error, Result, Sample};
 
 mod quantised;
+mod rows;
 pub use quantised::QuantisedTransport;
+use rows::LightRows;
 
 /// Coefficients summed in the working precision before the sum is added in f64.
 pub const RUN: usize = 64;
@@ -224,7 +227,7 @@ impl<T: Sample> PreparedTransport<T> {
     /// [`shade`](Self::shade) into `out` (`(V, 3)`), reused from frame to frame.
     pub fn shade_into(&self, lighting: &Lighting, out: &mut Array2<T>) -> Result<()> {
         let out = checked_output(self.param, self.vertex_count(), lighting, out)?;
-        let light = lighting.quads::<T>();
+        let light = LightRows::<T>::new(lighting);
         // The flat arrays once, not a row lookup per vertex: this loop runs at memory speed.
         let (offsets, indices, values) = self.rows.parts();
         out.par_chunks_mut(3 * CHUNK)
@@ -234,7 +237,7 @@ impl<T: Sample> PreparedTransport<T> {
                 for (k, row) in rows.chunks_exact_mut(3).enumerate() {
                     let v = first + k;
                     let (a, b) = (offsets[v] as usize, offsets[v + 1] as usize);
-                    let sum = dot(&indices[a..b], &values[a..b], &light);
+                    let sum = light.gather(&indices[a..b], &values[a..b], |i| i as usize, |t| t);
                     let a = self.albedo[v];
                     for c in 0..3 {
                         row[c] = T::from_f64(sum[c] * a[c] * std::f64::consts::FRAC_1_PI);
@@ -276,18 +279,9 @@ fn checked_output<'a, T: Sample>(
 }
 
 /// Zero rows appended up to a power of two: a valid index `i` equals `i & (len - 1)`, and
-/// reading `rows[i & (len - 1)]` in the hot loops ([`dot`]) needs no bounds check.
+/// reading `rows[i & (len - 1)]` in the hot loops ([`LightRows`]) needs no bounds check.
 pub(crate) fn pad_to_power_of_two<Q: Default + Clone>(rows: &mut Vec<Q>) {
     rows.resize(rows.len().next_power_of_two(), Q::default());
-}
-
-/// `sum_i values_i light[indices_i]` per channel ([`sum_runs`]); `light` padded by
-/// [`pad_to_power_of_two`].
-#[inline]
-fn dot<T: Sample>(indices: &[u32], values: &[T], light: &[T::Quad]) -> [f64; 3] {
-    debug_assert!(light.len().is_power_of_two());
-    let mask = light.len() - 1;
-    sum_runs::<T, _, _>(indices, values, |i, t| light[i as usize & mask] * t)
 }
 
 /// `sum_k term(a_k, b_k)` per channel, in order (`a` and `b` of one length): runs of [`RUN`]

@@ -15,7 +15,7 @@
 use ndarray::Array2;
 use rayon::prelude::*;
 
-use super::{CHUNK, PreparedTransport, sum_runs};
+use super::{CHUNK, LightRows, PreparedTransport};
 use crate::faces::Parameterization;
 use crate::relight::light::lighting::Lighting;
 use crate::{Result, Sample};
@@ -154,21 +154,24 @@ impl QuantisedTransport {
     /// [`shade`](Self::shade) into `out` (`(V, 3)`), in any sample type; the arithmetic is f32.
     pub fn shade_into<T: Sample>(&self, lighting: &Lighting, out: &mut Array2<T>) -> Result<()> {
         let out = super::checked_output(self.param, self.vertex_count(), lighting, out)?;
-        let quads = lighting.quads::<f32>();
+        let light = LightRows::<f32>::new(lighting);
         out.par_chunks_mut(3 * CHUNK)
             .enumerate()
             .for_each(|(chunk, rows)| {
                 let first = chunk * CHUNK;
-                // Here, so that the compiler sees `mask < light.len()` and checks no bound.
-                let (light, mask) = (quads.as_slice(), quads.len() - 1);
                 for (k, row) in rows.chunks_exact_mut(3).enumerate() {
                     let v = first + k;
                     let (gaps, values) = self.entries(v);
                     let mut index = 0usize;
-                    let sum = sum_runs::<f32, _, _>(gaps, values, move |gap, q| {
-                        index += usize::from(gap);
-                        light[index & mask] * f32::from(q)
-                    });
+                    let sum = light.gather(
+                        gaps,
+                        values,
+                        move |gap: u16| {
+                            index += usize::from(gap);
+                            index
+                        },
+                        f32::from,
+                    );
                     let f = self.factors[v];
                     for c in 0..3 {
                         row[c] = T::from_f64(sum[c] * f[c]);

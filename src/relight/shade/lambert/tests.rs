@@ -622,3 +622,29 @@ fn a_mapped_cache_shades_in_place_and_equal_to_the_transport_in_memory() {
             .is_mapped()
     );
 }
+
+proptest::proptest! {
+    /// A truncated lighting's rows gathered through the byte table give the dense rows' sums,
+    /// bit for bit; a lighting of 255 non-zero rows or more stays dense.
+    #[test]
+    fn compact_light_rows_give_the_dense_rows_sums_bit_for_bit(
+        keep in 1usize..400,
+        terms in proptest::collection::vec((0u32..4096, -1e3f32..1e3f32), 0..300),
+    ) {
+        let param = Parameterization::new(ParamKind::Cube, 16).unwrap();
+        let map = SphereMap::<f64>::from_fn(param, 3, |d, out| {
+            out.copy_from_slice(&[1.0 + d[0] * d[1], (3.0 * d[2]).sin() + 1.5, d[1].exp()]);
+        })
+        .unwrap();
+        let lighting = Lighting::from_map(&map, Selection::Largest(keep)).unwrap();
+        let rows = LightRows::<f32>::new(&lighting);
+        let compact = matches!(rows, LightRows::Compact { .. });
+        proptest::prop_assert_eq!(compact, lighting.kept() + param.faces() < 256);
+        let dense = LightRows::<f32>::Dense(lighting.quads::<f32>());
+        let (indices, values): (Vec<u32>, Vec<f32>) = terms.into_iter().unzip();
+        let sum = |r: &LightRows<f32>| {
+            r.gather(&indices, &values, |i| i as usize, |t| t).map(f64::to_bits)
+        };
+        proptest::prop_assert_eq!(sum(&rows), sum(&dense));
+    }
+}
