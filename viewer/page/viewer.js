@@ -599,7 +599,9 @@ function command() {
   const eye = eyePosition().map(round);
   if (s.dynamic) {
     const yaw = round(state.yaw + (viewer.frame?.header.path_yaw ?? 0));
-    const parts = ['haarshift relight scene', quote(s.cache), '--env', quote(s.env), `--yaw ${yaw}`, `--pitch ${round(state.pitch)}`, `--roll ${round(state.roll)}`, ...s.dynamic.build_flags];
+    // The page's visibility budget replaces the build's.
+    const build = s.dynamic.build_flags.filter((f) => !(state.keep_visibility && f.startsWith('--keep-visibility ')));
+    const parts = ['haarshift relight scene', quote(s.cache), '--env', quote(s.env), `--yaw ${yaw}`, `--pitch ${round(state.pitch)}`, `--roll ${round(state.roll)}`, ...build];
     if (state.light_rotation !== 'source') parts.push(`--light-rotation ${state.light_rotation}`);
     if (state.keep_light) parts.push(`--keep-light ${state.keep_light}`);
     if (state.keep_visibility) parts.push(`--keep-visibility ${state.keep_visibility}`);
