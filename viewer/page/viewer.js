@@ -464,12 +464,15 @@ function setupControls(scene) {
   depth.oninput = () => { state.depth = +depth.value >= scene.levels ? null : +depth.value; send(); };
   $('basis').value = state.basis;
   $('basis').onchange = () => { state.basis = $('basis').value; send(); };
+  // Measured BRDFs the server was given (--merl), by name.
+  for (const m of scene.measured) $('material').add(new Option(`merl:${m.name}`, `merl:${m.name}`));
   const [kind, exponent] = state.brdf.split(':');
-  $('material').value = kind === 'blinn' ? 'blinn' : kind === 'phong' ? 'phong' : 'lambert';
-  if (exponent) $('exponent').value = exponent;
+  if (kind === 'merl') $('material').value = state.brdf;
+  else $('material').value = kind === 'blinn' ? 'blinn' : kind === 'phong' ? 'phong' : 'lambert';
+  if (exponent && kind !== 'merl') $('exponent').value = exponent;
   const material = () => {
     const m = $('material').value;
-    state.brdf = m === 'lambert' ? 'lambert' : `${m}:${+$('exponent').value}`;
+    state.brdf = m === 'lambert' || m.startsWith('merl:') ? m : `${m}:${+$('exponent').value}`;
     send();
   };
   $('material').onchange = material;
@@ -617,7 +620,8 @@ function command() {
   if (state.basis !== 'haar') parts.push(`--basis ${state.basis}`);
   if (state.light_rotation !== 'source' && state.basis !== 'ambient') parts.push(`--light-rotation ${state.light_rotation}`);
   if (state.brdf !== 'lambert') {
-    parts.push(`--brdf ${state.brdf}`);
+    const measured = s.measured.find((m) => `merl:${m.name}` === state.brdf);
+    parts.push(`--brdf ${measured ? quote(`merl:${measured.path}`) : state.brdf}`);
     if (state.brdf_rotation !== 'haar') parts.push(`--brdf-rotation ${state.brdf_rotation}`);
     if (state.rotation_cache) parts.push(`--rotation-cache ${state.rotation_cache}`);
     if (state.keep_brdf) parts.push(`--keep-brdf ${state.keep_brdf}`);

@@ -12,7 +12,7 @@ use haarshift::relight::dynamic::motion::{FrameState, MotionPath};
 use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
 use haarshift::relight::light::environment::Environment;
 use haarshift::relight::shade::LightSpec;
-use haarshift::relight::{Mesh, SceneCache};
+use haarshift::relight::{Brdf, Mesh, SceneCache};
 use haarshift::render::camera::Camera;
 use haarshift::render::view::ViewSpec;
 use haarshift::sphere::SphereRotation;
@@ -72,6 +72,9 @@ pub struct ViewedScene {
     pub angles: [f64; 3],
     /// The camera the page starts at: `relight render`'s default for this scene.
     pub camera: Camera,
+    /// Measured BRDFs the page may choose (`relight view --merl FILE`), read once: the page
+    /// names them by file stem (`merl:STEM`), never by path.
+    pub measured: Vec<(String, Brdf)>,
 }
 
 impl ViewedScene {
@@ -137,7 +140,71 @@ impl ViewedScene {
             environment,
             angles,
             camera,
+            measured: Vec::new(),
         })
+    }
+
+    /// The scene with the MERL tables `files` offered as materials, each read now (a bad file
+    /// is an error naming it, before the server starts). A dynamic scene's materials are its
+    /// scene file's: it takes none.
+    ///
+    /// ```no_run
+    /// use haarshift::relight::shade::LightSpec;
+    /// use haarshift_viewer::ViewedScene;
+    /// let light = LightSpec { env: Some("park.hdr".into()), ..LightSpec::default() };
+    /// let scene = ViewedScene::load("bunny.hsr".as_ref(), &light).unwrap()
+    ///     .with_measured(&["gold-metallic-paint.binary".into()]).unwrap();
+    /// assert_eq!(scene.measured[0].0, "gold-metallic-paint");
+    /// ```
+    pub fn with_measured(mut self, files: &[PathBuf]) -> Result<ViewedScene> {
+        if !files.is_empty() && matches!(self.source, Source::Dynamic(_)) {
+            return Err(Error::parameter(
+                "merl",
+                "a scene file's materials are its own: measured BRDFs go in its objects' \"brdf\"",
+            ));
+        }
+        for file in files {
+            let name = file
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            if self.measured.iter().any(|(n, _)| *n == name) {
+                return Err(Error::parameter(
+                    "merl",
+                    format!("{}: a second table named {name:?}", file.display()),
+                ));
+            }
+            let brdf = format!("merl:{}", file.display()).parse::<Brdf>()?;
+            self.measured.push((name, brdf));
+        }
+        Ok(self)
+    }
+
+    /// The material the page names `name`: `lambert`, `phong:EXP`, `blinn:EXP`, or
+    /// `merl:STEM` of a table given with [`with_measured`](Self::with_measured) (a page never
+    /// makes the server read a file).
+    pub fn brdf(&self, name: &str) -> Result<Brdf> {
+        let Some(stem) = name.strip_prefix("merl:") else {
+            return name.parse();
+        };
+        match self.measured.iter().find(|(n, _)| n == stem) {
+            Some((_, brdf)) => Ok(brdf.clone()),
+            None => Err(Error::parameter(
+                "brdf",
+                format!(
+                    "{name}: the viewer offers the measured BRDFs given with --merl ({})",
+                    if self.measured.is_empty() {
+                        "none".to_owned()
+                    } else {
+                        self.measured
+                            .iter()
+                            .map(|(n, _)| format!("merl:{n}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    }
+                ),
+            )),
+        }
     }
 
     /// The mesh as the scene is loaded (a dynamic scene's objects where its file puts them).
@@ -210,6 +277,10 @@ impl ViewedScene {
             "stored_coefficients": stored,
             "sh_bands": sh_bands,
             "dynamic": dynamic,
+            "measured": self.measured.iter().map(|(name, brdf)| json!({
+                "name": name,
+                "path": brdf.to_string().trim_start_matches("merl:"),
+            })).collect::<Vec<_>>(),
             "cache": self.path,
             "env": self.env_path,
             "angles": self.angles,

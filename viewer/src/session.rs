@@ -16,7 +16,6 @@ use serde_json::json;
 use tungstenite::{Message, WebSocket};
 
 use haarshift::product::Selection;
-use haarshift::relight::Brdf;
 use haarshift::relight::dynamic::{Change, DynamicScene, Placement};
 use haarshift::relight::light::environment::LightRotation;
 use haarshift::relight::material::orient::BrdfRotation;
@@ -402,7 +401,7 @@ impl Session {
                 "the reference is computed in the background: turn on the error view",
             ));
         }
-        let brdf = page_brdf(&state.brdf)?;
+        let brdf = self.scene.brdf(&state.brdf)?;
         let param = self.scene.param();
         let texels = param.texels();
         let levels = param.face_size().trailing_zeros() as usize;
@@ -452,7 +451,7 @@ impl Session {
     /// Starts the reference of `state`'s lighting and material unless it is the one sent or
     /// being computed; one at a time (a newer one starts when the running one ends).
     fn start_reference(&mut self, state: &ViewState) {
-        let Ok(brdf) = page_brdf(&state.brdf) else {
+        let Ok(brdf) = self.scene.brdf(&state.brdf) else {
             return;
         };
         let placed = self.placed.as_ref().map(|p| p.scene.clone());
@@ -668,18 +667,6 @@ fn placements(
         }
     }
     Ok((placements, yaw))
-}
-
-/// A BRDF the page may ask for: by name, never a file (a page must not make the server read
-/// files).
-fn page_brdf(name: &str) -> Result<Brdf> {
-    if name.starts_with("merl") {
-        return Err(Error::parameter(
-            "brdf",
-            "measured BRDFs are not offered by the viewer: lambert, phong:EXP or blinn:EXP",
-        ));
-    }
-    name.parse()
 }
 
 /// Whether frames of `spec` change with the eye.

@@ -416,6 +416,24 @@ impl Client {
         }
     }
 
+    /// The next message, a packet: its kind, header and payload as f32.
+    pub fn packet(&mut self) -> (u32, Value, Vec<f32>) {
+        match self.next() {
+            tungstenite::Message::Binary(b) => {
+                let kind = u32::from_le_bytes(b[0..4].try_into().unwrap());
+                let len = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
+                let header: Value = serde_json::from_slice(&b[8..8 + len]).unwrap();
+                let start = (8 + len).next_multiple_of(4);
+                let values = b[start..]
+                    .chunks_exact(4)
+                    .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                    .collect();
+                (kind, header, values)
+            }
+            other => panic!("a packet expected, got {other:?}"),
+        }
+    }
+
     /// The next message: a frame answering state `seq`.
     fn frame(&mut self, seq: u64) {
         match self.next() {
@@ -645,4 +663,72 @@ fn the_results_page_shows_an_experiment_s_records_pictures_and_plot() {
     assert!(marked[1].as_u64().unwrap() > 0, "{marked}");
     let errors = browser.console_errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
+}
+
+#[test]
+fn a_measured_brdf_given_with_merl_is_offered_by_name_and_shaded_as_relight_render_does() {
+    use haarshift::relight::material::merl::MerlBrdf;
+    let dir = tempfile::tempdir().unwrap();
+    let cache = bunny_cache(dir.path());
+    let env = testdata("envmaps/rooitou_park_256x128.npy");
+    let table = dir.path().join("sheen.binary");
+    MerlBrdf::from_fn(|theta_h, _, _| {
+        let lobe = theta_h.cos().powi(20);
+        [0.2 + 2.0 * lobe, 0.15 + lobe, 0.1]
+    })
+    .unwrap()
+    .write(&table, false)
+    .unwrap();
+    let view = ViewProcess::start(&[p(&cache), "--env", p(&env), "--merl", p(&table)]);
+    let mut page = Client::opened(&view.url);
+    // A page names a table it was offered, never a file.
+    for name in ["merl:/etc/passwd", "merl:other"] {
+        page.send(&format!(
+            r#"{{"type": "state", "seq": 1, "brdf": "{name}"}}"#
+        ));
+        page.refused("given with --merl (merl:sheen)");
+    }
+    page.send(
+        r#"{"type": "state", "seq": 2, "yaw": 30, "brdf": "merl:sheen",
+            "light_rotation": "source", "eye": [0, 3, 8]}"#,
+    );
+    let (kind, header, radiance) = page.packet();
+    assert_eq!((kind, &header["seq"]), (3, &Value::from(2)), "{header}");
+    let (png, npy) = (dir.path().join("m.png"), dir.path().join("m.npy"));
+    succeeds(&[
+        "relight",
+        "render",
+        p(&cache),
+        "--env",
+        p(&env),
+        "--yaw",
+        "30",
+        "--brdf",
+        &format!("merl:{}", p(&table)),
+        "--camera",
+        "0,3,8",
+        "--look-at",
+        "0,1,0",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "-o",
+        p(&png),
+        "--vertices",
+        p(&npy),
+    ]);
+    let rendered: Array2<f32> = ndarray_npy::read_npy(&npy).unwrap();
+    assert_eq!(radiance, rendered.as_slice().unwrap());
+    // The table, not a Lambertian stand-in: the same view in Lambert is another frame.
+    page.send(
+        r#"{"type": "state", "seq": 3, "yaw": 30, "light_rotation": "source", "eye": [0, 3, 8]}"#,
+    );
+    let (_, _, lambert) = page.packet();
+    let gap: f32 = lambert
+        .iter()
+        .zip(&radiance)
+        .map(|(a, b)| (a - b).abs())
+        .sum();
+    assert!(gap > 0.01 * lambert.iter().sum::<f32>(), "{gap}");
 }

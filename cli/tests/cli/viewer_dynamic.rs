@@ -51,24 +51,6 @@ fn played(dir: &Path, scene: &Path, path: &Path) -> Array3<f32> {
     ndarray_npy::read_npy(&frames).unwrap()
 }
 
-/// A packet's kind, header and payload as f32.
-fn packet(page: &mut Client) -> (u32, Value, Vec<f32>) {
-    match page.next() {
-        tungstenite::Message::Binary(b) => {
-            let kind = u32::from_le_bytes(b[0..4].try_into().unwrap());
-            let len = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
-            let header: Value = serde_json::from_slice(&b[8..8 + len]).unwrap();
-            let start = (8 + len).next_multiple_of(4);
-            let values = b[start..]
-                .chunks_exact(4)
-                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-                .collect();
-            (kind, header, values)
-        }
-        other => panic!("a packet expected, got {other:?}"),
-    }
-}
-
 /// The relative RMS difference of two radiance arrays.
 fn relative_rms(a: &[f32], b: &[f32]) -> f64 {
     assert_eq!(a.len(), b.len());
@@ -98,9 +80,9 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
         r#"{"type": "state", "seq": 1, "yaw": 30, "light_rotation": "source",
             "objects": [[0, 0, 0], [2, 1.2, 3]]}"#,
     );
-    let (kind, header, positions) = packet(&mut page);
+    let (kind, header, positions) = page.packet();
     assert_eq!(kind, 6, "{header}");
-    let (kind, header, moved) = packet(&mut page);
+    let (kind, header, moved) = page.packet();
     assert_eq!((kind, &header["seq"]), (3, &Value::from(1)), "{header}");
     assert_eq!(
         header["translations"][1],
@@ -123,9 +105,9 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
     // The ball where the file has it: other shadows (so the comparison above tells
     // placements apart), and positions sent again.
     page.send(r#"{"type": "state", "seq": 2, "yaw": 30, "light_rotation": "source"}"#);
-    let (kind, _, back) = packet(&mut page);
+    let (kind, _, back) = page.packet();
     assert_eq!(kind, 6);
-    let (_, _, at_rest) = packet(&mut page);
+    let (_, _, at_rest) = page.packet();
     assert_ne!(back, positions);
     let at_rest_error = relative_rms(&at_rest, expected);
     assert!(
@@ -135,9 +117,9 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
 
     // Path frame 8 of 25: the ball halfway along its first segment, from x = 6.5 to -6.5.
     page.send(r#"{"type": "state", "seq": 3, "path_frame": 8, "light_rotation": "source"}"#);
-    let (kind, _, _) = packet(&mut page);
+    let (kind, _, _) = page.packet();
     assert_eq!(kind, 6);
-    let (_, header, frame) = packet(&mut page);
+    let (_, header, frame) = page.packet();
     assert_eq!(
         header["translations"][1],
         serde_json::json!([0.0, 1.2, 3.0])
@@ -178,8 +160,8 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
         other => panic!("unchanged expected, got {other:?}"),
     }
     page.send(r#"{"type": "state", "seq": 9, "path_frame": 9, "light_rotation": "source"}"#);
-    assert_eq!(packet(&mut page).0, 6);
-    let (kind, header, frame9) = packet(&mut page);
+    assert_eq!(page.packet().0, 6);
+    let (kind, header, frame9) = page.packet();
     assert_eq!((kind, &header["seq"]), (3, &Value::from(9)), "{header}");
     let expected9 = all.index_axis(ndarray::Axis(0), 9).to_owned();
     assert!(relative_rms(&frame9, expected9.as_slice().unwrap()) < 1e-6);

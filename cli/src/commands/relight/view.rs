@@ -31,6 +31,7 @@ Examples:
   haarshift relight view cubes.hsr --env park.hdr --port 9000 --open
   haarshift relight view bunny.hsr --env park.hdr --yaw 120 --port 0   (any free port)
   haarshift relight view bunny.hsr --env park.hdr --results results/relight/experiments
+  haarshift relight view bunny.hsr --env park.hdr --merl gold-metallic-paint.binary   (merl:gold-metallic-paint on the page)
   haarshift relight view testdata/scenes/bunny_and_ball.json --animate testdata/scenes/ball_path.json";
 
 /// Serve a precomputed or dynamic scene to the browser and relight it interactively.
@@ -51,6 +52,11 @@ pub struct Args {
 
     #[command(flatten)]
     pub light: LightFlags,
+
+    /// A measured BRDF (MERL table) the page offers as a material, named by its file stem;
+    /// repeat for more (a scene cache only)
+    #[arg(long, value_name = "FILE")]
+    pub merl: Vec<PathBuf>,
 
     /// The port to listen on; 0 takes a free one
     #[arg(long, value_name = "P", default_value_t = 8765)]
@@ -111,7 +117,8 @@ pub fn run(args: Args) -> Result<()> {
             }
         }
         ViewedScene::load(&args.scene, &args.light.spec())?
-    };
+    }
+    .with_measured(&args.merl)?;
     let viewer = Viewer::bind(
         scene,
         ViewerOptions {
