@@ -152,7 +152,7 @@ def exact(directory, rays):
     return answers
 
 
-def arbitrate(directory, name, against, ours, theirs, different):
+def arbitrate(directory, name, against, ours, different):
     """One line: who of haarshift and `against` the f64 answer agrees with on the rays they
     answer differently, and how near an edge those rays pass."""
     answers = exact(directory, different)
@@ -195,20 +195,20 @@ def main():
             assert h1["rays"] == n == h2["rays"] == len(blocked), (h1, h2, n, len(blocked))
             different = np.flatnonzero(blocked != ours)
             if len(different):
-                notes.append(arbitrate(directory, name, "Embree", ours, blocked, different))
-                cos = grazing(directory, different)
+                notes.append(arbitrate(directory, name, "Embree", ours, different))
+                first = different[:10]
                 listed = ", ".join(
                     f"ray {i}: haarshift {'blocked' if ours[i] else 'open'}, Embree "
                     f"{'blocked' if blocked[i] else 'open'}, "
                     + ("no triangle" if c is None else f"cos to the triangle's plane {c:.2e}")
-                    for i, c in zip(different[:10], cos[:10])
+                    for i, c in zip(first, grazing(directory, first))
                 )
                 notes.append(f"  The first ten: {listed}")
             single = np.load(directory / "single_ray.npy")
             changed = np.flatnonzero(single != ours)
             if len(changed):
                 notes.append(
-                    arbitrate(directory, name, "the single-ray path", ours, single, changed)
+                    arbitrate(directory, name, "the single-ray path", ours, changed)
                 )
             elif not h1["baseline_equal"]:
                 notes.append(f"- {name}: the transport differs from the single-ray path's")

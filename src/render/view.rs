@@ -129,31 +129,29 @@ impl ViewSpec {
             triangles: mesh.triangles(),
             radiance,
         };
-        let colour = match self.backdrop {
-            Backdrop::Colour(c) => c,
-            Backdrop::Environment => {
-                let map = env.downsampled(env.map().height().min(BACKGROUND_HEIGHT))?;
-                // Only a whole-column yaw reads a lookup (see `sky`).
-                let whole = rotation.whole_column_yaw(map.width()).is_some();
-                let lookup = match kept {
-                    Some(kept) if whole => {
-                        let lookup = match kept.take() {
-                            Some(lookup) if lookup.fits(camera, width, height, &map) => lookup,
-                            _ => SkyLookup::new(camera, width, height, &map)?,
-                        };
-                        Some(&*kept.insert(lookup))
-                    }
-                    _ => None,
-                };
-                let sky = Sky {
-                    map: &map,
-                    rotation,
-                    lookup,
-                };
-                return render(camera, width, height, &drawn, Background::Sky(sky));
+        let map = match self.backdrop {
+            Backdrop::Colour(c) => {
+                return render(camera, width, height, &drawn, Background::Colour(c));
             }
+            Backdrop::Environment => env.downsampled(env.map().height().min(BACKGROUND_HEIGHT))?,
         };
-        render(camera, width, height, &drawn, Background::Colour(colour))
+        // Only a whole-column yaw reads a lookup (see `sky`).
+        let lookup = match kept {
+            Some(kept) if rotation.whole_column_yaw(map.width()).is_some() => {
+                let lookup = match kept.take() {
+                    Some(lookup) if lookup.fits(camera, width, height, &map) => lookup,
+                    _ => SkyLookup::new(camera, width, height, &map)?,
+                };
+                Some(&*kept.insert(lookup))
+            }
+            _ => None,
+        };
+        let sky = Sky {
+            map: &map,
+            rotation,
+            lookup,
+        };
+        render(camera, width, height, &drawn, Background::Sky(sky))
     }
 }
 

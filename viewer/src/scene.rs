@@ -292,8 +292,7 @@ impl ViewedScene {
             "bounds": { "min": bounds.min, "max": bounds.max },
             "max_sessions": max_sessions,
         });
-        let positions: Vec<f32> = mesh.positions().iter().map(|&v| v as f32).collect();
-        let mut payload = sample_bytes(&positions, SampleFormat::F32);
+        let mut payload = positions_bytes(&mesh);
         payload.extend(
             mesh.triangles()
                 .iter()
@@ -323,6 +322,13 @@ impl ViewedScene {
             &sample_bytes(&rgb, SampleFormat::F32),
         )
     }
+}
+
+/// `mesh`'s positions `(V, 3)` as little-endian f32: the scene packet's first payload, and a
+/// positions packet's.
+pub(crate) fn positions_bytes(mesh: &Mesh) -> Vec<u8> {
+    let positions: Vec<f32> = mesh.positions().iter().map(|&v| v as f32).collect();
+    sample_bytes(&positions, SampleFormat::F32)
 }
 
 /// The `relight scene` flags that build a scene as `options` say (its fields and own

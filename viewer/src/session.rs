@@ -33,7 +33,7 @@ use crate::progress::{Counter, watch};
 use crate::protocol::{
     Notice, PacketKind, PictureRequest, Request, SampleFormat, ViewState, packet, sample_bytes,
 };
-use crate::scene::{Source, ViewedScene};
+use crate::scene::{Source, ViewedScene, positions_bytes};
 
 /// How long an idle session waits on its socket before it looks at its reference again.
 const IDLE_WAIT: Duration = Duration::from_millis(50);
@@ -320,6 +320,7 @@ impl Session {
         state: &ViewState,
     ) -> Result<Option<Vec<Vec<u8>>>> {
         check_dynamic(state)?;
+        self.check_budgets(state)?;
         let glossy = !glossy_material(base)?.is_lambert();
         let mut key = ViewState {
             seq: 0,
@@ -342,12 +343,12 @@ impl Session {
                     None => base.clone(),
                 },
                 keep_visibility: state.keep_visibility,
-                sent: (0..base.object_count())
-                    .map(|k| base.placement(k))
-                    .collect(),
+                sent: placements_now(base),
+                path_yaw: 0.0,
             },
         };
         let placed = self.placed.insert(placed);
+        placed.path_yaw = path_yaw;
         for (k, &p) in placements.iter().enumerate() {
             if placed.scene.placement(k) != p {
                 placed.scene.place(k, p)?;
@@ -369,18 +370,12 @@ impl Session {
             })?;
         let mut packets = Vec::new();
         if placed.sent != placements {
-            let positions: Vec<f32> = placed
-                .scene
-                .mesh()
-                .positions()
-                .iter()
-                .map(|&v| v as f32)
-                .collect();
-            let header = json!({ "vertices": positions.len() / 3 });
+            let mesh = placed.scene.mesh();
+            let header = json!({ "vertices": mesh.vertex_count() });
             packets.push(packet(
                 PacketKind::Positions,
                 &header,
-                &sample_bytes(&positions, SampleFormat::F32),
+                &positions_bytes(&mesh),
             )?);
             placed.sent.clone_from(&placements);
         }
@@ -392,16 +387,9 @@ impl Session {
         Ok(Some(packets))
     }
 
-    /// The shader `state` asks for, its budgets checked against the scene's.
-    fn spec(&self, state: &ViewState) -> Result<ShaderSpec> {
-        let method: Method = state.basis.parse()?;
-        if method == Method::Reference {
-            return Err(Error::parameter(
-                "basis",
-                "the reference is computed in the background: turn on the error view",
-            ));
-        }
-        let brdf = self.scene.brdf(&state.brdf)?;
+    /// Refuses budgets the scene's maps cannot meet: none kept, more than its texels, a depth
+    /// past its levels.
+    fn check_budgets(&self, state: &ViewState) -> Result<()> {
         let param = self.scene.param();
         let texels = param.texels();
         let levels = param.face_size().trailing_zeros() as usize;
@@ -423,6 +411,20 @@ impl Session {
                 format!("{d}: the scene's maps have {levels} detail levels"),
             ));
         }
+        Ok(())
+    }
+
+    /// The shader `state` asks for, its budgets checked against the scene's.
+    fn spec(&self, state: &ViewState) -> Result<ShaderSpec> {
+        let method: Method = state.basis.parse()?;
+        if method == Method::Reference {
+            return Err(Error::parameter(
+                "basis",
+                "the reference is computed in the background: turn on the error view",
+            ));
+        }
+        let brdf = self.scene.brdf(&state.brdf)?;
+        self.check_budgets(state)?;
         let material = GlossyOptions {
             brdf: brdf.clone(),
             rotation: state.brdf_rotation.parse::<BrdfRotation>()?,
@@ -454,14 +456,9 @@ impl Session {
         let Ok(brdf) = self.scene.brdf(&state.brdf) else {
             return;
         };
+        // The state's frame was drawn: a dynamic scene's copy is placed as it says.
+        let path_yaw = self.placed.as_ref().map_or(0.0, |p| p.path_yaw);
         let placed = self.placed.as_ref().map(|p| p.scene.clone());
-        let path_yaw = match &self.scene.source {
-            Source::Cache(_) => 0.0,
-            Source::Dynamic(base) => match placements(base, self.scene.motion.as_deref(), state) {
-                Ok((_, yaw)) => yaw,
-                Err(_) => return,
-            },
-        };
         let glossy = match &placed {
             Some(scene) => glossy_material(scene).is_ok_and(|b| !b.is_lambert()),
             None => !brdf.is_lambert(),
@@ -470,9 +467,7 @@ impl Session {
             angles: [state.yaw + path_yaw, state.pitch, state.roll],
             brdf: state.brdf.clone(),
             eye: glossy.then(|| state.eye.unwrap_or(self.scene.camera.position())),
-            placements: placed.as_ref().map_or_else(Vec::new, |s| {
-                (0..s.object_count()).map(|k| s.placement(k)).collect()
-            }),
+            placements: placed.as_ref().map_or_else(Vec::new, placements_now),
         };
         if self.reference.as_ref() == Some(&key) || self.job.is_some() {
             return;
@@ -593,6 +588,15 @@ struct Placed {
     keep_visibility: Option<usize>,
     /// The placements whose positions the page has.
     sent: Vec<Placement>,
+    /// The lighting's yaw the motion path adds at the frame drawn last.
+    path_yaw: f64,
+}
+
+/// Every object's placement in `scene` now.
+fn placements_now(scene: &DynamicScene) -> Vec<Placement> {
+    (0..scene.object_count())
+        .map(|k| scene.placement(k))
+        .collect()
 }
 
 /// Refuses what a dynamic scene does not offer: it is shaded by Haar product integrals with
@@ -630,7 +634,7 @@ fn placements(
     state: &ViewState,
 ) -> Result<(Vec<Placement>, f64)> {
     let n = scene.object_count();
-    let mut placements: Vec<Placement> = (0..n).map(|k| scene.placement(k)).collect();
+    let mut placements = placements_now(scene);
     let mut yaw = 0.0;
     if let Some(f) = state.path_frame {
         let frames = motion.ok_or_else(|| {

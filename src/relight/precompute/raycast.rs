@@ -10,12 +10,11 @@
 //! node and traced by packets of up to 16 rays that share their origin, which is every query
 //! visibility makes. Before, the rays went one by one through `obvhs`'s own compressed 8-wide
 //! BVH (CWBVH, Ylitie et al. 2017; its any-hit `ray_traverse_miss`). On the same rays, one
-//! thread, the whole precomputation (rays and encoding) is 2.1x faster than through that path
-//! on the bunny, 1.2x on the cubes scene and 1.1x on a 600,000-triangle scene, and against
-//! Intel Embree 4.4's single-ray `rtcOccluded1` (rays only) it is 1.1x faster on the bunny but
-//! 0.71x and 0.22x on the two larger scenes (`benches/compare_rays.py`,
-//! `benches/rays_results.md`; `cargo bench --bench rays`). Embree is not bound (yet): on large
-//! scenes it is the faster tracer. Of the crates `tools/bvh-compare`
+//! thread, the whole precomputation (rays and encoding) is faster than through that path on
+//! every scene measured, and than Intel Embree 4.4's single-ray `rtcOccluded1` (rays only) on
+//! the bunny but not on the two larger scenes: the figures are `benches/rays_results.md`
+//! (`python3 benches/compare_rays.py`; `cargo bench --bench rays`). Embree is not bound (yet):
+//! on large scenes it is the faster tracer. Of the crates `tools/bvh-compare`
 //! measured (its own workspace, so the candidates never enter this crate's build: `cd
 //! tools/bvh-compare && cargo run --release`), `obvhs`'s single-ray query was the fastest, 1.5-2x
 //! faster than `bvh` 0.12 (binary SAH BVH, nalgebra, a back-face-culling triangle test) and

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
+use haarshift::relight::dynamic::fields::file::FieldStore;
 use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions};
 use haarshift::relight::light::environment::{Environment, LightRotation};
 use haarshift::relight::material::brdf::DEFAULT_ELEVATIONS;
@@ -204,6 +205,17 @@ impl DynamicFlags {
             shell_grid: self.shell_grid,
             progress: true,
         }))
+    }
+
+    /// The field files of `--fields-dir`, the directory made ready (created if absent);
+    /// `force` replaces files that do not match.
+    pub fn field_store(&self, force: bool) -> Result<Option<FieldStore>> {
+        let store = self
+            .fields_dir
+            .as_ref()
+            .map(|dir| FieldStore::new(dir, force));
+        store.as_ref().map(FieldStore::prepare).transpose()?;
+        Ok(store)
     }
 }
 

@@ -234,12 +234,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let view = args.camera.view()?;
     let options = args.dynamic.options()?;
-    let mut store = args
-        .dynamic
-        .fields_dir
-        .as_ref()
-        .map(|dir| FieldStore::new(dir, args.force));
-    store.as_ref().map(FieldStore::prepare).transpose()?;
+    let mut store = args.dynamic.field_store(args.force)?;
 
     let start = Instant::now();
     let mut scene = DynamicScene::load_with(&args.scene, &options, store.as_mut())?;

@@ -4,7 +4,6 @@ use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
 use haarshift::relight::dynamic::DynamicScene;
-use haarshift::relight::dynamic::fields::file::FieldStore;
 use haarshift::{Error, Result};
 use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
 
@@ -88,12 +87,7 @@ pub fn run(args: Args) -> Result<()> {
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let scene = if is_json {
         let options = args.dynamic.options()?;
-        let mut store = args
-            .dynamic
-            .fields_dir
-            .as_ref()
-            .map(|dir| FieldStore::new(dir, false));
-        store.as_ref().map(FieldStore::prepare).transpose()?;
+        let mut store = args.dynamic.field_store(false)?;
         let built = DynamicScene::load_with(&args.scene, &options, store.as_mut())?;
         ViewedScene::dynamic(
             built,

@@ -230,22 +230,29 @@ impl<T: Sample> PreparedTransport<T> {
         let light = LightRows::<T>::new(lighting);
         // The flat arrays once, not a row lookup per vertex: this loop runs at memory speed.
         let (offsets, indices, values) = self.rows.parts();
-        out.par_chunks_mut(3 * CHUNK)
-            .enumerate()
-            .for_each(|(chunk, rows)| {
-                let first = chunk * CHUNK;
-                for (k, row) in rows.chunks_exact_mut(3).enumerate() {
-                    let v = first + k;
-                    let (a, b) = (offsets[v] as usize, offsets[v + 1] as usize);
-                    let sum = light.gather(&indices[a..b], &values[a..b], |i| i as usize, |t| t);
-                    let a = self.albedo[v];
-                    for c in 0..3 {
-                        row[c] = T::from_f64(sum[c] * a[c] * std::f64::consts::FRAC_1_PI);
-                    }
-                }
-            });
+        shade_vertices(out, |v| {
+            let (a, b) = (offsets[v] as usize, offsets[v + 1] as usize);
+            let sum = light.gather(&indices[a..b], &values[a..b], |i| i as usize, |t| t);
+            let a = self.albedo[v];
+            std::array::from_fn(|c| sum[c] * a[c] * std::f64::consts::FRAC_1_PI)
+        });
         Ok(())
     }
+}
+
+/// Writes `radiance(v)` into row `v` of the flat `(V, 3)` `out`, vertices in parallel in
+/// chunks of [`CHUNK`].
+fn shade_vertices<T: Sample>(out: &mut [T], radiance: impl Fn(usize) -> [f64; 3] + Sync) {
+    out.par_chunks_mut(3 * CHUNK)
+        .enumerate()
+        .for_each(|(chunk, rows)| {
+            for (k, row) in rows.chunks_exact_mut(3).enumerate() {
+                let r = radiance(chunk * CHUNK + k);
+                for c in 0..3 {
+                    row[c] = T::from_f64(r[c]);
+                }
+            }
+        });
 }
 
 /// `out` as a flat slice, once the lighting is of `param` and `out` is `(vertices, 3)` and

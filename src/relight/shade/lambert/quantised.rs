@@ -13,9 +13,8 @@
 //! vertex. What it costs in accuracy on real maps: `results/relight/quantised.md`.
 
 use ndarray::Array2;
-use rayon::prelude::*;
 
-use super::{CHUNK, LightRows, PreparedTransport};
+use super::{LightRows, PreparedTransport};
 use crate::faces::Parameterization;
 use crate::relight::light::lighting::Lighting;
 use crate::{Result, Sample};
@@ -155,29 +154,17 @@ impl QuantisedTransport {
     pub fn shade_into<T: Sample>(&self, lighting: &Lighting, out: &mut Array2<T>) -> Result<()> {
         let out = super::checked_output(self.param, self.vertex_count(), lighting, out)?;
         let light = LightRows::<f32>::new(lighting);
-        out.par_chunks_mut(3 * CHUNK)
-            .enumerate()
-            .for_each(|(chunk, rows)| {
-                let first = chunk * CHUNK;
-                for (k, row) in rows.chunks_exact_mut(3).enumerate() {
-                    let v = first + k;
-                    let (gaps, values) = self.entries(v);
-                    let mut index = 0usize;
-                    let sum = light.gather(
-                        gaps,
-                        values,
-                        move |gap: u16| {
-                            index += usize::from(gap);
-                            index
-                        },
-                        f32::from,
-                    );
-                    let f = self.factors[v];
-                    for c in 0..3 {
-                        row[c] = T::from_f64(sum[c] * f[c]);
-                    }
-                }
-            });
+        super::shade_vertices(out, |v| {
+            let (gaps, values) = self.entries(v);
+            let mut index = 0usize;
+            let next = move |gap: u16| {
+                index += usize::from(gap);
+                index
+            };
+            let sum = light.gather(gaps, values, next, f32::from);
+            let f = self.factors[v];
+            std::array::from_fn(|c| sum[c] * f[c])
+        });
         Ok(())
     }
 }

@@ -33,27 +33,18 @@ impl<T: Sample> LightRows<T> {
     /// The rows of `lighting` in `T`, compact when at most 255 are non-zero.
     pub(crate) fn new(lighting: &Lighting) -> Self {
         let dense = lighting.quads::<T>();
-        let nonzero = |r: &[T]| r.iter().any(|x| *x != T::zero());
-        let coefficients = lighting.coefficients_f64();
-        let row = |i: usize| {
-            let r = coefficients.row(i);
-            [r[0], r[1], r[2]].map(T::from_f64)
-        };
-        let count = (0..coefficients.nrows())
-            .filter(|&i| nonzero(&row(i)))
-            .count();
-        if count >= SLOTS {
+        let nonzero: Vec<usize> = (0..dense.len())
+            .filter(|&i| T::first_three(dense[i]).iter().any(|x| *x != T::zero()))
+            .collect();
+        if nonzero.len() >= SLOTS {
             return LightRows::Dense(dense);
         }
         let mut slots = vec![0u8; dense.len()];
         let mut rows = Box::new([T::Quad::default(); SLOTS]);
-        let mut next = 1;
-        for i in 0..coefficients.nrows() {
-            if nonzero(&row(i)) {
-                slots[i] = next as u8;
-                rows[next] = dense[i];
-                next += 1;
-            }
+        for (k, &i) in nonzero.iter().enumerate() {
+            // Slot k + 1 <= 255: fewer than SLOTS rows are non-zero.
+            slots[i] = (k + 1) as u8;
+            rows[k + 1] = dense[i];
         }
         LightRows::Compact { slots, rows }
     }
