@@ -8,17 +8,19 @@ SCENE --param cube --resolution 32 --visibility-samples 1`) as f32 .npy arrays w
 answers. Embree casts the same f32 rays through `embreex` (Embree 4.4.0, its only occlusion
 query: `rtcOccluded1` per ray, looped in C; the binding offers no packet or stream query), on
 one thread, and on two as two processes each casting half the rays at once (the slower
-process's time). haarshift's figure is the whole precomputation (rays and the Haar encoding
+process's time). haarshift's figures are the whole precomputation (rays and the Haar encoding
 of every vertex's transport, `vertex_range`) with RAYON_NUM_THREADS=1 and 2, the fastest of
-three; "before" is the same precomputation through the single-ray path the packets replaced
-(benches/single_ray.rs), in the same process. BVH builds are timed apart, not in the rates.
-Every ray answered differently by haarshift and Embree, or by the packets and the single-ray
-path, is worked out in f64 against every triangle to say which answer is exact.
+three, with each of its ray tracers (`RayTracer`): Embree 3.13.5 (Debian's libembree3, its
+16-wide packet query `rtcOccluded16`, the default where it is installed) and our own packets.
+BVH builds are timed apart, not in the rates. Every ray answered differently by haarshift's
+tracers and Embree 4.4, or by the two tracers, is worked out in f64 against every triangle
+to say which answer is exact.
 
 Scenes: the bunny (every vertex), the cubes scene (testdata/scenes/cubes.json, 85,860
 vertices: a run of 2,000 of them) and a generated scene of 600,000 triangles (14 x 14 cubes of
 16 x 16 cells a face: 2,000 vertices). Writes benches/rays_results.md.
 
+    apt-get install libembree-dev         # haarshift's Embree tracer (.ci/run installs it)
     pip install --user numpy embreex      # test-only; not part of .ci/run
     python3 benches/compare_rays.py
 """
@@ -152,17 +154,22 @@ def exact(directory, rays):
     return answers
 
 
-def arbitrate(directory, name, against, ours, different):
-    """One line: who of haarshift and `against` the f64 answer agrees with on the rays they
-    answer differently, and how near an edge those rays pass."""
+def whose(name):
+    """The possessive of a name: "our packets'", "Embree 4.4's"."""
+    return name + ("'" if name.endswith("s") else "'s")
+
+
+def arbitrate(directory, name, who, against, ours, different):
+    """One line: who of `who` (answers `ours`) and `against` the f64 answer agrees with on the
+    rays they answer differently, and how near an edge those rays pass."""
     answers = exact(directory, different)
     truth = np.array([b for b, _ in answers])
     margins = np.abs([m for _, m in answers])
     agree = int((truth == ours[different].astype(bool)).sum())
     return (
-        f"- {name}: {len(different)} rays answered differently by haarshift and {against}. "
-        f"In f64 against every triangle, haarshift's answer is the exact one on {agree}, "
-        f"{against}'s on {len(different) - agree}; every one passes within "
+        f"- {name}: {len(different)} rays answered differently by {who} and {against}. "
+        f"In f64 against every triangle, the exact answer is {whose(who)} on {agree} and "
+        f"{whose(against)} on {len(different) - agree}; every one passes within "
         f"{margins.max():.1e} (barycentric) of a triangle's edge (median {np.median(margins):.1e})"
     )
 
@@ -172,7 +179,9 @@ def main():
         embree_child(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
         return
     subprocess.run(
-        ["cargo", "build", "--release", "--example", "rays"], cwd=ROOT, check=True
+        ["cargo", "build", "--release", "--features", "embree", "--example", "rays"],
+        cwd=ROOT,
+        check=True,
     )
     import embreex
 
@@ -186,39 +195,41 @@ def main():
             args = [str(EXAMPLE), str(path), *export] + (["--vertices", vertices] if vertices else [])
             subprocess.run(args, check=True)
             ours = np.load(directory / "blocked.npy")
+            packets = np.load(directory / "packets.npy")
             n = len(ours)
             e1, blocked = embree(directory, n, 1)
             e1 = min(e1, embree(directory, n, 1)[0])
             e2 = min(embree(directory, n, 2)[0] for _ in range(2))
-            h1 = haarshift(path, vertices, 1, "--baseline")
-            h2 = haarshift(path, vertices, 2)
-            assert h1["rays"] == n == h2["rays"] == len(blocked), (h1, h2, n, len(blocked))
-            different = np.flatnonzero(blocked != ours)
-            if len(different):
-                notes.append(arbitrate(directory, name, "Embree", ours, different))
-                first = different[:10]
+            h1, h2 = (haarshift(path, vertices, t, "--tracer", "embree") for t in (1, 2))
+            p1, p2 = (haarshift(path, vertices, t, "--tracer", "packets") for t in (1, 2))
+            assert h1["rays"] == n == h2["rays"] == len(blocked) == p1["rays"], (h1, p1, n)
+            for who, answers in (("haarshift (Embree 3)", ours), ("our packets", packets)):
+                different = np.flatnonzero(blocked != answers)
+                if len(different):
+                    notes.append(arbitrate(directory, name, who, "Embree 4.4", answers, different))
+            first = np.flatnonzero(blocked != ours)[:10]
+            if len(first):
                 listed = ", ".join(
-                    f"ray {i}: haarshift {'blocked' if ours[i] else 'open'}, Embree "
+                    f"ray {i}: haarshift {'blocked' if ours[i] else 'open'}, Embree 4.4 "
                     f"{'blocked' if blocked[i] else 'open'}, "
                     + ("no triangle" if c is None else f"cos to the triangle's plane {c:.2e}")
                     for i, c in zip(first, grazing(directory, first))
                 )
                 notes.append(f"  The first ten: {listed}")
-            single = np.load(directory / "single_ray.npy")
-            changed = np.flatnonzero(single != ours)
+            changed = np.flatnonzero(packets != ours)
             if len(changed):
                 notes.append(
-                    arbitrate(directory, name, "the single-ray path", ours, changed)
+                    arbitrate(directory, name, "haarshift (Embree 3)", "our packets", ours, changed)
                 )
-            elif not h1["baseline_equal"]:
-                notes.append(f"- {name}: the transport differs from the single-ray path's")
             rate = lambda s: n / s / 1e6
             rows.append(
                 f"| {name} | {h1['triangles']:,} | {h1['vertices']:,} | {n:,} | "
-                f"{int(ours.sum()):,} / {int(blocked.sum()):,} | {len(different)} | "
-                f"{h1['build_seconds']:.2f} | {rate(h1['baseline_seconds']):.2f} | "
+                f"{int(ours.sum()):,} / {int(packets.sum()):,} / {int(blocked.sum()):,} | "
+                f"{h1['build_seconds']:.2f} / {p1['build_seconds']:.2f} | "
                 f"{rate(e1):.2f} | {rate(h1['seconds']):.2f} | **{e1 / h1['seconds']:.2f}x** | "
-                f"{rate(e2):.2f} | {rate(h2['seconds']):.2f} | **{e2 / h2['seconds']:.2f}x** |"
+                f"{rate(p1['seconds']):.2f} | {e1 / p1['seconds']:.2f}x | "
+                f"{rate(e2):.2f} | {rate(h2['seconds']):.2f} | **{e2 / h2['seconds']:.2f}x** | "
+                f"{rate(p2['seconds']):.2f} | {e2 / p2['seconds']:.2f}x |"
             )
             print(rows[-1], flush=True)
     table = "\n".join(rows)
@@ -228,23 +239,22 @@ def main():
 Written by `python3 benches/compare_rays.py` (see its docstring for what is measured): the
 same f32 rays, exported by `examples/rays.rs` from haarshift's precomputation, cast by
 haarshift and by Embree {getattr(embreex, "__version__", "4.4.0")} through `embreex`
-(`rtcOccluded1` per ray). Rates in millions of rays per second; haarshift's are its whole
-precomputation, rays and Haar encoding of the transport; "before" is haarshift's
-precomputation through the single-ray CWBVH path it replaced; the ratios are Embree's time
-over haarshift's (above 1: haarshift faster). BVH builds (seconds, haarshift's packet BVH) are
-not in the rates. Measured in one run on this 2-core machine (load average {load[0]:.1f},
-{load[1]:.1f}, {load[2]:.1f}: shared with other work, so rates are lower than on an idle
-machine; the ratios are what carries).
+(`rtcOccluded1` per ray, the "Embree 4.4" columns). Rates in millions of rays per second;
+haarshift's are its whole precomputation, rays and Haar encoding of the transport, with each
+of its ray tracers: "haarshift" is the default where Embree is installed, Embree 3.13.5's
+16-wide packets (`rtcOccluded16`, Debian's libembree3), and "our packets" is haarshift's own
+tracer, in every build. The ratios are Embree 4.4's time over haarshift's (above 1: haarshift
+faster). BVH builds (seconds, Embree 3's / our packets') are not in the rates. Measured in
+one run on this 2-core machine (load average {load[0]:.1f}, {load[1]:.1f}, {load[2]:.1f}).
 
-| scene | triangles | vertices | rays (both) | blocked (haarshift / Embree) | differ | build s | haarshift before, 1 thread | Embree 1 thread | haarshift 1 thread | ratio | Embree 2 processes | haarshift 2 threads | ratio |
-|---|---|---|---|---|---|---|---|---|---|---|---|---|---|
+| scene | triangles | vertices | rays (all) | blocked (haarshift / our packets / Embree 4.4) | build s | Embree 4.4, 1 thread | haarshift 1 thread | ratio | our packets 1 thread | ratio | Embree 4.4, 2 processes | haarshift 2 threads | ratio | our packets 2 threads | ratio |
+|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|
 {table}
 
-Rays answered differently by haarshift and Embree, or by haarshift's packets and the
-single-ray path they replaced, each worked out in f64 against every triangle to say which
-answer is exact (the first ten listed with the cosine between the ray and the plane of the
-triangle Embree finds along it: grazing rays have a cosine near 0). A scene not listed has
-the same answers in all three.
+Rays answered differently by two of the three, each worked out in f64 against every triangle
+to say which answer is exact (for haarshift against Embree 4.4, the first ten listed with the
+cosine between the ray and the plane of the triangle Embree finds along it: grazing rays have
+a cosine near 0). A scene not listed has the same answers in all three.
 
 {differences}
 """

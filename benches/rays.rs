@@ -1,4 +1,4 @@
-//! Occlusion rays of the vertex-major precomputation: the packet traversal of `SceneBvh`
+//! Occlusion rays of the vertex-major precomputation: our packet traversal (`RayTracer::Packets`)
 //! against the single-ray CWBVH path it replaced (`single_ray`, the named baseline), in the same
 //! run, on one thread. Two groups on the bunny (1,839 vertices, 3,674 triangles) with cube
 //! 32 x 32 texel-centre rays, one per texel above the horizon:
@@ -12,7 +12,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use haarshift::faces::{ParamKind, Parameterization};
-use haarshift::relight::{Mesh, Occlusion, SceneBvh, VisibilityOptions, ray_offset, vertex_range};
+use haarshift::relight::{
+    Mesh, Occlusion, RayTracer, SceneBvh, VisibilityOptions, ray_offset, vertex_range,
+};
 
 #[path = "single_ray.rs"]
 mod single_ray;
@@ -52,7 +54,8 @@ fn bench(c: &mut Criterion) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
     let mesh = Mesh::load(path.as_ref()).unwrap();
     let param = Parameterization::new(ParamKind::Cube, 32).unwrap();
-    let (packets, baseline) = (SceneBvh::new(&mesh), single_ray::SingleRay::new(&mesh));
+    let packets = SceneBvh::with_tracer(&mesh, RayTracer::Packets);
+    let baseline = single_ray::SingleRay::new(&mesh);
     let work = rays(&mesh, param);
     assert_eq!(cast(&packets, &work), cast(&baseline, &work));
     let one = rayon::ThreadPoolBuilder::new()

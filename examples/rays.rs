@@ -3,18 +3,16 @@
 //! the CLI's `relight precompute SCENE --param cube --resolution 32 --visibility-samples 1`.
 //!
 //! ```text
-//! cargo run --release --example rays -- SCENE [--vertices A..B] [--export DIR] [--repeat R] [--baseline]
+//! cargo run --release --features embree --example rays -- SCENE [--tracer T] [--vertices A..B] [--export DIR] [--repeat R]
 //!   SCENE       a mesh (PLY, OBJ) or a scene file (JSON), as the CLI reads it
+//!   --tracer    the ray tracer, `packets` or `embree` (RayTracer; the best available by default)
 //!   --vertices  precompute these vertices only (all by default)
 //!   --export    write the mesh as Embree takes it (vertices.npy f32 (V, 3), triangles.npy
 //!               i32 (T, 3)) and every ray cast, in casting order: origins.npy and
-//!               directions.npy f32 (N, 3), blocked.npy u8 (N,), and the same rays' answers
-//!               through the single-ray path the packets replaced, single_ray.npy u8 (N,)
+//!               directions.npy f32 (N, 3), blocked.npy u8 (N,) (the tracer's answers), and
+//!               the same rays' answers through our packets, packets.npy u8 (N,)
 //!   --repeat    time the precomputation (rays and Haar encoding, `vertex_range`) R times
 //!               on the rayon pool (RAYON_NUM_THREADS) and print the fastest as JSON
-//!   --baseline  also time it through the single-ray path the packets replaced
-//!               (benches/single_ray.rs), in the same process, and say whether the two
-//!               transports are equal
 //! ```
 //!
 //! The rays exported are those the precomputation asks its [`Occlusion`] about, recorded as
@@ -27,12 +25,9 @@ use std::time::Instant;
 
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::relight::{
-    Occlusion, Scene, SceneBvh, TransportSet, VisibilityOptions, vertex_range,
+    Occlusion, RayTracer, Scene, SceneBvh, TransportSet, VisibilityOptions, vertex_range,
 };
 use ndarray::{Array1, Array2};
-
-#[path = "../benches/single_ray.rs"]
-mod single_ray;
 
 /// Every ray asked: origins, directions, answers (1: blocked).
 type Recorded = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u8>);
@@ -82,30 +77,35 @@ fn rows(v: Vec<[f32; 3]>) -> Array2<f32> {
     Array2::from_shape_vec((n, 3), v.into_iter().flatten().collect()).expect("n x 3")
 }
 
-/// The fastest of `repeat` precomputations of `vertices` through `occlusion`: rays, seconds
-/// and the transport.
+/// The fastest of `repeat` precomputations of `vertices` through `occlusion`: rays and
+/// seconds.
 fn fastest(
     scene: &Scene,
     occlusion: &impl Occlusion,
     options: &VisibilityOptions,
     vertices: &Range<usize>,
     repeat: usize,
-) -> haarshift::Result<(u64, f64, Option<TransportSet>)> {
-    let mut best = (0, f64::INFINITY, None);
+) -> haarshift::Result<(u64, f64)> {
+    let mut best = (0, f64::INFINITY);
     for _ in 0..repeat {
-        let (set, report) = vertex_range(&scene.mesh, occlusion, options, vertices.clone())?;
-        best = (report.rays, best.1.min(report.seconds), Some(set));
+        let (_, report): (TransportSet, _) =
+            vertex_range(&scene.mesh, occlusion, options, vertices.clone())?;
+        best = (report.rays, best.1.min(report.seconds));
     }
     Ok(best)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let usage = "usage: rays SCENE [--vertices A..B] [--export DIR] [--repeat R] [--baseline]";
+    let usage = "usage: rays SCENE [--tracer T] [--vertices A..B] [--export DIR] [--repeat R]";
     let scene = Scene::load(Path::new(&args.next().ok_or(usage)?))?;
     let mesh = &scene.mesh;
-    let (mut vertices, mut export, mut repeat, mut baseline) =
-        (0..mesh.vertex_count(), None::<PathBuf>, 0, false);
+    let (mut vertices, mut export, mut repeat, mut tracer) = (
+        0..mesh.vertex_count(),
+        None::<PathBuf>,
+        0,
+        RayTracer::best(),
+    );
     while let Some(flag) = args.next() {
         match flag.as_str() {
             "--vertices" => {
@@ -115,24 +115,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             "--export" => export = Some(args.next().ok_or(usage)?.into()),
             "--repeat" => repeat = args.next().ok_or(usage)?.parse()?,
-            "--baseline" => baseline = true,
+            "--tracer" => tracer = args.next().ok_or(usage)?.parse()?,
             _ => return Err(usage.into()),
         }
     }
     let options = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 32)?);
     let start = Instant::now();
-    let bvh = SceneBvh::new(mesh);
+    let bvh = SceneBvh::with_tracer(mesh, tracer);
     let build = start.elapsed().as_secs_f64();
+    if bvh.tracer() != tracer {
+        return Err(format!("the {tracer} ray tracer is not available in this build").into());
+    }
     if let Some(dir) = export {
         std::fs::create_dir_all(&dir)?;
         let (origins, directions, blocked) =
             Recorder::record(&bvh, mesh, &options, vertices.clone())?;
-        let old = single_ray::SingleRay::new(mesh);
-        let (_, old_directions, single_ray) =
-            Recorder::record(&old, mesh, &options, vertices.clone())?;
+        let packets = SceneBvh::with_tracer(mesh, RayTracer::Packets);
+        let (_, packet_directions, packet_blocked) =
+            Recorder::record(&packets, mesh, &options, vertices.clone())?;
         assert_eq!(
-            old_directions, directions,
-            "both paths are asked the same rays"
+            packet_directions, directions,
+            "both tracers are asked the same rays"
         );
         let positions = mesh.positions().mapv(|x| x as f32);
         let triangles = mesh.triangles().iter().flatten().map(|&i| i as i32);
@@ -142,26 +145,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ndarray_npy::write_npy(dir.join("origins.npy"), &rows(origins))?;
         ndarray_npy::write_npy(dir.join("directions.npy"), &rows(directions))?;
         ndarray_npy::write_npy(dir.join("blocked.npy"), &Array1::from(blocked))?;
-        ndarray_npy::write_npy(dir.join("single_ray.npy"), &Array1::from(single_ray))?;
+        ndarray_npy::write_npy(dir.join("packets.npy"), &Array1::from(packet_blocked))?;
     }
     if repeat > 0 {
-        let (rays, seconds, set) = fastest(&scene, &bvh, &options, &vertices, repeat)?;
-        let mut line = format!(
-            "{{\"triangles\": {}, \"vertices\": {}, \"threads\": {}, \"build_seconds\": {build}, \
-             \"rays\": {rays}, \"seconds\": {seconds}",
+        let (rays, seconds) = fastest(&scene, &bvh, &options, &vertices, repeat)?;
+        println!(
+            "{{\"tracer\": \"{tracer}\", \"triangles\": {}, \"vertices\": {}, \"threads\": {}, \
+             \"build_seconds\": {build}, \"rays\": {rays}, \"seconds\": {seconds}}}",
             mesh.triangles().len(),
             vertices.len(),
             rayon::current_num_threads()
         );
-        if baseline {
-            let old = single_ray::SingleRay::new(mesh);
-            let (_, before, old) = fastest(&scene, &old, &options, &vertices, repeat)?;
-            line += &format!(
-                ", \"baseline_seconds\": {before}, \"baseline_equal\": {}",
-                old == set
-            );
-        }
-        println!("{line}}}");
     }
     Ok(())
 }

@@ -11,6 +11,8 @@
 //! whose vertices would not fit in [`PrecomputeOptions::budget`] is refused from its count,
 //! before the BVH or any transport is built.
 
+#[cfg(feature = "embree")]
+mod embree;
 mod packet;
 pub mod raycast;
 pub mod shadowmap;
@@ -30,7 +32,7 @@ use crate::relight::precompute::visibility::{
 use crate::relight::scene::cache_shard::Provenance;
 use crate::relight::scene::validate::{DEFAULT_MEMORY_LIMIT, MemoryBudget};
 use crate::relight::{
-    CacheParams, CacheShard, Scene, SceneBvh, SceneCache, SceneError, TransportSet,
+    CacheParams, CacheShard, RayTracer, Scene, SceneBvh, SceneCache, SceneError, TransportSet,
 };
 use crate::{Error, Result};
 
@@ -72,6 +74,8 @@ pub struct PrecomputeOptions {
     pub map_size: usize,
     /// The most bytes the scene and its transport may take ([`budget`](Self::budget)).
     pub memory_limit: u64,
+    /// The ray tracer of [`Order::Vertex`] ([`RayTracer::best`] unless changed).
+    pub ray_tracer: RayTracer,
 }
 
 impl PrecomputeOptions {
@@ -83,6 +87,7 @@ impl PrecomputeOptions {
             order: Order::Vertex,
             map_size: DEFAULT_MAP_SIZE,
             memory_limit: DEFAULT_MEMORY_LIMIT,
+            ray_tracer: RayTracer::best(),
         }
     }
 
@@ -97,6 +102,16 @@ impl PrecomputeOptions {
     /// assert!(err.to_string().contains("resolution"));
     /// ```
     pub fn check(&self) -> Result<()> {
+        if !self.ray_tracer.available() {
+            return Err(Error::parameter(
+                "ray tracer",
+                format!(
+                    "{} is not available: this build lacks the cargo feature `embree` or the \
+                     system's libembree3 did not start",
+                    self.ray_tracer
+                ),
+            ));
+        }
         let param = self.visibility.param;
         if param.texels() <= MAX_TEXELS {
             return Ok(());
@@ -312,7 +327,7 @@ fn transport(
     match (options.order, shard) {
         (Order::Vertex, shard) => vertex_range(
             mesh,
-            &SceneBvh::new(mesh),
+            &SceneBvh::with_tracer(mesh, options.ray_tracer),
             &options.visibility,
             shard.unwrap_or(Shard::whole()).range(mesh.vertex_count()),
         ),

@@ -4,21 +4,27 @@
 //! [`Occlusion::occluded`] for one ray and [`Occlusion::occluded_from`] for many rays of one
 //! origin (a vertex's rays), and the rest of the crate never sees the BVH.
 //!
-//! **The BVH: [`obvhs`] builds, our packets trace ([`packet`](super::packet)).** `obvhs`
-//! builds a binary BVH with PLOC, reinsertion and leaf collapsing (small dependencies: `glam`,
-//! `bytemuck`, a radix sort; dual MIT/Apache); it is laid out with both children's boxes in each
-//! node and traced by packets of up to 16 rays that share their origin, which is every query
-//! visibility makes. Before, the rays went one by one through `obvhs`'s own compressed 8-wide
-//! BVH (CWBVH, Ylitie et al. 2017; its any-hit `ray_traverse_miss`). On the same rays, one
-//! thread, the whole precomputation (rays and encoding) is faster than through that path on
-//! every scene measured, and than Intel Embree 4.4's single-ray `rtcOccluded1` (rays only) on
-//! the bunny but not on the two larger scenes: the figures are `benches/rays_results.md`
-//! (`python3 benches/compare_rays.py`; `cargo bench --bench rays`). Embree is not bound (yet):
-//! on large scenes it is the faster tracer. Of the crates `tools/bvh-compare`
-//! measured (its own workspace, so the candidates never enter this crate's build: `cd
-//! tools/bvh-compare && cargo run --release`), `obvhs`'s single-ray query was the fastest, 1.5-2x
-//! faster than `bvh` 0.12 (binary SAH BVH, nalgebra, a back-face-culling triangle test) and
-//! `parry3d` 0.31 (a whole collision library).
+//! **Two tracers, one interface ([`RayTracer`]).** [`SceneBvh::new`] takes the faster one this
+//! build offers ([`RayTracer::best`]):
+//! * [`RayTracer::Embree`]: Intel Embree 3.13.5 (the system's `libembree3`, Debian's
+//!   `libembree-dev`) through the `embree3` crate's bindings, its 16-wide packet query
+//!   ([`embree`](super::embree)); in builds with the cargo feature `embree`, which the CLI, the
+//!   viewer and the Python package turn on. On the same rays, one thread, the whole
+//!   precomputation (rays and encoding) through it is faster than Embree 4.4's single-ray
+//!   `rtcOccluded1` alone on every scene `benches/rays_results.md` measures, and than our packets.
+//! * [`RayTracer::Packets`]: our own, in every build. `obvhs` builds a binary BVH with PLOC,
+//!   reinsertion and leaf collapsing (small dependencies: `glam`, `bytemuck`, a radix sort; dual
+//!   MIT/Apache); it is laid out with both children's boxes in each node and traced by packets
+//!   of up to 16 rays that share their origin ([`packet`](super::packet)), which is every query
+//!   visibility makes. Its answers are those of testing every triangle with Moller-Trumbore in
+//!   f32, bit for bit. Of the pure-Rust crates `tools/bvh-compare` measured (its own workspace,
+//!   so the candidates never enter this crate's build: `cd tools/bvh-compare && cargo run
+//!   --release`), `obvhs`'s single-ray query was the fastest, 1.5-2x faster than `bvh` 0.12
+//!   (binary SAH BVH, nalgebra, a back-face-culling triangle test) and `parry3d` 0.31 (a whole
+//!   collision library); our packets are faster again on every scene measured.
+//!
+//! The two answer alike except on rays through a triangle's edge, whose f32 answer is decided
+//! by rounding (`benches/compare_rays.py` works each such ray out in f64).
 //!
 //! Rays are f32 (the BVH's precision). What the BVH is given is cleaned in f32, after the
 //! conversion: triangles of zero area there are left out (no ray can hit one) and repeated
@@ -32,11 +38,8 @@
 //! areas all tie builds in time quadratic in its triangles (a scene of extent `1e-23` took a
 //! minute for 12,000 under the fuzzer). Scaling by `2^k` is exact in floating point: the
 //! answers are those of the same scene at that size. (The traversal itself has no absolute
-//! epsilon: `obvhs`'s CWBVH skipped a box the ray left before `t = 1e-4`, so an occluder that
-//! near the origin was missed; none is now. On the bunny every visibility bit is the old
-//! path's; on the cubes scene some rays differ from it, see `benches/rays_results.md`.) A ray
-//! hits a triangle
-//! when the Moller-Trumbore test finds `0 <= t < t_max`
+//! epsilon: nothing is skipped near the origin.) With our packets a ray hits a triangle when
+//! the Moller-Trumbore test finds `0 <= t < t_max`
 //! ([`obvhs::rt_triangle::RtTriangle::intersect`]); the caller offsets origins off surfaces.
 
 use std::collections::HashSet;
@@ -78,25 +81,82 @@ pub trait Occlusion: Sync {
             *b = self.occluded(origin, d, t_max);
         }
     }
+
+    /// The [`RayTracer`] answering, for reports (`None`: another implementation).
+    fn tracer(&self) -> Option<RayTracer> {
+        None
+    }
 }
 
-/// The scene's triangles in a BVH traced by packets of rays that share their origin
-/// ([`packet`](super::packet)).
+crate::named::named_enum! {
+    /// The ray tracers a [`SceneBvh`] traces with; [`RayTracer::best`] is what
+    /// [`SceneBvh::new`] takes.
+    ///
+    /// ```
+    /// use haarshift::relight::RayTracer;
+    /// assert!(RayTracer::Packets.available()); // every build has it
+    /// assert_eq!("embree".parse::<RayTracer>().unwrap(), RayTracer::Embree);
+    /// ```
+    pub enum RayTracer ("ray tracer") {
+        /// haarshift's own binary BVH traced by packets of rays that share their origin
+        /// ([`packet`](super::packet)): in every build, its answers specified to the bit.
+        Packets = "packets",
+        /// Intel Embree 3's 16-wide packet query ([`embree`](super::embree)): in builds with the
+        /// cargo feature `embree` (the CLI's and the Python package's), when Embree starts.
+        Embree = "embree",
+    }
+}
+
+impl RayTracer {
+    /// Whether this build offers the tracer and it starts on this machine.
+    pub fn available(self) -> bool {
+        match self {
+            RayTracer::Packets => true,
+            #[cfg(feature = "embree")]
+            RayTracer::Embree => super::embree::available(),
+            #[cfg(not(feature = "embree"))]
+            RayTracer::Embree => false,
+        }
+    }
+
+    /// The faster tracer available: Embree where it is (`benches/rays_results.md`), else
+    /// our packets.
+    pub fn best() -> RayTracer {
+        if RayTracer::Embree.available() {
+            RayTracer::Embree
+        } else {
+            RayTracer::Packets
+        }
+    }
+}
+
+/// The scene's triangles in a BVH of the chosen [`RayTracer`].
 ///
 /// ```
-/// use haarshift::relight::{Mesh, Occlusion, SceneBvh};
+/// use haarshift::relight::{Mesh, Occlusion, RayTracer, SceneBvh};
 /// use ndarray::array;
 /// let roof = Mesh::new(array![[-1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.0, -1.0]],
 ///                      vec![[0, 1, 2]], None).unwrap();
 /// let bvh = SceneBvh::new(&roof);
+/// assert_eq!(bvh.tracer(), RayTracer::best());
 /// assert!(bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
 /// assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, -1.0, 0.0], f32::INFINITY));
 /// assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.5)); // stops short of it
 /// ```
 pub struct SceneBvh {
-    bvh: Option<PacketBvh>,
+    /// `None` for a scene with no triangle of non-zero area.
+    tracer: Option<Tracer>,
+    /// The tracer that answers (see [`SceneBvh::tracer`]).
+    kind: RayTracer,
     /// The power of two the positions were scaled by (1 unless the scene is tiny).
     scale: f32,
+}
+
+/// A built BVH of one [`RayTracer`].
+enum Tracer {
+    Packets(PacketBvh),
+    #[cfg(feature = "embree")]
+    Embree(super::embree::EmbreeScene),
 }
 
 /// The extent (largest side of the bounding box, in f32) below which [`SceneBvh`] scales a
@@ -120,8 +180,29 @@ fn scale_for(lo: [f32; 3], hi: [f32; 3]) -> f32 {
 
 impl SceneBvh {
     /// Builds the BVH of `mesh`'s distinct triangles of non-zero area in f32 (see the
-    /// [module docs](self)), a scene smaller than [`SMALL_EXTENT`] scaled up first.
+    /// [module docs](self)), a scene smaller than [`SMALL_EXTENT`] scaled up first, with
+    /// [`RayTracer::best`].
     pub fn new(mesh: &Mesh) -> Self {
+        Self::with_tracer(mesh, RayTracer::best())
+    }
+
+    /// As [`SceneBvh::new`], traced by `tracer` when it is
+    /// [available](RayTracer::available) and builds the scene, else by our packets (see
+    /// [`SceneBvh::tracer`]).
+    ///
+    /// ```
+    /// use haarshift::relight::{Mesh, Occlusion, RayTracer, SceneBvh};
+    /// use ndarray::array;
+    /// let roof = Mesh::new(array![[-1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.0, -1.0]],
+    ///                      vec![[0, 1, 2]], None).unwrap();
+    /// let ours = SceneBvh::with_tracer(&roof, RayTracer::Packets);
+    /// assert_eq!(ours.tracer(), RayTracer::Packets);
+    /// let best = SceneBvh::with_tracer(&roof, RayTracer::best());
+    /// for d in [[0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.3, 0.9, 0.3]] {
+    ///     assert_eq!(ours.occluded([0.0; 3], d, 9.0), best.occluded([0.0; 3], d, 9.0));
+    /// }
+    /// ```
+    pub fn with_tracer(mesh: &Mesh, tracer: RayTracer) -> Self {
         let p = mesh.positions();
         let f32_row = |i: usize| {
             let r = p.row(i);
@@ -137,7 +218,7 @@ impl SceneBvh {
         let scale = scale_for(lo, hi);
         let point = |i: u32| f32_row(i as usize).map(|x| x * scale);
         let mut seen = HashSet::with_capacity(mesh.triangles().len());
-        let triangles: Vec<Triangle> = mesh
+        let triangles: Vec<[[f32; 3]; 3]> = mesh
             .triangles()
             .iter()
             .filter_map(|t| {
@@ -145,29 +226,65 @@ impl SceneBvh {
                 let [a, b, c] = corners.map(|v| v.map(f64::from));
                 let mut key = corners.map(|v| v.map(f32::to_bits));
                 key.sort_unstable();
-                (cross(sub(b, a), sub(c, a)) != [0.0; 3] && seen.insert(key)).then(|| {
-                    let [v0, v1, v2] = corners.map(Vec3A::from_array);
-                    Triangle { v0, v1, v2 }
-                })
+                (cross(sub(b, a), sub(c, a)) != [0.0; 3] && seen.insert(key)).then_some(corners)
             })
             .collect();
         drop(seen);
+        let built = (!triangles.is_empty()).then(|| build(&triangles, tracer));
+        let kind = match &built {
+            None if tracer.available() => tracer,
+            #[cfg(feature = "embree")]
+            Some(Tracer::Embree(_)) => RayTracer::Embree,
+            _ => RayTracer::Packets,
+        };
         SceneBvh {
-            bvh: (!triangles.is_empty()).then(|| PacketBvh::new(&triangles)),
+            tracer: built,
+            kind,
             scale,
         }
     }
+
+    /// The tracer that answers this scene's queries: the one asked for, or
+    /// [`RayTracer::Packets`] when that one was not available or could not build the scene.
+    pub fn tracer(&self) -> RayTracer {
+        self.kind
+    }
+}
+
+/// The BVH of `triangles` (not empty) for `tracer`, our packets' when that one is not
+/// available or fails to build.
+fn build(triangles: &[[[f32; 3]; 3]], tracer: RayTracer) -> Tracer {
+    #[cfg(feature = "embree")]
+    if tracer == RayTracer::Embree
+        && let Some(scene) = super::embree::EmbreeScene::new(triangles)
+    {
+        return Tracer::Embree(scene);
+    }
+    let _ = tracer;
+    let triangles: Vec<Triangle> = triangles
+        .iter()
+        .map(|t| {
+            let [v0, v1, v2] = t.map(Vec3A::from_array);
+            Triangle { v0, v1, v2 }
+        })
+        .collect();
+    Tracer::Packets(PacketBvh::new(&triangles))
 }
 
 impl Occlusion for SceneBvh {
     fn occluded(&self, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
-        let mut blocked = [false];
-        if let Some(bvh) = &self.bvh {
-            // In the BVH's scaled space: origin + t d becomes s origin + (s t) d.
-            let o = origin.map(|x| x * self.scale);
-            bvh.occluded_packet::<1>(o, &[direction], t_max * self.scale, &mut blocked);
+        // In the BVH's scaled space: origin + t d becomes s origin + (s t) d.
+        let (o, t_max) = (origin.map(|x| x * self.scale), t_max * self.scale);
+        match &self.tracer {
+            None => false,
+            Some(Tracer::Packets(bvh)) => {
+                let mut blocked = [false];
+                bvh.occluded_packet::<1>(o, &[direction], t_max, &mut blocked);
+                blocked[0]
+            }
+            #[cfg(feature = "embree")]
+            Some(Tracer::Embree(scene)) => scene.occluded(o, direction, t_max),
         }
-        blocked[0]
     }
 
     fn occluded_from(
@@ -178,17 +295,28 @@ impl Occlusion for SceneBvh {
         blocked: &mut [bool],
     ) {
         let n = directions.len().min(blocked.len());
-        let Some(bvh) = &self.bvh else {
-            blocked[..n].fill(false);
-            return;
-        };
-        let o = origin.map(|x| x * self.scale);
-        for (d, b) in directions[..n]
-            .chunks(LANES)
-            .zip(blocked[..n].chunks_mut(LANES))
-        {
-            bvh.occluded_packet::<LANES>(o, d, t_max * self.scale, b);
+        let (directions, blocked) = (&directions[..n], &mut blocked[..n]);
+        let (o, t_max) = (origin.map(|x| x * self.scale), t_max * self.scale);
+        match &self.tracer {
+            None => blocked.fill(false),
+            Some(Tracer::Packets(bvh)) => {
+                for (d, b) in directions.chunks(LANES).zip(blocked.chunks_mut(LANES)) {
+                    bvh.occluded_packet::<LANES>(o, d, t_max, b);
+                }
+            }
+            #[cfg(feature = "embree")]
+            Some(Tracer::Embree(scene)) => {
+                use super::embree::EMBREE_LANES;
+                let packets = directions.chunks(EMBREE_LANES);
+                for (d, b) in packets.zip(blocked.chunks_mut(EMBREE_LANES)) {
+                    scene.occluded_packet(o, d, t_max, b);
+                }
+            }
         }
+    }
+
+    fn tracer(&self) -> Option<RayTracer> {
+        Some(self.kind)
     }
 }
 

@@ -13,8 +13,67 @@ fn bunny_on_ground() -> Mesh {
     mesh
 }
 
+/// The triangles our packets trace (none for another tracer).
 fn traced(bvh: &SceneBvh) -> &[obvhs::rt_triangle::RtTriangle] {
-    bvh.bvh.as_ref().map_or(&[], |b| &b.triangles)
+    match &bvh.tracer {
+        Some(Tracer::Packets(b)) => &b.triangles,
+        _ => &[],
+    }
+}
+
+/// Our packets' BVH of `mesh`.
+fn packets(mesh: &Mesh) -> SceneBvh {
+    SceneBvh::with_tracer(mesh, RayTracer::Packets)
+}
+
+/// The BVH of `mesh` with every tracer this build offers.
+fn every_tracer(mesh: &Mesh) -> Vec<SceneBvh> {
+    let tracers = RayTracer::ALL.iter().filter(|t| t.available());
+    let bvhs: Vec<SceneBvh> = tracers.map(|&t| SceneBvh::with_tracer(mesh, t)).collect();
+    for (bvh, t) in bvhs.iter().zip(RayTracer::ALL) {
+        assert_eq!(bvh.tracer(), *t, "an available tracer builds");
+    }
+    bvhs
+}
+
+/// Tracer-independent oracle: the ray against every triangle of `mesh` in f64
+/// (Moller-Trumbore), `None` when the answer is not clear-cut, that is when a triangle's
+/// barycentric coordinates or distance come within `1e-5` (relative) of deciding otherwise: a
+/// ray through an edge, whose f32 answer rounding decides.
+fn exact(mesh: &Mesh, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<bool> {
+    const TOL: f64 = 1e-5;
+    let (o, d, t_max) = (o.map(f64::from), d.map(f64::from), f64::from(t_max));
+    let p = mesh.positions();
+    let corner = |i: u32| [0, 1, 2].map(|k| f64::from(p[[i as usize, k]] as f32));
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let mut unclear = false;
+    for t in mesh.triangles() {
+        let [a, b, c] = t.map(corner);
+        let (e1, e2) = (sub(b, a), sub(c, a));
+        let q = cross(d, e2);
+        let det = dot(e1, q);
+        if det == 0.0 {
+            continue;
+        }
+        let s = sub(o, a);
+        let u = dot(s, q) / det;
+        let r = cross(s, e1);
+        let v = dot(d, r) / det;
+        let dist = dot(e2, r) / det;
+        let inside = u.min(v).min(1.0 - u - v);
+        let length = dot(d, d).sqrt() * dot(e1, e1).sqrt().max(dot(e2, e2).sqrt());
+        let near = dist / length;
+        let far = if t_max.is_finite() {
+            (t_max - dist) / t_max.max(1.0)
+        } else {
+            f64::INFINITY
+        };
+        if inside > TOL && near > TOL && far > TOL {
+            return Some(true);
+        }
+        unclear |= inside > -TOL && near > -TOL && far > -TOL;
+    }
+    (!unclear).then_some(false)
 }
 
 /// The oracle: every triangle tested, the same intersection routine.
@@ -28,15 +87,12 @@ fn brute_force(bvh: &SceneBvh, origin: [f32; 3], direction: [f32; 3], t_max: f32
     traced(bvh).iter().any(|t| t.intersect(&ray) < t_max)
 }
 
-#[test]
-fn bvh_answers_as_testing_every_triangle() {
-    let mesh = bunny_on_ground();
-    let bvh = SceneBvh::new(&mesh);
-    assert_eq!(traced(&bvh).len(), mesh.triangles().len()); // none degenerate here
+/// Rays from near the bunny's vertices (the visibility case) and from anywhere in its box,
+/// with `t_max` 2 or infinite.
+fn bunny_rays(mesh: &Mesh) -> impl Iterator<Item = ([f32; 3], [f32; 3], f32)> + '_ {
     let b = mesh.bounds();
     let mut rng = StdRng::seed_from_u64(11);
-    let mut hits = 0;
-    for k in 0..20_000 {
+    (0..20_000).map(move |k| {
         let origin: [f32; 3] = std::array::from_fn(|i| {
             // Half the rays start near vertices (the visibility case), half anywhere.
             if k % 2 == 0 {
@@ -48,8 +104,38 @@ fn bvh_answers_as_testing_every_triangle() {
         });
         let d: [f32; 3] = std::array::from_fn(|_| rng.random_range(-1.0f32..1.0));
         let len = d.iter().map(|x| x * x).sum::<f32>().sqrt();
-        let d = d.map(|x| x / len);
         let t_max = if k % 3 == 0 { 2.0 } else { f32::INFINITY };
+        (origin, d.map(|x| x / len), t_max)
+    })
+}
+
+#[test]
+fn every_tracer_answers_every_clear_cut_ray_as_f64() {
+    let mesh = bunny_on_ground();
+    for bvh in every_tracer(&mesh) {
+        let (mut hits, mut unclear) = (0, 0);
+        // A quarter of the rays: the f64 oracle tests every triangle for each.
+        for (k, (o, d, t_max)) in bunny_rays(&mesh).enumerate().step_by(4) {
+            let got = bvh.occluded(o, d, t_max);
+            match exact(&mesh, o, d, t_max) {
+                Some(want) => assert_eq!(got, want, "{}: ray {k}", bvh.tracer()),
+                None => unclear += 1,
+            }
+            hits += usize::from(got);
+        }
+        // Both outcomes are well represented, and few rays are left unjudged.
+        assert!((1_000..4_000).contains(&hits), "{hits}");
+        assert!(unclear < 50, "{unclear}"); // 1%
+    }
+}
+
+#[test]
+fn bvh_answers_as_testing_every_triangle() {
+    let mesh = bunny_on_ground();
+    let bvh = packets(&mesh);
+    assert_eq!(traced(&bvh).len(), mesh.triangles().len()); // none degenerate here
+    let mut hits = 0;
+    for (k, (origin, d, t_max)) in bunny_rays(&mesh).enumerate() {
         let want = brute_force(&bvh, origin, d, t_max);
         assert_eq!(bvh.occluded(origin, d, t_max), want, "ray {k}");
         hits += usize::from(want);
@@ -62,9 +148,10 @@ fn bvh_answers_as_testing_every_triangle() {
 fn degenerate_triangles_never_occlude() {
     let positions = ndarray::array![[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]];
     let mesh = Mesh::new(positions, vec![[0, 1, 2], [0, 0, 1]], None).unwrap();
-    let bvh = SceneBvh::new(&mesh);
-    assert!(traced(&bvh).is_empty());
-    assert!(!bvh.occluded([0.5, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
+    assert!(traced(&packets(&mesh)).is_empty());
+    for bvh in every_tracer(&mesh) {
+        assert!(!bvh.occluded([0.5, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
+    }
     // A scene built the usual way is unaffected by such triangles.
     let scene = Scene::from_mesh(mesh, true).unwrap();
     assert!(SceneBvh::new(&scene.mesh).occluded([0.5, 2.0, 0.0], [0.0, -1.0, 0.0], 10.0));
@@ -84,10 +171,11 @@ fn repeated_and_f32_degenerate_triangles_are_kept_once_and_dropped() {
     ];
     let triangles = vec![[0, 1, 2], [1, 2, 0], [0, 2, 1], [3, 4, 5], [0, 0, 1]];
     let mesh = Mesh::new(positions, triangles.clone(), None).unwrap();
-    let bvh = SceneBvh::new(&mesh);
-    assert_eq!(traced(&bvh).len(), 1);
-    assert!(bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
-    assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, -1.0, 0.0], f32::INFINITY));
+    assert_eq!(traced(&packets(&mesh)).len(), 1);
+    for bvh in every_tracer(&mesh) {
+        assert!(bvh.occluded([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], f32::INFINITY));
+        assert!(!bvh.occluded([0.0, 0.0, 0.0], [0.0, -1.0, 0.0], f32::INFINITY));
+    }
     // The mesh keeps every triangle as read: cleaning feeds only the BVH.
     assert_eq!(mesh.triangles(), &triangles[..]);
 }
@@ -105,10 +193,13 @@ fn a_tiny_scene_answers_as_the_same_scene_at_an_extent_between_one_and_two() {
     let b = mesh.bounds();
     let extent = (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max);
     let unit = 2f64.powi(-(extent.log2().floor() as i32));
-    let (near, tiny) = (
-        SceneBvh::new(&scaled(unit)),
-        SceneBvh::new(&scaled(2f64.powi(-76))),
-    );
+    let (near, tiny) = (scaled(unit), scaled(2f64.powi(-76)));
+    for (near, tiny) in every_tracer(&near).into_iter().zip(every_tracer(&tiny)) {
+        tiny_answers_as_near(&near, &tiny, unit);
+    }
+}
+
+fn tiny_answers_as_near(near: &SceneBvh, tiny: &SceneBvh, unit: f64) {
     assert_eq!(near.scale, 1.0);
     assert_eq!(f64::from(tiny.scale), unit * 2f64.powi(76));
     let mut rng = StdRng::seed_from_u64(7);
@@ -135,37 +226,79 @@ fn a_tiny_scene_answers_as_the_same_scene_at_an_extent_between_one_and_two() {
     assert!((1_000..19_000).contains(&hits), "{hits}");
 }
 
-#[test]
-fn packets_from_vertices_answer_as_testing_every_triangle() {
-    // The visibility case: from just above vertices of the bunny on its ground, one ray to
-    // every cube 8 x 8 texel centre, in the order and packets precomputation casts them.
-    let mesh = bunny_on_ground();
-    let bvh = SceneBvh::new(&mesh);
+/// The visibility case: from just above every 97th vertex of `mesh`, one ray to every cube
+/// 8 x 8 texel centre, in the order precomputation casts them.
+fn vertex_rays(mesh: &Mesh) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
     let param = crate::faces::Parameterization::new(crate::faces::ParamKind::Cube, 8).unwrap();
-    let directions: Vec<[f32; 3]> = (0..param.texels())
+    let directions = (0..param.texels())
         .map(|t| {
             param
                 .texel_direction(t / 64, (t / 8) % 8, t % 8)
                 .map(|x| x as f32)
         })
         .collect();
-    let eps = crate::relight::ray_offset(&mesh);
+    let eps = crate::relight::ray_offset(mesh);
+    let origins = (0..mesh.vertex_count())
+        .step_by(97)
+        .map(|v| {
+            std::array::from_fn(|k| {
+                (mesh.positions()[[v, k]] + eps * mesh.normals()[[v, k]]) as f32
+            })
+        })
+        .collect();
+    (origins, directions)
+}
+
+#[test]
+fn packets_from_vertices_answer_as_testing_every_triangle() {
+    let mesh = bunny_on_ground();
+    let bvh = packets(&mesh);
+    let (origins, directions) = vertex_rays(&mesh);
     let mut blocked = vec![false; directions.len()];
     let mut hits = 0;
-    for v in (0..mesh.vertex_count()).step_by(97) {
-        let origin: [f32; 3] = std::array::from_fn(|k| {
-            (mesh.positions()[[v, k]] + eps * mesh.normals()[[v, k]]) as f32
-        });
-        bvh.occluded_from(origin, &directions, f32::INFINITY, &mut blocked);
+    for origin in &origins {
+        bvh.occluded_from(*origin, &directions, f32::INFINITY, &mut blocked);
         for (d, &b) in directions.iter().zip(&blocked) {
-            assert_eq!(
-                b,
-                brute_force(&bvh, origin, *d, f32::INFINITY),
-                "vertex {v} {d:?}"
-            );
+            let want = brute_force(&bvh, *origin, *d, f32::INFINITY);
+            assert_eq!(b, want, "{origin:?} {d:?}");
             hits += usize::from(b);
         }
     }
-    let rays = directions.len() * mesh.vertex_count().div_ceil(97);
+    let rays = directions.len() * origins.len();
     assert!((rays / 5..rays * 4 / 5).contains(&hits), "{hits} of {rays}");
+}
+
+#[test]
+fn every_tracer_answers_the_rays_of_vertices_as_f64() {
+    let mesh = bunny_on_ground();
+    let (origins, directions) = vertex_rays(&mesh);
+    for bvh in every_tracer(&mesh) {
+        let mut blocked = vec![false; directions.len()];
+        let (mut hits, mut unclear) = (0, 0);
+        // Every other vertex: the f64 oracle tests every triangle for each ray.
+        for origin in origins.iter().step_by(2) {
+            bvh.occluded_from(*origin, &directions, f32::INFINITY, &mut blocked);
+            for (d, &b) in directions.iter().zip(&blocked) {
+                match exact(&mesh, *origin, *d, f32::INFINITY) {
+                    Some(want) => assert_eq!(b, want, "{}: {origin:?} {d:?}", bvh.tracer()),
+                    None => unclear += 1,
+                }
+                hits += usize::from(b);
+            }
+        }
+        let rays = directions.len() * origins.len().div_ceil(2);
+        assert!((rays / 5..rays * 4 / 5).contains(&hits), "{hits} of {rays}");
+        assert!(unclear < rays / 100, "{unclear} of {rays}");
+    }
+}
+
+#[cfg(feature = "embree")]
+#[test]
+fn embree_is_the_best_tracer_where_it_is_built() {
+    assert!(RayTracer::Embree.available());
+    assert_eq!(RayTracer::best(), RayTracer::Embree);
+    assert_eq!(
+        SceneBvh::new(&bunny_on_ground()).tracer(),
+        RayTracer::Embree
+    );
 }

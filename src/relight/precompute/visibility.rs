@@ -43,7 +43,7 @@ use crate::product::Selection;
 use crate::progress::Task;
 use crate::relight::Mesh;
 use crate::relight::harmonics::check_bands;
-use crate::relight::precompute::raycast::Occlusion;
+use crate::relight::precompute::raycast::{Occlusion, RayTracer};
 use crate::relight::precompute::shadowmap::ShadowMap;
 use crate::relight::precompute::transport::{Encoded, Encoder, TransportSet};
 use crate::relight::scene::mesh::dot;
@@ -116,6 +116,9 @@ pub struct PrecomputeReport {
     /// (visibility bits and depth buffers, or per-thread texel arrays, and the shared tables:
     /// solid angles and spherical harmonics).
     pub working_bytes: usize,
+    /// The ray tracer that answered ([`Occlusion::tracer`]; `None` for the shadow-buffer order
+    /// and for an [`Occlusion`] of the caller's own).
+    pub tracer: Option<RayTracer>,
 }
 
 /// The distance rays start off their surface: `1e-4 x` the bounding-box diagonal.
@@ -297,6 +300,7 @@ pub fn vertex_range(
         rays,
         seconds: start.elapsed().as_secs_f64(),
         working_bytes: rayon::current_num_threads() * Scratch::bytes(param) + encoder.bytes(),
+        tracer: occlusion.tracer(),
     };
     Ok((set, report))
 }
@@ -479,6 +483,7 @@ pub fn direction_major(
         rays: 0,
         seconds: start.elapsed().as_secs_f64(),
         working_bytes: bits_bytes + maps_bytes + encoder.bytes(),
+        tracer: None,
     };
     Ok((set, report))
 }

@@ -6,10 +6,10 @@ use haarshift::Result;
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
-use haarshift::relight::VisibilityOptions;
 use haarshift::relight::precompute::{
     DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_shard, shard_is_done,
 };
+use haarshift::relight::{RayTracer, VisibilityOptions};
 
 use super::flags::{SceneFlags, ShardFlags, bytes};
 use crate::commands::{choice, names, print, refuse_outputs};
@@ -84,6 +84,13 @@ pub struct Args {
     #[arg(long, default_value = "vertex", value_parser = choice::<Order>(names!(Order)))]
     pub order: Order,
 
+    /// The ray tracer of --order vertex: `embree` (Intel Embree 3's packets, where the
+    /// system's libembree3 is installed: the default there) or `packets` (haarshift's own,
+    /// always available; its answers specified to the bit). Both answer alike except on rays
+    /// through a triangle's edge
+    #[arg(long, value_parser = choice::<RayTracer>(names!(RayTracer)))]
+    pub ray_tracer: Option<RayTracer>,
+
     /// Shadow-buffer side for --order direction
     #[arg(long, value_name = "M", default_value_t = DEFAULT_MAP_SIZE)]
     pub map_size: usize,
@@ -120,6 +127,7 @@ pub fn run(args: Args) -> Result<()> {
         order: args.order,
         map_size: args.map_size,
         memory_limit: args.scene.memory_limit,
+        ray_tracer: args.ray_tracer.unwrap_or_else(RayTracer::best),
     };
     options.check()?;
     let scene = args.scene.load_within(options.budget(shard))?;
@@ -153,7 +161,7 @@ pub fn run(args: Args) -> Result<()> {
     };
     print(&format!(
         "{}: {vertices} vertices{what}, {triangles} triangles, {} {} ({} texels), {} order\n\
-         rays {}, {:.3} s, {:.3} M rays/s, working memory {}\n\
+         rays {}{}, {:.3} s, {:.3} M rays/s, working memory {}\n\
          transport {} ({} coefficients), file {}, peak memory {}\n",
         args.output.display(),
         param.kind(),
@@ -161,6 +169,7 @@ pub fn run(args: Args) -> Result<()> {
         param.texels(),
         args.order,
         report.rays,
+        report.tracer.map_or(String::new(), |t| format!(" ({t})")),
         report.seconds,
         rate / 1e6,
         bytes(report.working_bytes as u64),
