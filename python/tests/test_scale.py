@@ -69,3 +69,14 @@ def test_a_shard_is_skipped_when_complete_and_bad_shards_are_refused(tmp_path, b
     with pytest.raises(FileExistsError):
         haarshift.relight.merge([part], output=taken)
     assert taken.read_bytes() == b"mine"
+
+
+def test_either_ray_tracer_writes_the_balls_cache_and_an_unknown_one_is_refused(tmp_path, balls):
+    # Embree is the default where it is built; our packets answer the balls' rays alike.
+    embree = tmp_path / "embree.hsr"
+    haarshift.relight.precompute(balls, output=embree, ray_tracer="embree", **OPTIONS)
+    packets = tmp_path / "packets.hsr"
+    haarshift.relight.precompute(balls, output=packets, ray_tracer="packets", **OPTIONS)
+    assert embree.read_bytes() == packets.read_bytes()
+    with pytest.raises(ValueError, match="unknown value \"optix\""):
+        haarshift.relight.precompute(balls, ray_tracer="optix", **OPTIONS)

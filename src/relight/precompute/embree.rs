@@ -3,19 +3,20 @@
 //! through the [`embree3`] crate's safe bindings.
 //!
 //! **Why Embree.** On the rays of a vertex-major precomputation (one origin, neighbouring
-//! directions), Embree's 16-wide packet query `rtcOccluded16` traverses its 4- and 8-wide
-//! BVHs with SIMD box tests per node and leaves of four triangles tested at once: 1.5-3x the
-//! rays a second of haarshift's own binary-tree packets ([`packet`](super::packet)) on the
-//! scenes `benches/rays_results.md` measures, and the more the larger the scene. Our packets
-//! stay the portable path and the one whose every bit is specified; Embree is chosen when it
-//! is compiled in and starts ([`RayTracer::best`](super::raycast::RayTracer::best)).
+//! directions), Embree's 16-wide packet query `rtcOccluded16` traverses its wide BVHs with
+//! SIMD box tests per node and tests several triangles at once: the whole precomputation,
+//! rays and encoding, runs 1.9-3.3x faster than through haarshift's own binary-tree packets
+//! ([`packet`](super::packet)) on the scenes `benches/rays_results.md` measures, the more the
+//! larger the scene. Our packets stay the portable path and the one whose every bit is
+//! specified; Embree is chosen when it is compiled in and starts
+//! ([`RayTracer::best`](super::raycast::RayTracer::best)).
 //!
-//! **What differs.** Embree's triangle test is its own (Moller-Trumbore in a different order
-//! of operations, and watertight in robust mode), so a ray through a shared edge may be
-//! answered otherwise than by our packets' test: every such ray passes within a few `1e-6`
-//! (barycentric) of an edge (`benches/compare_rays.py` works each one out in f64). The scene
-//! is built with `ROBUST` so that a ray through an edge shared by two triangles hits one of
-//! them. A hit counts at `0 <= t <= t_max` (Embree's closed interval, where our packets' is
+//! **What differs.** Embree's triangle test is its own, so a ray through a shared edge may be
+//! answered otherwise than by our packets' Moller-Trumbore: every such ray passes within a few
+//! `1e-6` (barycentric) of an edge (`benches/compare_rays.py` works each one out in f64). The
+//! scene is built `ROBUST` (Embree's watertight mode, at some cost in speed): a ray through an
+//! edge shared by two triangles then hits one of them, and every ray of the three scenes
+//! `benches/rays_results.md` measures is answered as Embree 4.4 answers it. A hit counts at `0 <= t <= t_max` (Embree's closed interval, where our packets' is
 //! `t < t_max`); visibility asks with `t_max` infinite.
 //!
 //! **Floating point.** Creating an Embree device switches the calling thread to
