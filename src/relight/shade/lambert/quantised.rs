@@ -154,7 +154,14 @@ impl QuantisedTransport {
     pub fn shade_into<T: Sample>(&self, lighting: &Lighting, out: &mut Array2<T>) -> Result<()> {
         let out = super::checked_output(self.param, self.vertex_count(), lighting, out)?;
         let light = LightRows::<f32>::new(lighting);
-        super::shade_vertices(out, |v| {
+        let upcoming = |w: usize| {
+            if w < self.vertex_count() {
+                let (gaps, values) = self.entries(w);
+                super::prefetch(gaps);
+                super::prefetch(values);
+            }
+        };
+        super::shade_vertices(out, upcoming, |v| {
             let (gaps, values) = self.entries(v);
             let mut index = 0usize;
             let next = move |gap: u16| {
