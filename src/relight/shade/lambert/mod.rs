@@ -277,8 +277,8 @@ const PREFETCH_AHEAD: usize = 3;
 /// Each vertex's transport is a run of a few hundred coefficients, read once, with a gather
 /// from the lighting's rows for each; asked for a few vertices ahead, the runs are in the
 /// cache by the time the gather loop reaches them: the cubes scene's frame is 15% faster
-/// (`results/relight/frame_floor.md`). The lines go to the second-level cache, not the first,
-/// where they would evict the lighting's rows. A prefetch only hints: the sums are the same.
+/// (`results/relight/frame_floor.md`). The lines go to the second-level cache: into the first,
+/// the frame was slower. A prefetch only hints: the sums are the same.
 #[inline(always)]
 fn prefetch<X>(run: &[X]) {
     #[cfg(target_arch = "x86_64")]
