@@ -121,6 +121,12 @@ impl RayTracer {
 
     /// The faster tracer available: Embree where it is (`benches/rays_results.md`), else
     /// our packets.
+    ///
+    /// ```
+    /// use haarshift::relight::RayTracer;
+    /// let best = RayTracer::best();
+    /// assert_eq!(best == RayTracer::Embree, RayTracer::Embree.available());
+    /// ```
     pub fn best() -> RayTracer {
         if RayTracer::Embree.available() {
             RayTracer::Embree
@@ -246,6 +252,14 @@ impl SceneBvh {
 
     /// The tracer that answers this scene's queries: the one asked for, or
     /// [`RayTracer::Packets`] when that one was not available or could not build the scene.
+    ///
+    /// ```
+    /// use haarshift::relight::{Generator, RayTracer, SceneBvh};
+    /// let mesh = Generator::Sphere { cells: 2 }.mesh().unwrap();
+    /// let asked = SceneBvh::with_tracer(&mesh, RayTracer::Embree);
+    /// let expected = if RayTracer::Embree.available() { RayTracer::Embree } else { RayTracer::Packets };
+    /// assert_eq!(asked.tracer(), expected);
+    /// ```
     pub fn tracer(&self) -> RayTracer {
         self.kind
     }

@@ -20,7 +20,9 @@ parameterisation (lat-long N x 2N, or cube 6 x N x N), times max(0, n . w) and t
 solid angle, Haar-transformed (orthonormal, face by face) and truncated to the K largest
 detail coefficients (plus each face's scaling coefficient); rays start 1e-4 x the scene's
 bounding-box diagonal off the surface along the normal, and a ray that hits any triangle is
-blocked. The cache (.hsr) holds the mesh, the albedo, the transport, the parameters, and the
+blocked. Rays are traced by Intel Embree 3 where this build links it (the default), else by
+haarshift's own packet tracer (--ray-tracer chooses; the output names the one that cast). The
+cache (.hsr) holds the mesh, the albedo, the transport, the parameters, and the
 scene file's environment and camera; `relight render` reads it.
 
 The input is a mesh (.obj or .ply; degenerate triangles and open or non-manifold meshes
@@ -36,6 +38,7 @@ Examples:
   haarshift relight precompute bunny.ply --ground-plane --resolution 64 --sh-bands 9 -o bunny.hsr
   haarshift relight precompute testdata/scenes/cubes.json --param cube --resolution 64 -o cubes.hsr
   haarshift relight precompute scene.json --order direction --map-size 2048 -o scene.hsr
+  haarshift relight precompute bunny.ply --ray-tracer packets -o bunny.hsr   # not Embree
 
 Sharded across machines (vertex order only): shard I of N computes the vertices
 [I x V / N, (I + 1) x V / N) against the whole scene, with the bits an unsharded run gives
