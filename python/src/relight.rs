@@ -306,8 +306,9 @@ fn precompute(
     options.order = parse::<Order>(order)?;
     if let Some(tracer) = ray_tracer {
         options.ray_tracer = parse::<RayTracer>(tracer)?;
-        options.check().or_raise()?;
     }
+    // Refused before the scene is read.
+    options.check().or_raise()?;
     let load = || -> haarshift::Result<Scene> {
         let mut loaded = Scene::load(&scene)?;
         if ground_plane {

@@ -134,6 +134,15 @@ pub fn wait_for_latest(browser: &mut Browser) {
     }
 }
 
+/// Runs `haarshift ARGS -o dir/NAME.png --vertices dir/NAME.npy` (a `relight render` without
+/// its outputs); returns the image's path and the per-vertex radiance.
+fn render_to(dir: &Path, name: &str, args: &[&str]) -> (std::path::PathBuf, Array2<f32>) {
+    let png = dir.join(format!("{name}.png"));
+    let npy = dir.join(format!("{name}.npy"));
+    succeeds(&[args, &["-o", p(&png), "--vertices", p(&npy)]].concat());
+    (png, ndarray_npy::read_npy(&npy).unwrap())
+}
+
 /// Runs the page's own `relight render` command line with outputs in `dir/NAME.png` and
 /// `.npy`; returns the image's luminance and the per-vertex radiance.
 fn render_as_the_page_says(
@@ -143,19 +152,15 @@ fn render_as_the_page_says(
 ) -> (Vec<f64>, Array2<f32>) {
     let command = browser.evaluate("haarshiftViewer.command()").unwrap();
     let command = command.as_str().unwrap();
-    let png = dir.join(format!("{name}.png"));
-    let npy = dir.join(format!("{name}.npy"));
     let words: Vec<&str> = command
         .strip_prefix("haarshift ")
         .and_then(|c| c.strip_suffix(" -o view.png --vertices view.npy"))
         .unwrap_or_else(|| panic!("unexpected command {command:?}"))
         .split_whitespace()
         .collect();
-    let mut args = words.clone();
-    args.extend(["-o", p(&png), "--vertices", p(&npy)]);
-    succeeds(&args);
+    let (png, radiance) = render_to(dir, name, &words);
     let image = image::open(&png).unwrap().to_rgb8();
-    (luminance(&image), ndarray_npy::read_npy(&npy).unwrap())
+    (luminance(&image), radiance)
 }
 
 /// Rec. 709 luminance of 8-bit pixels, row-major.
@@ -290,29 +295,27 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
         .unwrap();
     let yaw = state_b["yaw"].to_string();
     let pitch = state_b["pitch"].to_string();
-    let truth = dir.path().join("truth.npy");
-    succeeds(&[
-        "relight",
-        "render",
-        p(&cache),
-        "--env",
-        p(&env),
-        "--yaw",
-        &yaw,
-        "--pitch",
-        &pitch,
-        "--basis",
-        "reference",
-        "--width",
-        "16",
-        "--height",
-        "12",
-        "-o",
-        p(&dir.path().join("truth.png")),
-        "--vertices",
-        p(&truth),
-    ]);
-    let truth: Array2<f32> = ndarray_npy::read_npy(&truth).unwrap();
+    let (_, truth) = render_to(
+        dir.path(),
+        "truth",
+        &[
+            "relight",
+            "render",
+            p(&cache),
+            "--env",
+            p(&env),
+            "--yaw",
+            &yaw,
+            "--pitch",
+            &pitch,
+            "--basis",
+            "reference",
+            "--width",
+            "16",
+            "--height",
+            "12",
+        ],
+    );
     let reference = page_floats(
         &mut browser,
         "Array.from(haarshiftViewer.reference.radiance)",
@@ -694,31 +697,29 @@ fn a_measured_brdf_given_with_merl_is_offered_by_name_and_shaded_as_relight_rend
     );
     let (kind, header, radiance) = page.packet();
     assert_eq!((kind, &header["seq"]), (3, &Value::from(2)), "{header}");
-    let (png, npy) = (dir.path().join("m.png"), dir.path().join("m.npy"));
-    succeeds(&[
-        "relight",
-        "render",
-        p(&cache),
-        "--env",
-        p(&env),
-        "--yaw",
-        "30",
-        "--brdf",
-        &format!("merl:{}", p(&table)),
-        "--camera",
-        "0,3,8",
-        "--look-at",
-        "0,1,0",
-        "--width",
-        "24",
-        "--height",
-        "16",
-        "-o",
-        p(&png),
-        "--vertices",
-        p(&npy),
-    ]);
-    let rendered: Array2<f32> = ndarray_npy::read_npy(&npy).unwrap();
+    let (_, rendered) = render_to(
+        dir.path(),
+        "m",
+        &[
+            "relight",
+            "render",
+            p(&cache),
+            "--env",
+            p(&env),
+            "--yaw",
+            "30",
+            "--brdf",
+            &format!("merl:{}", p(&table)),
+            "--camera",
+            "0,3,8",
+            "--look-at",
+            "0,1,0",
+            "--width",
+            "24",
+            "--height",
+            "16",
+        ],
+    );
     assert_eq!(radiance, rendered.as_slice().unwrap());
     // The table, not a Lambertian stand-in: the same view in Lambert is another frame.
     page.send(

@@ -74,19 +74,20 @@ impl EmbreeScene {
     /// reports an error (out of memory, say): the caller then traces with its own BVH.
     pub(crate) fn new(triangles: &[[[f32; 3]; 3]]) -> Option<Self> {
         let device = device()?;
+        // Three corners a triangle, each its own vertex: every index must fit a u32.
         let vertices = triangles.len().checked_mul(3)?;
-        let indices: Vec<[u32; 3]> = (0..u32::try_from(triangles.len()).ok()?)
-            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-            .collect();
+        let corners = u32::try_from(vertices).ok()?;
         let mut geometry = device.create_geometry(GeometryKind::TRIANGLE).ok()?;
         geometry
             .set_new_buffer::<[f32; 3]>(BufferUsage::VERTEX, 0, Format::FLOAT3, 12, vertices)
             .ok()?
             .copy_from_slice(triangles.as_flattened());
-        geometry
-            .set_new_buffer::<[u32; 3]>(BufferUsage::INDEX, 0, Format::UINT3, 12, indices.len())
-            .ok()?
-            .copy_from_slice(&indices);
+        let mut index = geometry
+            .set_new_buffer::<[u32; 3]>(BufferUsage::INDEX, 0, Format::UINT3, 12, triangles.len())
+            .ok()?;
+        for (triangle, first) in index.iter_mut().zip((0..corners).step_by(3)) {
+            *triangle = [first, first + 1, first + 2];
+        }
         let geometry = geometry.commit();
         let mut scene = device.create_scene().ok()?;
         scene.set_flags(SceneFlags::ROBUST);

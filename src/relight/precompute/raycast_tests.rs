@@ -29,11 +29,13 @@ fn packets(mesh: &Mesh) -> SceneBvh {
 /// The BVH of `mesh` with every tracer this build offers.
 fn every_tracer(mesh: &Mesh) -> Vec<SceneBvh> {
     let tracers = RayTracer::ALL.iter().filter(|t| t.available());
-    let bvhs: Vec<SceneBvh> = tracers.map(|&t| SceneBvh::with_tracer(mesh, t)).collect();
-    for (bvh, t) in bvhs.iter().zip(RayTracer::ALL) {
-        assert_eq!(bvh.tracer(), *t, "an available tracer builds");
-    }
-    bvhs
+    tracers
+        .map(|&t| {
+            let bvh = SceneBvh::with_tracer(mesh, t);
+            assert_eq!(bvh.tracer(), t, "an available tracer builds");
+            bvh
+        })
+        .collect()
 }
 
 /// Tracer-independent oracle: the ray against every triangle of `mesh` in f64
