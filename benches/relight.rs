@@ -25,6 +25,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use rayon::prelude::*;
 use std::sync::OnceLock;
+use std::time::{Duration, Instant};
 
 use haarshift::faces::param::SphereMap;
 use haarshift::faces::param::{ParamKind, Parameterization};
@@ -121,6 +122,22 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
+/// The time of `iters` runs of `timed`, each followed by an untimed run of `other`.
+fn alternate<A, B>(
+    iters: u64,
+    mut timed: impl FnMut() -> A,
+    mut other: impl FnMut() -> B,
+) -> Duration {
+    let mut total = Duration::ZERO;
+    for _ in 0..iters {
+        let start = Instant::now();
+        std::hint::black_box(timed());
+        total += start.elapsed();
+        std::hint::black_box(other());
+    }
+    total
+}
+
 /// The Cubes scene's transport at cube 64, 420 coefficients a vertex, ready to shade.
 fn cubes_transport(param: Parameterization) -> PreparedTransport<f32> {
     let mesh = Generator::Cubes {
@@ -180,11 +197,35 @@ fn bench_relighting(c: &mut Criterion) {
             b.iter(|| Lighting::encode(&env, &fast, &general, keep).expect("encodes"))
         });
     }
+    // Each frame alternates with a plain read of the same bytes (the frame's floor: the same
+    // offsets, indices and values read once, in the same parallel chunks of vertices, their
+    // bits summed as integers, which the compiler vectorises: nothing gathered, nothing
+    // waiting on a floating-point add), and each read with a frame, one of the two timed: so
+    // that both start from the same cache (275 MiB is about this machine's last-level cache)
+    // and are measured under the same neighbours' load.
+    let read = |t: &PreparedTransport<f32>| {
+        (0..t.vertex_count())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .map(|v| {
+                let (indices, values) = t.coefficients(v);
+                let i = indices.iter().fold(0u32, |s, &i| s.wrapping_add(i));
+                let w = values.iter().fold(0u32, |s, x| s.wrapping_add(x.to_bits()));
+                u64::from(i ^ w)
+            })
+            .sum::<u64>()
+    };
+    let truncated = || Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
     group.bench_function("shade_keep420_f32", |b| {
-        let t = prepared();
-        let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
+        let (t, light) = (prepared(), truncated());
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
-        b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
+        b.iter_custom(|n| {
+            alternate(
+                n,
+                || t.shade_into(&light, &mut out).expect("shades"),
+                || read(t),
+            )
+        })
     });
     // Every lighting coefficient kept: its 24,576 rows gathered from the dense table (a
     // truncated lighting's few non-zero rows go through a byte table that stays in L1).
@@ -192,48 +233,60 @@ fn bench_relighting(c: &mut Criterion) {
         let t = prepared();
         let light = Lighting::encode(&env, &mapping, &whole, Selection::All).expect("encodes");
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
-        b.iter(|| t.shade_into(&light, &mut out).expect("shades"))
+        b.iter_custom(|n| {
+            alternate(
+                n,
+                || t.shade_into(&light, &mut out).expect("shades"),
+                || read(t),
+            )
+        })
     });
-    // The floor of a frame: the same offsets, indices and values read once, in the same
-    // parallel chunks of vertices, their bits summed (integer sums, which the compiler
-    // vectorises: nothing gathered, nothing waiting on a floating-point add).
     group.bench_function("plain_read_of_the_shaded_bytes", |b| {
-        let t = prepared();
-        b.iter(|| {
-            (0..t.vertex_count())
-                .into_par_iter()
-                .with_min_len(CHUNK)
-                .map(|v| {
-                    let (indices, values) = t.coefficients(v);
-                    let i = indices.iter().fold(0u32, |s, &i| s.wrapping_add(i));
-                    let w = values.iter().fold(0u32, |s, x| s.wrapping_add(x.to_bits()));
-                    u64::from(i ^ w)
-                })
-                .sum::<u64>()
+        let (t, light) = (prepared(), truncated());
+        let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
+        b.iter_custom(|n| {
+            alternate(
+                n,
+                || read(t),
+                || t.shade_into(&light, &mut out).expect("shades"),
+            )
         })
     });
     // The same transport in 16 bits a coefficient (--precision q16), and its own floor.
     let quantised = OnceLock::new();
     let packed = || quantised.get_or_init(|| QuantisedTransport::new(prepared()));
+    let read_q16 = |q: &QuantisedTransport| {
+        (0..q.vertex_count())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .map(|v| {
+                let (gaps, values) = q.entries(v);
+                let g = gaps.iter().fold(0u16, |s, &g| s.wrapping_add(g));
+                let w = values.iter().fold(0i16, |s, &x| s.wrapping_add(x));
+                u64::from(g) ^ w as u64
+            })
+            .sum::<u64>()
+    };
     group.bench_function("shade_keep420_q16", |b| {
-        let q = packed();
-        let light = Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
+        let (q, light) = (packed(), truncated());
         let mut out = ndarray::Array2::<f32>::zeros((q.vertex_count(), 3));
-        b.iter(|| q.shade_into(&light, &mut out).expect("shades"))
+        b.iter_custom(|n| {
+            alternate(
+                n,
+                || q.shade_into(&light, &mut out).expect("shades"),
+                || read_q16(q),
+            )
+        })
     });
     group.bench_function("plain_read_of_the_q16_bytes", |b| {
-        let q = packed();
-        b.iter(|| {
-            (0..q.vertex_count())
-                .into_par_iter()
-                .with_min_len(CHUNK)
-                .map(|v| {
-                    let (gaps, values) = q.entries(v);
-                    let g = gaps.iter().fold(0u16, |s, &g| s.wrapping_add(g));
-                    let w = values.iter().fold(0i16, |s, &x| s.wrapping_add(x));
-                    u64::from(g) ^ w as u64
-                })
-                .sum::<u64>()
+        let (q, light) = (packed(), truncated());
+        let mut out = ndarray::Array2::<f32>::zeros((q.vertex_count(), 3));
+        b.iter_custom(|n| {
+            alternate(
+                n,
+                || read_q16(q),
+                || q.shade_into(&light, &mut out).expect("shades"),
+            )
         })
     });
     group.bench_function("encode_and_shade/whole_column_yaw", |b| {

@@ -34,7 +34,9 @@
 //! **Speed.** Vertices in parallel (rayon) in chunks of [`CHUNK`]; the hot loop allocates
 //! nothing and reads the lighting rows at the vertex's indices, which are ascending: the
 //! dense rows (`texels x 4 x size_of T`, 393 KB for a `6 x 64^2` cube in f32), or for a
-//! truncated lighting its few non-zero rows through a byte table (`LightRows`).
+//! truncated lighting its few non-zero rows through a byte table (`LightRows`), visiting only
+//! the terms whose texel the lighting lights, found sixteen at a time (`LitTexels`): the same
+//! sums, bit for bit.
 
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
@@ -54,10 +56,11 @@ use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::transport::TransportSet;
 use crate::{Error, Result, Sample};
 
+mod lit;
 mod quantised;
 mod rows;
 pub use quantised::QuantisedTransport;
-use rows::LightRows;
+use rows::{DotBuffers, LightRows};
 
 /// Coefficients summed in the working precision before the sum is added in f64.
 pub const RUN: usize = 64;
@@ -237,9 +240,9 @@ impl<T: Sample> PreparedTransport<T> {
                 prefetch(&values[run]);
             }
         };
-        shade_vertices(out, upcoming, |v| {
+        shade_vertices(out, DotBuffers::default, upcoming, |v, buffers| {
             let (a, b) = (offsets[v] as usize, offsets[v + 1] as usize);
-            let sum = light.gather(&indices[a..b], &values[a..b], |i| i as usize, |t| t);
+            let sum = light.dot(&indices[a..b], &values[a..b], buffers);
             let a = self.albedo[v];
             std::array::from_fn(|c| sum[c] * a[c] * std::f64::consts::FRAC_1_PI)
         });
@@ -247,21 +250,23 @@ impl<T: Sample> PreparedTransport<T> {
     }
 }
 
-/// Writes `radiance(v)` into row `v` of the flat `(V, 3)` `out`, vertices in parallel in
-/// chunks of [`CHUNK`]; before each vertex `v`, `upcoming(v + PREFETCH_AHEAD)` asks the
-/// cache for a later vertex's transport ([`prefetch`]; it is given indices past the last
+/// Writes `radiance(v, buffers)` into row `v` of the flat `(V, 3)` `out`, vertices in
+/// parallel in chunks of [`CHUNK`], `buffers` made by `buffers()` once per parallel task and
+/// kept from vertex to vertex; before each vertex `v`, `upcoming(v + PREFETCH_AHEAD)` asks
+/// the cache for a later vertex's transport ([`prefetch`]; it is given indices past the last
 /// vertex too, and ignores them).
-fn shade_vertices<T: Sample>(
+fn shade_vertices<T: Sample, B>(
     out: &mut [T],
+    buffers: impl Fn() -> B + Sync + Send,
     upcoming: impl Fn(usize) + Sync,
-    radiance: impl Fn(usize) -> [f64; 3] + Sync,
+    radiance: impl Fn(usize, &mut B) -> [f64; 3] + Sync,
 ) {
     out.par_chunks_mut(3 * CHUNK)
         .enumerate()
-        .for_each(|(chunk, rows)| {
+        .for_each_init(buffers, |buffers, (chunk, rows)| {
             for (k, row) in rows.chunks_exact_mut(3).enumerate() {
                 upcoming(chunk * CHUNK + k + PREFETCH_AHEAD);
-                let r = radiance(chunk * CHUNK + k);
+                let r = radiance(chunk * CHUNK + k, buffers);
                 for c in 0..3 {
                     row[c] = T::from_f64(r[c]);
                 }
@@ -276,8 +281,8 @@ const PREFETCH_AHEAD: usize = 3;
 ///
 /// Each vertex's transport is a run of a few hundred coefficients, read once, with a gather
 /// from the lighting's rows for each; asked for a few vertices ahead, the runs are in the
-/// cache by the time the gather loop reaches them: the cubes scene's frame is 15% faster
-/// (`results/relight/frame_floor.md`). The lines go to the second-level cache: into the first,
+/// cache by the time the frame reaches them: the cubes scene's frame was 15% faster when this
+/// was added (`results/relight/frame_floor.md`). The lines go to the second-level cache: into the first,
 /// the frame was slower. A prefetch only hints: the sums are the same.
 #[inline(always)]
 fn prefetch<X>(run: &[X]) {
@@ -342,7 +347,6 @@ fn sum_runs<T: Sample, A: Copy, B: Copy>(
     b: &[B],
     mut term: impl FnMut(A, B) -> T::Quad,
 ) -> [f64; 3] {
-    const LANES: usize = 4;
     debug_assert_eq!(a.len(), b.len());
     let mut total = [0.0f64; 3];
     for (a, b) in a.chunks(RUN).zip(b.chunks(RUN)) {
@@ -357,12 +361,21 @@ fn sum_runs<T: Sample, A: Copy, B: Copy>(
         for (lane, (&x, &y)) in a_rest.iter().zip(b_rest).enumerate() {
             acc[lane] += term(x, y);
         }
-        let run = T::first_three((acc[0] + acc[1]) + (acc[2] + acc[3]));
-        for c in 0..3 {
-            total[c] += run[c].as_f64();
-        }
+        add_run::<T>(&mut total, acc);
     }
     total
+}
+
+/// Independent accumulators of a run in [`sum_runs`].
+const LANES: usize = 4;
+
+/// Adds a run's accumulators, in a fixed order, to `total` in f64 ([`sum_runs`]).
+#[inline(always)]
+fn add_run<T: Sample>(total: &mut [f64; 3], acc: [T::Quad; LANES]) {
+    let run = T::first_three((acc[0] + acc[1]) + (acc[2] + acc[3]));
+    for c in 0..3 {
+        total[c] += run[c].as_f64();
+    }
 }
 
 /// Every vertex's outgoing radiance: [`PreparedTransport::new`] then

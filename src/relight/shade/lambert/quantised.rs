@@ -161,17 +161,22 @@ impl QuantisedTransport {
                 super::prefetch(values);
             }
         };
-        super::shade_vertices(out, upcoming, |v| {
-            let (gaps, values) = self.entries(v);
-            let mut index = 0usize;
-            let next = move |gap: u16| {
-                index += usize::from(gap);
-                index
-            };
-            let sum = light.gather(gaps, values, next, f32::from);
-            let f = self.factors[v];
-            std::array::from_fn(|c| sum[c] * f[c])
-        });
+        super::shade_vertices(
+            out,
+            || (),
+            upcoming,
+            |v, ()| {
+                let (gaps, values) = self.entries(v);
+                let mut index = 0usize;
+                let next = move |gap: u16| {
+                    index += usize::from(gap);
+                    index
+                };
+                let sum = light.gather(gaps, values, next, f32::from);
+                let f = self.factors[v];
+                std::array::from_fn(|c| sum[c] * f[c])
+            },
+        );
         Ok(())
     }
 }
