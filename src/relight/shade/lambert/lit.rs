@@ -55,10 +55,10 @@ impl LitTexels {
         if out.len() < room {
             out.resize(room, 0);
         }
-        #[cfg(target_arch = "x86_64")]
         if self.wide {
-            // SAFETY: the CPU has the two features `positions_avx512` is compiled for, and
-            // `out` has room for `indices.len() + 16` positions.
+            // SAFETY: the CPU has the two features `positions_avx512` is compiled for (`wide`
+            // is never set elsewhere), and `out` has room for `indices.len() + 16` positions.
+            #[cfg(target_arch = "x86_64")]
             return unsafe { self.positions_avx512(indices, out) };
         }
         self.positions_one_at_a_time(indices, 0, 0, out)
