@@ -117,7 +117,23 @@ impl TransportSet {
     /// Encodes one more vertex from its unweighted values `V x max(0, n . w)`, `(faces, S, S)`:
     /// weighted by the solid angles, transformed, truncated, stored (and projected onto the
     /// spherical harmonics when the set carries them). It makes its tables on every call; the
-    /// precomputation makes them once.
+    /// precomputation makes them once. A value that is not finite is refused, as a cache file
+    /// holding one is: a frame skips the terms its lighting leaves dark, which is exact only
+    /// for finite transport.
+    ///
+    /// ```
+    /// use haarshift::faces::param::{ParamKind, Parameterization};
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::TransportSet;
+    /// use ndarray::Array3;
+    /// let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
+    /// let mut set = TransportSet::new(param, Selection::All);
+    /// set.push(Array3::ones((6, 4, 4)).view()).unwrap();
+    /// let mut bad = Array3::ones((6, 4, 4));
+    /// bad[[2, 1, 3]] = f32::INFINITY;
+    /// assert!(set.push(bad.view()).is_err());
+    /// assert_eq!(set.vertex_count(), 1);
+    /// ```
     pub fn push(&mut self, values: ArrayView3<'_, f32>) -> Result<()> {
         let bands = self.sh.as_ref().map(ShTransfer::bands);
         let vertex = Encoder::new(self.param, self.keep, bands)?.encode(values)?;
