@@ -122,6 +122,44 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
+/// `sum_v bits(v)` over the vertices, in the frame's parallel chunks: a plain read of the
+/// transport when `bits` sums a vertex's bytes.
+fn plain_read(vertices: usize, bits: impl Fn(usize) -> u64 + Sync + Send) -> u64 {
+    (0..vertices)
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .map(bits)
+        .sum()
+}
+
+/// Prints how many texels `light` lights and what share of the stored coefficients fall on
+/// them: the terms a frame visits (`relight::shade::lambert`).
+fn report_lit_terms(t: &PreparedTransport<f32>, light: &Lighting) {
+    let rows = light.coefficients();
+    let lit: Vec<bool> = rows
+        .rows()
+        .into_iter()
+        .map(|r| r.iter().any(|&x| x != 0.0))
+        .collect();
+    let on_lit: usize = (0..t.vertex_count())
+        .map(|v| {
+            t.coefficients(v)
+                .0
+                .iter()
+                .filter(|&&i| lit[i as usize])
+                .count()
+        })
+        .sum();
+    eprintln!(
+        "the lighting lights {} of {} texels; {} of the {} stored coefficients ({:.1}%) fall on them",
+        lit.iter().filter(|&&l| l).count(),
+        lit.len(),
+        on_lit,
+        t.coefficient_count(),
+        100.0 * on_lit as f64 / t.coefficient_count() as f64
+    );
+}
+
 /// The time of `iters` runs of `timed`, each followed by an untimed run of `other`.
 fn alternate<A, B>(
     iters: u64,
@@ -201,23 +239,21 @@ fn bench_relighting(c: &mut Criterion) {
     // offsets, indices and values read once, in the same parallel chunks of vertices, their
     // bits summed as integers, which the compiler vectorises: nothing gathered, nothing
     // waiting on a floating-point add), and each read with a frame, one of the two timed: so
-    // that both start from the same cache (275 MiB is about this machine's last-level cache)
+    // that both start from the same cache (278 MiB is about this machine's last-level cache)
     // and are measured under the same neighbours' load.
     let read = |t: &PreparedTransport<f32>| {
-        (0..t.vertex_count())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .map(|v| {
-                let (indices, values) = t.coefficients(v);
-                let i = indices.iter().fold(0u32, |s, &i| s.wrapping_add(i));
-                let w = values.iter().fold(0u32, |s, x| s.wrapping_add(x.to_bits()));
-                u64::from(i ^ w)
-            })
-            .sum::<u64>()
+        plain_read(t.vertex_count(), |v| {
+            let (indices, values) = t.coefficients(v);
+            let i = indices.iter().fold(0u32, |s, &i| s.wrapping_add(i));
+            let w = values.iter().fold(0u32, |s, x| s.wrapping_add(x.to_bits()));
+            u64::from(i ^ w)
+        })
     };
     let truncated = || Lighting::encode(&env, &mapping, &whole, keep).expect("encodes");
+    let lit_terms = std::sync::Once::new();
     group.bench_function("shade_keep420_f32", |b| {
         let (t, light) = (prepared(), truncated());
+        lit_terms.call_once(|| report_lit_terms(t, &light));
         let mut out = ndarray::Array2::zeros((t.vertex_count(), 3));
         b.iter_custom(|n| {
             alternate(
@@ -256,16 +292,12 @@ fn bench_relighting(c: &mut Criterion) {
     let quantised = OnceLock::new();
     let packed = || quantised.get_or_init(|| QuantisedTransport::new(prepared()));
     let read_q16 = |q: &QuantisedTransport| {
-        (0..q.vertex_count())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .map(|v| {
-                let (gaps, values) = q.entries(v);
-                let g = gaps.iter().fold(0u16, |s, &g| s.wrapping_add(g));
-                let w = values.iter().fold(0i16, |s, &x| s.wrapping_add(x));
-                u64::from(g) ^ w as u64
-            })
-            .sum::<u64>()
+        plain_read(q.vertex_count(), |v| {
+            let (gaps, values) = q.entries(v);
+            let g = gaps.iter().fold(0u16, |s, &g| s.wrapping_add(g));
+            let w = values.iter().fold(0i16, |s, &x| s.wrapping_add(x));
+            u64::from(g) ^ w as u64
+        })
     };
     group.bench_function("shade_keep420_q16", |b| {
         let (q, light) = (packed(), truncated());

@@ -5,9 +5,9 @@
 //! **Why Embree.** On the rays of a vertex-major precomputation (one origin, neighbouring
 //! directions), Embree's 16-wide packet query `rtcOccluded16` traverses its wide BVHs with
 //! SIMD box tests per node and tests several triangles at once: the whole precomputation,
-//! rays and encoding, runs 1.9-3.3x faster than through haarshift's own binary-tree packets
-//! ([`packet`](super::packet)) on the scenes `benches/rays_results.md` measures, the more the
-//! larger the scene. Our packets stay the portable path and the one whose every bit is
+//! rays and encoding, runs 1.9-3.3x faster on one thread than through haarshift's own
+//! binary-tree packets ([`packet`](super::packet)) on the scenes `benches/rays_results.md`
+//! measures, the more the larger the scene. Our packets stay the portable path and the one whose every bit is
 //! specified; Embree is chosen when it is compiled in and starts
 //! ([`RayTracer::best`](super::raycast::RayTracer::best)).
 //!
@@ -16,8 +16,9 @@
 //! `1e-6` (barycentric) of an edge (`benches/compare_rays.py` works each one out in f64). The
 //! scene is built `ROBUST` (Embree's watertight mode, at some cost in speed): a ray through an
 //! edge shared by two triangles then hits one of them, and every ray of the three scenes
-//! `benches/rays_results.md` measures is answered as Embree 4.4 answers it. A hit counts at `0 <= t <= t_max` (Embree's closed interval, where our packets' is
-//! `t < t_max`); visibility asks with `t_max` infinite.
+//! `benches/rays_results.md` measures is answered as Embree 4.4 answers it. A hit counts at
+//! `0 <= t <= t_max` (Embree's closed interval, where our packets' is `t < t_max`);
+//! visibility asks with `t_max` infinite.
 //!
 //! **Floating point.** Creating an Embree device switches the calling thread to
 //! flush-to-zero and denormals-are-zero (`embree3` does, for Embree's speed). That would change

@@ -4,10 +4,11 @@
 /// vertex's coefficient indices against before it gathers anything.
 ///
 /// **Why.** A lighting truncated to its largest coefficients (200 of 24,576 in the viewer)
-/// meets few of a vertex's coefficients: 6.7% of the cubes scene's. Finding those terms
-/// first, sixteen indices at a time, and then summing only them leaves a frame little to do
-/// beyond reading its transport (`results/relight/frame_floor.md`). With AVX-512 the sixteen
-/// tests are one gather from this table (3 KB for a 6 x 64^2 cube: it stays in the
+/// meets few of a vertex's coefficients: 6.6% of the cubes scene's (the `relight` bench
+/// prints the share). Finding those terms first, sixteen indices at a time, and then summing
+/// only them leaves a frame little to do beyond reading its transport
+/// (`results/relight/frame_floor.md`). With AVX-512 the sixteen tests are one gather from this
+/// table (4 KB for a 6 x 64^2 cube, its 24,576 texels padded to 32,768: it stays in the
 /// first-level cache) and the positions found are packed with one compress; without it they
 /// are tested one at a time. Both find the same positions (tested).
 #[derive(Debug)]

@@ -282,8 +282,8 @@ const PREFETCH_AHEAD: usize = 3;
 /// Each vertex's transport is a run of a few hundred coefficients, read once, with a gather
 /// from the lighting's rows for each; asked for a few vertices ahead, the runs are in the
 /// cache by the time the frame reaches them: the cubes scene's frame was 15% faster when this
-/// was added (`results/relight/frame_floor.md`). The lines go to the second-level cache: into the first,
-/// the frame was slower. A prefetch only hints: the sums are the same.
+/// was added (`results/relight/frame_floor.md`). The lines go to the second-level cache: into
+/// the first, the frame was slower. A prefetch only hints: the sums are the same.
 #[inline(always)]
 fn prefetch<X>(run: &[X]) {
     #[cfg(target_arch = "x86_64")]
