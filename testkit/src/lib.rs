@@ -1,0 +1,80 @@
+//! How a test that needs an optional system component (Chromium, Embree, Slurm, node) behaves
+//! where that component is missing.
+//!
+//! On a machine with only Rust, a C toolchain and Python the workspace's tests pass: a test
+//! whose component is absent is **skipped**, and says so in one line on the process's standard
+//! error, visible in `cargo test`'s default output. libtest captures the `eprintln!` of a
+//! passing test, so the line is written through [`std::io::stderr`]'s handle, which it does not
+//! capture. Where the environment variable [`REQUIRE`] names the component (a comma-separated
+//! list, as `.ci/run` sets: `HAARSHIFT_REQUIRE=chromium,embree,slurm,node`), its absence
+//! **fails** the test instead, so that a CI run can never go green by skipping.
+//!
+//! ```
+//! // A component that is present hands its value on.
+//! assert_eq!(haarshift_testkit::needs("chromium", Ok::<_, String>(7)), Some(7));
+//! ```
+
+use std::fmt::Display;
+use std::io::Write;
+
+/// The environment variable listing the components whose absence fails a test.
+pub const REQUIRE: &str = "HAARSHIFT_REQUIRE";
+
+/// Whether [`REQUIRE`] names `component` (its entries trimmed, compared exactly).
+///
+/// ```
+/// assert!(!haarshift_testkit::required("a-component-no-list-names"));
+/// ```
+pub fn required(component: &str) -> bool {
+    std::env::var(REQUIRE).is_ok_and(|list| list.split(',').any(|c| c.trim() == component))
+}
+
+/// `found`'s value, or, when the component is missing (`Err(why)`, `why` saying what is
+/// missing and how to install it): `None` after one line `skipped: TEST: why` on standard
+/// error, or a panic when [`required`]. A test returns at once on `None`.
+///
+/// ```
+/// let missing: Result<(), &str> = Err("no frobnicator on the PATH (apt-get install frob)");
+/// assert_eq!(haarshift_testkit::needs("a-component-no-list-names", missing), None);
+/// ```
+pub fn needs<T, E: Display>(component: &str, found: Result<T, E>) -> Option<T> {
+    let why = match found {
+        Ok(value) => return Some(value),
+        Err(why) => why,
+    };
+    let thread = std::thread::current();
+    let test = thread.name().unwrap_or("a test");
+    assert!(
+        !required(component),
+        "{test}: {component} is required ({REQUIRE}) but missing: {why}"
+    );
+    // Not eprintln!: libtest would capture it and show nothing for a passing test.
+    let _ = writeln!(std::io::stderr(), "skipped: {test}: {why}");
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // One test: it alone sets the variable, so no other test of this crate sees it change.
+    #[test]
+    fn a_required_component_fails_and_any_other_is_skipped() {
+        // SAFETY: no other thread of this test binary reads or writes the environment.
+        unsafe { std::env::set_var(REQUIRE, " embree ,chromium") };
+        assert!(required("chromium") && required("embree"));
+        assert!(!required("chrom") && !required("slurm"));
+        assert_eq!(needs("slurm", Err::<(), _>("no slurmctld")), None);
+        assert_eq!(needs("slurm", Ok::<_, String>(3)), Some(3));
+        let failed = std::panic::catch_unwind(|| needs("chromium", Err::<(), _>("no chromium")));
+        let message = *failed.unwrap_err().downcast::<String>().unwrap();
+        assert!(
+            message.contains("chromium is required (HAARSHIFT_REQUIRE) but missing: no chromium"),
+            "{message}"
+        );
+        // SAFETY: as above.
+        unsafe { std::env::remove_var(REQUIRE) };
+        assert!(!required("chromium"));
+        assert_eq!(needs("chromium", Err::<(), _>("no chromium")), None);
+    }
+}
