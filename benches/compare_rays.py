@@ -20,7 +20,7 @@ Scenes: the bunny (every vertex), the cubes scene (testdata/scenes/cubes.json, 8
 vertices: a run of 2,000 of them) and a generated scene of 600,000 triangles (14 x 14 cubes of
 16 x 16 cells a face: 2,000 vertices). Writes benches/rays_results.md.
 
-    apt-get install libembree-dev         # haarshift's Embree tracer (.ci/run installs it)
+    apt-get install libembree3-3          # haarshift's Embree tracer, loaded at run time (.ci/run installs it)
     pip install --user numpy embreex      # test-only; not part of .ci/run
     python3 benches/compare_rays.py
 """
@@ -179,7 +179,7 @@ def main():
         embree_child(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
         return
     subprocess.run(
-        ["cargo", "build", "--release", "--features", "embree", "--example", "rays"],
+        ["cargo", "build", "--release", "--example", "rays"],
         cwd=ROOT,
         check=True,
     )

@@ -5,7 +5,7 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod commands;
 mod peak;
@@ -49,12 +49,32 @@ enum Command {
     },
 }
 
+/// The command line, parsed. When help may be shown, `relight precompute`'s help gains the
+/// line on this machine's ray tracer, which loads Embree to find out; other runs skip that.
+fn parse() -> Cli {
+    let help = std::env::args_os().any(|a| a == "--help" || a == "-h" || a == "help");
+    if !help {
+        return Cli::parse();
+    }
+    let command = Cli::command().mut_subcommand("relight", |relight| {
+        relight.mut_subcommand("precompute", |precompute| {
+            let after = precompute
+                .get_after_help()
+                .map(|h| h.to_string())
+                .unwrap_or_default();
+            let line = commands::relight::precompute::tracer_help();
+            precompute.after_help(format!("{line}\n\n{after}"))
+        })
+    });
+    Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit())
+}
+
 fn main() -> ExitCode {
     // A bug must still end in one line, not a backtrace.
     std::panic::set_hook(Box::new(|info| {
         eprintln!("haarshift: internal error (please report it): {info}");
     }));
-    let cli = Cli::parse();
+    let cli = parse();
     if matches!(
         &cli.command,
         Command::Relight {

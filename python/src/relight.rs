@@ -233,6 +233,13 @@ impl Cache {
         (p.kind().to_string(), p.face_size())
     }
 
+    /// The ray tracer that cast the visibility (`"embree"` or `"packets"`; None for the
+    /// direction order's shadow buffers).
+    #[getter]
+    fn ray_tracer(&self) -> Option<String> {
+        self.cache.params.ray_tracer.clone()
+    }
+
     /// Spherical-harmonic bands stored beside the Haar transport (None: none).
     #[getter]
     fn sh_bands(&self) -> Option<usize> {
@@ -263,9 +270,10 @@ impl Cache {
 /// worker returns a path; an `output` that already holds this shard complete is not computed
 /// again (`force=True` recomputes it). `merge` joins the shards.
 ///
-/// `ray_tracer` is `"embree"` (Intel Embree 3, the default where the system's libembree3 is
-/// installed) or `"packets"` (haarshift's own, always available); the two answer alike except
-/// on rays through a triangle's edge.
+/// `ray_tracer` is `"embree"` (Intel Embree 3, the default where the system's
+/// libembree3.so.3 loads at run time; refused with what to install where it does not) or
+/// `"packets"` (haarshift's own, always available); the two answer alike except on rays
+/// through a triangle's edge. The cache records the one that cast (`Cache.ray_tracer`).
 ///
 /// >>> import json, os, tempfile, haarshift
 /// >>> d = tempfile.mkdtemp(); path = os.path.join(d, "ball.json")

@@ -1,5 +1,6 @@
 """Shared fixtures: test images made here or read from the repository's testdata/, and the
 command-line binary that `cargo test --workspace --release` builds."""
+import os
 import pathlib
 import shutil
 import subprocess
@@ -39,3 +40,15 @@ def cli():
         return result
 
     return run
+
+
+def needs(component, missing):
+    """Skips the calling test, saying why, when `missing` (what is missing and how to install
+    it) is not None, unless HAARSHIFT_REQUIRE lists `component`: then the test fails, so that
+    CI can never pass by skipping. Skips are listed in pytest's summary (-rs, pyproject.toml)."""
+    if missing is None:
+        return
+    required = [c.strip() for c in os.environ.get("HAARSHIFT_REQUIRE", "").split(",")]
+    if component in required:
+        pytest.fail(f"{component} is required (HAARSHIFT_REQUIRE) but missing: {missing}")
+    pytest.skip(f"{missing}")

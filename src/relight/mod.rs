@@ -46,7 +46,8 @@ pub use error::SceneError;
 pub use harmonics::ShTransfer;
 pub use light::lighting::Lighting;
 pub use material::brdf::Brdf;
-pub use precompute::raycast::{Occlusion, RayTracer, SceneBvh};
+pub use precompute::embree::EMBREE_LIBRARY_VAR;
+pub use precompute::raycast::{Hit, Occlusion, RayTracer, SceneBvh};
 pub use precompute::shadowmap::ShadowMap;
 pub use precompute::transport::TransportSet;
 pub use precompute::visibility::{

@@ -12,6 +12,7 @@ mod experiment;
 mod experiment_relight;
 mod flags;
 mod hdr;
+mod ray_tracer;
 mod readme;
 mod relight;
 mod relight_error;

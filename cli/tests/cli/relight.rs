@@ -88,28 +88,6 @@ fn precompute_reports_rays_time_memory_and_sizes() {
 }
 
 #[test]
-fn both_ray_tracers_precompute_the_bunny_alike_and_say_which_cast() {
-    // Embree is the default where it is built (the CLI's default feature); our packets on
-    // request. The bunny's rays pass no triangle's edge closely enough for the two to differ.
-    let dir = tempfile::tempdir().unwrap();
-    let bunny = testdata("meshes/bunny.ply");
-    let flags = ["--resolution", "8"];
-    let (default, packets) = (dir.path().join("a.hsr"), dir.path().join("b.hsr"));
-    let stdout = precompute(&bunny, &default, &flags);
-    assert!(stdout.contains(" (embree), "), "{stdout}");
-    let stdout = precompute(
-        &bunny,
-        &packets,
-        &[&flags[..], &["--ray-tracer", "packets"]].concat(),
-    );
-    assert!(stdout.contains(" (packets), "), "{stdout}");
-    assert_eq!(
-        std::fs::read(&default).unwrap(),
-        std::fs::read(&packets).unwrap()
-    );
-}
-
-#[test]
 fn an_existing_output_is_refused_before_any_work_and_replaced_with_force() {
     let dir = tempfile::tempdir().unwrap();
     let out = file(dir.path(), "scene.hsr", b"precious");

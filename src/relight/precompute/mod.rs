@@ -11,8 +11,7 @@
 //! whose vertices would not fit in [`PrecomputeOptions::budget`] is refused from its count,
 //! before the BVH or any transport is built.
 
-#[cfg(feature = "embree")]
-mod embree;
+pub mod embree;
 mod packet;
 pub mod raycast;
 pub mod shadowmap;
@@ -102,14 +101,10 @@ impl PrecomputeOptions {
     /// assert!(err.to_string().contains("resolution"));
     /// ```
     pub fn check(&self) -> Result<()> {
-        if !self.ray_tracer.available() {
+        if let Some(why) = self.ray_tracer.unavailable() {
             return Err(Error::parameter(
                 "ray tracer",
-                format!(
-                    "{} is not available: this build lacks the cargo feature `embree` or the \
-                     system's libembree3 did not start",
-                    self.ray_tracer
-                ),
+                format!("{} is not available: {why}", self.ray_tracer),
             ));
         }
         let param = self.visibility.param;
@@ -177,7 +172,7 @@ impl PrecomputeOptions {
     }
 
     /// What the cache records of these options.
-    fn record(&self, ground_plane: bool) -> CacheParams {
+    fn record(&self, ground_plane: bool, tracer: Option<RayTracer>) -> CacheParams {
         let v = &self.visibility;
         CacheParams {
             param: v.param.kind().to_string(),
@@ -189,6 +184,7 @@ impl PrecomputeOptions {
             map_size: (self.order == Order::Direction).then_some(self.map_size),
             ground_plane,
             sh_bands: v.sh_bands,
+            ray_tracer: tracer.map(|t| t.to_string()),
         }
     }
 }
@@ -216,7 +212,7 @@ pub fn precompute(
 ) -> Result<(SceneCache, PrecomputeReport)> {
     let (transport, report) = transport(&scene, options, None)?;
     let mut cache = SceneCache::new(
-        options.record(scene.ground_plane),
+        options.record(scene.ground_plane, report.tracer),
         scene.mesh,
         scene.albedo,
         transport,
@@ -252,7 +248,7 @@ pub fn precompute_shard(
     let (transport, report) = transport(&scene, options, Some(shard))?;
     let mut part = CacheShard::new(
         shard,
-        options.record(scene.ground_plane),
+        options.record(scene.ground_plane, report.tracer),
         scene.mesh,
         scene.albedo,
         transport,
@@ -293,7 +289,10 @@ pub fn shard_is_done(
         return Ok(false);
     }
     let found = CacheShard::read(path)?;
-    let params = options.record(scene.ground_plane);
+    // The tracer a rerun would cast with: the one asked for (it fell back only if Embree
+    // failed to build the scene, and then the records differ and the shard is recast).
+    let tracer = (options.order == Order::Vertex).then_some(options.ray_tracer);
+    let params = options.record(scene.ground_plane, tracer);
     let wanted = Provenance {
         params: &params,
         mesh: &scene.mesh,

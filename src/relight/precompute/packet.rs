@@ -66,6 +66,8 @@ pub(crate) struct PacketBvh {
     root: ([f32; 3], [f32; 3], Child),
     /// Triangles in leaf order.
     pub(crate) triangles: Vec<RtTriangle>,
+    /// `order[i]`: the index, in the slice [`PacketBvh::new`] was given, of `triangles[i]`.
+    order: Vec<u32>,
     /// The most entries the traversal stack holds: the tree's depth plus one.
     stack: usize,
 }
@@ -103,6 +105,7 @@ impl PacketBvh {
             .iter()
             .map(|&i| RtTriangle::from(&triangles[i as usize]))
             .collect();
+        let order = bvh2.primitive_indices.clone();
         let mut nodes = Vec::with_capacity(bvh2.nodes.len() / 2);
         // (obvhs node, our node, its depth): inner nodes still to lay out.
         let mut pending = Vec::new();
@@ -142,6 +145,7 @@ impl PacketBvh {
             nodes,
             root: (lo, hi, root),
             triangles: ordered,
+            order,
             stack: deepest + 1,
         }
     }
@@ -197,6 +201,59 @@ impl PacketBvh {
         for (i, b) in blocked.iter_mut().enumerate() {
             *b = hit >> i & 1 == 1;
         }
+    }
+
+    /// The closest hit of the ray `origin + t direction`, `0 <= t < t_max`: the index of its
+    /// triangle in the slice [`PacketBvh::new`] was given, `t`, and the barycentric weights
+    /// `(u, v)` of that triangle's second and third corners. Of hits at the same `t`, the
+    /// first met in the traversal is kept.
+    pub(crate) fn closest_hit(
+        &self,
+        origin: [f32; 3],
+        direction: [f32; 3],
+        t_max: f32,
+    ) -> Option<(u32, f32, f32, f32)> {
+        let mut rays = Rays::<1> {
+            d: direction.map(|x| [x]),
+            inv: direction.map(|x| [1.0 / x]),
+            t_max: [t_max],
+            axis: 0,
+            up: false,
+            span: None,
+            parallel: direction.contains(&0.0),
+        };
+        let mut best = None;
+        let mut stack = Vec::with_capacity(self.stack);
+        let (lo, hi, root) = self.root;
+        if box_lanes(lo, hi, origin, &rays) != 0 {
+            stack.push(root);
+        }
+        // Depth first; a box is opened only while it may hold a hit nearer than the best.
+        while let Some(child) = stack.pop() {
+            if child.count > 0 {
+                let first = child.index as usize;
+                for (i, tri) in self.triangles[first..first + child.count as usize]
+                    .iter()
+                    .enumerate()
+                {
+                    let (hit, t, u, v) = moller_trumbore(tri, origin, direction, rays.t_max[0]);
+                    if hit {
+                        rays.t_max[0] = t;
+                        best = Some((self.order[first + i], t, u, v));
+                    }
+                }
+                continue;
+            }
+            let node = &self.nodes[child.index as usize];
+            for c in 0..2 {
+                let lo = [node.lo[0][c], node.lo[1][c], node.lo[2][c]];
+                let hi = [node.hi[0][c], node.hi[1][c], node.hi[2][c]];
+                if box_lanes(lo, hi, origin, &rays) != 0 {
+                    stack.push(node.child[c]);
+                }
+            }
+        }
+        best
     }
 
     /// The lanes of `all` whose rays hit a triangle.
@@ -328,28 +385,61 @@ fn box_lanes<const N: usize>(lo: [f32; 3], hi: [f32; 3], o: [f32; 3], rays: &Ray
 /// the origin done once.
 #[inline(always)]
 fn triangle_lanes<const N: usize>(tri: &RtTriangle, o: [f32; 3], rays: &Rays<N>) -> u32 {
-    let (v0, e1, e2, ng) = (tri.v0, tri.e1, tri.e2, tri.ng);
-    let c = v0 - Vec3A::from_array(o);
-    let ng_c = ng.dot(c);
-    let (c, e1, e2, ng) = (c.to_array(), e1.to_array(), e2.to_array(), ng.to_array());
+    let (c, ng_c) = shared(tri, o);
     let mut hit = [false; N];
     for (i, hit) in hit.iter_mut().enumerate() {
         let d = [rays.d[0][i], rays.d[1][i], rays.d[2][i]];
-        // r = d x c, glam's component order.
-        let r = [
-            d[1] * c[2] - d[2] * c[1],
-            d[2] * c[0] - d[0] * c[2],
-            d[0] * c[1] - d[1] * c[0],
-        ];
-        let inv_det = 1.0 / (ng[0] * d[0] + ng[1] * d[1] + ng[2] * d[2]);
-        let u = (r[0] * e2[0] + r[1] * e2[1] + r[2] * e2[2]) * inv_det;
-        let v = (r[0] * e1[0] + r[1] * e1[1] + r[2] * e1[2]) * inv_det;
-        let w = 1.0 - u - v;
-        let signs = u.to_bits() | v.to_bits() | w.to_bits();
-        let t = ng_c * inv_det;
-        *hit = inv_det != 0.0 && signs & 0x8000_0000 == 0 && t >= 0.0 && t < rays.t_max[i];
+        *hit = lane(tri, c, ng_c, d, rays.t_max[i]).0;
     }
     mask(hit)
+}
+
+/// What [`RtTriangle::intersect`] computes once per origin: the first corner minus the origin,
+/// and its dot product with the triangle's normal.
+#[inline(always)]
+fn shared(tri: &RtTriangle, o: [f32; 3]) -> ([f32; 3], f32) {
+    let c = tri.v0 - Vec3A::from_array(o);
+    (c.to_array(), tri.ng.dot(c))
+}
+
+/// [`RtTriangle::intersect`] for one direction `d`, the operations in its order (so its
+/// bits): whether the ray hits at `0 <= t < t_max`, `t`, and the weights `(u, v)` of the
+/// second and third corners (`e1 = v0 - v1`, `e2 = v2 - v0`: `u` multiplies `e2`'s
+/// cofactor, Moller and Trumbore 1997 as Embree writes it).
+#[inline(always)]
+fn lane(
+    tri: &RtTriangle,
+    c: [f32; 3],
+    ng_c: f32,
+    d: [f32; 3],
+    t_max: f32,
+) -> (bool, f32, f32, f32) {
+    let (e1, e2, ng) = (tri.e1.to_array(), tri.e2.to_array(), tri.ng.to_array());
+    // r = d x c, glam's component order.
+    let r = [
+        d[1] * c[2] - d[2] * c[1],
+        d[2] * c[0] - d[0] * c[2],
+        d[0] * c[1] - d[1] * c[0],
+    ];
+    let inv_det = 1.0 / (ng[0] * d[0] + ng[1] * d[1] + ng[2] * d[2]);
+    let u = (r[0] * e2[0] + r[1] * e2[1] + r[2] * e2[2]) * inv_det;
+    let v = (r[0] * e1[0] + r[1] * e1[1] + r[2] * e1[2]) * inv_det;
+    let w = 1.0 - u - v;
+    let signs = u.to_bits() | v.to_bits() | w.to_bits();
+    let t = ng_c * inv_det;
+    let hit = inv_det != 0.0 && signs & 0x8000_0000 == 0 && t >= 0.0 && t < t_max;
+    (hit, t, u, v)
+}
+
+/// [`lane`] for one ray from `o`.
+fn moller_trumbore(
+    tri: &RtTriangle,
+    o: [f32; 3],
+    d: [f32; 3],
+    t_max: f32,
+) -> (bool, f32, f32, f32) {
+    let (c, ng_c) = shared(tri, o);
+    lane(tri, c, ng_c, d, t_max)
 }
 
 /// The bits `i` for which `lanes[i]` holds.

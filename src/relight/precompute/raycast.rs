@@ -6,10 +6,10 @@
 //!
 //! **Two tracers, one interface ([`RayTracer`]).** [`SceneBvh::new`] takes the faster one this
 //! build offers ([`RayTracer::best`]):
-//! * [`RayTracer::Embree`]: Intel Embree 3.13.5 (the system's `libembree3`, Debian's
-//!   `libembree-dev`) through the `embree3` crate's bindings, its 16-wide packet query
-//!   ([`embree`](super::embree)); in builds with the cargo feature `embree`, which the CLI, the
-//!   viewer and the Python package turn on. On the same rays, one thread, the whole
+//! * [`RayTracer::Embree`]: Intel Embree 3 (the system's `libembree3.so.3`, Debian's and
+//!   Ubuntu's `libembree3-3`), loaded at run time where it is installed, its 16-wide packet
+//!   query ([`embree`](super::embree)); every build can use it and none needs it. On the same
+//!   rays, one thread, the whole
 //!   precomputation (rays and encoding) through it is faster than Embree 4.4's single-ray
 //!   `rtcOccluded1` alone on every scene `benches/rays_results.md` measures, and than our packets.
 //! * [`RayTracer::Packets`]: our own, in every build. `obvhs` builds a binary BVH with PLOC,
@@ -25,6 +25,14 @@
 //!
 //! The two answer alike except on rays through a triangle's edge, whose f32 answer is decided
 //! by rounding (`benches/compare_rays.py` works each such ray out in f64).
+//!
+//! **Closest hits.** [`SceneBvh::closest_hits_from`] finds, for each ray, the nearest
+//! triangle it meets ([`Hit`]: the mesh's triangle, the distance, the barycentric weights of
+//! its second and third corners), with either tracer. A hit names the mesh triangle the
+//! BVH's triangle stands for: of repeated triangles (the same three corners in any order,
+//! whatever their winding) the first in the mesh's order stands for all, so a pair of
+//! opposite-facing duplicates answers as the first of the two; a triangle of zero area is
+//! never hit.
 //!
 //! Rays are f32 (the BVH's precision). What the BVH is given is cleaned in f32, after the
 //! conversion: triangles of zero area there are left out (no ray can hit one) and repeated
@@ -101,21 +109,52 @@ crate::named::named_enum! {
         /// haarshift's own binary BVH traced by packets of rays that share their origin
         /// ([`packet`](super::packet)): in every build, its answers specified to the bit.
         Packets = "packets",
-        /// Intel Embree 3's 16-wide packet query ([`embree`](super::embree)): in builds with the
-        /// cargo feature `embree` (the CLI's and the Python package's), when Embree starts.
+        /// Intel Embree 3's 16-wide packet query ([`embree`](super::embree)): where the
+        /// system's `libembree3.so.3` loads and its device starts.
         Embree = "embree",
     }
 }
 
 impl RayTracer {
-    /// Whether this build offers the tracer and it starts on this machine.
+    /// Whether the tracer starts on this machine.
     pub fn available(self) -> bool {
+        self.unavailable().is_none()
+    }
+
+    /// Why the tracer cannot trace on this machine (for Embree: the library did not load,
+    /// with what to install, or its device did not start), `None` when it can.
+    ///
+    /// ```
+    /// use haarshift::relight::RayTracer;
+    /// assert_eq!(RayTracer::Packets.unavailable(), None);
+    /// if let Some(why) = RayTracer::Embree.unavailable() {
+    ///     assert!(why.contains("libembree3-3"), "{why}");
+    /// }
+    /// ```
+    pub fn unavailable(self) -> Option<&'static str> {
         match self {
-            RayTracer::Packets => true,
-            #[cfg(feature = "embree")]
-            RayTracer::Embree => super::embree::available(),
-            #[cfg(not(feature = "embree"))]
-            RayTracer::Embree => false,
+            RayTracer::Packets => None,
+            RayTracer::Embree => super::embree::unavailable(),
+        }
+    }
+
+    /// One line on which tracer this machine would use and why: Embree's version where it
+    /// loads, else why it did not.
+    ///
+    /// ```
+    /// use haarshift::relight::RayTracer;
+    /// let line = RayTracer::choice();
+    /// assert!(line.starts_with(RayTracer::best().name()), "{line}");
+    /// ```
+    pub fn choice() -> String {
+        match super::embree::version() {
+            Some(version) => format!("embree (Embree {version} loaded)"),
+            None => format!(
+                "packets ({})",
+                RayTracer::Embree
+                    .unavailable()
+                    .unwrap_or("Embree did not load")
+            ),
         }
     }
 
@@ -152,6 +191,8 @@ impl RayTracer {
 pub struct SceneBvh {
     /// `None` for a scene with no triangle of non-zero area.
     tracer: Option<Tracer>,
+    /// `source[i]`: the mesh triangle the BVH's triangle `i` stands for.
+    source: Vec<u32>,
     /// The tracer that answers (see [`SceneBvh::tracer`]).
     kind: RayTracer,
     /// The power of two the positions were scaled by (1 unless the scene is tiny).
@@ -161,8 +202,22 @@ pub struct SceneBvh {
 /// A built BVH of one [`RayTracer`].
 enum Tracer {
     Packets(PacketBvh),
-    #[cfg(feature = "embree")]
     Embree(super::embree::EmbreeScene),
+}
+
+/// The closest triangle a ray meets ([`SceneBvh::closest_hits_from`]): the point is
+/// `origin + t direction = (1 - u - v) p0 + u p1 + v p2`, `p0, p1, p2` the corners of
+/// `mesh.triangles()[triangle]` in their stored order (up to f32 rounding).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// The mesh's triangle, an index into [`Mesh::triangles`].
+    pub triangle: usize,
+    /// The distance along the ray's direction (in units of its length).
+    pub t: f32,
+    /// The barycentric weight of the triangle's second corner.
+    pub u: f32,
+    /// The barycentric weight of the triangle's third corner.
+    pub v: f32,
 }
 
 /// The extent (largest side of the bounding box, in f32) below which [`SceneBvh`] scales a
@@ -224,27 +279,29 @@ impl SceneBvh {
         let scale = scale_for(lo, hi);
         let point = |i: u32| f32_row(i as usize).map(|x| x * scale);
         let mut seen = HashSet::with_capacity(mesh.triangles().len());
-        let triangles: Vec<[[f32; 3]; 3]> = mesh
+        let (triangles, source): (Vec<[[f32; 3]; 3]>, Vec<u32>) = mesh
             .triangles()
             .iter()
-            .filter_map(|t| {
+            .zip(0u32..)
+            .filter_map(|(t, index)| {
                 let corners = t.map(point);
                 let [a, b, c] = corners.map(|v| v.map(f64::from));
                 let mut key = corners.map(|v| v.map(f32::to_bits));
                 key.sort_unstable();
-                (cross(sub(b, a), sub(c, a)) != [0.0; 3] && seen.insert(key)).then_some(corners)
+                (cross(sub(b, a), sub(c, a)) != [0.0; 3] && seen.insert(key))
+                    .then_some((corners, index))
             })
-            .collect();
+            .unzip();
         drop(seen);
         let built = (!triangles.is_empty()).then(|| build(&triangles, tracer));
         let kind = match &built {
             None if tracer.available() => tracer,
-            #[cfg(feature = "embree")]
             Some(Tracer::Embree(_)) => RayTracer::Embree,
             _ => RayTracer::Packets,
         };
         SceneBvh {
             tracer: built,
+            source,
             kind,
             scale,
         }
@@ -263,19 +320,71 @@ impl SceneBvh {
     pub fn tracer(&self) -> RayTracer {
         self.kind
     }
+
+    /// `hits[i]`: the closest triangle the ray `origin + t directions[i]` meets at
+    /// `0 <= t < t_max` (with Embree `t <= t_max`), or `None`, for the first
+    /// `directions.len().min(hits.len())` rays; see [`Hit`] and the [module docs](self).
+    ///
+    /// ```
+    /// use haarshift::relight::{Mesh, SceneBvh};
+    /// use ndarray::array;
+    /// // Two roofs, at heights 1 and 2, the lower one the second triangle.
+    /// let roofs = Mesh::new(array![[-1.0, 2.0, 1.0], [1.0, 2.0, 1.0], [0.0, 2.0, -1.0],
+    ///                              [-1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.0, -1.0]],
+    ///                       vec![[0, 1, 2], [3, 4, 5]], None).unwrap();
+    /// let mut hits = [None; 2];
+    /// SceneBvh::new(&roofs).closest_hits_from([0.0; 3], &[[0.0, 1.0, 0.0], [0.0, -1.0, 0.0]],
+    ///                                         f32::INFINITY, &mut hits);
+    /// let hit = hits[0].unwrap();
+    /// assert_eq!((hit.triangle, hit.t), (1, 1.0));
+    /// assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.5).abs() < 1e-6);
+    /// assert_eq!(hits[1], None);
+    /// ```
+    pub fn closest_hits_from(
+        &self,
+        origin: [f32; 3],
+        directions: &[[f32; 3]],
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        let n = directions.len().min(hits.len());
+        let (directions, hits) = (&directions[..n], &mut hits[..n]);
+        let (o, t_max_scaled) = (origin.map(|x| x * self.scale), t_max * self.scale);
+        let mut raw = [None; super::embree::EMBREE_LANES];
+        for (d, h) in directions
+            .chunks(super::embree::EMBREE_LANES)
+            .zip(hits.chunks_mut(super::embree::EMBREE_LANES))
+        {
+            let raw = &mut raw[..d.len()];
+            match &self.tracer {
+                None => raw.fill(None),
+                Some(Tracer::Packets(bvh)) => {
+                    for (r, &d) in raw.iter_mut().zip(d) {
+                        *r = bvh.closest_hit(o, d, t_max_scaled);
+                    }
+                }
+                Some(Tracer::Embree(scene)) => scene.closest_packet(o, d, t_max_scaled, raw),
+            }
+            for (h, r) in h.iter_mut().zip(raw.iter()) {
+                *h = r.map(|(index, t, u, v)| Hit {
+                    triangle: self.source[index as usize] as usize,
+                    t: t / self.scale,
+                    u,
+                    v,
+                });
+            }
+        }
+    }
 }
 
 /// The BVH of `triangles` (not empty) for `tracer`, our packets' when that one is not
 /// available or fails to build.
 fn build(triangles: &[[[f32; 3]; 3]], tracer: RayTracer) -> Tracer {
-    #[cfg(feature = "embree")]
     if tracer == RayTracer::Embree
         && let Some(scene) = super::embree::EmbreeScene::new(triangles)
     {
         return Tracer::Embree(scene);
     }
-    #[cfg(not(feature = "embree"))]
-    let _ = tracer; // no Embree in this build: our packets answer whatever was asked for
     let triangles: Vec<Triangle> = triangles
         .iter()
         .map(|t| {
@@ -297,7 +406,6 @@ impl Occlusion for SceneBvh {
                 bvh.occluded_packet::<1>(o, &[direction], t_max, &mut blocked);
                 blocked[0]
             }
-            #[cfg(feature = "embree")]
             Some(Tracer::Embree(scene)) => scene.occluded(o, direction, t_max),
         }
     }
@@ -319,7 +427,6 @@ impl Occlusion for SceneBvh {
                     bvh.occluded_packet::<LANES>(o, d, t_max, b);
                 }
             }
-            #[cfg(feature = "embree")]
             Some(Tracer::Embree(scene)) => {
                 use super::embree::EMBREE_LANES;
                 let packets = directions.chunks(EMBREE_LANES);

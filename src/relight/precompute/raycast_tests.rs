@@ -26,9 +26,12 @@ fn packets(mesh: &Mesh) -> SceneBvh {
     SceneBvh::with_tracer(mesh, RayTracer::Packets)
 }
 
-/// The BVH of `mesh` with every tracer this build offers.
+/// The BVH of `mesh` with every tracer: Embree only where it loads (skipped in one line
+/// otherwise, a failure where `HAARSHIFT_REQUIRE` names it).
 fn every_tracer(mesh: &Mesh) -> Vec<SceneBvh> {
-    let tracers = RayTracer::ALL.iter().filter(|t| t.available());
+    let tracers = RayTracer::ALL.iter().filter(|t| {
+        haarshift_testkit::needs(t.name(), t.unavailable().map_or(Ok(()), Err)).is_some()
+    });
     tracers
         .map(|&t| {
             let bvh = SceneBvh::with_tracer(mesh, t);
@@ -38,42 +41,61 @@ fn every_tracer(mesh: &Mesh) -> Vec<SceneBvh> {
         .collect()
 }
 
-/// Tracer-independent oracle: the ray against every triangle of `mesh` in f64
-/// (Moller-Trumbore), `None` when the answer is not clear-cut, that is when a triangle's
-/// barycentric coordinates or distance come within `1e-5` (relative) of deciding otherwise: a
-/// ray through an edge, whose f32 answer rounding decides.
-fn exact(mesh: &Mesh, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<bool> {
-    const TOL: f64 = 1e-5;
+/// How far the f64 answers must be from deciding otherwise to count as clear-cut.
+const TOL: f64 = 1e-5;
+
+/// The ray against every triangle of `mesh` in f64 (Moller-Trumbore): for each triangle whose
+/// plane it crosses, `(triangle, t, u, v, margin)`, `margin` the least of its barycentric
+/// coordinates, its distance relative to the ray's and the edge's lengths, and its room below
+/// `t_max`: a hit when positive, a clear-cut answer when farther than [`TOL`] from 0.
+fn f64_crossings(
+    mesh: &Mesh,
+    o: [f32; 3],
+    d: [f32; 3],
+    t_max: f32,
+) -> impl Iterator<Item = (usize, f64, f64, f64, f64)> + '_ {
     let (o, d, t_max) = (o.map(f64::from), d.map(f64::from), f64::from(t_max));
     let p = mesh.positions();
-    let corner = |i: u32| [0, 1, 2].map(|k| f64::from(p[[i as usize, k]] as f32));
+    let corner = move |i: u32| [0, 1, 2].map(|k| f64::from(p[[i as usize, k]] as f32));
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    mesh.triangles()
+        .iter()
+        .enumerate()
+        .filter_map(move |(index, t)| {
+            let [a, b, c] = t.map(corner);
+            let (e1, e2) = (sub(b, a), sub(c, a));
+            let q = cross(d, e2);
+            let det = dot(e1, q);
+            if det == 0.0 {
+                return None;
+            }
+            let s = sub(o, a);
+            let u = dot(s, q) / det;
+            let r = cross(s, e1);
+            let v = dot(d, r) / det;
+            let dist = dot(e2, r) / det;
+            let inside = u.min(v).min(1.0 - u - v);
+            let length = dot(d, d).sqrt() * dot(e1, e1).sqrt().max(dot(e2, e2).sqrt());
+            let far = if t_max.is_finite() {
+                (t_max - dist) / t_max.max(1.0)
+            } else {
+                f64::INFINITY
+            };
+            Some((index, dist, u, v, inside.min(dist / length).min(far)))
+        })
+}
+
+/// Tracer-independent oracle: the ray against every triangle of `mesh` in f64, `None` when
+/// the answer is not clear-cut, that is when a triangle's barycentric coordinates or distance
+/// come within [`TOL`] (relative) of deciding otherwise: a ray through an edge, whose f32
+/// answer rounding decides.
+fn exact(mesh: &Mesh, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<bool> {
     let mut unclear = false;
-    for t in mesh.triangles() {
-        let [a, b, c] = t.map(corner);
-        let (e1, e2) = (sub(b, a), sub(c, a));
-        let q = cross(d, e2);
-        let det = dot(e1, q);
-        if det == 0.0 {
-            continue;
-        }
-        let s = sub(o, a);
-        let u = dot(s, q) / det;
-        let r = cross(s, e1);
-        let v = dot(d, r) / det;
-        let dist = dot(e2, r) / det;
-        let inside = u.min(v).min(1.0 - u - v);
-        let length = dot(d, d).sqrt() * dot(e1, e1).sqrt().max(dot(e2, e2).sqrt());
-        let near = dist / length;
-        let far = if t_max.is_finite() {
-            (t_max - dist) / t_max.max(1.0)
-        } else {
-            f64::INFINITY
-        };
-        if inside > TOL && near > TOL && far > TOL {
+    for (.., margin) in f64_crossings(mesh, o, d, t_max) {
+        if margin > TOL {
             return Some(true);
         }
-        unclear |= inside > -TOL && near > -TOL && far > -TOL;
+        unclear |= margin > -TOL;
     }
     (!unclear).then_some(false)
 }
@@ -294,13 +316,144 @@ fn every_tracer_answers_the_rays_of_vertices_as_f64() {
     }
 }
 
-#[cfg(feature = "embree")]
 #[test]
-fn embree_is_the_best_tracer_where_it_is_built() {
-    assert!(RayTracer::Embree.available());
+fn embree_is_the_best_tracer_where_it_loads() {
+    let why = RayTracer::Embree.unavailable().map_or(Ok(()), Err);
+    if haarshift_testkit::needs("embree", why).is_none() {
+        // Where it does not load, the reason names the package to install.
+        let why = RayTracer::Embree.unavailable().unwrap();
+        assert!(why.contains("apt-get install libembree3-3"), "{why}");
+        assert_eq!(RayTracer::best(), RayTracer::Packets);
+        assert!(RayTracer::choice().starts_with("packets ("));
+        return;
+    }
     assert_eq!(RayTracer::best(), RayTracer::Embree);
+    assert!(
+        RayTracer::choice().starts_with("embree (Embree 3."),
+        "{}",
+        RayTracer::choice()
+    );
     assert_eq!(
         SceneBvh::new(&bunny_on_ground()).tracer(),
         RayTracer::Embree
     );
+}
+
+/// Tracer-independent oracle of the closest hit: the ray against every triangle of `mesh` in
+/// f64, `Some(None)` for no hit, `Some(Some((triangle, t, u, v)))` for the nearest, and `None`
+/// when the answer is not clear-cut: a crossing within [`TOL`] of an edge, of the origin or of
+/// `t_max`, or two hits within [`TOL`] (relative) of the same distance.
+fn exact_closest(
+    mesh: &Mesh,
+    o: [f32; 3],
+    d: [f32; 3],
+    t_max: f32,
+) -> Option<Option<(usize, f64, f64, f64)>> {
+    let mut hits = Vec::new();
+    for (index, dist, u, v, margin) in f64_crossings(mesh, o, d, t_max) {
+        if margin.abs() <= TOL {
+            return None;
+        }
+        if margin > 0.0 {
+            hits.push((index, dist, u, v));
+        }
+    }
+    hits.sort_by(|a, b| a.1.total_cmp(&b.1));
+    match hits.as_slice() {
+        [first, second, ..] if (second.1 - first.1) <= TOL * first.1.max(1e-3) => None,
+        [first, ..] => Some(Some(*first)),
+        [] => Some(None),
+    }
+}
+
+#[test]
+fn every_tracer_finds_the_closest_hit_as_f64() {
+    let mesh = bunny_on_ground();
+    let rays: Vec<_> = bunny_rays(&mesh).step_by(8).collect();
+    for bvh in every_tracer(&mesh) {
+        let (mut hits, mut unclear) = (0, 0);
+        for (k, chunk) in rays.chunks(7).enumerate() {
+            // Rays of one origin, as a vertex casts them: the chunk's directions from its first.
+            let (o, _, t_max) = chunk[0];
+            let directions: Vec<[f32; 3]> = chunk.iter().map(|r| r.1).collect();
+            let mut got = vec![None; directions.len()];
+            bvh.closest_hits_from(o, &directions, t_max, &mut got);
+            for (d, got) in directions.iter().zip(&got) {
+                let Some(want) = exact_closest(&mesh, o, *d, t_max) else {
+                    unclear += 1;
+                    continue;
+                };
+                let tracer = bvh.tracer();
+                match (got, want) {
+                    (None, None) => {}
+                    (Some(h), Some((triangle, t, u, v))) => {
+                        assert_eq!(h.triangle, triangle, "{tracer}: ray {k} {d:?}");
+                        let close =
+                            |a: f32, b: f64| (f64::from(a) - b).abs() <= 1e-4 * b.abs().max(1.0);
+                        assert!(
+                            close(h.t, t) && close(h.u, u) && close(h.v, v),
+                            "{tracer}: {h:?} against {t} {u} {v}"
+                        );
+                        hits += 1;
+                    }
+                    _ => panic!("{tracer}: ray {k} {d:?}: {got:?} against {want:?}"),
+                }
+                // The occlusion query agrees.
+                assert_eq!(
+                    bvh.occluded(o, *d, t_max),
+                    got.is_some(),
+                    "{tracer}: ray {k}"
+                );
+            }
+        }
+        assert!((300..2_000).contains(&hits), "{hits} of {}", rays.len());
+        assert!(unclear < rays.len() / 50, "{unclear} of {}", rays.len());
+    }
+}
+
+#[test]
+fn a_closest_hit_names_the_first_of_repeated_triangles_and_never_a_flat_one() {
+    // A flat triangle first (corners on the line y = 1, z = 1), then one facing down, its
+    // mirror image (the same corners, the other winding) and its copy, all in the plane
+    // y = 1, then one at y = 2.
+    let positions = ndarray::array![
+        [-1.0, 1.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, -1.0],
+        [3.0, 1.0, 1.0],
+        [-1.0, 2.0, 1.0],
+        [1.0, 2.0, 1.0],
+        [0.0, 2.0, -1.0]
+    ];
+    let triangles = vec![[0, 1, 3], [0, 1, 2], [0, 2, 1], [1, 2, 0], [4, 5, 6]];
+    let mesh = Mesh::new(positions, triangles, None).unwrap();
+    for bvh in every_tracer(&mesh) {
+        let up = [[0.0, 1.0, 0.0], [0.1, 1.0, 0.1], [0.0, -1.0, 0.0]];
+        let mut hits = [None; 3];
+        bvh.closest_hits_from([0.0, 0.0, 0.0], &up, f32::INFINITY, &mut hits);
+        for h in &hits[..2] {
+            let h = h.unwrap();
+            assert_eq!(h.triangle, 1, "{}", bvh.tracer());
+            assert!((h.t - 1.0).abs() < 1e-6, "{h:?}");
+        }
+        assert_eq!(hits[2], None);
+        // From between the two planes, up: the roof at y = 2, triangle 4, at its centroid's
+        // weights.
+        bvh.closest_hits_from(
+            [0.0, 1.5, 1.0 / 3.0],
+            &up[..1],
+            f32::INFINITY,
+            &mut hits[..1],
+        );
+        let h = hits[0].unwrap();
+        assert_eq!(h.triangle, 4, "{}", bvh.tracer());
+        assert!((h.t - 0.5).abs() < 1e-6, "{h:?}");
+        assert!(
+            (h.u - 1.0 / 3.0).abs() < 1e-6 && (h.v - 1.0 / 3.0).abs() < 1e-6,
+            "{h:?}"
+        );
+        // t_max short of it: nothing.
+        bvh.closest_hits_from([0.0, 1.5, 0.0], &up[..1], 0.25, &mut hits[..1]);
+        assert_eq!(hits[0], None);
+    }
 }

@@ -27,7 +27,7 @@
 //!
 //! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
 //! environment and camera in the header; version 3 the shard record; version 4 the aligned
-//! arrays. A file of another version
+//! arrays; version 5 the ray tracer in the parameters. A file of another version
 //! is refused, never guessed at.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
@@ -52,7 +52,7 @@ use crate::relight::{Mesh, SceneError};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
-pub const CACHE_VERSION: u32 = 4;
+pub const CACHE_VERSION: u32 = 5;
 
 const FORMAT: Format = Format {
     magic: b"HSRCACHE",
@@ -120,6 +120,10 @@ pub struct CacheParams {
     pub ground_plane: bool,
     /// Bands of the spherical-harmonic transfer stored beside the Haar transport, if any.
     pub sh_bands: Option<usize>,
+    /// The [`RayTracer`](crate::relight::RayTracer) that cast the visibility rays (`embree`
+    /// or `packets`; `None` for the direction order's shadow buffers). Shards merge only when
+    /// they agree on it: the two may answer a ray through an edge differently.
+    pub ray_tracer: Option<String>,
 }
 
 /// The JSON header of a cache file.
@@ -170,7 +174,7 @@ pub struct ShardRecord {
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
 ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
-///     sh_bands: None };
+///     sh_bands: None, ray_tracer: Some("packets".into()) };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");

@@ -24,6 +24,7 @@ fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
         map_size: None,
         ground_plane: true,
         sh_bands,
+        ray_tracer: Some("packets".into()),
     };
     let mut cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
     // The scene file's lighting and camera travel in the header.

@@ -20,10 +20,12 @@ parameterisation (lat-long N x 2N, or cube 6 x N x N), times max(0, n . w) and t
 solid angle, Haar-transformed (orthonormal, face by face) and truncated to the K largest
 detail coefficients (plus each face's scaling coefficient); rays start 1e-4 x the scene's
 bounding-box diagonal off the surface along the normal, and a ray that hits any triangle is
-blocked. Rays are traced by Intel Embree 3 where this build links it (the default), else by
-haarshift's own packet tracer (--ray-tracer chooses; the output names the one that cast). The
-cache (.hsr) holds the mesh, the albedo, the transport, the parameters, and the
-scene file's environment and camera; `relight render` reads it.
+blocked. Rays are traced by Intel Embree 3 where the system's libembree3.so.3 loads (Debian
+and Ubuntu: apt-get install libembree3-3; $HAARSHIFT_EMBREE names another file), else by
+haarshift's own packet tracer (--ray-tracer chooses; the output and the cache name the one
+that cast, and `relight merge` joins only shards cast by one). The cache (.hsr) holds the
+mesh, the albedo, the transport, the parameters, and the scene file's environment and
+camera; `relight render` reads it.
 
 The input is a mesh (.obj or .ply; degenerate triangles and open or non-manifold meshes
 work) or a scene file (.json, see the library's relight::scene docs).
@@ -88,9 +90,9 @@ pub struct Args {
     pub order: Order,
 
     /// The ray tracer of --order vertex: `embree` (Intel Embree 3's packets, where the
-    /// system's libembree3 is installed: the default there) or `packets` (haarshift's own,
+    /// system's libembree3.so.3 loads: the default there) or `packets` (haarshift's own,
     /// always available; its answers specified to the bit). Both answer alike except on rays
-    /// through a triangle's edge
+    /// through a triangle's edge. This machine's default is printed below the flags
     #[arg(long, value_parser = choice::<RayTracer>(names!(RayTracer)))]
     pub ray_tracer: Option<RayTracer>,
 
@@ -109,6 +111,12 @@ pub struct Args {
     /// Replace the output if it exists (a shard: even a complete one)
     #[arg(long)]
     pub force: bool,
+}
+
+/// `relight precompute --help`'s line on the tracer this machine would use and why. Finding
+/// out loads Embree, so it is asked only when help is shown.
+pub fn tracer_help() -> String {
+    format!("Ray tracer on this machine: {}", RayTracer::choice())
 }
 
 pub fn run(args: Args) -> Result<()> {

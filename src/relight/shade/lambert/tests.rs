@@ -582,6 +582,7 @@ fn a_mapped_cache_shades_in_place_and_equal_to_the_transport_in_memory() {
         map_size: None,
         ground_plane: false,
         sh_bands: None,
+        ray_tracer: Some("packets".into()),
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("ball.hsr");
