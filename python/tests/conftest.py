@@ -26,12 +26,16 @@ def rng():
 
 @pytest.fixture(scope="session")
 def cli():
-    """Runs the haarshift binary; skips when it has not been built (CI builds it first)."""
+    """Runs the haarshift binary, target/release/haarshift (which `cargo build --release -p
+    haarshift-cli` builds, as does `cargo test --workspace --release`) or else the one on the
+    PATH; skips, saying how to build it, when there is neither (CI builds it first)."""
     binary = ROOT / "target" / "release" / "haarshift"
     if not binary.exists():
         found = shutil.which("haarshift")
         if found is None:
-            pytest.skip("target/release/haarshift not built: run cargo build --release")
+            pytest.skip(
+                "target/release/haarshift not built: run cargo build --release -p haarshift-cli"
+            )
         binary = pathlib.Path(found)
 
     def run(*args):
