@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-use haarshift_viewer::browser::Browser;
+use haarshift_viewer::browser::{Browser, chromium};
 use ndarray::Array2;
 use serde_json::Value;
 
@@ -190,6 +190,9 @@ fn screenshot(browser: &mut Browser) -> Vec<f64> {
 
 #[test]
 fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
+    if haarshift_testkit::needs("chromium", chromium()).is_none() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cache = bunny_cache(dir.path());
     let env = testdata("envmaps/rooitou_park_256x128.npy");
@@ -810,6 +813,9 @@ fn a_burst_of_states_is_answered_by_the_newest_state_s_frame_only() {
 
 #[test]
 fn the_results_page_shows_an_experiment_s_records_pictures_and_plot() {
+    if haarshift_testkit::needs("chromium", chromium()).is_none() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cache = bunny_cache(dir.path());
     let env = testdata("envmaps/rooitou_park_256x128.npy");
