@@ -11,7 +11,7 @@ use haarshift_viewer::browser::{Browser, chromium};
 use ndarray::Array2;
 use serde_json::Value;
 
-use crate::common::{fails_cleanly, p, succeeds, testdata};
+use crate::common::{fails_cleanly_within, p, succeeds, testdata};
 
 /// The image size of the page's canvas and of the renders it is compared with.
 const SIZE: [usize; 2] = [320, 240];
@@ -653,10 +653,8 @@ fn only_the_address_s_own_names_and_those_of_allow_host_are_answered() {
     let (cache, env, results) = (p(&cache), p(&env), p(&results));
     for bad in ["http://viewer.lan", "viewer.lan:port", "viewer.lan/ws"] {
         let args = ["relight", "view", cache, "--env", env, "--port", "0"];
-        fails_cleanly(
-            &[&args[..], &["--allow-host", bad]].concat(),
-            &["allowed host", bad],
-        );
+        let args = [&args[..], &["--allow-host", bad]].concat();
+        fails_cleanly_within(Duration::from_secs(60), &args, &["allowed host", bad]);
     }
     let view = ViewProcess::start(&[
         cache,
@@ -698,31 +696,24 @@ fn only_the_address_s_own_names_and_those_of_allow_host_are_answered() {
         "/results/files/../relight.csv",
         "/secret",
     ];
+    let mut answered = Vec::new();
     for path in paths {
         for host in &refused {
             let origin = host.as_ref().map(|h| format!("http://{h}"));
             for method in ["GET", "POST"] {
                 let answer = status(method, path, host.as_deref(), origin.as_deref());
-                assert_eq!(
-                    answer, "HTTP/1.1 403 Forbidden",
-                    "{method} {path} at {host:?}"
-                );
+                if answer != "HTTP/1.1 403 Forbidden" {
+                    answered.push(format!("{method} {path} at {host:?}: {answer}"));
+                }
             }
         }
     }
+    assert!(answered.is_empty(), "answered: {answered:#?}");
     let two = format!(
         "GET / HTTP/1.1\r\nHost: {}\r\nHost: {evil}\r\n\r\n",
         at("localhost")
     );
     assert_eq!(status_line(&view.url, &two), "HTTP/1.1 403 Forbidden");
-    let refusal = http(&view.url, request("GET", "/", Some(&evil), None).as_bytes());
-    assert!(
-        refusal.ends_with(&format!(
-            "this viewer answers 127.0.0.1:{port}, localhost:{port}, [::1]:{port}, \
-             viewer.lan:{port}, proxy.lan:8080 only (relight view --allow-host NAME adds one)\n"
-        )),
-        "{refusal}"
-    );
 
     // The loopback's names at the port, and those allowed, in any case.
     for host in [
@@ -776,6 +767,16 @@ fn only_the_address_s_own_names_and_those_of_allow_host_are_answered() {
         request("GET", "/", Some(&at("localhost")), None).as_bytes(),
     );
     assert!(index.contains("viewer.js"), "{index}");
+
+    // The refusal says which names are answered.
+    let refusal = http(&view.url, request("GET", "/", Some(&evil), None).as_bytes());
+    assert!(
+        refusal.ends_with(&format!(
+            "this viewer answers 127.0.0.1:{port}, localhost:{port}, [::1]:{port}, \
+             viewer.lan:{port}, proxy.lan:8080 only (relight view --allow-host NAME adds one)\n"
+        )),
+        "{refusal}"
+    );
 
     // A page at localhost gets its session (once the handshakes above have left theirs).
     let localhost = view.url.replace("//127.0.0.1:", "//localhost:");
