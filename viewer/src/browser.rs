@@ -8,8 +8,9 @@
 //! `{id, method, params, sessionId}`, its answer carries the same `id`, everything else is an
 //! event, kept so that [`Browser::console_errors`] can list the page's errors.
 
+use std::ffi::OsString;
 use std::net::TcpStream;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -56,31 +57,61 @@ pub struct Browser {
     events: Vec<Value>,
 }
 
-/// The browser to launch: `$CHROMIUM`, else `chromium` on the `PATH`.
+/// The browser to launch: `$CHROMIUM` (when set and not empty), else `chromium` on the
+/// `PATH`; either must be an executable file, or there is none (a test then skips).
 ///
 /// ```
 /// // Either a path or a one-line reason saying how to install one.
 /// match haarshift_viewer::browser::chromium() {
 ///     Ok(path) => assert!(path.ends_with("chromium") || std::env::var_os("CHROMIUM").is_some()),
-///     Err(e) => assert!(e.to_string().contains("apt-get install chromium")),
+///     Err(e) => assert!(e.to_string().contains("(apt-get install chromium"), "{e}"),
 /// }
 /// ```
 pub fn chromium() -> Result<PathBuf> {
-    if let Some(path) = std::env::var_os("CHROMIUM") {
-        return Ok(PathBuf::from(path));
+    find_chromium(std::env::var_os("CHROMIUM"), std::env::var_os("PATH"))
+}
+
+/// [`chromium`] with `$CHROMIUM` and `$PATH` given.
+fn find_chromium(named: Option<OsString>, path: Option<OsString>) -> Result<PathBuf> {
+    if let Some(named) = named.filter(|n| !n.is_empty()).map(PathBuf::from) {
+        // The one named or none: another found on the PATH is not the browser asked for.
+        return if executable(&named) {
+            Ok(named)
+        } else {
+            Err(Error::parameter(
+                "browser",
+                format!(
+                    "$CHROMIUM names {}, which is no executable file (apt-get install chromium, \
+                     or name another)",
+                    named.display()
+                ),
+            ))
+        };
     }
-    std::env::var_os("PATH")
-        .into_iter()
-        .flat_map(|p| std::env::split_paths(&p).collect::<Vec<_>>())
+    path.iter()
+        .flat_map(std::env::split_paths)
         .map(|dir| dir.join("chromium"))
-        .find(|p| p.is_file())
+        .find(|p| executable(p))
         .ok_or_else(|| {
             Error::parameter(
                 "browser",
-                "no chromium on the PATH: install Debian's `chromium` (apt-get install chromium) \
-                 or name one in $CHROMIUM",
+                "no chromium on the PATH (apt-get install chromium, or name one in $CHROMIUM)",
             )
         })
+}
+
+/// Whether `path` is a file its owner, group or others may execute.
+fn executable(path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        path.metadata()
+            .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+    }
+    #[cfg(not(unix))]
+    {
+        path.is_file()
+    }
 }
 
 fn failure(what: impl std::fmt::Display) -> Error {
@@ -277,5 +308,50 @@ impl Drop for Browser {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
+    }
+}
+
+// The modes set are Unix's.
+#[cfg(all(test, unix))]
+mod tests {
+    use super::find_chromium;
+    use std::os::unix::fs::PermissionsExt;
+
+    #[test]
+    fn only_an_executable_file_counts_as_chromium() {
+        let dir = tempfile::tempdir().unwrap();
+        let (bin, other) = (dir.path().join("bin"), dir.path().join("other"));
+        std::fs::create_dir_all(&bin).unwrap();
+        std::fs::create_dir_all(other.join("chromium")).unwrap(); // a directory of that name
+        let browser = bin.join("chromium");
+        std::fs::write(&browser, "#!/bin/sh\n").unwrap();
+        let mode = |m| std::fs::set_permissions(&browser, std::fs::Permissions::from_mode(m));
+        let path = std::env::join_paths([&other, &bin]).unwrap();
+        let found = |named: Option<&std::path::Path>| {
+            find_chromium(named.map(Into::into), Some(path.clone()))
+        };
+
+        mode(0o644).unwrap();
+        let absent = found(None).unwrap_err().to_string();
+        assert!(
+            absent.contains("no chromium on the PATH (apt-get install chromium"),
+            "{absent}"
+        );
+        let named = found(Some(&browser)).unwrap_err().to_string();
+        assert!(
+            named.contains("no executable file (apt-get install chromium"),
+            "{named}"
+        );
+        let missing = dir.path().join("nonexistent");
+        assert!(found(Some(&missing)).is_err());
+        assert!(found(Some(&other.join("chromium"))).is_err());
+
+        mode(0o755).unwrap();
+        assert_eq!(found(None).unwrap(), browser);
+        assert_eq!(found(Some(&browser)).unwrap(), browser);
+        assert_eq!(found(Some("".as_ref())).unwrap(), browser, "empty: not set");
+        // A $CHROMIUM that is missing is absent, even with one on the PATH.
+        assert!(found(Some(&missing)).is_err());
+        assert!(find_chromium(None, None).is_err());
     }
 }

@@ -16,11 +16,22 @@
 //! | [`progress`] | the reference's progress, counted for the page that asked |
 //! | [`browser`] | headless Chromium over the DevTools protocol: the page's tests and frame-rate script |
 //!
+//! The viewer answers only its own names, against DNS rebinding (a page of another site
+//! pointing its name at the loopback to read the viewer as its own): every request's `Host`
+//! must be a name of the address listened on at its port (on the loopback `127.0.0.1:PORT`,
+//! `localhost:PORT` or `[::1]:PORT`) or one of
+//! [`ViewerOptions::allowed_hosts`](server::ViewerOptions::allowed_hosts)
+//! (`relight view --allow-host NAME`, which allows `NAME:PORT`, or `NAME:OTHER` as given),
+//! compared case-insensitively, or it is refused with 403 before anything else is looked at.
+//! A WebSocket must also come from a page at one of those names (`Origin: http://NAME:PORT`);
+//! one without `Origin` is refused.
+//!
 //! The page's sessions are in `session.rs`: each keeps its own shader (rebuilt when the
 //! method, material or budgets change), answers only the newest state queued on its socket,
 //! and computes the reference of the error view on a thread of its own.
 
 pub mod browser;
+mod host;
 pub mod progress;
 pub mod protocol;
 pub mod scene;

@@ -5,9 +5,14 @@
 //! files embedded in the binary, `GET /ws` with the WebSocket handshake (RFC 6455, the accept
 //! key by `tungstenite`), after which the thread runs the page's [`Session`]. Every page gets
 //! a session of its own (its own shader, frames and reference) up to
-//! [`ViewerOptions::max_sessions`] at once; one more is told so in one line and closed. A
-//! WebSocket from a page of another origin than the address asked for is refused (403): any
-//! page the user opens could otherwise drive a server on the loopback.
+//! [`ViewerOptions::max_sessions`] at once; one more is told so in one line and closed.
+//!
+//! Before anything else, every request's `Host` must be a name of the address listened on or
+//! one of [`ViewerOptions::allowed_hosts`], or it is refused (403): a page of another site
+//! that rebinds its own name to this address would otherwise read the viewer's answers. A
+//! WebSocket must also come from a page at such a name (`Origin`), and one without `Origin`
+//! (no browser opens one so) is refused too: any page the user opens could otherwise drive a
+//! server on the loopback.
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -21,6 +26,7 @@ use tungstenite::{Message, handshake::derive_accept_key};
 
 use haarshift::{Error, Result};
 
+use crate::host::AllowedHosts;
 use crate::protocol::Notice;
 use crate::scene::ViewedScene;
 use crate::session::Session;
@@ -40,6 +46,7 @@ const RESULTS_HTML: &str = include_str!("../page/results.html");
 /// use haarshift_viewer::ViewerOptions;
 /// let o = ViewerOptions::default();
 /// assert_eq!((o.address.ip().to_string(), o.address.port(), o.max_sessions), ("127.0.0.1".into(), 8765, 4));
+/// assert!(o.allowed_hosts.is_empty()); // 127.0.0.1, localhost and [::1] at port 8765 only
 /// ```
 #[derive(Clone, Debug)]
 pub struct ViewerOptions {
@@ -50,6 +57,11 @@ pub struct ViewerOptions {
     /// An `experiment relight` output directory, served at `/results`: its records
     /// (`relight.json`) and pictures (`*.png`) side by side.
     pub results: Option<PathBuf>,
+    /// Names the page may be reached by besides those of `address` (its IP address and, on
+    /// the loopback or every interface, `127.0.0.1`, `localhost` and `[::1]`): `NAME`, at the
+    /// port listened on, or `NAME:PORT` (the port a proxy in front serves). A request whose
+    /// `Host` is none of them is refused; case does not matter.
+    pub allowed_hosts: Vec<String>,
 }
 
 impl Default for ViewerOptions {
@@ -58,6 +70,7 @@ impl Default for ViewerOptions {
             address: SocketAddr::from(([127, 0, 0, 1], 8765)),
             max_sessions: 4,
             results: None,
+            allowed_hosts: Vec::new(),
         }
     }
 }
@@ -77,10 +90,12 @@ pub struct Viewer {
     listener: TcpListener,
     scene: Arc<ViewedScene>,
     options: ViewerOptions,
+    hosts: Arc<AllowedHosts>,
 }
 
 impl Viewer {
-    /// Listens on `options.address` for pages of `scene`.
+    /// Listens on `options.address` for pages of `scene`; a name of
+    /// [`allowed_hosts`](ViewerOptions::allowed_hosts) that is no host name is refused.
     pub fn bind(scene: ViewedScene, options: ViewerOptions) -> Result<Viewer> {
         if options.max_sessions == 0 {
             return Err(Error::parameter(
@@ -94,18 +109,19 @@ impl Viewer {
                 format!("cannot listen on {}: {e}", options.address),
             )
         })?;
+        // The port taken, not 0 when 0 was asked for: it is the one in the page's `Host`.
+        let hosts = AllowedHosts::new(listening(&listener)?, &options.allowed_hosts)?;
         Ok(Viewer {
             listener,
             scene: Arc::new(scene),
             options,
+            hosts: Arc::new(hosts),
         })
     }
 
     /// The address listened on (with the port taken when 0 was asked for).
     pub fn address(&self) -> Result<SocketAddr> {
-        self.listener
-            .local_addr()
-            .map_err(|e| Error::parameter("address", e.to_string()))
+        listening(&self.listener)
     }
 
     /// The page's address, `http://HOST:PORT/`.
@@ -123,9 +139,17 @@ impl Viewer {
             let scene = Arc::clone(&self.scene);
             let sessions = Arc::clone(&sessions);
             let options = self.options.clone();
-            std::thread::spawn(move || connection(stream, scene, sessions, options));
+            let hosts = Arc::clone(&self.hosts);
+            std::thread::spawn(move || connection(stream, scene, sessions, options, &hosts));
         }
     }
+}
+
+/// The address `listener` listens on.
+fn listening(listener: &TcpListener) -> Result<SocketAddr> {
+    listener
+        .local_addr()
+        .map_err(|e| Error::parameter("address", e.to_string()))
 }
 
 /// One connection: the page, the script, or a session.
@@ -134,6 +158,7 @@ fn connection(
     scene: Arc<ViewedScene>,
     sessions: Arc<AtomicUsize>,
     options: ViewerOptions,
+    hosts: &AllowedHosts,
 ) {
     let _ = stream.set_read_timeout(Some(HEAD_WAIT));
     let Some((head, rest)) = read_head(&mut stream) else {
@@ -157,6 +182,23 @@ fn connection(
             .find(|h| h.name.eq_ignore_ascii_case(name))
             .and_then(|h| std::str::from_utf8(h.value).ok())
     };
+    // Two `Host` headers are as good as none: which one a proxy or the browser meant is unknown.
+    let mut host_headers = request
+        .headers
+        .iter()
+        .filter(|h| h.name.eq_ignore_ascii_case("host"));
+    let host = match (host_headers.next(), host_headers.next()) {
+        (Some(h), None) => std::str::from_utf8(h.value).ok(),
+        _ => None,
+    };
+    if !hosts.host(host) {
+        let body = format!(
+            "another host: this viewer answers {} only (relight view --allow-host NAME adds one)\n",
+            hosts.names()
+        );
+        let _ = respond(&mut stream, "403 Forbidden", "text/plain", body.as_bytes());
+        return;
+    }
     let path = request.path.unwrap_or("/");
     let path = path.split(['?', '#']).next().unwrap_or("/");
     match (request.method, path) {
@@ -165,7 +207,7 @@ fn connection(
             let _ = respond(&mut stream, "200 OK", kind, body.as_bytes());
         }
         (Some("GET"), "/ws") => {
-            let origin_ok = header("origin").is_none_or(|o| same_origin(o, header("host")));
+            let origin_ok = hosts.origin(header("origin"));
             let key = header("sec-websocket-key").map(str::to_owned);
             let upgrade = header("upgrade").is_some_and(|u| u.eq_ignore_ascii_case("websocket"));
             match (origin_ok, upgrade, key) {
@@ -174,7 +216,7 @@ fn connection(
                         &mut stream,
                         "403 Forbidden",
                         "text/plain",
-                        b"another origin\n",
+                        b"a page of another origin, or none\n",
                     );
                 }
                 (true, true, Some(key)) => session(stream, rest, &key, scene, &sessions, options),
@@ -307,12 +349,6 @@ fn plain_png(name: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_'))
 }
 
-/// Whether a page at `origin` is this server's own: the page's origin is the address the
-/// browser asked for (the `Host` header), whichever name or interface that is.
-fn same_origin(origin: &str, host: Option<&str>) -> bool {
-    host.is_some_and(|host| origin == format!("http://{host}"))
-}
-
 /// The request head (through its blank line) and any bytes read after it, or `None` when the
 /// client sent no complete head within the limits.
 fn read_head(stream: &mut TcpStream) -> Option<(Vec<u8>, Vec<u8>)> {
@@ -347,8 +383,6 @@ fn respond(stream: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> std
 
 #[cfg(test)]
 mod tests {
-    use super::same_origin;
-
     #[test]
     fn result_files_are_the_records_and_plain_png_names_only() {
         let dir = tempfile::tempdir().unwrap();
@@ -370,17 +404,5 @@ mod tests {
         ] {
             assert_eq!(read(refused), None, "{refused}");
         }
-    }
-
-    #[test]
-    fn only_the_page_of_the_address_asked_for_is_its_own() {
-        assert!(same_origin("http://127.0.0.1:8765", Some("127.0.0.1:8765")));
-        assert!(same_origin("http://viewer.lan:80", Some("viewer.lan:80")));
-        assert!(!same_origin("http://evil.example", Some("127.0.0.1:8765")));
-        assert!(!same_origin(
-            "http://127.0.0.1:9999",
-            Some("127.0.0.1:8765")
-        ));
-        assert!(!same_origin("http://127.0.0.1:8765", None));
     }
 }

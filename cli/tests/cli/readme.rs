@@ -247,7 +247,9 @@ fn every_later_readme_command_runs_from_the_root_of_a_fresh_copy() {
 fn serves_its_page(args: &[String], dir: &Path) {
     let args: Vec<&str> = args[2..].iter().map(String::as_str).collect();
     let view = crate::viewer::ViewProcess::start_in(Some(dir), &args);
-    let page = crate::viewer::http(&view.url, b"GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+    let host = crate::viewer::authority(&view.url);
+    let request = format!("GET / HTTP/1.1\r\nHost: {host}\r\n\r\n");
+    let page = crate::viewer::http(&view.url, request.as_bytes());
     assert!(
         page.starts_with("HTTP/1.1 200"),
         "`relight view {}`: {page}",

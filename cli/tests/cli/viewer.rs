@@ -7,11 +7,11 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-use haarshift_viewer::browser::Browser;
+use haarshift_viewer::browser::{Browser, chromium};
 use ndarray::Array2;
 use serde_json::Value;
 
-use crate::common::{p, succeeds, testdata};
+use crate::common::{fails_cleanly_within, p, succeeds, testdata};
 
 /// The image size of the page's canvas and of the renders it is compared with.
 const SIZE: [usize; 2] = [320, 240];
@@ -190,18 +190,19 @@ fn screenshot(browser: &mut Browser) -> Vec<f64> {
 
 #[test]
 fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
+    if haarshift_testkit::needs("chromium", chromium()).is_none() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cache = bunny_cache(dir.path());
     let env = testdata("envmaps/rooitou_park_256x128.npy");
     let view = ViewProcess::start(&[p(&cache), "--env", p(&env)]);
     let mut browser = Browser::launch(SIZE[0], SIZE[1]).unwrap();
-    load_page(
-        &mut browser,
-        &format!(
-            "{}#width={}&height={}&panel=0&yaw=30&pitch=10&keep_light=200",
-            view.url, SIZE[0], SIZE[1]
-        ),
+    let first_view = format!(
+        "#width={}&height={}&panel=0&yaw=30&pitch=10&keep_light=200",
+        SIZE[0], SIZE[1]
     );
+    load_page(&mut browser, &format!("{}{first_view}", view.url));
     assert_eq!(
         browser.evaluate("haarshiftViewer.webgl2").unwrap(),
         Value::Bool(true),
@@ -330,13 +331,28 @@ fn the_page_draws_in_headless_chromium_what_relight_render_computes() {
 
     let errors = browser.console_errors();
     assert!(errors.is_empty(), "console errors: {errors:?}");
+
+    // The page through the loopback's other name: the first view again, the same frame.
+    let localhost = view.url.replace("//127.0.0.1:", "//localhost:");
+    assert_ne!(localhost, view.url);
+    load_page(&mut browser, &format!("{localhost}{first_view}"));
+    wait_for_latest(&mut browser);
+    assert_eq!(
+        browser.evaluate("location.host").unwrap(),
+        Value::from(&localhost["http://".len()..localhost.len() - 1])
+    );
+    let (state_l, radiance_l) = page_frame(&mut browser);
+    assert_eq!(state_l["yaw"], state_a["yaw"], "{state_l}");
+    assert_eq!(radiance_l, rendered_a);
+    let errors = browser.console_errors();
+    assert!(errors.is_empty(), "console errors: {errors:?}");
 }
 
 /// A WebSocket client of the viewer, as a page would be.
 pub struct Client(tungstenite::WebSocket<std::net::TcpStream>);
 
 impl Client {
-    /// Connects to `/ws`, with an `Origin` header when given.
+    /// Connects to `/ws` (its `Host` the url's), with an `Origin` header when given.
     fn connect(url: &str, origin: Option<&str>) -> Result<Client, tungstenite::Error> {
         use tungstenite::client::IntoClientRequest;
         let address = url.trim_start_matches("http://").trim_end_matches('/');
@@ -359,7 +375,7 @@ impl Client {
 
     /// Reads the scene and environment packets a session opens with.
     pub fn opened(url: &str) -> Client {
-        let mut client = Client::connect(url, None).unwrap();
+        let mut client = Client::connect(url, Some(origin(url))).unwrap();
         assert_eq!(client.packet_kind(), 1);
         assert_eq!(client.packet_kind(), 2);
         client
@@ -369,7 +385,7 @@ impl Client {
     /// finishing its frame, and its session ends with it.
     fn reopened(url: &str) -> Client {
         for _ in 0..300 {
-            let mut client = Client::connect(url, None).unwrap();
+            let mut client = Client::connect(url, Some(origin(url))).unwrap();
             match client.next() {
                 tungstenite::Message::Binary(b) if b[0] == 1 => {
                     assert_eq!(client.packet_kind(), 2);
@@ -449,6 +465,16 @@ impl Client {
             other => panic!("a frame expected, got {other:?}"),
         }
     }
+}
+
+/// The origin of the page at `url` (`http://HOST:PORT/`): `http://HOST:PORT`.
+fn origin(url: &str) -> &str {
+    url.trim_end_matches('/')
+}
+
+/// The `HOST:PORT` of `url` (`http://HOST:PORT/`), as the page's requests name it.
+pub fn authority(url: &str) -> &str {
+    origin(url).trim_start_matches("http://")
 }
 
 /// The answer to a raw HTTP request.
@@ -551,7 +577,7 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
     let mut second = Client::opened(&view.url);
     second.send(r#"{"type": "state", "seq": 1, "yaw": 80}"#);
     second.frame(1);
-    let mut third = Client::connect(&view.url, None).unwrap();
+    let mut third = Client::connect(&view.url, Some(origin(&view.url))).unwrap();
     third.refused("serves 2 pages at once");
     drop(third);
 
@@ -564,24 +590,199 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
     again.send(r#"{"type": "state", "seq": 1, "pitch": 5}"#);
     again.frame(1);
 
-    // Another site's page may not drive the viewer; plain HTTP gets its status lines.
+    // Another site's page may not drive the viewer, nor a socket that names no page; plain
+    // HTTP gets its status lines.
     assert!(Client::connect(&view.url, Some("http://example.com")).is_err());
-    assert!(http(&view.url, b"GET /ws HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 400"));
-    assert!(
-        http(&view.url, b"GET /secret HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 404")
-    );
-    assert!(http(&view.url, b"POST / HTTP/1.1\r\nHost: x\r\n\r\n").starts_with("HTTP/1.1 405"));
+    assert!(Client::connect(&view.url, None).is_err());
+    let host = authority(&view.url);
+    let get = |path: &str| format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n");
+    let ws = format!("GET /ws HTTP/1.1\r\nHost: {host}\r\nOrigin: http://{host}\r\n\r\n");
+    assert!(http(&view.url, ws.as_bytes()).starts_with("HTTP/1.1 400"));
+    assert!(http(&view.url, get("/secret").as_bytes()).starts_with("HTTP/1.1 404"));
+    let post = format!("POST / HTTP/1.1\r\nHost: {host}\r\n\r\n");
+    assert!(http(&view.url, post.as_bytes()).starts_with("HTTP/1.1 405"));
     assert!(http(&view.url, b"\x00\x01garbage\r\n\r\n").starts_with("HTTP/1.1 400"));
     let mut huge = b"GET / HTTP/1.1\r\nX: ".to_vec();
     huge.extend(vec![b'a'; 64 * 1024]);
     assert_eq!(http(&view.url, &huge), "");
-    let index = http(&view.url, b"GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+    let index = http(&view.url, get("/").as_bytes());
     assert!(
         index.starts_with("HTTP/1.1 200") && index.contains("viewer.js"),
         "{index}"
     );
     page.send(r#"{"type": "state", "seq": 9, "yaw": 14}"#);
     page.frame(9);
+}
+
+/// The first line of the answer to a raw HTTP request (a WebSocket's 101 is not read on).
+fn status_line(url: &str, request: &str) -> String {
+    use std::io::Write;
+    let mut stream = std::net::TcpStream::connect(authority(url)).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .unwrap();
+    let _ = stream.write_all(request.as_bytes());
+    let mut line = String::new();
+    let _ = BufReader::new(stream).read_line(&mut line);
+    line.trim_end().to_owned()
+}
+
+/// A request for `path` with the `Host` and `Origin` headers given (a WebSocket's upgrade
+/// headers for `/ws`).
+fn request(method: &str, path: &str, host: Option<&str>, origin: Option<&str>) -> String {
+    let mut request = format!("{method} {path} HTTP/1.1\r\n");
+    if let Some(host) = host {
+        request += &format!("Host: {host}\r\n");
+    }
+    if let Some(origin) = origin {
+        request += &format!("Origin: {origin}\r\n");
+    }
+    if path == "/ws" {
+        request += "Upgrade: websocket\r\nConnection: Upgrade\r\n\
+                    Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n";
+    }
+    request + "\r\n"
+}
+
+#[test]
+fn only_the_address_s_own_names_and_those_of_allow_host_are_answered() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = bunny_cache(dir.path());
+    let env = testdata("envmaps/rooitou_park_256x128.npy");
+    let results = testdata("../results/relight/experiments");
+    let (cache, env, results) = (p(&cache), p(&env), p(&results));
+    for bad in ["http://viewer.lan", "viewer.lan:port", "viewer.lan/ws"] {
+        let args = ["relight", "view", cache, "--env", env, "--port", "0"];
+        let args = [&args[..], &["--allow-host", bad]].concat();
+        fails_cleanly_within(Duration::from_secs(60), &args, &["allowed host", bad]);
+    }
+    let view = ViewProcess::start(&[
+        cache,
+        "--env",
+        env,
+        "--results",
+        results,
+        "--allow-host",
+        "Viewer.LAN",
+        "--allow-host",
+        "proxy.lan:8080",
+    ]);
+    let port = authority(&view.url).rsplit_once(':').unwrap().1;
+    let at = |name: &str| format!("{name}:{port}");
+    let status = |method, path, host: Option<&str>, origin: Option<&str>| {
+        status_line(&view.url, &request(method, path, host, origin))
+    };
+
+    // A rebound page (another name, its own origin), no Host, and names at other ports: 403
+    // on every path, before the path or the method is looked at.
+    let evil = at("evil.example");
+    let refused = [
+        Some(evil.clone()),
+        Some(at("localhost.evil.example")),
+        None,
+        Some("localhost".to_owned()),
+        Some("127.0.0.1:1".to_owned()),
+        Some("viewer.lan:8080".to_owned()),
+        Some(at("proxy.lan")),
+    ];
+    let paths = [
+        "/",
+        "/index.html",
+        "/viewer.js",
+        "/ws",
+        "/results",
+        "/results/relight.json",
+        "/results/files",
+        "/results/files/../relight.csv",
+        "/secret",
+    ];
+    let mut answered = Vec::new();
+    for path in paths {
+        for host in &refused {
+            let origin = host.as_ref().map(|h| format!("http://{h}"));
+            for method in ["GET", "POST"] {
+                let answer = status(method, path, host.as_deref(), origin.as_deref());
+                if answer != "HTTP/1.1 403 Forbidden" {
+                    answered.push(format!("{method} {path} at {host:?}: {answer}"));
+                }
+            }
+        }
+    }
+    assert!(answered.is_empty(), "answered: {answered:#?}");
+    let two = format!(
+        "GET / HTTP/1.1\r\nHost: {}\r\nHost: {evil}\r\n\r\n",
+        at("localhost")
+    );
+    assert_eq!(status_line(&view.url, &two), "HTTP/1.1 403 Forbidden");
+
+    // The loopback's names at the port, and those allowed, in any case.
+    for host in [
+        at("127.0.0.1"),
+        at("localhost"),
+        at("LocalHost"),
+        at("[::1]"),
+        at("viewer.lan"),
+        at("VIEWER.lan"),
+        "proxy.lan:8080".to_owned(),
+    ] {
+        let page = format!("http://{host}");
+        let host = Some(host.as_str());
+        for (path, expected) in [
+            ("/", "200 OK"),
+            ("/viewer.js", "200 OK"),
+            ("/results", "200 OK"),
+            ("/results/relight.json", "200 OK"),
+            ("/results/files/../relight.csv", "404 Not Found"),
+            ("/secret", "404 Not Found"),
+        ] {
+            let answer = status("GET", path, host, None);
+            assert_eq!(answer, format!("HTTP/1.1 {expected}"), "{path} at {host:?}");
+        }
+        assert_eq!(
+            status("POST", "/", host, None),
+            "HTTP/1.1 405 Method Not Allowed"
+        );
+        // A WebSocket of a page at an accepted name only: never without Origin.
+        let ws = |origin: Option<&str>| status("GET", "/ws", host, origin);
+        assert_eq!(
+            ws(Some(&page)),
+            "HTTP/1.1 101 Switching Protocols",
+            "{page}"
+        );
+        for origin in [
+            None,
+            Some(format!("http://{evil}")),
+            Some(page.replace("http:", "https:")),
+            Some("http://localhost:1".to_owned()),
+        ] {
+            assert_eq!(
+                ws(origin.as_deref()),
+                "HTTP/1.1 403 Forbidden",
+                "{origin:?}"
+            );
+        }
+    }
+    let index = http(
+        &view.url,
+        request("GET", "/", Some(&at("localhost")), None).as_bytes(),
+    );
+    assert!(index.contains("viewer.js"), "{index}");
+
+    // The refusal says which names are answered.
+    let refusal = http(&view.url, request("GET", "/", Some(&evil), None).as_bytes());
+    assert!(
+        refusal.ends_with(&format!(
+            "this viewer answers 127.0.0.1:{port}, localhost:{port}, [::1]:{port}, \
+             viewer.lan:{port}, proxy.lan:8080 only (relight view --allow-host NAME adds one)\n"
+        )),
+        "{refusal}"
+    );
+
+    // A page at localhost gets its session (once the handshakes above have left theirs).
+    let localhost = view.url.replace("//127.0.0.1:", "//localhost:");
+    let mut page = Client::reopened(&localhost);
+    page.send(r#"{"type": "state", "seq": 1, "yaw": 10}"#);
+    page.frame(1);
 }
 
 #[test]
@@ -613,6 +814,9 @@ fn a_burst_of_states_is_answered_by_the_newest_state_s_frame_only() {
 
 #[test]
 fn the_results_page_shows_an_experiment_s_records_pictures_and_plot() {
+    if haarshift_testkit::needs("chromium", chromium()).is_none() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let cache = bunny_cache(dir.path());
     let env = testdata("envmaps/rooitou_park_256x128.npy");
@@ -624,13 +828,6 @@ fn the_results_page_shows_an_experiment_s_records_pictures_and_plot() {
         .unwrap()
         .filter(|e| e.as_ref().unwrap().path().extension() == Some("png".as_ref()))
         .count();
-    assert!(
-        http(
-            &view.url,
-            b"GET /results/files/../relight.csv HTTP/1.1\r\n\r\n"
-        )
-        .starts_with("HTTP/1.1 404")
-    );
     let mut browser = Browser::launch(1000, 800).unwrap();
     browser.navigate(&format!("{}results", view.url)).unwrap();
     browser

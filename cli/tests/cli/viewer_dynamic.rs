@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use haarshift_viewer::browser::Browser;
+use haarshift_viewer::browser::{Browser, chromium};
 use ndarray::Array3;
 use serde_json::Value;
 
@@ -169,6 +169,9 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
 
 #[test]
 fn the_page_drags_a_dynamic_scene_s_object_and_plays_its_path_in_headless_chromium() {
+    if haarshift_testkit::needs("chromium", chromium()).is_none() {
+        return;
+    }
     let scene = testdata("scenes/bunny_and_ball.json");
     let path = testdata("scenes/ball_path.json");
     let mut args = vec![p(&scene), "--animate", p(&path)];

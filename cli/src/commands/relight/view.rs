@@ -20,6 +20,12 @@ view, saves it as PNG, and keeps its view in the URL. Nothing is fetched from th
 the server listens on 127.0.0.1 unless --host says otherwise, and serves each page (up to
 --max-sessions) a session of its own.
 
+Against DNS rebinding (another site's page pointing its own name at this address), the
+server answers a request only when its Host is a name of the address listened on, at its
+port (on 127.0.0.1: 127.0.0.1:PORT, localhost:PORT or [::1]:PORT), or one given with
+--allow-host; anything else gets 403. With --host 0.0.0.0, name the machine's names and
+addresses the pages use with --allow-host.
+
 A scene file (SCENE.json, as relight scene takes it) is built into occlusion fields first
 (or its fields loaded from --fields-dir): the page then moves its objects (drag with the
 object chosen) and plays --animate's motion path, each frame occlusion fields and Haar
@@ -30,6 +36,7 @@ Examples:
   haarshift relight view cubes.hsr --env park.hdr --port 9000 --open
   haarshift relight view bunny.hsr --env park.hdr --yaw 120 --port 0   (any free port)
   haarshift relight view bunny.hsr --env park.hdr --results results/relight/experiments
+  haarshift relight view bunny.hsr --env park.hdr --host 0.0.0.0 --allow-host viewer.lan --allow-host 192.168.1.5
   haarshift relight view bunny.hsr --env park.hdr --merl gold-metallic-paint.binary   (merl:gold-metallic-paint on the page)
   haarshift relight view testdata/scenes/bunny_and_ball.json --animate testdata/scenes/ball_path.json";
 
@@ -65,6 +72,12 @@ pub struct Args {
     /// no authentication)
     #[arg(long, value_name = "ADDR", default_value = "127.0.0.1")]
     pub host: IpAddr,
+
+    /// Another name the page is reached by (Host), answered besides the address's own: NAME at
+    /// --port, or NAME:PORT as given (a proxy's port); repeat for more. Needed with --host
+    /// 0.0.0.0
+    #[arg(long = "allow-host", value_name = "NAME")]
+    pub allow_host: Vec<String>,
 
     /// Pages served at once, each a session of its own; one more is refused in one line
     #[arg(long, value_name = "N", default_value_t = 4)]
@@ -119,6 +132,7 @@ pub fn run(args: Args) -> Result<()> {
             address: SocketAddr::new(args.host, args.port),
             max_sessions: args.max_sessions,
             results: args.results.clone(),
+            allowed_hosts: args.allow_host.clone(),
         },
     )?;
     let url = viewer.url();

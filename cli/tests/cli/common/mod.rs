@@ -4,7 +4,8 @@
 pub mod maps;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// A file in the repository's `testdata/`.
 pub fn testdata(name: &str) -> PathBuf {
@@ -67,6 +68,34 @@ pub fn fails_cleanly(args: &[&str], needles: &[&str]) -> String {
 /// after `error:`).
 pub fn usage_error_in(dir: Option<&Path>, args: &[&str], needles: &[&str]) -> String {
     failure(run_in(dir, args), args, 2, "error: ", needles)
+}
+
+/// [`fails_cleanly`] of a command that serves when it does not fail (`relight view`): killed,
+/// and the test failed, when it still runs after `limit`.
+pub fn fails_cleanly_within(limit: Duration, args: &[&str], needles: &[&str]) -> String {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_haarshift"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let start = Instant::now();
+    while child
+        .try_wait()
+        .expect("the binary is waited for")
+        .is_none()
+    {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{args:?} still runs after {limit:?}: it should have failed");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child
+        .wait_with_output()
+        .expect("the binary's output is read");
+    failure(out, args, 1, "haarshift: ", needles)
 }
 
 /// [`usage_error_in`] in the current directory.
