@@ -70,3 +70,10 @@ pub(crate) fn sphere_grid(intervals: usize, phis: usize) -> Vec<([f64; 3], f64)>
     }
     out
 }
+
+/// The bits of a mesh's positions and of its normals, to compare meshes exactly (`==` on
+/// floats holds 0.0 and -0.0 equal; a hash does not).
+pub(crate) fn mesh_bits(mesh: &crate::relight::Mesh) -> (Vec<u64>, Vec<u64>) {
+    let bits = |a: ndarray::ArrayView2<'_, f64>| a.iter().map(|x| x.to_bits()).collect();
+    (bits(mesh.positions()), bits(mesh.normals()))
+}
