@@ -71,9 +71,21 @@ pub(crate) fn sphere_grid(intervals: usize, phis: usize) -> Vec<([f64; 3], f64)>
     out
 }
 
-/// The bits of a mesh's positions and of its normals, to compare meshes exactly (`==` on
-/// floats holds 0.0 and -0.0 equal; a hash does not).
-pub(crate) fn mesh_bits(mesh: &crate::relight::Mesh) -> (Vec<u64>, Vec<u64>) {
-    let bits = |a: ndarray::ArrayView2<'_, f64>| a.iter().map(|x| x.to_bits()).collect();
-    (bits(mesh.positions()), bits(mesh.normals()))
+/// How many position and how many normal components of two meshes differ in their bits (all
+/// of them when the vertex counts differ): meshes compared exactly, as a hash compares them
+/// (`==` on floats holds 0.0 and -0.0 equal), and a failure that says how far apart they are.
+pub(crate) fn differing_bits(a: &crate::relight::Mesh, b: &crate::relight::Mesh) -> (usize, usize) {
+    let count = |x: ndarray::ArrayView2<'_, f64>, y: ndarray::ArrayView2<'_, f64>| {
+        if x.dim() != y.dim() {
+            return x.len().max(y.len());
+        }
+        x.iter()
+            .zip(y)
+            .filter(|(p, q)| p.to_bits() != q.to_bits())
+            .count()
+    };
+    (
+        count(a.positions(), b.positions()),
+        count(a.normals(), b.normals()),
+    )
 }
