@@ -364,8 +364,8 @@ fn stored_normals_are_kept_bit_for_bit_where_normalising_them_again_is_not() {
 
 #[test]
 fn file_normals_of_any_magnitude_become_unit_and_store() {
-    // Squared lengths below f64's normal range (1e-320 is subnormal, its square root off in
-    // the fourth digit) and above it (1e400 overflows, and n / inf was zero).
+    // Squared lengths below f64's normal range (1e-320 is subnormal: normalised plainly, the
+    // first came out of length 1.0000056) and above it (1e400 overflows, and n / inf was zero).
     let given = array![
         [1e-160, 0.0, 0.0],
         [3e-170, 4e-170, 0.0],
