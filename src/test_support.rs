@@ -70,3 +70,22 @@ pub(crate) fn sphere_grid(intervals: usize, phis: usize) -> Vec<([f64; 3], f64)>
     }
     out
 }
+
+/// How many position and how many normal components of two meshes differ in their bits (all
+/// of them when the vertex counts differ): meshes compared exactly, as a hash compares them
+/// (`==` on floats holds 0.0 and -0.0 equal), and a failure that says how far apart they are.
+pub(crate) fn differing_bits(a: &crate::relight::Mesh, b: &crate::relight::Mesh) -> (usize, usize) {
+    let count = |x: ndarray::ArrayView2<'_, f64>, y: ndarray::ArrayView2<'_, f64>| {
+        if x.dim() != y.dim() {
+            return x.len().max(y.len());
+        }
+        x.iter()
+            .zip(y)
+            .filter(|(p, q)| p.to_bits() != q.to_bits())
+            .count()
+    };
+    (
+        count(a.positions(), b.positions()),
+        count(a.normals(), b.normals()),
+    )
+}

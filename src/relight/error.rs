@@ -39,6 +39,14 @@ pub enum SceneError {
         /// The offending component.
         value: f64,
     },
+    /// A stored vertex normal (a scene cache's) is neither unit nor zero, which no mesh's is.
+    #[error("vertex {vertex} has a normal of length {length}, neither 1 nor 0")]
+    NotUnitNormal {
+        /// The vertex, 0-based.
+        vertex: usize,
+        /// The normal's length.
+        length: f64,
+    },
     /// A coordinate is not finite or farther from the origin than
     /// [`MAX_COORDINATE`](super::validate::MAX_COORDINATE) (what the BVH's f32 boxes can hold).
     #[error(

@@ -2,8 +2,9 @@
 //! runs, as written, in a copy of the repository's files (with `results/` as committed), twice,
 //! succeeds both times, prints its table and leaves `results/` alone; and every `haarshift`
 //! line of its other `sh` blocks runs in order from the root of a copy and succeeds (the few
-//! that take minutes as written at the smaller sizes of [`SMALLER`]); `relight view`, a server,
-//! on a free port until it serves its page.
+//! that take minutes as written at the smaller sizes of [`SMALLER`]), and every `cmp A B` line
+//! among them finds the two files it names equal, byte for byte; `relight view`, a server, on a
+//! free port until it serves its page.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -139,9 +140,18 @@ const SMALLER: &[(&str, &str)] = &[
 /// sampling, 29,720 points a shape by default), so that each scene command takes seconds.
 const SPARSER_FIELDS: &[&str] = &["--circles", "10", "--circle-points", "20", "--shells", "4"];
 
-/// The arguments of every `haarshift` line in the README's `sh` blocks after the first, in
-/// order, without trailing `# comments`.
-fn later_commands(readme: &str) -> Vec<Vec<String>> {
+/// A line of the README's later `sh` blocks that the test runs.
+#[derive(Debug, PartialEq)]
+enum Step {
+    /// A `haarshift` command: its arguments.
+    Haarshift(Vec<String>),
+    /// `cmp A B`: two files the commands before it wrote, which must be equal.
+    Cmp(String, String),
+}
+
+/// Every `haarshift` and `cmp` line in the README's `sh` blocks after the first, in order,
+/// without trailing `# comments`.
+fn later_steps(readme: &str) -> Vec<Step> {
     readme
         .split("```")
         .skip(1)
@@ -149,10 +159,18 @@ fn later_commands(readme: &str) -> Vec<Vec<String>> {
         .skip(1)
         .filter_map(|block| block.strip_prefix("sh\n"))
         .flat_map(str::lines)
-        .filter_map(|line| line.trim().strip_prefix("haarshift "))
-        .map(|line| {
+        .filter_map(|line| {
+            let line = line.trim();
             let command = line.split(" #").next().unwrap_or(line);
-            command.split_whitespace().map(str::to_owned).collect()
+            let (program, rest) = command.split_once(' ')?;
+            let words: Vec<String> = rest.split_whitespace().map(str::to_owned).collect();
+            match (program, words.as_slice()) {
+                ("haarshift", _) => Some(Step::Haarshift(words)),
+                ("cmp", [a, b]) => Some(Step::Cmp(a.clone(), b.clone())),
+                // A comparison the test would otherwise skip without a word.
+                ("cmp", _) => panic!("`{command}`: the test compares two files, no options"),
+                _ => None,
+            }
         })
         .collect()
 }
@@ -180,27 +198,32 @@ fn smaller(args: &[String]) -> Vec<String> {
 }
 
 #[test]
-fn later_blocks_parse_into_haarshift_commands_at_smaller_sizes() {
+fn later_blocks_parse_into_haarshift_commands_at_smaller_sizes_and_comparisons() {
     let readme = "```sh\ncargo run --release -p haarshift-cli -- first\n```\n\
                   ```text\nhaarshift not-a-command\n```\n\
                   ```sh\nhaarshift rotate a.png -o b.png   # a comment\n\
-                  haarshift relight scene s.json --resolution 64 -o s.png\n```\n";
-    let commands = later_commands(readme);
+                  haarshift relight scene s.json --resolution 64 -o s.png\n\
+                  cmp s.png b.png   # byte for byte\nbash other.sh\n```\n";
+    let words = |w: &[&str]| w.iter().map(|s| (*s).to_owned()).collect::<Vec<_>>();
+    let rotate = words(&["rotate", "a.png", "-o", "b.png"]);
+    let scene = [
+        "relight",
+        "scene",
+        "s.json",
+        "--resolution",
+        "64",
+        "-o",
+        "s.png",
+    ];
     assert_eq!(
-        commands,
+        later_steps(readme),
         vec![
-            vec!["rotate", "a.png", "-o", "b.png"],
-            vec![
-                "relight",
-                "scene",
-                "s.json",
-                "--resolution",
-                "64",
-                "-o",
-                "s.png"
-            ],
+            Step::Haarshift(rotate.clone()),
+            Step::Haarshift(words(&scene)),
+            Step::Cmp("s.png".into(), "b.png".into()),
         ]
     );
+    let commands = [rotate, words(&scene)];
     assert_eq!(smaller(&commands[0]), commands[0]);
     let mut expected: Vec<&str> = vec!["relight", "scene", "s.json", "--resolution", "16"];
     expected.extend(["-o", "s.png"]);
@@ -211,18 +234,27 @@ fn later_blocks_parse_into_haarshift_commands_at_smaller_sizes() {
 #[test]
 fn every_later_readme_command_runs_from_the_root_of_a_fresh_copy() {
     let readme = std::fs::read_to_string(repository().join("README.md")).unwrap();
-    let commands = later_commands(&readme);
+    let steps = later_steps(&readme);
+    let compared = steps.iter().filter(|s| matches!(s, Step::Cmp(..))).count();
     assert!(
-        commands.len() >= 20,
-        "the README's sh blocks hold {} haarshift commands",
-        commands.len()
+        steps.len() - compared >= 20 && compared >= 1,
+        "the README's sh blocks hold {} haarshift commands and {compared} comparisons",
+        steps.len() - compared
     );
     let work = tempfile::tempdir().unwrap();
     let clone = work.path().join("haarshift");
     for dir in ["testdata", "results"] {
         copy_tree(&repository().join(dir), &clone.join(dir));
     }
-    for args in commands.iter().map(|args| smaller(args)) {
+    for step in &steps {
+        let args = match step {
+            Step::Haarshift(args) => smaller(args),
+            Step::Cmp(a, b) => {
+                let read = |name: &str| std::fs::read(clone.join(name)).unwrap();
+                assert!(read(a) == read(b), "`cmp {a} {b}`: the files differ");
+                continue;
+            }
+        };
         if args.starts_with(&["relight".to_owned(), "view".to_owned()]) {
             serves_its_page(&args, &clone);
             continue;

@@ -1,12 +1,13 @@
 //! `haarshift relight precompute --shard` and `relight merge`: shards run as separate
-//! processes merge into the unsharded cache byte for byte, `--shard auto` reads Slurm's and
+//! processes merge into the unsharded cache byte for byte (of a scene file of generators, and
+//! of mesh files and a scene file naming one), `--shard auto` reads Slurm's and
 //! Kubernetes' variables, a complete shard is skipped, and every bad set of shards is refused
 //! with one line naming the file.
 
 use std::path::{Path, PathBuf};
 
 use crate::common::{
-    fails_cleanly, fails_cleanly_scheduled, p, run_scheduled, succeeds_with_stdout, text,
+    fails_cleanly, fails_cleanly_scheduled, p, run_scheduled, succeeds_with_stdout, testdata, text,
 };
 
 /// A sphere resting on the ground plane (96 + 1089 = 1185 vertices): the ground's shadow
@@ -105,6 +106,63 @@ fn one_three_and_seven_shards_merge_into_the_unsharded_cache_byte_for_byte() {
             args.push(p(&png));
             fails_cleanly(&args, &["is shard 6/7 of a scene cache", "relight merge"]);
         }
+    }
+}
+
+#[test]
+fn mesh_files_scene_files_and_generators_merge_byte_for_byte() {
+    // Each input's normals are normalised once (computed, read from a file or moved by a
+    // transform), in ways that a second normalisation of the shard read back moved by a
+    // unit in the last place: the merge must keep the bits the shards were written with.
+    let dir = tempfile::tempdir().unwrap();
+    let (ply, obj) = (testdata("meshes/bunny.ply"), testdata("meshes/bunny.obj"));
+    let named = dir.path().join("named.json");
+    let object = serde_json::json!({
+        "mesh": ply,
+        "transform": {"scale": 0.5, "yaw": 30, "translate": [0, 0.2, 0]},
+    });
+    let scene = serde_json::json!({"objects": [object], "ground_plane": true});
+    std::fs::write(&named, scene.to_string()).unwrap();
+    let generated = dir.path().join("generated.json");
+    std::fs::write(
+        &generated,
+        r#"{"objects": [{"generator": {"cylinder_and_bump": {"cells": 8}}},
+                        {"generator": {"sphere": {"cells": 3}},
+                         "transform": {"translate": [2, 1, 0], "yaw": 30, "pitch": 10}}]}"#,
+    )
+    .unwrap();
+    let inputs: [(&Path, &[&str], usize); 5] = [
+        (&ply, &[], 1839),
+        (&ply, &["--ground-plane"], 1839 + 1089),
+        (&obj, &[], 1839),
+        (&named, &[], 1839 + 1089),
+        (&generated, &[], 1475),
+    ];
+    for (k, (input, extra, vertices)) in inputs.into_iter().enumerate() {
+        let what = format!("{} {extra:?}", input.display());
+        let sub = dir.path().join(k.to_string());
+        std::fs::create_dir(&sub).unwrap();
+        let whole = sub.join("whole.hsr");
+        precompute(input, &whole, extra);
+        let parts: Vec<_> = ["1/2", "0/2"]
+            .iter()
+            .map(|shard| {
+                let out = sub.join(format!("part-{}.hsr", &shard[..1]));
+                precompute(input, &out, &[extra, &["--shard", shard]].concat());
+                out
+            })
+            .collect();
+        let merged = sub.join("merged.hsr");
+        let stdout = merge(&parts, &merged);
+        let counted = format!("2 shards merged, {vertices} vertices");
+        assert!(stdout.contains(&counted), "{what}: {stdout}");
+        assert!(
+            std::fs::read(&merged).unwrap() == std::fs::read(&whole).unwrap(),
+            "{what}: the merged cache is not the unsharded one"
+        );
+        // A shard read back is its scene's, so a rerun skips it.
+        let again = precompute(input, &parts[1], &[extra, &["--shard", "0/2"]].concat());
+        assert!(again.ends_with("is complete: skipped\n"), "{what}: {again}");
     }
 }
 

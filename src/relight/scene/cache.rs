@@ -32,8 +32,10 @@
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
 //! cache"), the version (another version is refused, never guessed at), the checksum (a
-//! flipped byte or a truncated file), the header and the sizes it announces, and, with
-//! [`SceneCache::read_for`], the scene: the mesh must hash to the same [`scene_hash`].
+//! flipped byte or a truncated file), the header and the sizes it announces, the mesh (as
+//! [`Mesh::new`] checks it, its normals unit or zero and kept bit for bit, so that the mesh
+//! read back hashes as the one written), and, with [`SceneCache::read_for`], the scene: the
+//! mesh must hash to the same [`scene_hash`].
 //! Files are written atomically ([`crate::io::write_file_atomically`]).
 
 use std::path::Path;
@@ -447,7 +449,8 @@ fn parse_parts(header: CacheHeader, mut r: Reader<'_>) -> Result<(CacheHeader, P
         None => None,
     };
     r.finish("transport")?;
-    let mesh = Mesh::new(positions, triangles, Some(normals))?;
+    // The normals as written, not normalised again: see `Mesh::stored`.
+    let mesh = Mesh::stored(positions, triangles, normals)?;
     let kind: ParamKind = header.params.param.parse()?;
     let param = Parameterization::new(kind, header.params.resolution)?;
     let transport = TransportSet::from_parts(

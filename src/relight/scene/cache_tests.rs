@@ -276,3 +276,54 @@ fn version_1_2_and_3_files_are_refused() {
         );
     }
 }
+
+#[test]
+fn a_cache_of_any_scene_reads_back_its_mesh_bit_for_bit() {
+    use crate::relight::precompute::{PrecomputeOptions, precompute};
+    use crate::test_support::differing_bits;
+    let testdata = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata");
+    let mesh_file = |name: &str, ground_plane: bool| {
+        let mesh = Mesh::load(&testdata.join("meshes").join(name)).unwrap();
+        Scene::from_mesh(mesh, ground_plane).unwrap()
+    };
+    let scene_file = |name: &str| Scene::load(&testdata.join("scenes").join(name)).unwrap();
+    // Mesh files (normals computed, then normalised), with and without the ground plane; a
+    // scene file naming a mesh; generators moved by transforms (normals mapped, then
+    // normalised). Every one had normals that a second normalisation moves.
+    let scenes = [
+        ("bunny.ply", mesh_file("bunny.ply", false)),
+        (
+            "bunny.ply with the ground plane",
+            mesh_file("bunny.ply", true),
+        ),
+        ("bunny.obj", mesh_file("bunny.obj", false)),
+        ("bunny.json", scene_file("bunny.json")),
+        (
+            "cylinder_and_bump.json",
+            scene_file("cylinder_and_bump.json"),
+        ),
+        ("sphere_on_plane.json", scene_file("sphere_on_plane.json")),
+    ];
+    let param = Parameterization::new(ParamKind::LatLong, 4).unwrap();
+    let options = PrecomputeOptions::new(VisibilityOptions::new(param));
+    for (name, scene) in scenes {
+        let (cache, _) = precompute(scene, &options).unwrap();
+        let (_dir, path) = written(&cache);
+        let (header, parts) = read_parts(&path).unwrap();
+        let differing = differing_bits(&parts.mesh, &cache.mesh);
+        assert_eq!(
+            differing,
+            (0, 0),
+            "{name}: position and normal components moved"
+        );
+        assert_eq!(parts.mesh.triangles(), cache.mesh.triangles(), "{name}");
+        let hash = scene_hash(&cache.mesh);
+        assert_eq!(
+            (header.scene_hash, scene_hash(&parts.mesh)),
+            (hash, hash),
+            "{name}"
+        );
+        // So the cache is found to be its scene's.
+        assert!(SceneCache::read_for(&path, &cache.mesh).is_ok(), "{name}");
+    }
+}

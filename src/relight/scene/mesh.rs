@@ -15,7 +15,8 @@
 //! replaced by the computed one), else the area-weighted mean of the incident triangles'
 //! normals: the normalised sum of the unnormalised cross products `(b - a) x (c - a)`, which
 //! weighs each triangle by twice its area. Triangles are wound counter-clockwise seen from
-//! outside.
+//! outside. A mesh read back from a scene cache keeps the normals it was written with, bit for
+//! bit (checked unit or zero, not normalised again), so that it hashes as it did.
 //!
 //! **What is refused and what works.** A mesh with no triangles, a triangle naming a vertex that
 //! does not exist, a NaN or infinite coordinate, or a file that is truncated or cannot be
@@ -90,43 +91,17 @@ impl Mesh {
         triangles: Vec<[u32; 3]>,
         normals: Option<Array2<f64>>,
     ) -> Result<Self> {
-        if positions.ncols() != 3 {
-            return Err(Error::shape(positions.shape(), "positions must be (V, 3)"));
-        }
-        if triangles.is_empty() {
-            return Err(SceneError::NoFaces.into());
-        }
-        let vertices = positions.nrows();
-        for (triangle, t) in triangles.iter().enumerate() {
-            if let Some(&index) = t.iter().find(|&&i| i as usize >= vertices) {
-                return Err(SceneError::IndexOutOfRange {
-                    triangle,
-                    index: index.into(),
-                    vertices,
-                }
-                .into());
-            }
-        }
-        check_finite(positions.view(), "position")?;
-        super::validate::check_positions(positions.view())?;
+        check_geometry(positions.view(), &triangles)?;
         let computed = area_weighted_normals(positions.view(), &triangles);
         let normals = match normals {
             None => computed,
             Some(given) => {
-                if given.dim() != positions.dim() {
-                    return Err(Error::shape(
-                        given.shape(),
-                        format!("normals must be ({vertices}, 3), one per vertex"),
-                    ));
-                }
-                check_finite(given.view(), "normal")?;
+                check_normals(given.view(), positions.nrows())?;
                 let mut given = given.as_standard_layout().into_owned();
                 for (mut n, fallback) in given.outer_iter_mut().zip(computed.outer_iter()) {
-                    let len = n.dot(&n).sqrt();
-                    if len > 0.0 {
-                        n /= len;
-                    } else {
-                        n.assign(&fallback);
+                    match unit([n[0], n[1], n[2]]) {
+                        Some(u) => n.assign(&ndarray::arr1(&u)),
+                        None => n.assign(&fallback),
                     }
                 }
                 given
@@ -135,6 +110,39 @@ impl Mesh {
         Ok(Mesh {
             positions: positions.as_standard_layout().into_owned(),
             normals,
+            triangles,
+        })
+    }
+
+    /// A mesh as a scene cache stores it: the checks of [`Mesh::new`], and every normal unit
+    /// (its squared length within [`UNIT_TOLERANCE`] of 1) or zero, as every mesh's are, and
+    /// kept bit for bit. Not [`Mesh::new`]: normalising is not idempotent in floating point
+    /// (`n / |n|` of a unit `n` may move its last bit), so normalising again would give the
+    /// mesh read back another [`scene_hash`](crate::relight::scene_hash) than the one written,
+    /// and a merge of shards other bytes than the unsharded cache. Keeping the stored bits is
+    /// exact by construction, where an idempotent normalisation would change every cache's
+    /// normals and still need this check.
+    pub(crate) fn stored(
+        positions: Array2<f64>,
+        triangles: Vec<[u32; 3]>,
+        normals: Array2<f64>,
+    ) -> Result<Self> {
+        check_geometry(positions.view(), &triangles)?;
+        check_normals(normals.view(), positions.nrows())?;
+        for (vertex, n) in normals.outer_iter().enumerate() {
+            let n = [n[0], n[1], n[2]];
+            let squared = dot(n, n);
+            if n != [0.0; 3] && (squared - 1.0).abs() > UNIT_TOLERANCE {
+                return Err(SceneError::NotUnitNormal {
+                    vertex,
+                    length: squared.sqrt(),
+                }
+                .into());
+            }
+        }
+        Ok(Mesh {
+            positions: positions.as_standard_layout().into_owned(),
+            normals: normals.as_standard_layout().into_owned(),
             triangles,
         })
     }
@@ -229,13 +237,12 @@ impl Mesh {
         position: impl Fn([f64; 3]) -> [f64; 3],
         normal: impl Fn([f64; 3]) -> [f64; 3],
     ) -> Result<Mesh> {
-        let map = |a: &Array2<f64>, f: &dyn Fn([f64; 3]) -> [f64; 3], unit: bool| {
+        let map = |a: &Array2<f64>, f: &dyn Fn([f64; 3]) -> [f64; 3], normals: bool| {
             let mut out = a.clone();
             for mut row in out.outer_iter_mut() {
                 let mut p = f([row[0], row[1], row[2]]);
-                let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-                if unit && len > 0.0 {
-                    p = p.map(|x| x / len);
+                if normals {
+                    p = unit(p).unwrap_or(p);
                 }
                 row.assign(&ndarray::arr1(&p));
             }
@@ -249,6 +256,41 @@ impl Mesh {
             triangles: self.triangles.clone(),
         })
     }
+}
+
+/// The checks of every mesh's positions and triangles: positions `(V, 3)`, finite and in
+/// range, at least one triangle, and every index below `V`.
+fn check_geometry(positions: ArrayView2<'_, f64>, triangles: &[[u32; 3]]) -> Result<()> {
+    if positions.ncols() != 3 {
+        return Err(Error::shape(positions.shape(), "positions must be (V, 3)"));
+    }
+    if triangles.is_empty() {
+        return Err(SceneError::NoFaces.into());
+    }
+    let vertices = positions.nrows();
+    for (triangle, t) in triangles.iter().enumerate() {
+        if let Some(&index) = t.iter().find(|&&i| i as usize >= vertices) {
+            return Err(SceneError::IndexOutOfRange {
+                triangle,
+                index: index.into(),
+                vertices,
+            }
+            .into());
+        }
+    }
+    check_finite(positions, "position")?;
+    super::validate::check_positions(positions)
+}
+
+/// Checks that normals given for `vertices` vertices are `(V, 3)` and finite.
+fn check_normals(normals: ArrayView2<'_, f64>, vertices: usize) -> Result<()> {
+    if normals.dim() != (vertices, 3) {
+        return Err(Error::shape(
+            normals.shape(),
+            format!("normals must be ({vertices}, 3), one per vertex"),
+        ));
+    }
+    check_finite(normals, "normal")
 }
 
 /// The first non-finite entry of a `(V, 3)` array as an error.
@@ -284,12 +326,36 @@ fn area_weighted_normals(positions: ArrayView2<'_, f64>, triangles: &[[u32; 3]])
         }
     }
     for mut row in sum.outer_iter_mut() {
-        let len = row.dot(&row).sqrt();
-        if len > 0.0 {
-            row /= len;
+        if let Some(u) = unit([row[0], row[1], row[2]]) {
+            row.assign(&ndarray::arr1(&u));
         }
     }
     sum
+}
+
+/// How far from 1 the squared length of a stored normal may be ([`Mesh::stored`]): [`unit`]
+/// leaves a few units in the last place (`~1e-16`); a normal that was never normalised, or
+/// damaged, is off by far more.
+const UNIT_TOLERANCE: f64 = 1e-12;
+
+/// `n / |n|`, or `None` for the zero vector: the one normalisation of every mesh's normals.
+/// A vector whose squared length leaves f64's normal range (components below about 1e-154
+/// or above 1e154) is first divided by its largest component, so that the result is unit to
+/// a few ulps whatever the magnitude (what [`Mesh::stored`] checks); any other vector gets
+/// plainly `n / |n|`.
+fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
+    let squared = dot(n, n);
+    let n = if squared.is_normal() && squared.is_finite() {
+        n
+    } else {
+        let largest = n.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        if largest == 0.0 {
+            return None;
+        }
+        n.map(|x| x / largest)
+    };
+    let len = dot(n, n).sqrt();
+    Some(n.map(|x| x / len))
 }
 
 pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
