@@ -251,12 +251,12 @@ fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
 }
 
 #[test]
-fn version_1_2_and_3_files_are_refused() {
+fn version_1_to_4_files_are_refused() {
     // Version 1 had no spherical-harmonic transfer, version 2 no shard record, version 3 no
-    // aligned arrays: their files must be remade, not misread.
+    // aligned arrays, version 4 no ray tracer: their files must be remade, not misread.
     let (_dir, path) = written(&made(2));
     let good = std::fs::read(&path).unwrap();
-    for old in [1u32, 2, 3] {
+    for old in [1u32, 2, 3, 4] {
         let mut bytes = good.clone();
         bytes[8..12].copy_from_slice(&old.to_le_bytes());
         std::fs::write(&path, &bytes).unwrap();
@@ -265,13 +265,13 @@ fn version_1_2_and_3_files_are_refused() {
             e,
             SceneError::CacheVersion {
                 found: old,
-                expected: 4
+                expected: 5
             }
         );
         assert_eq!(
             e.to_string(),
             format!(
-                "scene cache has format version {old}, this build reads version 4; compute it again"
+                "scene cache has format version {old}, this build reads version 5; compute it again"
             )
         );
     }
