@@ -1,8 +1,10 @@
 //! Images of per-vertex radiance: a perspective [`camera`], the software rasteriser
 //! ([`raster`]: z-buffer, perspective-correct interpolation; [`sky`]: the environment behind), exposure,
-//! sRGB and files ([`output`]), and animated GIFs ([`animation`]).
+//! sRGB and files ([`output`]), animated GIFs ([`animation`]), and the radiance baked into a
+//! glTF 2.0 mesh ([`baked`]).
 
 pub mod animation;
+pub mod baked;
 pub mod camera;
 pub mod output;
 pub mod raster;

@@ -7,6 +7,7 @@ use clap::Subcommand;
 use haarshift::Result;
 
 pub mod animate;
+pub mod bake;
 pub mod error;
 pub(crate) mod flags;
 pub mod gallery;
@@ -17,7 +18,7 @@ pub mod render;
 pub mod scene;
 pub mod view;
 
-/// Relight meshes under environment maps: precompute (whole or in shards, merged by merge), render, reference, animate, gallery,
+/// Relight meshes under environment maps: precompute (whole or in shards, merged by merge), render, bake (glTF out), reference, animate, gallery,
 /// dynamic scenes of moving objects (scene), the error of renders against a reference, and the
 /// interactive viewer in the browser (view).
 #[derive(Subcommand, Debug)]
@@ -25,6 +26,7 @@ pub enum RelightCommand {
     Precompute(Box<precompute::Args>),
     Merge(Box<merge::Args>),
     Render(Box<render::Args>),
+    Bake(Box<bake::Args>),
     Reference(Box<reference::Args>),
     Animate(Box<animate::Args>),
     Gallery(Box<gallery::Args>),
@@ -38,6 +40,7 @@ pub fn run(command: RelightCommand) -> Result<()> {
         RelightCommand::Precompute(args) => precompute::run(*args),
         RelightCommand::Merge(args) => merge::run(*args),
         RelightCommand::Render(args) => render::run(*args),
+        RelightCommand::Bake(args) => bake::run(*args),
         RelightCommand::Reference(args) => reference::run(*args),
         RelightCommand::Animate(args) => animate::run(*args),
         RelightCommand::Gallery(args) => gallery::run(*args),
