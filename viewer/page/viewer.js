@@ -3,7 +3,7 @@
 // described in viewer/src/protocol.rs.
 'use strict';
 
-const PACKET = { scene: 1, environment: 2, frame: 3, reference: 4, picture: 5, positions: 6 };
+const PACKET = { scene: 1, environment: 2, frame: 3, reference: 4, picture: 5, positions: 6, glb: 7 };
 const $ = (id) => document.getElementById(id);
 
 // Everything tests and the frame-rate script read over the DevTools protocol.
@@ -111,6 +111,8 @@ function packet(buffer) {
     viewer.positionsReceived += 1;
   } else if (kind === PACKET.picture) {
     download(new Blob([new Uint8Array(buffer, start)], { type: 'image/x-exr' }), 'haarshift-view.exr');
+  } else if (kind === PACKET.glb) {
+    download(new Blob([new Uint8Array(buffer, start)], { type: 'model/gltf-binary' }), 'haarshift-view.glb');
   } else if (kind === PACKET.reference) {
     viewer.reference = { header, radiance: new Float32Array(buffer, start) };
     referenceStatus = `reference ready (${header.seconds.toFixed(1)} s)`;
@@ -502,6 +504,9 @@ function setupControls(scene) {
   };
   // The linear radiance, drawn by the server's rasteriser from the last frame.
   $('exr').onclick = () => socket.send(JSON.stringify({ type: 'picture', look_at: orbit.target, fov: orbit.fov, width: canvas.width, height: canvas.height }));
+  // The mesh with the last frame's radiance as glTF colours (relight bake's file), at the
+  // page's exposure.
+  $('glb').onclick = () => socket.send(JSON.stringify({ type: 'glb', exposure }));
 }
 
 // A dynamic scene: its objects are dragged (the one chosen) and its motion path played; the

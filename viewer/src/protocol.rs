@@ -46,6 +46,35 @@ pub enum Request {
     State(Box<ViewState>),
     /// The last frame drawn as a linear OpenEXR picture, by `relight render`'s rasteriser.
     Picture(PictureRequest),
+    /// The last frame's radiance baked into binary glTF, as `relight bake` writes it.
+    Glb(GlbRequest),
+}
+
+/// The baked glTF of the last frame: its colours `clamp(2^exposure x radiance, 0, 1)`, as
+/// `relight bake --exposure` makes them (the page's exposure slider).
+///
+/// ```
+/// use haarshift_viewer::protocol::{GlbRequest, Request};
+/// let r: Request = serde_json::from_str(r#"{"type": "glb", "exposure": 1.5}"#).unwrap();
+/// assert_eq!(r, Request::Glb(GlbRequest { exposure: 1.5 }));
+/// assert!(GlbRequest { exposure: 1e9 }.check().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GlbRequest {
+    /// Stops.
+    pub exposure: f64,
+}
+
+impl GlbRequest {
+    /// Refuses an exposure `relight bake` would refuse.
+    pub fn check(&self) -> Result<()> {
+        haarshift::render::baked::BakeInfo {
+            exposure: self.exposure,
+            ..Default::default()
+        }
+        .check()
+    }
 }
 
 /// The largest picture side, in pixels.
@@ -275,6 +304,8 @@ pub enum PacketKind {
     /// A dynamic scene's mesh as the next frame places its objects: header the vertex count,
     /// payload positions `(V, 3)` f32 (the triangles stay the scene packet's).
     Positions = 6,
+    /// A baked glTF of the last frame: header its size, payload a `.glb` file.
+    Glb = 7,
 }
 
 /// The bytes of one binary message of `kind`: its JSON `header`, then `payload` aligned to 4

@@ -24,6 +24,7 @@ use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{
     FrameSpec, Method, ShadeOptions, Shader, ShaderSpec, Shading, ShadingInput,
 };
+use haarshift::render::baked::{BakeInfo, GltfContainer, baked_gltf};
 use haarshift::render::output::write_render;
 use haarshift::render::view::{Backdrop, ViewSpec};
 use haarshift::sphere::SphereRotation;
@@ -31,7 +32,7 @@ use haarshift::{Error, Result};
 
 use crate::progress::{Counter, watch};
 use crate::protocol::{
-    Notice, PacketKind, PictureRequest, Request, SampleFormat, ViewState, packet, sample_bytes,
+    GlbRequest, Notice, PacketKind, PictureRequest, Request, SampleFormat, ViewState, packet, sample_bytes,
 };
 use crate::scene::{Source, ViewedScene, positions_bytes};
 
@@ -126,6 +127,7 @@ impl Session {
                         continue;
                     }
                     Ok(Request::Picture(picture)) => vec![self.picture(&picture)],
+                    Ok(Request::Glb(glb)) => vec![self.glb(&glb)],
                     Err(e) => vec![notice(&Notice::Error {
                         message: e.to_string(),
                     })],
@@ -162,6 +164,7 @@ impl Session {
         match &request {
             Request::State(state) => state.check()?,
             Request::Picture(picture) => picture.check()?,
+            Request::Glb(glb) => glb.check()?,
         }
         Ok(request)
     }
@@ -203,6 +206,47 @@ impl Session {
             packet(PacketKind::Picture, &header, &bytes)
         };
         match picture() {
+            Ok(packet) => Message::binary(packet),
+            Err(e) => notice(&Notice::Error {
+                message: e.to_string(),
+            }),
+        }
+    }
+
+    /// The last frame baked into binary glTF by the library's writer (`relight bake`'s), the
+    /// mesh as that frame placed it, or the reason there is none.
+    fn glb(&self, request: &GlbRequest) -> Message {
+        let glb = || -> Result<Vec<u8>> {
+            let ((radiance, _, _), state) = self
+                .last
+                .as_ref()
+                .zip(self.drawn.as_ref())
+                .ok_or_else(|| Error::parameter("glb", "no frame has been drawn yet"))?;
+            let mesh = match &self.placed {
+                Some(placed) => std::borrow::Cow::Owned(placed.scene.mesh()),
+                None => self.scene.mesh(),
+            };
+            let path_yaw = self.placed.as_ref().map_or(0.0, |p| p.path_yaw);
+            let info = BakeInfo {
+                exposure: request.exposure,
+                environment: self
+                    .scene
+                    .env_path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned()),
+                rotation_degrees: [state.yaw + path_yaw, state.pitch, state.roll],
+                shading: format!("relight view: {} {}", state.basis, state.brdf),
+                cache: self
+                    .scene
+                    .path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned()),
+            };
+            let bytes = baked_gltf(&mesh, radiance.view(), &info, GltfContainer::Glb)?;
+            let header = json!({ "bytes": bytes.len(), "format": "glb" });
+            packet(PacketKind::Glb, &header, &bytes)
+        };
+        match glb() {
             Ok(packet) => Message::binary(packet),
             Err(e) => notice(&Notice::Error {
                 message: e.to_string(),

@@ -6,6 +6,7 @@
 
 mod common;
 
+mod bake;
 mod compute_precision;
 mod deploy;
 mod experiment;

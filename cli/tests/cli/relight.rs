@@ -820,7 +820,14 @@ fn the_gallery_writes_its_images_table_and_turntable() {
 
 #[test]
 fn every_subcommand_has_an_example_in_its_help() {
-    for sub in ["precompute", "render", "reference", "animate", "gallery"] {
+    for sub in [
+        "precompute",
+        "render",
+        "bake",
+        "reference",
+        "animate",
+        "gallery",
+    ] {
         let help = succeeds_with_stdout(&["relight", sub, "--help"]);
         assert!(
             help.contains(&format!("haarshift relight {sub} ")),

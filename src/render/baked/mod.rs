@@ -50,7 +50,6 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::io::Write as _;
 use std::path::Path;
 
 use gltf_json as json;
