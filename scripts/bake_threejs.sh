@@ -33,8 +33,8 @@ strip() { sed "s|$work/||g" "$1"; }
     echo "\`bunny.glb\`; the Khronos glTF Validator's report of that file; the page"
     echo "\`tools/bake-threejs\` (three.js's GLTFLoader alone, no haarshift code) in headless"
     echo "Chromium: \`bake_threejs.png\`. Beside it \`bake_haarshift.png\`, \`relight render\` of the same"
-    echo "radiance over the page's background colour (#202020 is sRGB 32, linear 0.0144); three.js"
-    echo "frames the model with its own camera, so the two views differ slightly."
+    echo "radiance over the page's background colour (#202020 is sRGB 32, linear 0.0144), from the"
+    echo "same camera (the page frames the model as \`relight render\`'s default camera does)."
     echo
     echo '```'
     strip "$work/precompute.txt"

@@ -1,5 +1,7 @@
-// Shows one baked glTF: framed from 20 degrees above the horizon on the +Z side (as
-// `relight render`'s default camera), no lights (the material is unlit), no tone mapping.
+// Shows one baked glTF: framed as `relight render`'s default camera frames a scene
+// (haarshift's Camera::framing: the bounding sphere filling a 40-degree vertical field of
+// view, from 20 degrees above the horizon on the +Z side), no lights (the material is unlit),
+// no tone mapping.
 // `window.baked` reports what the loader made of the file once a frame is drawn.
 import * as THREE from "three";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";

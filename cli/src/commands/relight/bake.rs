@@ -52,7 +52,7 @@ pub struct Args {
     /// Rotations of the lighting about +Y, degrees, one file each: A or A,B,...
     /// [default: the scene file's]
     #[arg(long, value_name = "A,B,...", value_parser = yaws, allow_hyphen_values = true)]
-    pub yaw: Option<Vec<f64>>,
+    pub yaw: Option<Yaws>,
 
     /// Rotation of the lighting about +X, degrees [default: the scene file's]
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
@@ -101,8 +101,12 @@ pub struct Args {
     pub force: bool,
 }
 
+/// The angles of `--yaw`, degrees, none listed twice.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Yaws(pub Vec<f64>);
+
 /// `--yaw`: one or more finite angles, comma-separated.
-fn yaws(s: &str) -> std::result::Result<Vec<f64>, String> {
+fn yaws(s: &str) -> std::result::Result<Yaws, String> {
     let angles = s
         .split(',')
         .map(|part| match part.trim().parse::<f64>() {
@@ -117,7 +121,7 @@ fn yaws(s: &str) -> std::result::Result<Vec<f64>, String> {
             return Err(format!("{s:?}: yaw {a} is listed twice (one file each)"));
         }
     }
-    Ok(angles)
+    Ok(Yaws(angles))
 }
 
 /// The file of each yaw: `output` itself for one (or none), `STEM_yawA.EXT` for several.
@@ -164,7 +168,7 @@ fn file_name(path: &Path) -> Option<String> {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let files = output_paths(&args.output, args.yaw.as_deref());
+    let files = output_paths(&args.output, args.yaw.as_ref().map(|y| y.0.as_slice()));
     let outputs: Vec<&Path> = files.iter().map(|(_, p)| p.as_path()).collect();
     let mut inputs = vec![args.cache.as_path()];
     inputs.extend(args.env.as_deref());
