@@ -32,7 +32,8 @@ use haarshift::{Error, Result};
 
 use crate::progress::{Counter, watch};
 use crate::protocol::{
-    GlbRequest, Notice, PacketKind, PictureRequest, Request, SampleFormat, ViewState, packet, sample_bytes,
+    GlbRequest, Notice, PacketKind, PictureRequest, Request, SampleFormat, ViewState, packet,
+    sample_bytes,
 };
 use crate::scene::{Source, ViewedScene, positions_bytes};
 

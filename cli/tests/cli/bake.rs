@@ -74,7 +74,10 @@ fn each_yaw_s_file_holds_the_mesh_and_relight_render_s_radiance_bit_for_bit() {
     let mesh = SceneCache::read(&cache).unwrap().mesh;
     for (yaw, name) in [("0", "out_yaw0.glb"), ("-90.5", "out_yaw-90.5.glb")] {
         let path = dir.path().join(name);
-        assert!(stdout.contains(&format!("{}: ", path.display())), "{stdout}");
+        assert!(
+            stdout.contains(&format!("{}: ", path.display())),
+            "{stdout}"
+        );
         let baked = BakedGltf::read(&path).unwrap();
         let radiance = rendered(dir.path(), &cache, yaw, &[]);
         assert_eq!(baked.radiance, radiance, "{name}");
@@ -84,7 +87,10 @@ fn each_yaw_s_file_holds_the_mesh_and_relight_render_s_radiance_bit_for_bit() {
         assert_eq!(baked.normals, mesh.normals().mapv(|x| x as f32));
         assert_eq!(baked.triangles, mesh.triangles());
         let stated = &baked.extras["haarshift"];
-        assert_eq!(stated["rotation_degrees"]["yaw"], yaw.parse::<f64>().unwrap());
+        assert_eq!(
+            stated["rotation_degrees"]["yaw"],
+            yaw.parse::<f64>().unwrap()
+        );
         assert_eq!(stated["exposure_stops"], 1.0);
         assert_eq!(stated["environment"], "rooitou_park_32x16.hdr");
         assert_eq!(stated["cache"], "sphere.hsr");
@@ -118,9 +124,15 @@ fn bad_requests_are_refused_in_one_line_before_any_work() {
     }
     for empty in ["", ",", "10,,20", "nan"] {
         let args = with(&["--yaw", empty], &out);
-        usage_error(&run(&args), &["--yaw", "expected one or more finite angles"]);
+        usage_error(
+            &run(&args),
+            &["--yaw", "expected one or more finite angles"],
+        );
     }
-    usage_error(&run(&with(&["--yaw", "5,5"], &out)), &["yaw 5 is listed twice"]);
+    usage_error(
+        &run(&with(&["--yaw", "5,5"], &out)),
+        &["yaw 5 is listed twice"],
+    );
     // An existing output, the second of a list: refused before the first is written.
     let second = dir.path().join("b_yaw20.glb");
     std::fs::write(&second, b"keep").unwrap();
@@ -136,7 +148,10 @@ fn bad_requests_are_refused_in_one_line_before_any_work() {
     let missing = dir.path().join("no/such/folder/x.glb");
     fails_cleanly(&run(&with(&[], &missing)), &["x.glb", "output directory"]);
     let under_file = second.join("x.glb");
-    fails_cleanly(&run(&with(&[], &under_file)), &["x.glb", "output directory"]);
+    fails_cleanly(
+        &run(&with(&[], &under_file)),
+        &["x.glb", "output directory"],
+    );
     // Another container, an absurd exposure, an output that is the cache.
     let obj = dir.path().join("b.obj");
     fails_cleanly(&run(&with(&[], &obj)), &["b.obj", ".glb or .gltf"]);
@@ -195,7 +210,10 @@ fn the_khronos_validator_finds_nothing_to_say_about_any_file_baked() {
     let cache = small_cache(dir.path());
     let glb = dir.path().join("v.glb");
     let gltf = dir.path().join("v.gltf");
-    bake(&cache, &["--yaw", "0,120", "--exposure", "-1", "-o", p(&glb)]);
+    bake(
+        &cache,
+        &["--yaw", "0,120", "--exposure", "-1", "-o", p(&glb)],
+    );
     bake(&cache, &["-o", p(&gltf)]);
     let files: Vec<PathBuf> = ["v_yaw0.glb", "v_yaw120.glb", "v.gltf"]
         .map(|n| dir.path().join(n))
@@ -215,17 +233,21 @@ fn the_khronos_validator_finds_nothing_to_say_about_any_file_baked() {
     let broken = dir.path().join("broken.gltf");
     std::fs::write(&broken, serde_json::to_vec(&document).unwrap()).unwrap();
     let (passed, reports) = run_node(&node, &tool.join("validate.mjs"), &[p(&broken)]);
-    assert!(!passed && reports[0]["errors"].as_u64() > Some(0), "{reports:?}");
     assert!(
-        reports[0].to_string().contains("ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND"),
+        !passed && reports[0]["errors"].as_u64() > Some(0),
+        "{reports:?}"
+    );
+    assert!(
+        reports[0]
+            .to_string()
+            .contains("ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND"),
         "{reports:?}"
     );
 }
 
 #[test]
 fn three_js_alone_shows_the_baked_colours_in_headless_chromium() {
-    let Some((node, tool)) =
-        haarshift_testkit::needs("node", node_tool("bake-threejs", "three"))
+    let Some((node, tool)) = haarshift_testkit::needs("node", node_tool("bake-threejs", "three"))
     else {
         return;
     };
@@ -255,8 +277,21 @@ fn three_js_alone_shows_the_baked_colours_in_headless_chromium() {
     let ours = dir.path().join("ours.png");
     let env = env();
     succeeds(&[
-        "relight", "render", p(&cache), "--env", p(&env), "--exposure", "1", "--width", "160",
-        "--height", "120", "--background", "0.0072,0.0072,0.0072", "-o", p(&ours),
+        "relight",
+        "render",
+        p(&cache),
+        "--env",
+        p(&env),
+        "--exposure",
+        "1",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--background",
+        "0.0072,0.0072,0.0072",
+        "-o",
+        p(&ours),
     ]);
     let ours = image::open(&ours).unwrap().to_rgb8();
     let background = shot.pixels().filter(|px| px.0 == [32, 32, 32]).count();
@@ -307,6 +342,9 @@ fn the_viewer_s_save_glb_is_the_last_frame_baked_as_relight_bake_bakes_it() {
         (&saved.positions, &saved.normals, &saved.triangles),
         (&baked.positions, &baked.normals, &baked.triangles)
     );
-    assert_eq!((&saved.colours, &saved.radiance), (&baked.colours, &baked.radiance));
+    assert_eq!(
+        (&saved.colours, &saved.radiance),
+        (&baked.colours, &baked.radiance)
+    );
     assert_eq!(saved.extras["haarshift"]["rotation_degrees"]["yaw"], 30.0);
 }

@@ -121,7 +121,10 @@ impl BakeInfo {
         }
         Err(Error::parameter(
             "exposure",
-            format!("{} stops (expected a finite number from -64 to 64)", self.exposure),
+            format!(
+                "{} stops (expected a finite number from -64 to 64)",
+                self.exposure
+            ),
         ))
     }
 
@@ -210,15 +213,21 @@ pub fn baked_gltf(
             reason: format!("the radiance must be (V, 3) for the mesh's {vertices} vertices"),
         });
     }
-    if let Some(((row, channel), value)) = radiance.indexed_iter().find(|(_, v)| !v.is_finite())
-    {
+    if let Some(((row, channel), value)) = radiance.indexed_iter().find(|(_, v)| !v.is_finite()) {
         return Err(Error::NonFinite {
             value: f64::from(*value),
             index: vec![row, channel],
         });
     }
     let (bin, layout) = pack(mesh, radiance, info)?;
-    let root = document(&layout, vertices, mesh.triangles().len(), info, container, &bin)?;
+    let root = document(
+        &layout,
+        vertices,
+        mesh.triangles().len(),
+        info,
+        container,
+        &bin,
+    )?;
     let text = json::serialize::to_string(&root).map_err(json_error)?;
     match container {
         GltfContainer::Gltf => Ok(text.into_bytes()),
@@ -290,7 +299,11 @@ fn pack(mesh: &Mesh, radiance: ArrayView2<'_, f32>, info: &BakeInfo) -> Result<(
     }
     for n in mesh.normals().outer_iter() {
         let n = [n[0] as f32, n[1] as f32, n[2] as f32];
-        let n = if n == [0.0; 3] { ZERO_NORMAL_STAND_IN } else { n };
+        let n = if n == [0.0; 3] {
+            ZERO_NORMAL_STAND_IN
+        } else {
+            n
+        };
         bin.extend(n.iter().flat_map(|x| x.to_le_bytes()));
     }
     let scale = info.colour_scale() as f32;
@@ -300,7 +313,12 @@ fn pack(mesh: &Mesh, radiance: ArrayView2<'_, f32>, info: &BakeInfo) -> Result<(
             .flat_map(|&x| (x * scale).clamp(0.0, 1.0).to_le_bytes()),
     );
     bin.extend(radiance.iter().flat_map(|x| x.to_le_bytes()));
-    bin.extend(mesh.triangles().iter().flatten().flat_map(|i| i.to_le_bytes()));
+    bin.extend(
+        mesh.triangles()
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes()),
+    );
     let layout = Layout {
         positions: (0, attribute),
         normals: (attribute, attribute),
@@ -464,7 +482,10 @@ fn glb(json: Vec<u8>, bin: Vec<u8>) -> Result<Vec<u8>> {
     let padded = |n: usize| n.div_ceil(4) * 4;
     let length = 12 + 8 + padded(json.len()) + 8 + padded(bin.len());
     let length = u32::try_from(length).map_err(|_| {
-        Error::parameter("mesh", format!("{length} bytes exceed the GLB's 32-bit length"))
+        Error::parameter(
+            "mesh",
+            format!("{length} bytes exceed the GLB's 32-bit length"),
+        )
     })?;
     let file = gltf::binary::Glb {
         header: gltf::binary::Header {

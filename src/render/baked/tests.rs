@@ -77,14 +77,22 @@ fn the_glb_container_has_its_header_and_padded_chunks() {
         assert_eq!(accessor["min"][k].as_f64().unwrap() as f32, min);
         assert_eq!(accessor["max"][k].as_f64().unwrap() as f32, max);
     }
-    assert_eq!(document["extensionsUsed"], serde_json::json!(["KHR_materials_unlit"]));
+    assert_eq!(
+        document["extensionsUsed"],
+        serde_json::json!(["KHR_materials_unlit"])
+    );
     assert!(document["materials"][0]["extensions"]["KHR_materials_unlit"].is_object());
 }
 
 #[test]
 fn a_vertex_without_a_normal_is_written_with_the_stand_in() {
     // Vertex 3 is on no triangle: its mesh normal is zero.
-    let positions = array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [5.0, 5.0, 5.0]];
+    let positions = array![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0],
+        [5.0, 5.0, 5.0]
+    ];
     let mesh = Mesh::new(positions, vec![[0, 1, 2]], None).unwrap();
     assert_eq!(mesh.normals().row(3).to_vec(), vec![0.0; 3]);
     let radiance = Array2::<f32>::zeros((4, 3));
@@ -102,11 +110,18 @@ fn bad_radiance_and_a_bad_name_are_refused() {
     assert!(matches!(e, Error::InvalidShape { .. }), "{e}");
     radiance[[4, 1]] = f32::NAN;
     let e = baked_gltf(&mesh, radiance.view(), &info(0.0), GltfContainer::Glb).unwrap_err();
-    assert!(matches!(e, Error::NonFinite { ref index, .. } if index == &[4, 1]), "{e}");
+    assert!(
+        matches!(e, Error::NonFinite { ref index, .. } if index == &[4, 1]),
+        "{e}"
+    );
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("out.obj");
     let e = write_baked_gltf(&path, &mesh, wrong.view(), &info(0.0), false).unwrap_err();
-    assert!(e.to_string().contains("out.obj: a baked glTF is written as .glb or .gltf"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("out.obj: a baked glTF is written as .glb or .gltf"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -201,9 +201,7 @@ pub fn run(args: Args) -> Result<()> {
             .position(),
     };
     let brdf = args.material.brdf()?;
-    let spec = args
-        .shading
-        .spec(args.basis, &brdf, &args.glossy, &light);
+    let spec = args.shading.spec(args.basis, &brdf, &args.glossy, &light);
     spec.check()?;
     let mut shader = spec.build(&ShadingInput::cache(&cache).from_file(&args.cache))?;
     for (yaw, path) in &files {
