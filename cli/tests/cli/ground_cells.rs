@@ -10,12 +10,11 @@ use ndarray::Array2;
 use crate::common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, usage_error};
 use crate::ray_tracer::version_and_header;
 
-/// The fields version 6 added to a cache's header (`params.ground_cells`, `params.refine`,
-/// `ground_vertices`), removed: what is left is a version 5 header's.
+/// The fields version 6 added to a cache's header (`params.ground_cells`, `ground_vertices`),
+/// removed: what is left is a version 5 header's.
 pub fn drop_version_6_fields(header: &mut serde_json::Value) {
     let params = header["params"].as_object_mut().unwrap();
     params.remove("ground_cells");
-    params.remove("refine");
     header.as_object_mut().unwrap().remove("ground_vertices");
 }
 
@@ -61,7 +60,6 @@ fn the_default_ground_plane_writes_version_5s_arrays_bit_for_bit() {
     assert_eq!((old_version, version), (5, 6));
     assert_eq!(header["params"]["ground_cells"], serde_json::json!(32));
     assert_eq!(header["ground_vertices"], serde_json::json!(33 * 33));
-    assert_eq!(header["params"]["refine"], serde_json::Value::Null);
     drop_version_6_fields(&mut header);
     assert_eq!(header, old_header);
     assert_eq!(arrays(&now).len(), arrays(&old).len());

@@ -186,7 +186,6 @@ impl PrecomputeOptions {
             ground_cells,
             sh_bands: v.sh_bands,
             ray_tracer: tracer.map(|t| t.to_string()),
-            refine: None,
         }
     }
 }
@@ -218,8 +217,7 @@ pub fn precompute(
         scene.mesh,
         scene.albedo,
         transport,
-    )?
-    .with_ground_vertices(scene.ground_vertices)?;
+    )?;
     cache.environment = scene.environment;
     cache.camera = scene.camera;
     Ok((cache, report))

@@ -29,9 +29,8 @@
 //! environment and camera in the header; version 3 the shard record; version 4 the aligned
 //! arrays; version 5 the ray tracer in the parameters; version 6 the ground plane's cells per
 //! side in the parameters ([`CacheParams::ground_cells`]), its vertex count in the header
-//! ([`CacheHeader::ground_vertices`], the trailing block the glossy shaders keep Lambertian)
-//! and the refinement's record ([`CacheParams::refine`], `relight precompute --refine`). A
-//! file of another version is refused, never guessed at.
+//! ([`CacheHeader::ground_vertices`], the trailing block the glossy shaders keep Lambertian).
+//! A file of another version is refused, never guessed at.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
 //! cache"), the version (another version is refused, never guessed at), the checksum (a
@@ -132,33 +131,17 @@ pub struct CacheParams {
     /// or `packets`; `None` for the direction order's shadow buffers). Shards merge only when
     /// they agree on it: the two may answer a ray through an edge differently.
     pub ray_tracer: Option<String>,
-    /// How the mesh was refined before its transport was computed (`--refine`), if it was.
-    #[serde(default)]
-    pub refine: Option<RefineRecord>,
-}
-
-/// What `relight precompute --refine TOL --max-vertices N` recorded
-/// ([`refine`](crate::relight::precompute::refine)).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RefineRecord {
-    /// The largest relative L2 difference of two vertices' transports an edge may keep.
-    pub tolerance: f64,
-    /// The vertex budget.
-    pub max_vertices: usize,
-    /// The scene's vertices before refining.
-    pub input_vertices: usize,
 }
 
 impl CacheParams {
-    /// The ground plane's vertices in a cache made with these parameters and not refined:
+    /// The ground plane's vertices in a cache made with these parameters:
     /// `(N + 1)^2` for [`ground_cells`](Self::ground_cells) `N`, 0 without a ground plane.
     ///
     /// ```
     /// use haarshift::relight::{CacheParams, KeepRecord};
     /// let mut p = CacheParams { param: "cube".into(), resolution: 4, keep: KeepRecord::All,
     ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: true,
-    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None, refine: None };
+    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None };
     /// assert_eq!(p.grid_ground_vertices(), 65 * 65);
     /// (p.ground_plane, p.ground_cells) = (false, None);
     /// assert_eq!(p.grid_ground_vertices(), 0);
@@ -219,7 +202,7 @@ pub struct ShardRecord {
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
 ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
-///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()), refine: None };
+///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()) };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");
@@ -242,9 +225,8 @@ pub struct SceneCache {
     pub environment: Option<EnvironmentSpec>,
     /// The scene file's camera, likewise.
     pub camera: Option<CameraSpec>,
-    /// How many of the last vertices are the ground plane's: [`SceneCache::new`] sets
-    /// [`CacheParams::grid_ground_vertices`], a refined scene's count is set with
-    /// [`SceneCache::with_ground_vertices`].
+    /// How many of the last vertices are the ground plane's:
+    /// [`CacheParams::grid_ground_vertices`], set by [`SceneCache::new`].
     pub ground_vertices: usize,
 }
 
@@ -275,54 +257,25 @@ impl SceneCache {
     ) -> Result<Self> {
         check_parts(&params, &mesh, &albedo, &transport, mesh.vertex_count())?;
         let ground_vertices = params.grid_ground_vertices();
-        SceneCache {
+        if ground_vertices > mesh.vertex_count() {
+            return Err(Error::parameter(
+                "ground cells",
+                format!(
+                    "a ground plane of {:?} cells per side has {ground_vertices} vertices, the mesh {}",
+                    params.ground_cells,
+                    mesh.vertex_count()
+                ),
+            ));
+        }
+        Ok(SceneCache {
             params,
             mesh,
             albedo,
             transport,
             environment: None,
             camera: None,
-            ground_vertices: 0,
-        }
-        .with_ground_vertices(ground_vertices)
-    }
-
-    /// The cache with its last `ground_vertices` vertices the ground plane's; refused when
-    /// the mesh has fewer, or when the ground was not refined and the count is not its
-    /// grid's ([`CacheParams::grid_ground_vertices`]).
-    ///
-    /// ```
-    /// use haarshift::relight::precompute::{PrecomputeOptions, precompute};
-    /// use haarshift::relight::{Generator, Scene, VisibilityOptions};
-    /// use haarshift::faces::{ParamKind, Parameterization};
-    /// let scene = Scene::from_mesh(Generator::Sphere { cells: 1 }.mesh().unwrap(), true).unwrap();
-    /// let param = Parameterization::new(ParamKind::Cube, 2).unwrap();
-    /// let (cache, _) = precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(param))).unwrap();
-    /// assert_eq!((cache.ground_vertices, cache.object_vertices()), (1089, 24));
-    /// assert!(cache.clone().with_ground_vertices(1089).is_ok());
-    /// assert!(cache.with_ground_vertices(1000).is_err()); // not refined: the grid's count
-    /// ```
-    pub fn with_ground_vertices(mut self, ground_vertices: usize) -> Result<Self> {
-        let v = self.mesh.vertex_count();
-        let grid = self.params.grid_ground_vertices();
-        let refined = self.params.refine.is_some() && self.params.ground_plane;
-        if ground_vertices > v || (!refined && ground_vertices != grid) {
-            return Err(Error::parameter(
-                "ground vertices",
-                format!(
-                    "{ground_vertices} of {v} vertices are the ground plane's, but its grid \
-                     of {:?} cells per side has {grid}{}",
-                    self.params.ground_cells,
-                    if refined {
-                        " and it was refined"
-                    } else {
-                        " and it was not refined"
-                    }
-                ),
-            ));
-        }
-        self.ground_vertices = ground_vertices;
-        Ok(self)
+            ground_vertices,
+        })
     }
 
     /// Writes the cache to `path` atomically (an existing file only with `force`); returns
@@ -380,9 +333,14 @@ impl SceneCache {
         if let Some(shard) = header.shard {
             return Err(SceneError::CacheIsShard(shard).into());
         }
-        let mut cache = SceneCache::new(header.params, parts.mesh, parts.albedo, parts.transport)?
-            .with_ground_vertices(header.ground_vertices)
-            .map_err(|e| SceneError::CacheCorrupt(e.to_string()))?;
+        let mut cache = SceneCache::new(header.params, parts.mesh, parts.albedo, parts.transport)?;
+        if header.ground_vertices != cache.ground_vertices {
+            return Err(SceneError::CacheCorrupt(format!(
+                "its header says {} ground vertices, its ground plane of {:?} cells per side has {}",
+                header.ground_vertices, cache.params.ground_cells, cache.ground_vertices
+            ))
+            .into());
+        }
         cache.environment = header.environment;
         cache.camera = header.camera;
         Ok(cache)

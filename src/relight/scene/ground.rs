@@ -11,8 +11,7 @@ use crate::{Error, Result};
 pub const GROUND_CELLS: usize = 32;
 
 /// The most cells per side a ground plane may have: `(1024 + 1)^2` vertices, about a
-/// million, beyond which a denser grid everywhere is the wrong tool (`--refine` puts
-/// vertices where the light needs them).
+/// million, beyond which a denser grid everywhere costs more than any shadow needs.
 pub const MAX_GROUND_CELLS: usize = 1024;
 
 /// Vertices the default ground plane adds: `(GROUND_CELLS + 1)^2`.

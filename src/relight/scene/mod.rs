@@ -9,8 +9,8 @@
 //! default: [`GROUND_VERTICES`]) appended after the mesh's, row by row from the corner at
 //! `(-x, +z)`, `x` fastest. The ground's vertices are always the last ones, and a scene and a
 //! cache record how many ([`Scene::ground_vertices`], [`CacheHeader::ground_vertices`](cache::CacheHeader::ground_vertices)):
-//! that count, not the grid's formula, is what tells the glossy shaders which vertices stay
-//! Lambertian, since a refined ground (`--refine`) has other counts.
+//! that count, not the default grid's formula, tells the glossy shaders which vertices stay
+//! Lambertian.
 //!
 //! # Generators
 //! Every size is fixed here, so a generator and its settings name one mesh (units are
@@ -112,7 +112,7 @@ pub struct Scene {
     /// The ground plane's cells per side, when it has been added.
     pub ground_cells: Option<usize>,
     /// How many of the last vertices are the ground plane's (0 without one): `(N + 1)^2` for
-    /// a grid of `N` cells, more once refined.
+    /// a grid of `N` cells.
     pub ground_vertices: usize,
 }
 
