@@ -270,6 +270,8 @@ impl Cache {
 /// worker returns a path; an `output` that already holds this shard complete is not computed
 /// again (`force=True` recomputes it). `merge` joins the shards.
 ///
+/// `ground_cells` (with `ground_plane=True`, default 32) is the ground plane's cells per side.
+///
 /// `ray_tracer` is `"embree"` (Intel Embree 3, the default where the system's
 /// libembree3.so.3 loads at run time; refused with what to install where it does not) or
 /// `"packets"` (haarshift's own, always available); the two answer alike except on rays
@@ -286,7 +288,7 @@ impl Cache {
 /// >>> open(os.path.join(d, "ball.hsr"), "rb").read() == open(os.path.join(d, "whole.hsr"), "rb").read()
 /// True
 #[pyfunction]
-#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, shard = None, output = None, force = false, ray_tracer = None))]
+#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, ground_cells = None, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, shard = None, output = None, force = false, ray_tracer = None))]
 #[allow(clippy::too_many_arguments)] // the keyword arguments of one Python function
 fn precompute(
     py: Python<'_>,
@@ -294,6 +296,7 @@ fn precompute(
     param: &str,
     resolution: usize,
     ground_plane: bool,
+    ground_cells: Option<usize>,
     keep_visibility: Option<usize>,
     samples: usize,
     seed: u64,
@@ -317,10 +320,18 @@ fn precompute(
     }
     // Refused before the scene is read.
     options.check().or_raise()?;
+    if ground_cells.is_some() && !ground_plane {
+        return Err(bad_argument(
+            "ground_cells",
+            "the ground plane's cells need ground_plane=True",
+        ));
+    }
     let load = || -> haarshift::Result<Scene> {
         let mut loaded = Scene::load(&scene)?;
-        if ground_plane {
-            loaded.add_ground_plane()?;
+        match (ground_plane, ground_cells) {
+            (false, _) => {}
+            (true, None) => loaded.add_ground_plane()?,
+            (true, Some(cells)) => loaded.add_ground_plane_of(cells)?,
         }
         Ok(loaded)
     };

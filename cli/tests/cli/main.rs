@@ -12,6 +12,7 @@ mod deploy;
 mod experiment;
 mod experiment_relight;
 mod flags;
+mod ground_cells;
 mod hdr;
 mod ray_tracer;
 mod readme;

@@ -120,7 +120,7 @@ fn both_ray_tracers_precompute_the_bunny_alike_and_say_which_cast() {
 }
 
 /// A cache file's version and its JSON header.
-fn version_and_header(bytes: &[u8]) -> (u32, serde_json::Value) {
+pub fn version_and_header(bytes: &[u8]) -> (u32, serde_json::Value) {
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
     let length = u64::from_le_bytes(bytes[16..24].try_into().unwrap()) as usize;
     (
@@ -130,7 +130,8 @@ fn version_and_header(bytes: &[u8]) -> (u32, serde_json::Value) {
 }
 
 /// `bytes` of an older cache relabelled as this build's version (the CRC-32 of what follows
-/// it made anew): the layout of the arrays is the same, the header only lacks the tracer.
+/// it made anew): the layout of the arrays is the same, the header only lacks the tracer and
+/// version 6's ground and refinement fields (read as absent: no ground plane, not refined).
 fn as_current_version(mut bytes: Vec<u8>) -> Vec<u8> {
     bytes[8..12].copy_from_slice(&haarshift::relight::scene::cache::CACHE_VERSION.to_le_bytes());
     let crc = crc32fast::hash(&bytes[16..]);
@@ -180,6 +181,7 @@ fn embree_loaded_at_run_time_casts_the_cache_the_linked_build_cast() {
         .unwrap()
         .remove("ray_tracer");
     assert_eq!(tracer, Some(serde_json::json!("embree")));
+    crate::ground_cells::drop_version_6_fields(&mut header);
     assert_eq!(header, old_header);
     // Every array: the linked build's cache, read as this version, equals ours.
     let relabelled = dir.path().join("linked.hsr");

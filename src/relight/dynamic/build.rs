@@ -175,8 +175,8 @@ impl DynamicScene {
             .collect::<Result<Vec<Mesh>>>()?;
         let objects_mesh = merge(meshes.iter().cloned());
         let ground = file
-            .ground_plane
-            .then(|| ground_plane_under(&objects_mesh.bounds()))
+            .ground_cells()?
+            .map(|cells| ground_plane_under(&objects_mesh.bounds(), cells))
             .transpose()?;
         let fields = (0..shapes.meshes.len())
             .map(|i| {

@@ -172,7 +172,7 @@ impl PrecomputeOptions {
     }
 
     /// What the cache records of these options.
-    fn record(&self, ground_plane: bool, tracer: Option<RayTracer>) -> CacheParams {
+    fn record(&self, ground_cells: Option<usize>, tracer: Option<RayTracer>) -> CacheParams {
         let v = &self.visibility;
         CacheParams {
             param: v.param.kind().to_string(),
@@ -182,7 +182,8 @@ impl PrecomputeOptions {
             seed: v.seed,
             order: self.order.to_string(),
             map_size: (self.order == Order::Direction).then_some(self.map_size),
-            ground_plane,
+            ground_plane: ground_cells.is_some(),
+            ground_cells,
             sh_bands: v.sh_bands,
             ray_tracer: tracer.map(|t| t.to_string()),
         }
@@ -212,7 +213,7 @@ pub fn precompute(
 ) -> Result<(SceneCache, PrecomputeReport)> {
     let (transport, report) = transport(&scene, options, None)?;
     let mut cache = SceneCache::new(
-        options.record(scene.ground_plane, report.tracer),
+        options.record(scene.ground_cells, report.tracer),
         scene.mesh,
         scene.albedo,
         transport,
@@ -248,7 +249,7 @@ pub fn precompute_shard(
     let (transport, report) = transport(&scene, options, Some(shard))?;
     let mut part = CacheShard::new(
         shard,
-        options.record(scene.ground_plane, report.tracer),
+        options.record(scene.ground_cells, report.tracer),
         scene.mesh,
         scene.albedo,
         transport,
@@ -292,7 +293,7 @@ pub fn shard_is_done(
     // The tracer a rerun would cast with: the one asked for (it fell back only if Embree
     // failed to build the scene, and then the records differ and the shard is recast).
     let tracer = (options.order == Order::Vertex).then_some(options.ray_tracer);
-    let params = options.record(scene.ground_plane, tracer);
+    let params = options.record(scene.ground_cells, tracer);
     let wanted = Provenance {
         params: &params,
         mesh: &scene.mesh,

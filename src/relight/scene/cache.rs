@@ -27,8 +27,10 @@
 //!
 //! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
 //! environment and camera in the header; version 3 the shard record; version 4 the aligned
-//! arrays; version 5 the ray tracer in the parameters. A file of another version
-//! is refused, never guessed at.
+//! arrays; version 5 the ray tracer in the parameters; version 6 the ground plane's cells per
+//! side in the parameters ([`CacheParams::ground_cells`]), its vertex count in the header
+//! ([`CacheHeader::ground_vertices`], the trailing block the glossy shaders keep Lambertian).
+//! A file of another version is refused, never guessed at.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
 //! cache"), the version (another version is refused, never guessed at), the checksum (a
@@ -54,7 +56,7 @@ use crate::relight::{Mesh, SceneError};
 use crate::{Error, Result};
 
 /// The format version this build reads and writes.
-pub const CACHE_VERSION: u32 = 5;
+pub const CACHE_VERSION: u32 = 6;
 
 const FORMAT: Format = Format {
     magic: b"HSRCACHE",
@@ -120,12 +122,33 @@ pub struct CacheParams {
     pub map_size: Option<usize>,
     /// Whether the ground plane was added.
     pub ground_plane: bool,
+    /// The ground plane's cells per side, with one (`None` without).
+    #[serde(default)]
+    pub ground_cells: Option<usize>,
     /// Bands of the spherical-harmonic transfer stored beside the Haar transport, if any.
     pub sh_bands: Option<usize>,
     /// The [`RayTracer`](crate::relight::RayTracer) that cast the visibility rays (`embree`
     /// or `packets`; `None` for the direction order's shadow buffers). Shards merge only when
     /// they agree on it: the two may answer a ray through an edge differently.
     pub ray_tracer: Option<String>,
+}
+
+impl CacheParams {
+    /// The ground plane's vertices in a cache made with these parameters:
+    /// `(N + 1)^2` for [`ground_cells`](Self::ground_cells) `N`, 0 without a ground plane.
+    ///
+    /// ```
+    /// use haarshift::relight::{CacheParams, KeepRecord};
+    /// let mut p = CacheParams { param: "cube".into(), resolution: 4, keep: KeepRecord::All,
+    ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: true,
+    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None };
+    /// assert_eq!(p.grid_ground_vertices(), 65 * 65);
+    /// (p.ground_plane, p.ground_cells) = (false, None);
+    /// assert_eq!(p.grid_ground_vertices(), 0);
+    /// ```
+    pub fn grid_ground_vertices(&self) -> usize {
+        self.ground_cells.map_or(0, super::ground_vertices)
+    }
 }
 
 /// The JSON header of a cache file.
@@ -138,6 +161,9 @@ pub struct CacheHeader {
     pub vertices: usize,
     /// Triangles.
     pub triangles: usize,
+    /// How many of the last vertices are the ground plane's (0 without one).
+    #[serde(default)]
+    pub ground_vertices: usize,
     /// Stored transport coefficients, all vertices.
     pub coefficients: usize,
     /// [`scene_hash`] of the mesh.
@@ -176,7 +202,7 @@ pub struct ShardRecord {
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
 ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
-///     sh_bands: None, ray_tracer: Some("packets".into()) };
+///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()) };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");
@@ -199,6 +225,9 @@ pub struct SceneCache {
     pub environment: Option<EnvironmentSpec>,
     /// The scene file's camera, likewise.
     pub camera: Option<CameraSpec>,
+    /// How many of the last vertices are the ground plane's:
+    /// [`CacheParams::grid_ground_vertices`], set by [`SceneCache::new`].
+    pub ground_vertices: usize,
 }
 
 /// A CRC-32 of the mesh's positions, normals and triangles: what "the same scene" means.
@@ -227,6 +256,17 @@ impl SceneCache {
         transport: TransportSet,
     ) -> Result<Self> {
         check_parts(&params, &mesh, &albedo, &transport, mesh.vertex_count())?;
+        let ground_vertices = params.grid_ground_vertices();
+        if ground_vertices > mesh.vertex_count() {
+            return Err(Error::parameter(
+                "ground cells",
+                format!(
+                    "a ground plane of {:?} cells per side has {ground_vertices} vertices, the mesh {}",
+                    params.ground_cells,
+                    mesh.vertex_count()
+                ),
+            ));
+        }
         Ok(SceneCache {
             params,
             mesh,
@@ -234,6 +274,7 @@ impl SceneCache {
             transport,
             environment: None,
             camera: None,
+            ground_vertices,
         })
     }
 
@@ -245,7 +286,7 @@ impl SceneCache {
             &self.mesh,
             &self.transport,
             (&self.environment, &self.camera),
-            None,
+            (self.ground_vertices, None),
         );
         write_parts(
             path,
@@ -261,7 +302,7 @@ impl SceneCache {
     /// Lambertian ([`Scene::object_vertices`](super::Scene::object_vertices) of the scene
     /// it was precomputed from).
     pub fn object_vertices(&self) -> usize {
-        super::object_vertices(self.mesh.vertex_count(), self.params.ground_plane)
+        super::object_vertices(self.mesh.vertex_count(), self.ground_vertices)
     }
 
     /// Reads a cache, refusing a damaged file, another version or a shard; see the
@@ -293,6 +334,13 @@ impl SceneCache {
             return Err(SceneError::CacheIsShard(shard).into());
         }
         let mut cache = SceneCache::new(header.params, parts.mesh, parts.albedo, parts.transport)?;
+        if header.ground_vertices != cache.ground_vertices {
+            return Err(SceneError::CacheCorrupt(format!(
+                "its header says {} ground vertices, its ground plane of {:?} cells per side has {}",
+                header.ground_vertices, cache.params.ground_cells, cache.ground_vertices
+            ))
+            .into());
+        }
         cache.environment = header.environment;
         cache.camera = header.camera;
         Ok(cache)
@@ -319,6 +367,15 @@ pub(super) fn check_parts(
     rows: usize,
 ) -> Result<()> {
     let v = mesh.vertex_count();
+    if params.ground_plane != params.ground_cells.is_some() {
+        return Err(Error::parameter(
+            "cache parameters",
+            format!(
+                "ground_plane {} with ground_cells {:?}: cells are recorded with a ground plane only",
+                params.ground_plane, params.ground_cells
+            ),
+        ));
+    }
     if albedo.dim() != (v, 3) || transport.vertex_count() != rows {
         return Err(Error::shape(
             albedo.shape(),
@@ -350,18 +407,20 @@ pub(super) fn check_parts(
 }
 
 /// The header of a file holding `transport` for `mesh` (the scene file's environment and
-/// camera in `scene_file`), a shard's when `shard` is given.
+/// camera in `scene_file`) whose last `ground_vertices` are the ground plane's, a shard's
+/// when `shard` is given.
 pub(super) fn header(
     params: &CacheParams,
     mesh: &Mesh,
     transport: &TransportSet,
     scene_file: (&Option<EnvironmentSpec>, &Option<CameraSpec>),
-    shard: Option<ShardRecord>,
+    (ground_vertices, shard): (usize, Option<ShardRecord>),
 ) -> CacheHeader {
     CacheHeader {
         params: params.clone(),
         vertices: mesh.vertex_count(),
         triangles: mesh.triangles().len(),
+        ground_vertices,
         coefficients: transport.coefficient_count(),
         scene_hash: scene_hash(mesh),
         environment: scene_file.0.clone(),

@@ -94,7 +94,7 @@ impl CacheShard {
             &self.mesh,
             &self.transport,
             (&self.environment, &self.camera),
-            Some(self.record),
+            (self.params.grid_ground_vertices(), Some(self.record)),
         );
         write_parts(
             path,

@@ -23,6 +23,7 @@ fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
         order: "vertex".into(),
         map_size: None,
         ground_plane: true,
+        ground_cells: Some(32),
         sh_bands,
         ray_tracer: Some("packets".into()),
     };
@@ -251,12 +252,13 @@ fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
 }
 
 #[test]
-fn version_1_to_4_files_are_refused() {
+fn version_1_to_5_files_are_refused() {
     // Version 1 had no spherical-harmonic transfer, version 2 no shard record, version 3 no
-    // aligned arrays, version 4 no ray tracer: their files must be remade, not misread.
+    // aligned arrays, version 4 no ray tracer, version 5 no ground plane counts: their files
+    // must be remade, not misread.
     let (_dir, path) = written(&made(2));
     let good = std::fs::read(&path).unwrap();
-    for old in [1u32, 2, 3, 4] {
+    for old in [1u32, 2, 3, 4, 5] {
         let mut bytes = good.clone();
         bytes[8..12].copy_from_slice(&old.to_le_bytes());
         std::fs::write(&path, &bytes).unwrap();
@@ -265,13 +267,13 @@ fn version_1_to_4_files_are_refused() {
             e,
             SceneError::CacheVersion {
                 found: old,
-                expected: 5
+                expected: 6
             }
         );
         assert_eq!(
             e.to_string(),
             format!(
-                "scene cache has format version {old}, this build reads version 5; compute it again"
+                "scene cache has format version {old}, this build reads version 6; compute it again"
             )
         );
     }

@@ -254,6 +254,10 @@ pub struct SceneFile {
     /// Whether to add the ground plane.
     #[serde(default)]
     pub ground_plane: bool,
+    /// The ground plane's cells per side (only with `ground_plane`; default
+    /// [`GROUND_CELLS`](super::GROUND_CELLS)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ground_cells: Option<usize>,
     /// The lighting.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub environment: Option<EnvironmentSpec>,
@@ -319,6 +323,7 @@ impl SceneFile {
     /// ([`check_memory`](Self::check_memory)).
     pub fn build_within(&self, dir: &Path, budget: &MemoryBudget) -> Result<Scene> {
         self.check_memory(budget)?;
+        let ground_cells = self.ground_cells()?;
         if self.objects.is_empty() {
             return Err(SceneError::SceneFile("a scene needs at least one object".into()).into());
         }
@@ -356,10 +361,42 @@ impl SceneFile {
             }),
             camera: self.camera.clone(),
             ground_plane: false,
+            ground_cells: None,
+            ground_vertices: 0,
         };
-        if self.ground_plane {
-            scene.add_ground_plane()?;
+        if let Some(cells) = ground_cells {
+            scene.add_ground_plane_of(cells)?;
         }
         Ok(scene)
+    }
+
+    /// The ground plane's cells per side, `None` without one; refuses `ground_cells` without
+    /// `"ground_plane": true` and a count outside
+    /// [`check_ground_cells`](super::check_ground_cells)'s range.
+    ///
+    /// ```
+    /// use haarshift::relight::SceneFile;
+    /// let file = |json: &str| serde_json::from_str::<SceneFile>(json).unwrap();
+    /// let objects = r#""objects": [{"generator": {"sphere": {}}}]"#;
+    /// assert_eq!(file(&format!("{{{objects}, \"ground_plane\": true}}")).ground_cells().unwrap(), Some(32));
+    /// let dense = file(&format!("{{{objects}, \"ground_plane\": true, \"ground_cells\": 64}}"));
+    /// assert_eq!(dense.ground_cells().unwrap(), Some(64));
+    /// assert!(file(&format!("{{{objects}, \"ground_cells\": 64}}")).ground_cells().is_err());
+    /// assert!(file(&format!("{{{objects}, \"ground_plane\": true, \"ground_cells\": 0}}")).ground_cells().is_err());
+    /// ```
+    pub fn ground_cells(&self) -> Result<Option<usize>> {
+        match (self.ground_plane, self.ground_cells) {
+            (false, None) => Ok(None),
+            (false, Some(cells)) => Err(SceneError::SceneFile(format!(
+                "\"ground_cells\": {cells} needs \"ground_plane\": true"
+            ))
+            .into()),
+            (true, cells) => {
+                let cells = cells.unwrap_or(super::GROUND_CELLS);
+                super::check_ground_cells(cells)
+                    .map_err(|e| SceneError::SceneFile(format!("\"ground_cells\": {e}")))?;
+                Ok(Some(cells))
+            }
+        }
     }
 }

@@ -3,10 +3,14 @@
 //! # Ground plane
 //! [`add_ground_plane`]: a square at the scene's lowest `y`, centred under the bounding box's
 //! centre, of side `4 x` the box's largest horizontal extent (`max(dx, dz)`), normal `+Y`,
-//! subdivided into a grid of [`GROUND_CELLS`]` x `[`GROUND_CELLS`] cells (so it can receive
-//! shadows): `(GROUND_CELLS + 1)^2 = 1089` ([`GROUND_VERTICES`]) vertices appended after the
-//! mesh's, row by row from
-//! the corner at `(-x, +z)`, `x` fastest.
+//! subdivided into a grid of `N x N` cells (so it can receive shadows; `N` is
+//! [`GROUND_CELLS`]` = 32` unless `--ground-cells` or a scene file's `"ground_cells"` says
+//! otherwise, `1..=`[`MAX_GROUND_CELLS`]): `(N + 1)^2` vertices ([`ground_vertices`], 1089 by
+//! default: [`GROUND_VERTICES`]) appended after the mesh's, row by row from the corner at
+//! `(-x, +z)`, `x` fastest. The ground's vertices are always the last ones, and a scene and a
+//! cache record how many ([`Scene::ground_vertices`], [`CacheHeader::ground_vertices`](cache::CacheHeader::ground_vertices)):
+//! that count, not the default grid's formula, tells the glossy shaders which vertices stay
+//! Lambertian.
 //!
 //! # Generators
 //! Every size is fixed here, so a generator and its settings name one mesh (units are
@@ -46,7 +50,8 @@
 //!   albedo `[0.8, 0.8, 0.8]`; `{"brdf": "phong", "exponent": 20, "albedo": [..]}` and
 //!   `"blinn"` are glossy, [`Material`]). Objects are merged in order, vertices numbered as they come.
 //! * `ground_plane` (default `false`): [`add_ground_plane`] after all objects, albedo
-//!   [`GROUND_ALBEDO`].
+//!   [`GROUND_ALBEDO`]; `ground_cells` (optional, only with `"ground_plane": true`, default
+//!   [`GROUND_CELLS`]): its cells per side.
 //! * `environment` (optional): the lighting's path and its rotation `g(p) = f(R p)`.
 //! * `camera` (optional): position, look-at point, vertical field of view in degrees.
 
@@ -64,8 +69,8 @@ pub(crate) use file::read_json;
 pub use file::{CameraSpec, EnvironmentSpec, Material, SceneFile, SceneObject, Transform};
 pub use generators::Generator;
 pub use ground::{
-    GROUND_ALBEDO, GROUND_CELLS, GROUND_VERTICES, add_ground_plane, ground_plane_under,
-    object_vertices,
+    GROUND_ALBEDO, GROUND_CELLS, GROUND_VERTICES, MAX_GROUND_CELLS, add_ground_plane,
+    check_ground_cells, ground_plane_under, ground_vertices, object_vertices,
 };
 
 use std::path::Path;
@@ -104,6 +109,11 @@ pub struct Scene {
     pub camera: Option<CameraSpec>,
     /// Whether the ground plane has been added (its vertices are the last ones).
     pub ground_plane: bool,
+    /// The ground plane's cells per side, when it has been added.
+    pub ground_cells: Option<usize>,
+    /// How many of the last vertices are the ground plane's (0 without one): `(N + 1)^2` for
+    /// a grid of `N` cells.
+    pub ground_vertices: usize,
 }
 
 impl Scene {
@@ -116,6 +126,8 @@ impl Scene {
             environment: None,
             camera: None,
             ground_plane: false,
+            ground_cells: None,
+            ground_vertices: 0,
         };
         scene.albedo =
             Array2::from_shape_fn((scene.mesh.vertex_count(), 3), |(_, c)| DEFAULT_ALBEDO[c]);
@@ -125,8 +137,8 @@ impl Scene {
         Ok(scene)
     }
 
-    /// Appends the ground plane ([`add_ground_plane`]) with albedo [`GROUND_ALBEDO`], unless the
-    /// scene has it already.
+    /// Appends the default ground plane ([`add_ground_plane`], [`GROUND_CELLS`] cells per
+    /// side) with albedo [`GROUND_ALBEDO`], unless the scene has one already (of any cells).
     ///
     /// ```
     /// use haarshift::relight::{Generator, Scene};
@@ -134,6 +146,7 @@ impl Scene {
     /// let v = scene.mesh.vertex_count();
     /// scene.add_ground_plane().unwrap();
     /// assert_eq!((scene.mesh.vertex_count(), scene.ground_plane), (v, true));
+    /// assert_eq!((scene.ground_cells, scene.ground_vertices), (Some(32), 33 * 33));
     /// ```
     ///
     /// Errors (leaving the scene as it was) as [`add_ground_plane`] does.
@@ -141,12 +154,40 @@ impl Scene {
         if self.ground_plane {
             return Ok(());
         }
-        let before = self.mesh.vertex_count();
-        add_ground_plane(&mut self.mesh)?;
+        self.add_ground_plane_of(GROUND_CELLS)
+    }
+
+    /// [`add_ground_plane`](Self::add_ground_plane) with `cells` cells per side
+    /// ([`ground_plane_under`]); a scene that has a ground plane already keeps it, and is
+    /// refused when its plane has other cells than `cells`.
+    ///
+    /// ```
+    /// use haarshift::relight::{Generator, Scene};
+    /// let mut scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
+    /// scene.add_ground_plane_of(64).unwrap();
+    /// assert_eq!((scene.mesh.vertex_count(), scene.object_vertices()), (54 + 65 * 65, 54));
+    /// assert!(scene.add_ground_plane_of(64).is_ok());
+    /// let err = scene.add_ground_plane_of(16).unwrap_err().to_string();
+    /// assert!(err.contains("has a ground plane of 64 cells per side, not 16"), "{err}");
+    /// ```
+    ///
+    /// Errors (leaving the scene as it was) as [`ground_plane_under`] does.
+    pub fn add_ground_plane_of(&mut self, cells: usize) -> Result<()> {
+        if self.ground_plane {
+            return match self.ground_cells {
+                Some(had) if had != cells => Err(crate::Error::parameter(
+                    "ground cells",
+                    format!("the scene has a ground plane of {had} cells per side, not {cells}"),
+                )),
+                _ => Ok(()),
+            };
+        }
+        let ground = ground_plane_under(&self.mesh.bounds(), cells)?;
+        self.mesh.append(&ground);
         self.ground_plane = true;
-        let added = Array2::from_shape_fn((self.mesh.vertex_count() - before, 3), |(_, c)| {
-            GROUND_ALBEDO[c]
-        });
+        self.ground_cells = Some(cells);
+        self.ground_vertices = ground.vertex_count();
+        let added = Array2::from_shape_fn((ground.vertex_count(), 3), |(_, c)| GROUND_ALBEDO[c]);
         self.albedo
             .append(ndarray::Axis(0), added.view())
             .expect("both are (V, 3)");
@@ -154,7 +195,7 @@ impl Scene {
     }
 
     /// The vertices of the scene's objects, `0..object_vertices()`: all but the ground plane's
-    /// (the last [`GROUND_VERTICES`] when the scene has it), which stays Lambertian under a
+    /// (the last [`ground_vertices`](Self::ground_vertices)), which stays Lambertian under a
     /// glossy BRDF.
     ///
     /// ```
@@ -164,7 +205,7 @@ impl Scene {
     /// assert_eq!(Scene::from_mesh(sphere, false).unwrap().object_vertices(), 54);
     /// ```
     pub fn object_vertices(&self) -> usize {
-        object_vertices(self.mesh.vertex_count(), self.ground_plane)
+        object_vertices(self.mesh.vertex_count(), self.ground_vertices)
     }
 
     /// Reads a scene: a JSON scene file (`.json`), or a mesh file (OBJ or PLY) as a scene of

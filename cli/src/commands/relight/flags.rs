@@ -29,10 +29,14 @@ pub struct SceneFlags {
     #[arg(value_name = "MESH|SCENE.json")]
     pub input: PathBuf,
 
-    /// Add a ground plane under the scene (a 32 x 32-cell square at its lowest y, 4 x its
-    /// horizontal extent), unless the scene file has one
+    /// Add a ground plane under the scene (a square grid at its lowest y, 4 x its horizontal
+    /// extent, of --ground-cells cells per side), unless the scene file has one
     #[arg(long)]
     pub ground_plane: bool,
+
+    /// The ground plane's cells per side (1 to 1024) [default: 32]
+    #[arg(long, value_name = "N", requires = "ground_plane", value_parser = ground_cells)]
+    pub ground_cells: Option<usize>,
 
     /// The most memory the scene and its work may take (e.g. 8GiB): a scene file whose
     /// generators, or a precomputation whose transport, would need more is refused before
@@ -63,13 +67,21 @@ impl SceneFlags {
     /// [`load`](Self::load) within `budget` (its limit is the caller's).
     pub fn load_within(&self, budget: MemoryBudget) -> Result<Scene> {
         let mut scene = Scene::load_within(&self.input, &budget)?;
-        if self.ground_plane {
-            scene
-                .add_ground_plane()
-                .map_err(|e| e.in_file(&self.input))?;
-        }
+        let added = match (self.ground_plane, self.ground_cells) {
+            (false, _) => Ok(()),
+            (true, None) => scene.add_ground_plane(),
+            (true, Some(cells)) => scene.add_ground_plane_of(cells),
+        };
+        added.map_err(|e| e.in_file(&self.input))?;
         Ok(scene)
     }
+}
+
+/// `--ground-cells`, checked by the library.
+fn ground_cells(s: &str) -> std::result::Result<usize, String> {
+    let cells: usize = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    haarshift::relight::scene::check_ground_cells(cells).map_err(|e| e.to_string())?;
+    Ok(cells)
 }
 
 /// Three numbers `x,y,z`.

@@ -581,6 +581,7 @@ fn a_mapped_cache_shades_in_place_and_equal_to_the_transport_in_memory() {
         order: "vertex".into(),
         map_size: None,
         ground_plane: false,
+        ground_cells: None,
         sh_bands: None,
         ray_tracer: Some("packets".into()),
     };
