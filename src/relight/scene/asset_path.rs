@@ -67,13 +67,10 @@ pub(crate) fn resolve(part: &str, uri: &str, dir: &Path) -> Result<AssetSource> 
         return Err(leaves("climbs out of the folder"));
     }
     let path = dir.join(relative);
-    let io = |source: std::io::Error, p: &Path| Error::Io {
-        path: p.to_path_buf(),
-        source,
-    };
+    let unreadable = |e: std::io::Error| refused(part, format!("{uri:?}: {e}"));
     let folder = std::fs::canonicalize(if dir.as_os_str().is_empty() { Path::new(".") } else { dir })
-        .map_err(|e| io(e, dir))?;
-    let target = std::fs::canonicalize(&path).map_err(|e| io(e, &path))?;
+        .map_err(unreadable)?;
+    let target = std::fs::canonicalize(&path).map_err(unreadable)?;
     if !target.starts_with(&folder) {
         return Err(leaves("resolves (through a link) outside the folder"));
     }

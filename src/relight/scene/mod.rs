@@ -39,7 +39,8 @@
 //! }
 //! ```
 //!
-//! * `objects` (at least one): each has exactly one of `mesh` (an OBJ or PLY path) and
+//! * `objects` (at least one): each has exactly one of `mesh` (an OBJ, PLY, glTF or GLB path,
+//!   [`MeshAsset`]; where the file carries colour, its albedo times the material's) and
 //!   `generator` (one of the table's names with its settings, `{}` for the defaults);
 //!   `transform` (optional: scale, then rotate by `R = Rz(roll) Ry(yaw) Rx(pitch)` in degrees,
 //!   the sphere module's convention, then translate); `material` (optional, default Lambertian

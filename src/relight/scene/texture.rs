@@ -162,7 +162,7 @@ impl Texture {
             self.texels[j * self.width + i]
         };
         if filter == Filter::Nearest {
-            return texel(x[0].round() as i64, x[1].round() as i64);
+            return texel((x[0] + 0.5).floor() as i64, (x[1] + 0.5).floor() as i64);
         }
         let base = x.map(f64::floor);
         let f = [x[0] - base[0], x[1] - base[1]];
