@@ -71,6 +71,21 @@ pub enum SceneError {
     /// The file cannot be parsed: truncated, corrupt, or a layout that is not a triangle mesh.
     #[error("not a readable mesh: {0}")]
     Corrupt(String),
+    /// A part of a mesh asset (a glTF node, mesh, accessor, buffer or image; an OBJ's
+    /// material library or texture) cannot be read, or names a file outside the asset's folder.
+    ///
+    /// ```
+    /// use haarshift::relight::SceneError;
+    /// let e = SceneError::Asset { part: "buffer 0".into(), reason: "no such file".into() };
+    /// assert_eq!(e.to_string(), "buffer 0: no such file");
+    /// ```
+    #[error("{part}: {reason}")]
+    Asset {
+        /// The part, e.g. `mesh 2, primitive 0, POSITION (accessor 5)`.
+        part: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// The scene file is not valid (bad JSON, unknown key, bad value).
     #[error("invalid scene file: {0}")]
     SceneFile(String),

@@ -17,6 +17,7 @@ mod hdr;
 mod ray_tracer;
 mod readme;
 mod relight;
+mod relight_assets;
 mod relight_error;
 mod relight_scene;
 mod relight_shard;

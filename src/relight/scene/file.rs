@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
-use crate::relight::scene::Scene;
+use crate::relight::scene::{MeshAsset, Scene};
 use crate::relight::scene::validate::{self, MemoryBudget};
 use crate::relight::{Brdf, Generator, Mesh, SceneError};
 use crate::sphere::SphereRotation;
@@ -167,7 +167,7 @@ pub struct SceneObject {
     /// A name an animation path can refer to (dynamic scenes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// A mesh file (OBJ or PLY), relative to the scene file.
+    /// A mesh file (OBJ, PLY, glTF or GLB), relative to the scene file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<PathBuf>,
     /// A procedural mesh.
@@ -185,14 +185,47 @@ impl SceneObject {
     /// The object's mesh in its own frame (before its transform): its mesh file, relative to
     /// `dir`, or its generator's; `k` is its place in the scene file, for the message.
     pub fn shape(&self, dir: &Path, k: usize) -> Result<Mesh> {
+        self.asset(dir, k, &MemoryBudget::default()).map(|a| a.mesh)
+    }
+
+    /// [`shape`](Self::shape) with the colour its mesh file carries ([`MeshAsset`]; a
+    /// generator's carries none), read within `budget`. The object's albedo is
+    /// [`albedo`](Self::albedo).
+    pub fn asset(&self, dir: &Path, k: usize, budget: &MemoryBudget) -> Result<MeshAsset> {
         match (&self.mesh, &self.generator) {
-            (Some(path), None) => Mesh::load(&dir.join(path)),
-            (None, Some(generator)) => generator.mesh(),
+            (Some(path), None) => MeshAsset::load_within(&dir.join(path), budget),
+            (None, Some(generator)) => generator.mesh().map(MeshAsset::plain),
             _ => Err(SceneError::SceneFile(format!(
                 "object {k} must have exactly one of \"mesh\" and \"generator\""
             ))
             .into()),
         }
+    }
+}
+
+impl SceneObject {
+    /// The object's albedo per vertex of `asset` (its [`asset`](Self::asset)): the material's
+    /// albedo times the asset's own where the file carries colour, else the material's alone.
+    ///
+    /// ```
+    /// use haarshift::relight::{Mesh, SceneObject};
+    /// use haarshift::relight::scene::MeshAsset;
+    /// use ndarray::array;
+    /// let mesh = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+    ///                      vec![[0, 1, 2]], None).unwrap();
+    /// let object: SceneObject = serde_json::from_str(
+    ///     r#"{"mesh": "x.ply", "material": {"brdf": "lambert", "albedo": [0.5, 1, 1]}}"#).unwrap();
+    /// let mut asset = MeshAsset::plain(mesh);
+    /// assert_eq!(object.albedo(&asset).unwrap().row(0).to_vec(), vec![0.5, 1.0, 1.0]);
+    /// asset.albedo = Some(array![[0.2, 0.4, 0.6], [1.0; 3], [1.0; 3]]);
+    /// assert_eq!(object.albedo(&asset).unwrap().row(0).to_vec(), vec![0.1, 0.4, 0.6]);
+    /// ```
+    pub fn albedo(&self, asset: &MeshAsset) -> Result<Array2<f32>> {
+        let a = self.material.albedo()?;
+        Ok(match &asset.albedo {
+            Some(own) => Array2::from_shape_fn(own.raw_dim(), |(v, c)| a[c] * own[[v, c]]),
+            None => Array2::from_shape_fn((asset.mesh.vertex_count(), 3), |(_, c)| a[c]),
+        })
     }
 }
 
@@ -332,10 +365,12 @@ impl SceneFile {
         }
         let mut mesh: Option<Mesh> = None;
         let mut albedo = Array2::<f32>::zeros((0, 3));
+        let mut warnings = Vec::new();
         for (k, object) in self.objects.iter().enumerate() {
-            let shape = object.shape(dir, k)?;
-            let shape = object.transform.apply(&shape)?;
-            let a = object.material.albedo()?;
+            let asset = object.asset(dir, k, budget)?;
+            let shape = object.transform.apply(&asset.mesh)?;
+            let rows = object.albedo(&asset)?;
+            warnings.extend(asset.warnings.iter().map(|w| format!("object {k}: {w}")));
             if !object.material.brdf()?.is_lambert() {
                 return Err(SceneError::SceneFile(format!(
                     "object {k}: a glossy material is shaded in dynamic scenes (relight scene); \
@@ -343,7 +378,6 @@ impl SceneFile {
                 ))
                 .into());
             }
-            let rows = Array2::from_shape_fn((shape.vertex_count(), 3), |(_, c)| a[c]);
             albedo
                 .append(ndarray::Axis(0), rows.view())
                 .expect("(V, 3)");
@@ -363,6 +397,7 @@ impl SceneFile {
             ground_plane: false,
             ground_cells: None,
             ground_vertices: 0,
+            warnings,
         };
         if let Some(cells) = ground_cells {
             scene.add_ground_plane_of(cells)?;

@@ -32,6 +32,8 @@ use std::path::Path;
 use ndarray::{Array2, ArrayView2, Axis};
 
 use crate::relight::SceneError;
+use crate::relight::scene::asset::MeshAsset;
+use crate::relight::scene::texture::srgb_to_linear;
 use crate::{Error, Result};
 
 /// An axis-aligned bounding box.
@@ -147,7 +149,8 @@ impl Mesh {
         })
     }
 
-    /// Reads an OBJ (`.obj`) or PLY (`.ply`) file, chosen by the extension.
+    /// Reads an OBJ (`.obj`), PLY (`.ply`), glTF (`.gltf`) or GLB (`.glb`) file, chosen by the
+    /// extension: the geometry of [`MeshAsset::load`], without its colour.
     ///
     /// ```
     /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/testdata/meshes/bunny.ply");
@@ -155,19 +158,7 @@ impl Mesh {
     /// assert_eq!((bunny.vertex_count(), bunny.triangles().len()), (1839, 3674));
     /// ```
     pub fn load(path: &Path) -> Result<Self> {
-        let extension = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        let mesh = match extension.as_deref() {
-            Some("obj") => read_obj(path),
-            Some("ply") => read_ply(path),
-            _ => Err(Error::Format {
-                path: path.to_path_buf(),
-                reason: "a mesh must be an .obj or .ply file".into(),
-            }),
-        };
-        mesh.map_err(|e| e.in_file(path))
+        MeshAsset::load(path).map(|asset| asset.mesh)
     }
 
     /// The vertex positions, `(V, 3)`.
@@ -227,6 +218,16 @@ impl Mesh {
             .expect("both are (V, 3)");
         self.triangles
             .extend(other.triangles.iter().map(|t| t.map(|i| i + offset)));
+    }
+
+    /// The mesh with every triangle's winding reversed (`[a, b, c]` to `[a, c, b]`), normals
+    /// kept: what a mirroring transform needs to keep triangles counter-clockwise seen from
+    /// outside.
+    pub(crate) fn reversed(mut self) -> Mesh {
+        for t in &mut self.triangles {
+            t.swap(1, 2);
+        }
+        self
     }
 
     /// The mesh with every position mapped by `position` and every normal by `normal` (then
@@ -383,98 +384,12 @@ fn fan(polygon: &[u32], triangles: &mut Vec<[u32; 3]>) {
 
 /// A parse failure as one line: the PLY reader's messages span several lines (the line, the
 /// string, the nested error), and an error is printed on one.
-fn corrupt(reason: impl std::fmt::Display) -> Error {
+pub(crate) fn corrupt(reason: impl std::fmt::Display) -> Error {
     let reason = reason.to_string();
     SceneError::Corrupt(reason.split_whitespace().collect::<Vec<_>>().join(" ")).into()
 }
 
-fn read_obj(path: &Path) -> Result<Mesh> {
-    let text = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    // A UTF-8 byte-order mark would otherwise hide the first statement.
-    let text = text.strip_prefix("\u{feff}".as_bytes()).unwrap_or(&text);
-    parse_obj(&String::from_utf8_lossy(text))
-}
-
-/// Parses OBJ text: `v x y z [w]`, `vn x y z`, `f` with `a`, `a/t`, `a/t/n` or `a//n` corners
-/// (1-based, or negative for relative); every other statement is ignored. File normals are used
-/// only when every corner's normal index equals its position index (the only way they can be
-/// per-vertex normals).
-fn parse_obj(text: &str) -> Result<Mesh> {
-    let mut positions: Vec<f64> = Vec::new();
-    let mut file_normals: Vec<f64> = Vec::new();
-    let mut triangles = Vec::new();
-    let mut normals_per_vertex = true;
-    let mut polygon = Vec::new();
-    for (line_no, line) in text.lines().enumerate() {
-        let bad = |what: &str| corrupt(format!("line {}: {what}", line_no + 1));
-        let mut words = line.split_whitespace();
-        let numbers = |words: std::str::SplitWhitespace<'_>, out: &mut Vec<f64>| -> Result<()> {
-            let parsed: Vec<f64> = words
-                .take(3)
-                .map(|w| w.parse::<f64>())
-                .collect::<Result<_, _>>()
-                .map_err(|_| bad("a coordinate is not a number"))?;
-            if parsed.len() != 3 {
-                return Err(bad("fewer than three coordinates"));
-            }
-            out.extend_from_slice(&parsed);
-            Ok(())
-        };
-        match words.next() {
-            Some("v") => numbers(words, &mut positions)?,
-            Some("vn") => numbers(words, &mut file_normals)?,
-            Some("f") => {
-                polygon.clear();
-                let v = (positions.len() / 3) as i64;
-                for corner in words {
-                    let mut parts = corner.split('/');
-                    let index = |part: Option<&str>| -> Result<Option<i64>> {
-                        match part {
-                            None | Some("") => Ok(None),
-                            Some(p) => match p.parse::<i64>() {
-                                Ok(0) => Err(bad("face index 0 (OBJ counts vertices from 1)")),
-                                Ok(i) => Ok(Some(if i < 0 { v + i } else { i - 1 })),
-                                Err(_) => Err(bad("a face index is not an integer")),
-                            },
-                        }
-                    };
-                    let position = index(parts.next())?.ok_or_else(|| bad("empty face corner"))?;
-                    let _texture = parts.next();
-                    let normal = index(parts.next())?;
-                    normals_per_vertex &= normal == Some(position);
-                    match u32::try_from(position) {
-                        Ok(p) if position < v => polygon.push(p),
-                        _ => {
-                            return Err(SceneError::IndexOutOfRange {
-                                triangle: triangles.len(),
-                                index: position as u64,
-                                vertices: v as usize,
-                            }
-                            .into());
-                        }
-                    }
-                }
-                if polygon.len() < 3 {
-                    return Err(bad("a face needs at least three corners"));
-                }
-                fan(&polygon, &mut triangles);
-            }
-            _ => {}
-        }
-    }
-    let v = positions.len() / 3;
-    let positions = Array2::from_shape_vec((v, 3), positions).map_err(corrupt)?;
-    let normals = (normals_per_vertex && !triangles.is_empty() && file_normals.len() == 3 * v)
-        .then(|| Array2::from_shape_vec((v, 3), file_normals))
-        .transpose()
-        .map_err(corrupt)?;
-    Mesh::new(positions, triangles, normals)
-}
-
-fn read_ply(path: &Path) -> Result<Mesh> {
+pub(crate) fn read_ply(path: &Path) -> Result<MeshAsset> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
     let file = std::fs::File::open(path).map_err(|source| Error::Io {
@@ -521,6 +436,8 @@ fn read_ply(path: &Path) -> Result<Mesh> {
     let mut positions = Array2::zeros((vertices.len(), 3));
     let mut normals = Array2::zeros((vertices.len(), 3));
     let mut has_normals = !vertices.is_empty();
+    let has_colour = vertices.first().is_some_and(|e| e.contains_key("red"));
+    let mut albedo = Array2::<f32>::zeros((if has_colour { vertices.len() } else { 0 }, 3));
     for (k, e) in vertices.iter().enumerate() {
         let p = read3(e, ["x", "y", "z"])
             .ok_or_else(|| corrupt(format!("vertex {k} has no numeric x, y and z")))?;
@@ -528,6 +445,10 @@ fn read_ply(path: &Path) -> Result<Mesh> {
         match read3(e, ["nx", "ny", "nz"]) {
             Some(n) => normals.row_mut(k).assign(&ndarray::arr1(&n)),
             None => has_normals = false,
+        }
+        if has_colour {
+            let rgb = ply_colour(e).map_err(|why| corrupt(format!("vertex {k}: {why}")))?;
+            albedo.row_mut(k).assign(&ndarray::arr1(&rgb));
         }
     }
     let mut triangles = Vec::with_capacity(faces.len());
@@ -554,7 +475,35 @@ fn read_ply(path: &Path) -> Result<Mesh> {
         }
         fan(&polygon, &mut triangles);
     }
-    Mesh::new(positions, triangles, has_normals.then_some(normals))
+    Ok(MeshAsset {
+        mesh: Mesh::new(positions, triangles, has_normals.then_some(normals))?,
+        albedo: has_colour.then_some(albedo),
+        warnings: Vec::new(),
+    })
+}
+
+/// A PLY vertex's `red green blue` as linear RGB: `uchar` (or `ushort`) as sRGB-encoded
+/// (divided by 255 or 65535, then [`srgb_to_linear`]), what scanners and exporters write;
+/// `float` or `double` as linear and in `[0, 1]`, as written by programs that store
+/// radiometric colour. Any other type, a missing channel, or a float outside `[0, 1]` is
+/// refused.
+fn ply_colour(e: &ply_rs_bw::ply::DefaultElement) -> std::result::Result<[f32; 3], String> {
+    use ply_rs_bw::ply::Property;
+    let mut out = [0.0f32; 3];
+    for (o, name) in out.iter_mut().zip(["red", "green", "blue"]) {
+        *o = match e.get(name) {
+            Some(Property::UChar(x)) => srgb_to_linear(f64::from(*x) / 255.0) as f32,
+            Some(Property::UShort(x)) => srgb_to_linear(f64::from(*x) / 65535.0) as f32,
+            Some(Property::Float(x)) if (0.0..=1.0).contains(x) => *x,
+            Some(Property::Double(x)) if (0.0..=1.0).contains(x) => *x as f32,
+            Some(Property::Float(_) | Property::Double(_)) => {
+                return Err(format!("a float {name} outside [0, 1]"));
+            }
+            Some(_) => return Err(format!("{name} is neither uchar, ushort, float nor double")),
+            None => return Err(format!("no {name} beside the first vertex's colour")),
+        };
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

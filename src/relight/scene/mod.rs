@@ -43,7 +43,8 @@
 //! }
 //! ```
 //!
-//! * `objects` (at least one): each has exactly one of `mesh` (an OBJ or PLY path) and
+//! * `objects` (at least one): each has exactly one of `mesh` (an OBJ, PLY, glTF or GLB path,
+//!   [`MeshAsset`]; where the file carries colour, its albedo times the material's) and
 //!   `generator` (one of the table's names with its settings, `{}` for the defaults);
 //!   `transform` (optional: scale, then rotate by `R = Rz(roll) Ry(yaw) Rx(pitch)` in degrees,
 //!   the sphere module's convention, then translate); `material` (optional, default Lambertian
@@ -55,15 +56,23 @@
 //! * `environment` (optional): the lighting's path and its rotation `g(p) = f(R p)`.
 //! * `camera` (optional): position, look-at point, vertical field of view in degrees.
 
+mod asset;
+mod asset_path;
 pub mod cache;
 pub mod cache_shard;
 mod file;
 pub(crate) mod framed;
 mod generators;
+mod gltf_file;
 mod ground;
 pub mod mesh;
+mod mtl;
+mod obj;
 pub(crate) mod shapes;
+pub mod texture;
 pub mod validate;
+
+pub use asset::MeshAsset;
 
 pub(crate) use file::read_json;
 pub use file::{CameraSpec, EnvironmentSpec, Material, SceneFile, SceneObject, Transform};
@@ -114,23 +123,44 @@ pub struct Scene {
     /// How many of the last vertices are the ground plane's (0 without one): `(N + 1)^2` for
     /// a grid of `N` cells.
     pub ground_vertices: usize,
+    /// What reading its mesh files approximated, one line each ([`MeshAsset::warnings`];
+    /// a scene file's prefixed by the object): the CLI prints them.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
     /// A scene of one mesh with the default material (and, if asked, the ground plane:
     /// errors as [`add_ground_plane`] does).
     pub fn from_mesh(mesh: Mesh, ground_plane: bool) -> Result<Scene> {
+        Self::from_asset(MeshAsset::plain(mesh), ground_plane)
+    }
+
+    /// A scene of one mesh file's asset: its own albedo where it carries colour, else the
+    /// default material's (and the ground plane, as [`from_mesh`](Self::from_mesh)).
+    ///
+    /// ```
+    /// use haarshift::relight::{Generator, Scene};
+    /// use haarshift::relight::scene::MeshAsset;
+    /// let mut asset = MeshAsset::plain(Generator::Sphere { cells: 1 }.mesh().unwrap());
+    /// asset.albedo = Some(ndarray::Array2::from_elem((24, 3), 0.25));
+    /// let scene = Scene::from_asset(asset, true).unwrap();
+    /// assert_eq!(scene.albedo.row(0).to_vec(), vec![0.25; 3]);
+    /// assert_eq!(scene.albedo.row(24).to_vec(), haarshift::relight::GROUND_ALBEDO.to_vec());
+    /// ```
+    pub fn from_asset(asset: MeshAsset, ground_plane: bool) -> Result<Scene> {
+        let v = asset.mesh.vertex_count();
         let mut scene = Scene {
-            albedo: Array2::zeros((0, 3)),
-            mesh,
+            albedo: asset
+                .albedo
+                .unwrap_or_else(|| Array2::from_shape_fn((v, 3), |(_, c)| DEFAULT_ALBEDO[c])),
+            mesh: asset.mesh,
             environment: None,
             camera: None,
             ground_plane: false,
             ground_cells: None,
             ground_vertices: 0,
+            warnings: asset.warnings,
         };
-        scene.albedo =
-            Array2::from_shape_fn((scene.mesh.vertex_count(), 3), |(_, c)| DEFAULT_ALBEDO[c]);
         if ground_plane {
             scene.add_ground_plane()?;
         }
@@ -208,8 +238,10 @@ impl Scene {
         object_vertices(self.mesh.vertex_count(), self.ground_vertices)
     }
 
-    /// Reads a scene: a JSON scene file (`.json`), or a mesh file (OBJ or PLY) as a scene of
-    /// one object with the default material; within the default [`MemoryBudget`].
+    /// Reads a scene: a JSON scene file (`.json`), or a mesh file (OBJ, PLY, glTF or GLB,
+    /// [`MeshAsset`]) as a scene of one object with the default material (the file's own
+    /// colour, where it carries colour, replacing the default albedo); within the default
+    /// [`MemoryBudget`].
     pub fn load(path: &Path) -> Result<Scene> {
         Self::load_within(path, &MemoryBudget::default())
     }
@@ -238,7 +270,7 @@ impl Scene {
             let (file, dir) = SceneFile::read(path)?;
             file.build_within(dir, budget)
         } else {
-            Scene::from_mesh(Mesh::load(path)?, false)
+            Scene::from_asset(MeshAsset::load_within(path, budget)?, false)
         };
         let scene = scene.map_err(|e| e.in_file(path))?;
         // A mesh file's size bounds its reader, not what the caller will store per vertex.

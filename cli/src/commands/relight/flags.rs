@@ -25,7 +25,7 @@ use crate::commands::{choice, names};
 /// A mesh or a scene file, and the ground plane.
 #[derive(clap::Args, Debug)]
 pub struct SceneFlags {
-    /// A mesh (.obj, .ply) or a scene file (.json)
+    /// A mesh (.obj, .ply, .gltf, .glb) or a scene file (.json)
     #[arg(value_name = "MESH|SCENE.json")]
     pub input: PathBuf,
 
@@ -67,6 +67,11 @@ impl SceneFlags {
     /// [`load`](Self::load) within `budget` (its limit is the caller's).
     pub fn load_within(&self, budget: MemoryBudget) -> Result<Scene> {
         let mut scene = Scene::load_within(&self.input, &budget)?;
+        // What the mesh files approximated (a glossy glTF material taken as its base colour):
+        // one line each, beside the work, not a refusal.
+        for warning in &scene.warnings {
+            eprintln!("haarshift: warning: {}: {warning}", self.input.display());
+        }
         let added = match (self.ground_plane, self.ground_cells) {
             (false, _) => Ok(()),
             (true, None) => scene.add_ground_plane(),
