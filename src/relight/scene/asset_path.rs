@@ -39,12 +39,21 @@ fn refused(part: &str, reason: impl Into<String>) -> Error {
 /// path is checked).
 pub(crate) fn resolve(part: &str, uri: &str, dir: &Path) -> Result<AssetSource> {
     if let Some(rest) = uri.strip_prefix("data:") {
-        return decode_data_uri(rest)
-            .map(AssetSource::Data)
-            .ok_or_else(|| refused(part, "a data: URI that is not base64 (data:[TYPE];base64,DATA)"));
+        return decode_data_uri(rest).map(AssetSource::Data).ok_or_else(|| {
+            refused(
+                part,
+                "a data: URI that is not base64 (data:[TYPE];base64,DATA)",
+            )
+        });
     }
-    let name = percent_decode(uri).ok_or_else(|| refused(part, format!("{uri:?} is not a valid URI")))?;
-    let leaves = |why: &str| refused(part, format!("{uri:?} {why}: an asset may name only files in its own folder"));
+    let name =
+        percent_decode(uri).ok_or_else(|| refused(part, format!("{uri:?} is not a valid URI")))?;
+    let leaves = |why: &str| {
+        refused(
+            part,
+            format!("{uri:?} {why}: an asset may name only files in its own folder"),
+        )
+    };
     if name.is_empty() {
         return Err(refused(part, "an empty URI"));
     }
@@ -68,8 +77,12 @@ pub(crate) fn resolve(part: &str, uri: &str, dir: &Path) -> Result<AssetSource> 
     }
     let path = dir.join(relative);
     let unreadable = |e: std::io::Error| refused(part, format!("{uri:?}: {e}"));
-    let folder = std::fs::canonicalize(if dir.as_os_str().is_empty() { Path::new(".") } else { dir })
-        .map_err(unreadable)?;
+    let folder = std::fs::canonicalize(if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    })
+    .map_err(unreadable)?;
     let target = std::fs::canonicalize(&path).map_err(unreadable)?;
     if !target.starts_with(&folder) {
         return Err(leaves("resolves (through a link) outside the folder"));
@@ -166,7 +179,10 @@ mod tests {
         ] {
             let r = reason(uri, dir.path());
             assert!(r.starts_with("buffer 0: "), "{r}");
-            assert!(r.contains(why) && r.contains("its own folder"), "{uri}: {r}");
+            assert!(
+                r.contains(why) && r.contains("its own folder"),
+                "{uri}: {r}"
+            );
         }
         assert!(reason("%zz", dir.path()).contains("not a valid URI"));
     }
@@ -181,8 +197,12 @@ mod tests {
             AssetSource::File(dir.path().join("./sub dir/x.bin"))
         );
         assert_eq!(
-            resolve("image 1", "data:application/octet-stream;base64,AAEC/w==", dir.path())
-                .unwrap(),
+            resolve(
+                "image 1",
+                "data:application/octet-stream;base64,AAEC/w==",
+                dir.path()
+            )
+            .unwrap(),
             AssetSource::Data(vec![0, 1, 2, 255])
         );
         assert!(reason("data:text/plain,hello", dir.path()).contains("not base64"));

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
-use crate::relight::scene::{MeshAsset, Scene};
 use crate::relight::scene::validate::{self, MemoryBudget};
+use crate::relight::scene::{MeshAsset, Scene};
 use crate::relight::{Brdf, Generator, Mesh, SceneError};
 use crate::sphere::SphereRotation;
 use crate::{Error, Result};

@@ -129,14 +129,15 @@ fn load_buffers(gltf: &gltf::Gltf, dir: &Path, budget: &MemoryBudget) -> Result<
             let part = format!("buffer {}", buffer.index());
             let length = buffer.length();
             let mut data = match buffer.source() {
-                gltf::buffer::Source::Bin => gltf
-                    .blob
-                    .clone()
-                    .ok_or_else(|| asset_error(&part, "names the GLB's BIN chunk, which the file lacks"))?,
+                gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
+                    asset_error(&part, "names the GLB's BIN chunk, which the file lacks")
+                })?,
                 gltf::buffer::Source::Uri(uri) => match resolve(&part, uri, dir)? {
                     AssetSource::Data(bytes) => bytes,
-                    AssetSource::File(file) => read_limited(&file, Some(length as u64), budget.limit)
-                        .map_err(|e| asset_error(&part, e))?,
+                    AssetSource::File(file) => {
+                        read_limited(&file, Some(length as u64), budget.limit)
+                            .map_err(|e| asset_error(&part, e))?
+                    }
                 },
             };
             if data.len() < length {
@@ -285,14 +286,29 @@ impl Reader<'_> {
             Ok(Some(e))
         };
         let normals = per_vertex(primitive.get(&Semantic::Normals), "NORMAL", FLOAT, &[3])?;
-        let colours = per_vertex(primitive.get(&Semantic::Colors(0)), "COLOR_0", COLOUR, &[3, 4])?;
+        let colours = per_vertex(
+            primitive.get(&Semantic::Colors(0)),
+            "COLOR_0",
+            COLOUR,
+            &[3, 4],
+        )?;
         let triangles = match primitive.indices() {
-            None if v % 3 == 0 => (0..v as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
-            None => return Err(SceneError::Corrupt(format!("{v} vertices without indices is not a list of triangles")).into()),
+            None if v % 3 == 0 => (0..v as u32 / 3)
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect(),
+            None => {
+                return Err(SceneError::Corrupt(format!(
+                    "{v} vertices without indices is not a list of triangles"
+                ))
+                .into());
+            }
             Some(indices) => {
                 let e = Elements::of(&indices, "indices", self.buffers, INDEX, &[1])?;
                 if e.count % 3 != 0 {
-                    return Err(asset_error(e.part, format!("{} indices is not a list of triangles", e.count)));
+                    return Err(asset_error(
+                        e.part,
+                        format!("{} indices is not a list of triangles", e.count),
+                    ));
                 }
                 let mut triangles = Vec::with_capacity(e.count / 3);
                 for t in 0..e.count / 3 {
@@ -315,13 +331,21 @@ impl Reader<'_> {
             }
         };
         let to_array = |e: &Elements<'_>| Array2::from_shape_fn((v, 3), |(k, c)| e.get(k, c));
-        let local = Mesh::new(to_array(&positions), triangles, normals.as_ref().map(to_array))?;
+        let local = Mesh::new(
+            to_array(&positions),
+            triangles,
+            normals.as_ref().map(to_array),
+        )?;
         let linear: [[f64; 3]; 3] = std::array::from_fn(|c| std::array::from_fn(|r| matrix[c][r]));
         let cofactor = cofactor(&linear);
         let det: f64 = (0..3).map(|r| linear[0][r] * cofactor[0][r]).sum();
         let sign = if det < 0.0 { -1.0 } else { 1.0 };
         let world = local.mapped(
-            |p| std::array::from_fn(|r| (0..3).map(|c| linear[c][r] * p[c]).sum::<f64>() + matrix[3][r]),
+            |p| {
+                std::array::from_fn(|r| {
+                    (0..3).map(|c| linear[c][r] * p[c]).sum::<f64>() + matrix[3][r]
+                })
+            },
             |n| std::array::from_fn(|r| sign * (0..3).map(|c| cofactor[c][r] * n[c]).sum::<f64>()),
         )?;
         let world = if det < 0.0 { world.reversed() } else { world };
@@ -359,7 +383,10 @@ impl Reader<'_> {
             let name = format!("TEXCOORD_{set}");
             let uv = Elements::of(&accessor, &name, self.buffers, TEXCOORD, &[2])?;
             if uv.count != v {
-                return Err(asset_error(uv.part, format!("has {} elements for {v} vertices", uv.count)));
+                return Err(asset_error(
+                    uv.part,
+                    format!("has {} elements for {v} vertices", uv.count),
+                ));
             }
             let texture = info.texture();
             let sampler = texture.sampler();
@@ -396,15 +423,22 @@ impl Reader<'_> {
         if !self.textures.contains_key(&k) {
             let part = format!("image {k}");
             let bytes = match image.source() {
-                gltf::image::Source::View { view, .. } => view_bytes(&view, self.buffers, &part)?.to_vec(),
+                gltf::image::Source::View { view, .. } => {
+                    view_bytes(&view, self.buffers, &part)?.to_vec()
+                }
                 gltf::image::Source::Uri { uri, .. } => match resolve(&part, uri, self.dir)? {
                     AssetSource::Data(bytes) => bytes,
                     AssetSource::File(file) => read_limited(&file, None, self.budget.limit)
                         .map_err(|e| asset_error(&part, e))?,
                 },
             };
-            let texture = Texture::decode(&bytes, Path::new(&part), self.budget.limit)
-                .map_err(|e| asset_error(&part, e.to_string().trim_start_matches(&format!("{part}: "))))?;
+            let texture =
+                Texture::decode(&bytes, Path::new(&part), self.budget.limit).map_err(|e| {
+                    asset_error(
+                        &part,
+                        e.to_string().trim_start_matches(&format!("{part}: ")),
+                    )
+                })?;
             self.textures.insert(k, texture);
         }
         Ok(&self.textures[&k])
@@ -420,7 +454,11 @@ fn cofactor(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
 }
 
 /// The bytes of a buffer view, checked against its buffer.
-fn view_bytes<'b>(view: &gltf::buffer::View<'_>, buffers: &'b [Vec<u8>], part: &str) -> Result<&'b [u8]> {
+fn view_bytes<'b>(
+    view: &gltf::buffer::View<'_>,
+    buffers: &'b [Vec<u8>],
+    part: &str,
+) -> Result<&'b [u8]> {
     let buffer = &buffers[view.buffer().index()];
     view.offset()
         .checked_add(view.length())
@@ -442,9 +480,17 @@ fn view_bytes<'b>(view: &gltf::buffer::View<'_>, buffers: &'b [Vec<u8>], part: &
 /// A component type an attribute may have, and whether it must be normalised.
 type Kind = (DataType, bool);
 const FLOAT: &[Kind] = &[(DataType::F32, false)];
-const TEXCOORD: &[Kind] = &[(DataType::F32, false), (DataType::U8, true), (DataType::U16, true)];
+const TEXCOORD: &[Kind] = &[
+    (DataType::F32, false),
+    (DataType::U8, true),
+    (DataType::U16, true),
+];
 const COLOUR: &[Kind] = TEXCOORD;
-const INDEX: &[Kind] = &[(DataType::U8, false), (DataType::U16, false), (DataType::U32, false)];
+const INDEX: &[Kind] = &[
+    (DataType::U8, false),
+    (DataType::U16, false),
+    (DataType::U32, false),
+];
 
 /// An accessor's elements, bounds checked once: element `k`'s component `c` is read from
 /// `bytes[k * stride + c * size..]`.
@@ -496,13 +542,11 @@ impl<'b> Elements<'b> {
         let element = size * components;
         let stride = view.stride().unwrap_or(element);
         let count = accessor.count();
-        let end = count
-            .checked_sub(1)
-            .map_or(Some(0), |last| {
-                last.checked_mul(stride)?
-                    .checked_add(element)?
-                    .checked_add(accessor.offset())
-            });
+        let end = count.checked_sub(1).map_or(Some(0), |last| {
+            last.checked_mul(stride)?
+                .checked_add(element)?
+                .checked_add(accessor.offset())
+        });
         match end {
             Some(end) if stride >= element && end <= bytes.len() => Ok(Elements {
                 bytes: &bytes[accessor.offset().min(bytes.len())..],

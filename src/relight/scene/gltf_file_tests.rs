@@ -65,7 +65,10 @@ fn load(doc: &Value, budget: &MemoryBudget) -> (Result<MeshAsset>, tempfile::Tem
 fn refusal(doc: &Value) -> String {
     let (result, dir) = load(doc, &MemoryBudget::default());
     let e = result.unwrap_err().to_string();
-    assert!(e.starts_with(&format!("{}: ", dir.path().join("x.gltf").display())), "{e}");
+    assert!(
+        e.starts_with(&format!("{}: ", dir.path().join("x.gltf").display())),
+        "{e}"
+    );
     assert_eq!(e.lines().count(), 1, "{e}");
     e
 }
@@ -85,17 +88,27 @@ fn the_glb_the_gltf_and_the_obj_with_mtl_read_the_same_mesh_and_albedo() {
     let ply = MeshAsset::load(&meshes("bunny_boxes_colours.ply")).unwrap();
     assert_eq!(ply.mesh.positions(), glb.mesh.positions());
     assert_eq!(ply.mesh.triangles(), glb.mesh.triangles());
-    let normals = (&ply.mesh.normals() - &glb.mesh.normals()).iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    let normals = (&ply.mesh.normals() - &glb.mesh.normals())
+        .iter()
+        .fold(0.0f64, |m, d| m.max(d.abs()));
     assert!(normals < 1e-15, "{normals}");
     let oracle = ply.albedo.unwrap();
-    let worst = (&oracle - albedo).iter().fold(0.0f32, |m, d| m.max(d.abs()));
+    let worst = (&oracle - albedo)
+        .iter()
+        .fold(0.0f32, |m, d| m.max(d.abs()));
     assert!(worst < 1e-6, "{worst}");
     // The texture varies: the bunny is not one colour.
-    let spread = albedo.column(0).iter().take(1839).fold((1.0f32, 0.0f32), |(lo, hi), &a| (lo.min(a), hi.max(a)));
+    let spread = albedo
+        .column(2)
+        .iter()
+        .take(1839)
+        .fold((1.0f32, 0.0f32), |(lo, hi), &a| (lo.min(a), hi.max(a)));
     assert!(spread.1 - spread.0 > 0.3, "{spread:?}");
     let obj = MeshAsset::load(&meshes("bunny_boxes.obj")).unwrap();
     assert_eq!(obj.mesh.triangles(), glb.mesh.triangles());
-    let worst = (obj.albedo.unwrap() - albedo).iter().fold(0.0f32, |m, d| m.max(d.abs()));
+    let worst = (obj.albedo.unwrap() - albedo)
+        .iter()
+        .fold(0.0f32, |m, d| m.max(d.abs()));
     assert!(worst < 1e-6, "{worst}");
 }
 
@@ -125,16 +138,31 @@ fn the_hierarchy_composes_transforms_and_the_mirrored_node_keeps_outward_normals
         let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
         r.map(|x| x / len)
     };
-    let mirror = [[-1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [-3.0, 0.0, 0.0, 1.0]];
+    let mirror = [
+        [-1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [-3.0, 0.0, 0.0, 1.0],
+    ];
     // The stored box: 24 vertices, faces +X, -X, +Y, -Y, +Z, -Z with their normals.
-    let face_normals = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    let face_normals = [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
     let local = asset.mesh.positions();
     let (p, n) = (asset.mesh.positions(), asset.mesh.normals());
     // Recover the local box from the mirrored copy (its own inverse) and check both copies.
     for k in 0..24 {
         let mirrored = [p[[24 + k, 0]], p[[24 + k, 1]], p[[24 + k, 2]]];
         let original = [-(mirrored[0] + 3.0), mirrored[1], mirrored[2]];
-        assert!(original.iter().all(|x| (x.abs() - 0.5).abs() < 1e-12), "{original:?}");
+        assert!(
+            original.iter().all(|x| (x.abs() - 0.5).abs() < 1e-12),
+            "{original:?}"
+        );
         let expected = world(original);
         for c in 0..3 {
             assert!((local[[k, c]] - expected[c]).abs() < 1e-6, "vertex {k}");
@@ -143,10 +171,17 @@ fn the_hierarchy_composes_transforms_and_the_mirrored_node_keeps_outward_normals
         let stored = face_normals[k / 4];
         let expected = normal(stored);
         for c in 0..3 {
-            assert!((n[[k, c]] - expected[c]).abs() < 1e-6, "normal {k}: {:?}", n.row(k));
+            assert!(
+                (n[[k, c]] - expected[c]).abs() < 1e-6,
+                "normal {k}: {:?}",
+                n.row(k)
+            );
         }
         // Mirrored: x negated (the inverse transpose of a reflection is itself).
-        assert_eq!([n[[24 + k, 0]], n[[24 + k, 1]], n[[24 + k, 2]]], [-stored[0], stored[1], stored[2]]);
+        assert_eq!(
+            [n[[24 + k, 0]], n[[24 + k, 1]], n[[24 + k, 2]]],
+            [-stored[0], stored[1], stored[2]]
+        );
     }
     // Both copies' triangles are counter-clockwise seen from outside: the geometric normal
     // agrees with the vertex normals and points away from the box's centre.
@@ -158,21 +193,38 @@ fn the_hierarchy_composes_transforms_and_the_mirrored_node_keeps_outward_normals
             crate::relight::scene::mesh::sub(b, a),
             crate::relight::scene::mesh::sub(c, a),
         );
-        let vertex_normal = [n[[tri[0] as usize, 0]], n[[tri[0] as usize, 1]], n[[tri[0] as usize, 2]]];
+        let vertex_normal = [
+            n[[tri[0] as usize, 0]],
+            n[[tri[0] as usize, 1]],
+            n[[tri[0] as usize, 2]],
+        ];
         let outward = crate::relight::scene::mesh::sub(a, centres[t / 12]);
-        assert!(crate::relight::scene::mesh::dot(g, vertex_normal) > 0.0, "triangle {t}");
-        assert!(crate::relight::scene::mesh::dot(g, outward) > 0.0, "triangle {t}");
+        assert!(
+            crate::relight::scene::mesh::dot(g, vertex_normal) > 0.0,
+            "triangle {t}"
+        );
+        assert!(
+            crate::relight::scene::mesh::dot(g, outward) > 0.0,
+            "triangle {t}"
+        );
     }
     // Without its stored normals the mirrored box's computed normals point outward too.
-    let mut doc: Value = serde_json::from_slice(&std::fs::read(meshes("hierarchy.gltf")).unwrap()).unwrap();
-    doc["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap().remove("NORMAL");
+    let mut doc: Value =
+        serde_json::from_slice(&std::fs::read(meshes("hierarchy.gltf")).unwrap()).unwrap();
+    doc["meshes"][0]["primitives"][0]["attributes"]
+        .as_object_mut()
+        .unwrap()
+        .remove("NORMAL");
     let (computed, _dir) = load(&doc, &MemoryBudget::default());
     let computed = computed.unwrap();
     for k in 0..48 {
         let row = computed.mesh.normals().row(k).to_vec();
         let centre = centres[k / 24];
         let out = crate::relight::scene::mesh::sub([p[[k, 0]], p[[k, 1]], p[[k, 2]]], centre);
-        assert!(crate::relight::scene::mesh::dot([row[0], row[1], row[2]], out) > 0.0, "vertex {k}");
+        assert!(
+            crate::relight::scene::mesh::dot([row[0], row[1], row[2]], out) > 0.0,
+            "vertex {k}"
+        );
     }
 }
 
@@ -190,9 +242,10 @@ fn the_default_material_factor_texture_and_colour_multiply() {
         d["meshes"][0]["primitives"][0]["material"] = json!(0);
         d["materials"] = json!([{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 1, 1],
             "metallicFactor": 0.5}}]);
-        d["accessors"].as_array_mut().unwrap().push(
-            json!({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"}),
-        );
+        d["accessors"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"}));
     });
     let (asset, _d) = load(&doc, &MemoryBudget::default());
     let asset = asset.unwrap();
@@ -200,26 +253,91 @@ fn the_default_material_factor_texture_and_colour_multiply() {
     assert_eq!(albedo.row(0).to_vec(), vec![0.25, 0.5, 0.25]);
     assert_eq!(albedo.row(2).to_vec(), vec![0.0, 0.25, 1.0]);
     assert_eq!(asset.warnings.len(), 1);
-    assert!(asset.warnings[0].starts_with("material 0 is metallic or glossy (metallicFactor 0.5, roughnessFactor 1)"), "{:?}", asset.warnings);
+    assert!(
+        asset.warnings[0].starts_with(
+            "material 0 is metallic or glossy (metallicFactor 0.5, roughnessFactor 1)"
+        ),
+        "{:?}",
+        asset.warnings
+    );
 }
 
 #[test]
 fn hostile_documents_are_refused_in_one_line_naming_the_part() {
     let cases: Vec<(Value, &[&str])> = vec![
-        (triangle(&[], |d| d["meshes"][0]["primitives"][0]["mode"] = json!(1)), &["primitive 0", "mode Lines", "only triangle lists"]),
-        (triangle(&[], |d| d["accessors"][0]["count"] = json!(4)), &["POSITION (accessor 0)", "run past its buffer view's 36 bytes"]),
-        (triangle(&[], |d| d["bufferViews"][1]["byteLength"] = json!(600)), &["buffer view 1", "runs past its buffer's 44 bytes"]),
-        (triangle(&[], |d| d["accessors"][1]["count"] = json!(2)), &["2 indices is not a list of triangles"]),
-        (triangle(&[], |d| d["accessors"][0]["componentType"] = json!(5121)), &["POSITION (accessor 0)", "not a type this attribute may have"]),
-        (triangle(&[], |d| d["buffers"][0]["uri"] = json!("missing.bin")), &["buffer 0", "missing.bin"]),
-        (triangle(&[], |d| d["buffers"][0]["uri"] = json!("../x.bin")), &["buffer 0", "climbs out"]),
-        (triangle(&[], |d| d["buffers"][0]["uri"] = json!("file:///etc/passwd")), &["buffer 0", "scheme"]),
-        (triangle(&[], |d| d["buffers"][0]["byteLength"] = json!(1000)), &["buffer 0", "holds 44 bytes, its byteLength says 1000"]),
-        (triangle(&[], |d| d["nodes"][0]["scale"] = json!([1e39, 1, 1])), &["node 0", "not finite"]),
-        (triangle(&[], |d| d["nodes"] = json!([{"mesh": 0, "children": [1]}, {"children": [0]}])), &["node 0", "is a root of the scene and has a parent"]),
-        (triangle(&[], |d| d["nodes"] = json!([{"children": [2]}, {"children": [2]}, {"mesh": 0}])), &["node 2", "more than one parent"]),
-        (triangle(&[], |d| { d.as_object_mut().unwrap().remove("scenes"); }), &["no scene"]),
-        (triangle(&[], |d| d["accessors"] = json!("x")), &["not a valid glTF 2.0 file"]),
+        (
+            triangle(&[], |d| d["meshes"][0]["primitives"][0]["mode"] = json!(1)),
+            &["primitive 0", "mode Lines", "only triangle lists"],
+        ),
+        (
+            triangle(&[], |d| d["accessors"][0]["count"] = json!(4)),
+            &[
+                "POSITION (accessor 0)",
+                "run past its buffer view's 36 bytes",
+            ],
+        ),
+        (
+            triangle(&[], |d| d["bufferViews"][1]["byteLength"] = json!(600)),
+            &["buffer view 1", "runs past its buffer's 44 bytes"],
+        ),
+        (
+            triangle(&[], |d| d["accessors"][1]["count"] = json!(2)),
+            &["2 indices is not a list of triangles"],
+        ),
+        (
+            triangle(&[], |d| d["accessors"][0]["componentType"] = json!(5121)),
+            &[
+                "POSITION (accessor 0)",
+                "not a type this attribute may have",
+            ],
+        ),
+        (
+            triangle(&[], |d| d["buffers"][0]["uri"] = json!("missing.bin")),
+            &["buffer 0", "missing.bin"],
+        ),
+        (
+            triangle(&[], |d| d["buffers"][0]["uri"] = json!("../x.bin")),
+            &["buffer 0", "climbs out"],
+        ),
+        (
+            triangle(&[], |d| {
+                d["buffers"][0]["uri"] = json!("file:///etc/passwd")
+            }),
+            &["buffer 0", "scheme"],
+        ),
+        (
+            triangle(&[], |d| d["buffers"][0]["byteLength"] = json!(1000)),
+            &["buffer 0", "holds 44 bytes, its byteLength says 1000"],
+        ),
+        (
+            triangle(
+                &[],
+                |d| d["nodes"] = json!([{"scale": [3e38, 1, 1], "children": [1]}, {"scale": [3e38, 1, 1], "mesh": 0}]),
+            ),
+            &["node 1", "not finite"],
+        ),
+        (
+            triangle(&[], |d| {
+                d["nodes"] = json!([{"mesh": 0, "children": [1]}, {"children": [0]}])
+            }),
+            &["node 0", "is a root of the scene and has a parent"],
+        ),
+        (
+            triangle(&[], |d| {
+                d["nodes"] = json!([{"children": [2]}, {"children": [2]}, {"mesh": 0}])
+            }),
+            &["node 2", "more than one parent"],
+        ),
+        (
+            triangle(&[], |d| {
+                d.as_object_mut().unwrap().remove("scenes");
+            }),
+            &["no scene"],
+        ),
+        (
+            triangle(&[], |d| d["accessors"] = json!("x")),
+            &["not a valid glTF 2.0 file"],
+        ),
     ];
     for (doc, needles) in cases {
         let e = refusal(&doc);
@@ -240,13 +358,19 @@ fn indices_beyond_the_vertices_and_nan_positions_are_refused() {
     let mut bad_index = bytes.clone();
     bad_index[38..40].copy_from_slice(&7u16.to_le_bytes());
     bytes[16..20].copy_from_slice(&f32::NAN.to_le_bytes());
-    for (data, needle) in [(bad_index, "refers to vertex 7 but there are 3 vertices"), (bytes, "vertex 1 has a non-finite position")] {
+    for (data, needle) in [
+        (bad_index, "refers to vertex 7 but there are 3 vertices"),
+        (bytes, "vertex 1 has a non-finite position"),
+    ] {
         doc["buffers"][0]["uri"] = json!(format!(
             "data:application/octet-stream;base64,{}",
             base64::engine::general_purpose::STANDARD.encode(&data)
         ));
         let e = refusal(&doc);
-        assert!(e.contains("node 0, mesh 0, primitive 0: ") && e.contains(needle), "{e}");
+        assert!(
+            e.contains("node 0, mesh 0, primitive 0: ") && e.contains(needle),
+            "{e}"
+        );
     }
 }
 
@@ -258,10 +382,18 @@ fn counts_and_textures_beyond_the_budget_are_refused_before_they_are_read() {
         d["nodes"] = json!(nodes);
         d["scenes"] = json!([{"nodes": (0..200).collect::<Vec<_>>()}]);
     });
-    let small = MemoryBudget { limit: 100_000, ..MemoryBudget::default() };
+    let small = MemoryBudget {
+        limit: 100_000,
+        ..MemoryBudget::default()
+    };
     let (result, _d) = load(&doc, &small);
     let e = result.unwrap_err().to_string();
-    assert!(e.contains("the glTF's primitives, every instance counted (600 vertices) needs 384000 bytes"), "{e}");
+    assert!(
+        e.contains(
+            "the glTF's primitives, every instance counted (600 vertices) needs 384000 bytes"
+        ),
+        "{e}"
+    );
     // A PNG whose header claims 60000 x 60000 RGB: refused from the header.
     let mut png = Vec::new();
     png.extend_from_slice(b"\x89PNG\r\n\x1a\n");
@@ -284,16 +416,22 @@ fn counts_and_textures_beyond_the_budget_are_refused_before_they_are_read() {
             d["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
             d["textures"] = json!([{"source": 0}]);
             d["images"] = json!([image]);
-            d["accessors"].as_array_mut().unwrap().push(
-                json!({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}),
-            );
+            d["accessors"]
+                .as_array_mut()
+                .unwrap()
+                .push(json!({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}));
         })
     };
-    let huge = textured(json!({"uri": format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(&png))}));
+    let huge = textured(
+        json!({"uri": format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(&png))}),
+    );
     let e = refusal(&huge);
     assert!(e.contains("image 0: ") && e.contains("memory limit"), "{e}");
     let outside = refusal(&textured(json!({"uri": "../checker.png"})));
-    assert!(outside.contains("image 0: \"../checker.png\" climbs out"), "{outside}");
+    assert!(
+        outside.contains("image 0: \"../checker.png\" climbs out"),
+        "{outside}"
+    );
     let missing_uv = triangle(&[], |d| {
         d["meshes"][0]["primitives"][0]["material"] = json!(0);
         d["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);

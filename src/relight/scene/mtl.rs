@@ -86,19 +86,23 @@ pub(crate) fn read_mtl(
             }
             _ => {
                 if rest.starts_with('-') || rest.is_empty() {
-                    return Err(bad(line_no, "map_Kd takes one file name; its options are not read".into()));
+                    return Err(bad(
+                        line_no,
+                        "map_Kd takes one file name; its options are not read".into(),
+                    ));
                 }
                 let texture_part = format!("{part}, line {line_no}, map_Kd");
                 let bytes = match resolve(&texture_part, rest, dir)? {
                     AssetSource::Data(bytes) => bytes,
                     AssetSource::File(file) => read_limited(&file, None, memory_limit)?,
                 };
-                let texture = Texture::decode(&bytes, Path::new(rest), memory_limit).map_err(|e| {
-                    Error::from(SceneError::Asset {
-                        part: texture_part.clone(),
-                        reason: e.to_string(),
-                    })
-                })?;
+                let texture =
+                    Texture::decode(&bytes, Path::new(rest), memory_limit).map_err(|e| {
+                        Error::from(SceneError::Asset {
+                            part: texture_part.clone(),
+                            reason: e.to_string(),
+                        })
+                    })?;
                 material.texture = Some(texture);
             }
         }

@@ -150,7 +150,9 @@ fn parse_obj(text: &str, dir: &Path, memory_limit: u64) -> Result<MeshAsset> {
                     let uv = match uv {
                         None => None,
                         Some(t) if (0..uvs.len() as i64).contains(&t) => Some(t as u32),
-                        Some(_) => return Err(bad("a texture coordinate index beyond the vt read so far")),
+                        Some(_) => {
+                            return Err(bad("a texture coordinate index beyond the vt read so far"));
+                        }
                     };
                     polygon.push(Corner {
                         position,
@@ -209,9 +211,10 @@ fn split_by_material(
     let v = geometry.vertex_count();
     // A texture coordinate matters only where the material has a texture.
     let key = |c: Corner| Corner {
-        uv: c
-            .uv
-            .filter(|_| c.material.is_some_and(|m| library[m as usize].texture.is_some())),
+        uv: c.uv.filter(|_| {
+            c.material
+                .is_some_and(|m| library[m as usize].texture.is_some())
+        }),
         ..c
     };
     let mut vertices: Vec<Corner> = (0..v as u32)
@@ -241,7 +244,9 @@ fn split_by_material(
     }
     let (positions, normals) = (geometry.positions(), geometry.normals());
     let split = |a: ndarray::ArrayView2<'_, f64>| {
-        Array2::from_shape_fn((vertices.len(), 3), |(k, c)| a[[vertices[k].position as usize, c]])
+        Array2::from_shape_fn((vertices.len(), 3), |(k, c)| {
+            a[[vertices[k].position as usize, c]]
+        })
     };
     let mesh = Mesh::new(split(positions), triangles, Some(split(normals)))?;
     let albedo = Array2::from_shape_fn((vertices.len(), 3), |(k, c)| {

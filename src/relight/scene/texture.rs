@@ -121,8 +121,7 @@ impl Texture {
     /// assert!(Texture::decode(png, "coins.png".as_ref(), 1000).is_err());
     /// ```
     pub fn decode(bytes: &[u8], name: &Path, memory_limit: u64) -> Result<Texture> {
-        let image =
-            read_image_from_memory::<f32>(bytes, name, &ReadOptions { memory_limit })?;
+        let image = read_image_from_memory::<f32>(bytes, name, &ReadOptions { memory_limit })?;
         let scale = image.depth().integer_max().unwrap_or(1.0);
         let planes = image.color_planes();
         let (channels, height, width) = planes.dim();
@@ -156,7 +155,8 @@ impl Texture {
         let size = [self.width, self.height];
         // Texel-centre coordinates; clamped far beyond any wrap period so that the casts
         // below stay exact integers.
-        let x: [f64; 2] = std::array::from_fn(|a| (uv[a] * size[a] as f64 - 0.5).clamp(-1e15, 1e15));
+        let x: [f64; 2] =
+            std::array::from_fn(|a| (uv[a] * size[a] as f64 - 0.5).clamp(-1e15, 1e15));
         let texel = |i: i64, j: i64| {
             let (i, j) = (wrap[0].index(i, self.width), wrap[1].index(j, self.height));
             self.texels[j * self.width + i]
@@ -167,7 +167,12 @@ impl Texture {
         let base = x.map(f64::floor);
         let f = [x[0] - base[0], x[1] - base[1]];
         let (i, j) = (base[0] as i64, base[1] as i64);
-        let (a, b, c, d) = (texel(i, j), texel(i + 1, j), texel(i, j + 1), texel(i + 1, j + 1));
+        let (a, b, c, d) = (
+            texel(i, j),
+            texel(i + 1, j),
+            texel(i, j + 1),
+            texel(i + 1, j + 1),
+        );
         std::array::from_fn(|k| {
             let top = f64::from(a[k]) * (1.0 - f[0]) + f64::from(b[k]) * f[0];
             let bottom = f64::from(c[k]) * (1.0 - f[0]) + f64::from(d[k]) * f[0];
@@ -225,7 +230,10 @@ mod tests {
         // x = 0.25, y = 0.3 by hand: channel 2 = 0.25 + 10 * 0.3 = 3.25.
         let (u, v) = ((0.5 + 0.25) / 3.0, (0.5 + 0.3) / 2.0);
         let s = at(u, v);
-        assert!((s[0] - 0.25).abs() < 1e-6 && (s[1] - 0.3).abs() < 1e-6, "{s:?}");
+        assert!(
+            (s[0] - 0.25).abs() < 1e-6 && (s[1] - 0.3).abs() < 1e-6,
+            "{s:?}"
+        );
         assert!((s[2] - 3.25).abs() < 1e-6, "{s:?}");
         // Beyond the last centre a clamped texture stays at the edge texel.
         assert_eq!(at(0.99, 0.99), [2.0, 1.0, 12.0]);
@@ -238,12 +246,18 @@ mod tests {
         let folded = |w: Wrap| (-4..7).map(|i| w.index(i, n)).collect::<Vec<_>>();
         assert_eq!(folded(Wrap::Repeat), [2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0]);
         assert_eq!(folded(Wrap::ClampToEdge), [0, 0, 0, 0, 0, 1, 2, 2, 2, 2, 2]);
-        assert_eq!(folded(Wrap::MirroredRepeat), [2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0]);
+        assert_eq!(
+            folded(Wrap::MirroredRepeat),
+            [2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0]
+        );
         // Repeat: half way between the last texel and the first across the seam.
         let t = ramp();
         let s = t.sample([1.0, 0.25], [Wrap::Repeat; 2], Filter::Linear);
         assert_eq!(s[0], 1.0); // (2 + 0) / 2
-        assert_eq!(t.sample([f64::NAN, 0.25], [Wrap::Repeat; 2], Filter::Nearest)[0], 0.0);
+        assert_eq!(
+            t.sample([f64::NAN, 0.25], [Wrap::Repeat; 2], Filter::Nearest)[0],
+            0.0
+        );
     }
 
     #[test]
@@ -251,11 +265,19 @@ mod tests {
         // A 2 x 1 8-bit RGB PNG: (0, 128, 255) and (10, 20, 30).
         let mut png = Vec::new();
         image::codecs::png::PngEncoder::new(&mut png)
-            .write_image(&[0, 128, 255, 10, 20, 30], 2, 1, image::ExtendedColorType::Rgb8)
+            .write_image(
+                &[0, 128, 255, 10, 20, 30],
+                2,
+                1,
+                image::ExtendedColorType::Rgb8,
+            )
             .unwrap();
         let t = Texture::decode(&png, "t.png".as_ref(), 1 << 20).unwrap();
         let lin = |k: u8| srgb_to_linear(f64::from(k) / 255.0) as f32;
-        assert_eq!(t.texels, vec![[lin(0), lin(128), lin(255)], [lin(10), lin(20), lin(30)]]);
+        assert_eq!(
+            t.texels,
+            vec![[lin(0), lin(128), lin(255)], [lin(10), lin(20), lin(30)]]
+        );
         assert!(Texture::from_linear(2, 2, vec![[0.0; 3]; 3]).is_err());
     }
 
