@@ -18,14 +18,14 @@ fn sky(n: usize) -> LatLongMap<f64> {
     .unwrap()
 }
 
-/// A 2 x 2 floor facing +Y, `cells` a side, with (when `wall`) a 2 x 1 wall at its back edge
-/// facing it.
+/// A 2 x 2 floor facing +Y, `cells` a side, with (when `wall`) a 2 x 1 wall just behind its
+/// back edge facing it.
 fn scene(cells: usize, wall: bool) -> Mesh {
     let floor = grid([-1.0, 0.0, 1.0], [2.0, 0.0, 0.0], [0.0, 0.0, -2.0], cells, cells).unwrap();
     if !wall {
         return floor;
     }
-    let wall = grid([-1.0, 0.0, -1.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], cells, cells).unwrap();
+    let wall = grid([-1.0, 0.0, -1.1], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], cells, cells).unwrap();
     merge([floor, wall])
 }
 
