@@ -267,7 +267,12 @@ pub fn interreflected(
 }
 
 /// Refuses more than [`MAX_BOUNCES`] bounces.
-pub(crate) fn check_bounces(bounces: usize) -> Result<()> {
+///
+/// ```
+/// use haarshift::relight::shade::reference::interreflection::check_bounces;
+/// assert!(check_bounces(8).is_ok() && check_bounces(9).is_err());
+/// ```
+pub fn check_bounces(bounces: usize) -> Result<()> {
     if bounces > MAX_BOUNCES {
         return Err(Error::parameter(
             "bounces",
