@@ -14,6 +14,7 @@ mod flags;
 mod hdr;
 mod ray_tracer;
 mod readme;
+mod reference_bounces;
 mod relight;
 mod relight_error;
 mod relight_scene;

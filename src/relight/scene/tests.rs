@@ -261,7 +261,13 @@ fn the_open_box_has_five_inward_faces_and_the_stated_extent() {
     assert_eq!((b.min, b.max), ([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0]));
     // Floor +Y, walls x = -1 (+X), x = 1 (-X), z = -1 (+Z), z = 1 (-Z): each face's normal
     // points from its plane toward the box's centre line, and every winding agrees with it.
-    let normals = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    let normals = [
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
     for v in 0..m.vertex_count() {
         let n = [0, 1, 2].map(|k| m.normals()[[v, k]]);
         assert_eq!(n, normals[v / face], "vertex {v}");

@@ -3,15 +3,15 @@
 
 use std::path::PathBuf;
 
-use haarshift::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
-use haarshift::render::{render_format, write_render};
 use haarshift::io::write_npy;
+use haarshift::relight::light::environment::Environment;
 use haarshift::relight::shade::reference::interreflection::{self, check_bounces};
 use haarshift::relight::shade::reference::path_trace::{PathTraceOptions, path_trace};
-use haarshift::relight::light::environment::Environment;
+use haarshift::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
 use haarshift::relight::{Brdf, Scene, SceneBvh};
 use haarshift::render::Camera;
 use haarshift::render::view::ViewSpec;
+use haarshift::render::{render_format, write_render};
 use haarshift::sphere::SphereRotation;
 use haarshift::{Result, SampleDepth};
 
@@ -207,7 +207,12 @@ fn interreflected(
             };
             let t = path_trace(&scene.mesh, &bvh, scene.albedo.view(), &lighting, &options)?;
             if let Some(path) = &args.stderr {
-                write_npy(t.standard_error.mapv(|x| x as f32).view(), SampleDepth::F32, path, args.force)?;
+                write_npy(
+                    t.standard_error.mapv(|x| x as f32).view(),
+                    SampleDepth::F32,
+                    path,
+                    args.force,
+                )?;
             }
             let about = format!(
                 "radiance (lambert) by {paths} paths of depth {} (seed {}) under {} x {} texels: \
@@ -224,14 +229,23 @@ fn interreflected(
         }
     };
     let radiance = radiance.mapv(|x| x as f32);
-    write_npy(radiance.view(), SampleDepth::F32, &args.vertices, args.force)?;
+    write_npy(
+        radiance.view(),
+        SampleDepth::F32,
+        &args.vertices,
+        args.force,
+    )?;
     text = format!(
         "{}: ({}, 3) {text}\n",
         args.vertices.display(),
         scene.mesh.vertex_count()
     );
     if let Some(path) = &args.stderr {
-        text += &format!("{}: ({}, 3) standard errors\n", path.display(), scene.mesh.vertex_count());
+        text += &format!(
+            "{}: ({}, 3) standard errors\n",
+            path.display(),
+            scene.mesh.vertex_count()
+        );
     }
     if let Some(path) = &args.output {
         let image = view.draw(camera, &scene.mesh, radiance.view(), env, rotation)?;

@@ -145,9 +145,8 @@ fn surface_at(
 ) -> Option<(Surface, [f64; 3])> {
     let tri = mesh.triangles()[hit.triangle];
     let (p, n) = (mesh.positions(), mesh.normals());
-    let corner = |a: &ndarray::ArrayView2<'_, f64>, k: usize| {
-        [0, 1, 2].map(|c| a[[tri[k] as usize, c]])
-    };
+    let corner =
+        |a: &ndarray::ArrayView2<'_, f64>, k: usize| [0, 1, 2].map(|c| a[[tri[k] as usize, c]]);
     let [a, b, c] = [0, 1, 2].map(|k| corner(&p, k));
     if dot(cross(sub(b, a), sub(c, a)), d) >= 0.0 {
         return None;
@@ -214,7 +213,10 @@ pub fn path_trace(
     if !(2..=1 << 24).contains(&paths) {
         return Err(Error::parameter(
             "paths",
-            format!("{paths}: must be 2 to {} (a standard error needs two)", 1 << 24),
+            format!(
+                "{paths}: must be 2 to {} (a standard error needs two)",
+                1 << 24
+            ),
         ));
     }
     let start = Instant::now();

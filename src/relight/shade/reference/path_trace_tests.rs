@@ -21,11 +21,25 @@ fn sky(n: usize) -> LatLongMap<f64> {
 /// A 2 x 2 floor facing +Y, `cells` a side, with (when `wall`) a 2 x 1 wall just behind its
 /// back edge facing it.
 fn scene(cells: usize, wall: bool) -> Mesh {
-    let floor = grid([-1.0, 0.0, 1.0], [2.0, 0.0, 0.0], [0.0, 0.0, -2.0], cells, cells).unwrap();
+    let floor = grid(
+        [-1.0, 0.0, 1.0],
+        [2.0, 0.0, 0.0],
+        [0.0, 0.0, -2.0],
+        cells,
+        cells,
+    )
+    .unwrap();
     if !wall {
         return floor;
     }
-    let wall = grid([-1.0, 0.0, -1.1], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], cells, cells).unwrap();
+    let wall = grid(
+        [-1.0, 0.0, -1.1],
+        [2.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        cells,
+        cells,
+    )
+    .unwrap();
     merge([floor, wall])
 }
 
@@ -33,7 +47,13 @@ fn albedo(v: usize) -> Array2<f32> {
     Array2::from_shape_fn((v, 3), |(_, c)| [0.7f32, 0.5, 0.3][c])
 }
 
-fn trace(mesh: &Mesh, light: &LatLongMap<f64>, paths: usize, bounces: usize, seed: u64) -> PathTrace {
+fn trace(
+    mesh: &Mesh,
+    light: &LatLongMap<f64>,
+    paths: usize,
+    bounces: usize,
+    seed: u64,
+) -> PathTrace {
     let a = albedo(mesh.vertex_count());
     let options = PathTraceOptions {
         paths,
@@ -88,7 +108,10 @@ fn four_times_the_paths_halve_the_error_against_the_closed_form() {
         let e = Array2::from_shape_fn(t.radiance.dim(), |(v, c)| t.radiance[[v, c]] - exact[c]);
         rms(&e)
     };
-    let (few, many) = (trace(&flat, &light, 64, 0, 1), trace(&flat, &light, 256, 0, 1));
+    let (few, many) = (
+        trace(&flat, &light, 64, 0, 1),
+        trace(&flat, &light, 256, 0, 1),
+    );
     let ratio = error(&many) / error(&few);
     // 169 vertices x 3 channels of independent errors: the ratio of two RMS is 1/2 within
     // about 5% (measured: see the message).
@@ -106,7 +129,8 @@ fn direct_light_agrees_with_the_reference_within_its_standard_errors() {
     let light = sky(32);
     let a = albedo(mesh.vertex_count());
     let bvh = SceneBvh::new(&mesh);
-    let (truth, _) = reference(&mesh, &bvh, a.view(), &light, &ReferenceOptions::default()).unwrap();
+    let (truth, _) =
+        reference(&mesh, &bvh, a.view(), &light, &ReferenceOptions::default()).unwrap();
     let t = trace(&mesh, &light, 512, 0, 3);
     let z = (&t.radiance - &truth) / &t.standard_error;
     let (rms_z, worst) = (rms(&z), z.iter().fold(0.0f64, |m, x| m.max(x.abs())));
