@@ -16,6 +16,7 @@ mod ground_cells;
 mod hdr;
 mod ray_tracer;
 mod readme;
+mod reference_bounces;
 mod relight;
 mod relight_assets;
 mod relight_error;

@@ -160,7 +160,7 @@ pub fn mirror(n: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
 }
 
 /// Two unit vectors completing the unit `n` to a right-handed orthonormal frame `(t, b, n)`.
-fn tangents(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn tangents(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     // Crossed with the axis least aligned with n, so the tangent never degenerates.
     let axis = if n[0].abs() < 0.6 {
         [1.0, 0.0, 0.0]

@@ -151,7 +151,7 @@ fn mix(mut z: u64) -> u64 {
 }
 
 /// Two uniform numbers in `[0, 1)` for one (seed, vertex, texel, sample).
-fn jitter(seed: u64, vertex: usize, texel: usize, sample: usize) -> (f64, f64) {
+pub(crate) fn jitter(seed: u64, vertex: usize, texel: usize, sample: usize) -> (f64, f64) {
     let h = mix(seed ^ mix((vertex as u64) << 32 ^ texel as u64) ^ mix(sample as u64 + 1));
     let unit = |x: u64| (x >> 11) as f64 / (1u64 << 53) as f64;
     (unit(h), unit(mix(h)))

@@ -83,6 +83,19 @@ pub enum Generator {
         /// Cells per side of each box face.
         cells: usize,
     },
+    /// An open box: a floor `[-1, 1]^2` at `y = 0` and four walls 2 high, all facing inward,
+    /// open at the top.
+    ///
+    /// ```
+    /// use haarshift::relight::Generator;
+    /// let b: Generator = serde_json::from_str(r#"{"box": {"cells": 2}}"#).unwrap();
+    /// assert_eq!(b.mesh().unwrap().vertex_count(), 5 * 9);
+    /// ```
+    #[serde(rename = "box")]
+    OpenBox {
+        /// Cells per side of each face.
+        cells: usize,
+    },
     /// A ground plane under a floating box.
     PlaneUnderBox {
         /// Height of the box's bottom face above the plane.
@@ -145,6 +158,7 @@ impl Generator {
                 grid_vertices(ground)?.checked_add(boxes(sphere, 1)?)
             }
             Generator::Sphere { cells } => boxes(cells, 1),
+            Generator::OpenBox { cells } => grid_vertices(cells)?.checked_mul(5),
             Generator::Table { cells } | Generator::Chair { cells } => {
                 boxes(cells, self.boxes().len())
             }
@@ -250,6 +264,19 @@ impl Generator {
                     .into_iter()
                     .map(|(lo, hi)| cuboid(lo, hi, cells));
                 merge(boxes.collect::<Result<Vec<_>>>()?)
+            }
+            Generator::OpenBox { cells } => {
+                at_least_one("cells", cells)?;
+                // (origin, u, v) with u x v pointing into the box.
+                let faces = [
+                    ([-1.0, 0.0, 1.0], [2.0, 0.0, 0.0], [0.0, 0.0, -2.0]),
+                    ([-1.0, 0.0, 1.0], [0.0, 0.0, -2.0], [0.0, 2.0, 0.0]),
+                    ([1.0, 0.0, -1.0], [0.0, 0.0, 2.0], [0.0, 2.0, 0.0]),
+                    ([-1.0, 0.0, -1.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+                    ([1.0, 0.0, 1.0], [-2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+                ];
+                let faces = faces.iter().map(|&(o, u, v)| grid(o, u, v, cells, cells));
+                merge(faces.collect::<Result<Vec<_>>>()?)
             }
             Generator::PlaneUnderBox { height } => {
                 positive("height", height)?;

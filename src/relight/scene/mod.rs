@@ -24,6 +24,7 @@
 //! | `sphere` | a unit sphere at the origin tessellated as a cube sphere, `cells x cells` per face, normals exact (radial) | `6 (cells + 1)^2` |
 //! | `table` | a table standing on `y = 0`: a top `[-1, 1] x [0.9, 1] x [-0.6, 0.6]` on four legs 0.08 thick at its corners, each box `cells x cells` a face | `30 (cells + 1)^2` |
 //! | `chair` | a chair standing on `y = 0`: a seat `[-0.25, 0.25] x [0.45, 0.5] x [-0.25, 0.25]`, a back `0.5` high at `z = 0.2 .. 0.25`, four legs 0.05 thick, each box `cells x cells` a face | `36 (cells + 1)^2` |
+//! | `box` | an open box standing on `y = 0`: five inward-facing squares `cells x cells` each (the floor `[-1, 1]^2` facing `+Y`, then the walls at `x = -1, 1` and `z = -1, 1`, 2 high, each facing the inside), open at the top: a concave scene for interreflections; every face has its own vertices | `5 (cells + 1)^2` |
 //! | `plane_under_box` | a `[-3, 3]^2` ground (2 x 2 cells, so vertex 4 is the origin) under a box with bottom face `[-1, 1]^2` at height `height` and top at `height + 0.5` (faces 4 x 4 cells); the form-factor test | 159 |
 //!
 //! # Scene file

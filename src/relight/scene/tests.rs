@@ -249,3 +249,36 @@ fn scene_files_resolve_paths_against_their_directory() {
     let single = Scene::load(&bunny).unwrap();
     assert_eq!(single.mesh, original);
 }
+
+#[test]
+fn the_open_box_has_five_inward_faces_and_the_stated_extent() {
+    let cells = 3;
+    let m = Generator::OpenBox { cells }.mesh().unwrap();
+    let face = (cells + 1) * (cells + 1);
+    assert_eq!(m.vertex_count(), 5 * face);
+    assert_eq!(m.triangles().len(), 5 * 2 * cells * cells);
+    let b = m.bounds();
+    assert_eq!((b.min, b.max), ([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0]));
+    // Floor +Y, walls x = -1 (+X), x = 1 (-X), z = -1 (+Z), z = 1 (-Z): each face's normal
+    // points from its plane toward the box's centre line, and every winding agrees with it.
+    let normals = [
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    for v in 0..m.vertex_count() {
+        let n = [0, 1, 2].map(|k| m.normals()[[v, k]]);
+        assert_eq!(n, normals[v / face], "vertex {v}");
+        let p = [0, 1, 2].map(|k| m.positions()[[v, k]]);
+        assert!(dot(n, [-p[0], 1.0 - p[1], -p[2]]) > 0.0);
+    }
+    for t in m.triangles() {
+        let [a, b, c] = t.map(|i| [0, 1, 2].map(|k| m.positions()[[i as usize, k]]));
+        let n = [0, 1, 2].map(|k| m.normals()[[t[0] as usize, k]]);
+        assert!(dot(n, cross(sub(b, a), sub(c, a))) > 0.0);
+    }
+    assert_eq!(Generator::OpenBox { cells }.vertex_count(), Some(5 * face));
+    assert!(Generator::OpenBox { cells: 0 }.mesh().is_err());
+}

@@ -3,8 +3,16 @@
 
 use std::path::PathBuf;
 
+use haarshift::io::write_npy;
+use haarshift::relight::light::environment::Environment;
+use haarshift::relight::shade::reference::interreflection::{self, check_bounces};
+use haarshift::relight::shade::reference::path_trace::{PathTraceOptions, path_trace};
 use haarshift::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
+use haarshift::relight::{Brdf, Scene, SceneBvh};
+use haarshift::render::Camera;
+use haarshift::render::view::ViewSpec;
 use haarshift::render::{render_format, write_render};
+use haarshift::sphere::SphereRotation;
 use haarshift::{Result, SampleDepth};
 
 use super::flags::{CameraFlags, LightFlags, MaterialFlags, SceneFlags, rotation};
@@ -22,12 +30,21 @@ triangle). No Haar transform, no cache: the ground truth that `relight render` i
 against (with --param latlong --resolution N and every coefficient kept, they agree to
 rounding). Same output formats as `relight render`.
 
+With --bounces B (Lambertian scenes), B bounces of interreflected light are gathered over
+the same rays: each ray that hits the front of a triangle brings the hit point's light of
+the bounce before, interpolated over the triangle's corners, times its interpolated albedo
+/ pi; the output is the sum. With --path-trace N the radiance is instead estimated by N
+cosine-weighted paths a vertex of depth B (seeded by --seed, repeatable), with its standard
+error (--stderr FILE.npy, and its RMS printed).
+
 Examples:
   haarshift relight reference testdata/meshes/bunny.ply --ground-plane --env park.hdr --vertices truth.npy
   haarshift relight reference bunny.ply --ground-plane --env park.hdr --resolution 64 --vertices truth.npy -o truth.png
   haarshift relight reference bunny.ply --ground-plane --env park.hdr --brdf phong:50 --resolution 128 --vertices glossy.npy
   haarshift relight reference bunny.ply --env park.hdr --brdf merl:gold-metallic-paint.binary --vertices gold.npy
-  haarshift relight reference scene.json --yaw 90 --albedo 0.5,0.5,0.5 --vertices truth.npy";
+  haarshift relight reference scene.json --yaw 90 --albedo 0.5,0.5,0.5 --vertices truth.npy
+  haarshift relight reference testdata/scenes/bunny_in_box.json --bounces 2 --vertices gather.npy
+  haarshift relight reference testdata/scenes/bunny_in_box.json --bounces 2 --path-trace 1024 --seed 3 --stderr se.npy --vertices paths.npy";
 
 /// Per-vertex radiance by direct quadrature (the ground truth), optionally rendered.
 #[derive(clap::Args, Debug)]
@@ -57,6 +74,23 @@ pub struct Args {
     #[command(flatten)]
     pub camera: CameraFlags,
 
+    /// Bounces of interreflected light (0 to 8; Lambertian only): the gather's, or with
+    /// --path-trace the paths' depth
+    #[arg(long, value_name = "B", default_value_t = 0)]
+    pub bounces: usize,
+
+    /// Estimate the radiance by N paths a vertex instead of the gather (a second truth)
+    #[arg(long, value_name = "N")]
+    pub path_trace: Option<usize>,
+
+    /// The path tracer's seed
+    #[arg(long, value_name = "S", default_value_t = 0, requires = "path_trace")]
+    pub seed: u64,
+
+    /// Where to write the path tracer's standard error per vertex, (V, 3) f32 .npy
+    #[arg(long, value_name = "FILE.npy", requires = "path_trace")]
+    pub stderr: Option<PathBuf>,
+
     /// Replace the outputs if they exist
     #[arg(long)]
     pub force: bool,
@@ -65,6 +99,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let mut outputs = vec![args.vertices.as_path()];
     outputs.extend(args.output.as_deref());
+    outputs.extend(args.stderr.as_deref());
     let mut inputs = vec![args.scene.input.as_path()];
     inputs.extend(args.light.env.as_deref());
     inputs.extend(args.material.brdf_file());
@@ -79,6 +114,9 @@ pub fn run(args: Args) -> Result<()> {
     let (env, angles) = args.light.load(scene.environment.as_ref())?;
     let rotation = rotation(angles)?;
     let camera = view.camera(scene.camera.as_ref(), &scene.mesh)?;
+    if args.bounces > 0 || args.path_trace.is_some() {
+        return interreflected(&args, &brdf, &scene, &env, &rotation, &view, &camera);
+    }
     let mut spec = ShaderSpec {
         method: Method::Reference,
         reference_resolution: Some(args.resolution),
@@ -110,6 +148,107 @@ pub fn run(args: Args) -> Result<()> {
     );
     if let Some(path) = &args.output {
         let image = view.draw(&camera, &scene.mesh, radiance.view(), &env, &rotation)?;
+        write_render(&image, path, args.camera.exposure, args.force)?;
+        text += &format!(
+            "{}: {} x {} image\n",
+            path.display(),
+            args.camera.width,
+            args.camera.height
+        );
+    }
+    print(&text)
+}
+
+/// `--bounces B` by the gather, or `--path-trace N`: Lambertian only.
+fn interreflected(
+    args: &Args,
+    brdf: &Brdf,
+    scene: &Scene,
+    env: &Environment,
+    rotation: &SphereRotation,
+    view: &ViewSpec,
+    camera: &Camera,
+) -> Result<()> {
+    check_bounces(args.bounces)?;
+    if !brdf.is_lambert() {
+        return Err(haarshift::Error::parameter(
+            "brdf",
+            format!("{brdf}: bounces and paths take Lambertian scenes only"),
+        ));
+    }
+    let lighting = env.lat_long(args.resolution, rotation)?;
+    let bvh = SceneBvh::new(&scene.mesh);
+    let (radiance, mut text) = match args.path_trace {
+        None => {
+            let r = interreflection::interreflected(
+                &scene.mesh,
+                &bvh,
+                scene.albedo.view(),
+                &lighting,
+                args.bounces,
+                true,
+            )?;
+            let about = format!(
+                "radiance (lambert) with {} bounces gathered over {} x {} texels: rays {}, {:.3} s",
+                args.bounces,
+                args.resolution,
+                2 * args.resolution,
+                r.report.rays,
+                r.report.seconds
+            );
+            (r.radiance(args.bounces), about)
+        }
+        Some(paths) => {
+            let options = PathTraceOptions {
+                paths,
+                bounces: args.bounces,
+                seed: args.seed,
+                progress: true,
+            };
+            let t = path_trace(&scene.mesh, &bvh, scene.albedo.view(), &lighting, &options)?;
+            if let Some(path) = &args.stderr {
+                write_npy(
+                    t.standard_error.mapv(|x| x as f32).view(),
+                    SampleDepth::F32,
+                    path,
+                    args.force,
+                )?;
+            }
+            let about = format!(
+                "radiance (lambert) by {paths} paths of depth {} (seed {}) under {} x {} texels: \
+                 RMS standard error {:.6e}, rays {}, {:.3} s",
+                args.bounces,
+                args.seed,
+                args.resolution,
+                2 * args.resolution,
+                t.rms_standard_error(),
+                t.report.rays,
+                t.report.seconds
+            );
+            (t.radiance, about)
+        }
+    };
+    let radiance = radiance.mapv(|x| x as f32);
+    write_npy(
+        radiance.view(),
+        SampleDepth::F32,
+        &args.vertices,
+        args.force,
+    )?;
+    text = format!(
+        "{}: ({}, 3) {text}\n",
+        args.vertices.display(),
+        scene.mesh.vertex_count()
+    );
+    if let Some(path) = &args.stderr {
+        text += &format!(
+            "{}: ({}, 3) standard errors\n",
+            path.display(),
+            scene.mesh.vertex_count()
+        );
+    }
+    if let Some(path) = &args.output {
+        let image = view.draw(camera, &scene.mesh, radiance.view(), env, rotation)?;
         write_render(&image, path, args.camera.exposure, args.force)?;
         text += &format!(
             "{}: {} x {} image\n",

@@ -45,6 +45,9 @@ use crate::sphere::LatLongMap;
 use crate::sphere::latlong::{direction, pixel_centre, pixel_solid_angle};
 use crate::{Error, Result};
 
+pub mod interreflection;
+pub mod path_trace;
+
 /// How to compute the reference.
 ///
 /// ```

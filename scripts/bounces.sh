@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# Interreflected light (issue 51) measured against its two truths. Prints Markdown:
+#   scripts/bounces.sh > results/relight/bounces.md
+# Scenes: the bunny on its ground plane and the bunny in an open box
+# (testdata/scenes/bunny_in_box.json), under the four 1k maps of testdata/envmaps/. For each:
+# the path tracer (`relight reference --path-trace`, depth 3) is the truth; against it the
+# relative RMS error over vertices of the pixel-domain gather (`relight reference --bounces B`)
+# and of the Haar render of a cache precomputed with `--bounces B` (all coefficients kept,
+# cube 6 x 32^2), B = 0 (direct only) to 3; precompute time and peak memory for each B; frame
+# time with bounces on and off (`relight render --direct-only`); and, where the build has
+# `--ground-cells`, the gather's difference from the path tracer as the ground gets denser.
+# Needs a build with `relight precompute --bounces`. Also writes the picture triple
+# results/relight/bounces_{direct,bounced,paths}.png (the bunny in the box, Rooitou Park).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+# shellcheck source=scripts/timing.sh
+source scripts/timing.sh
+paths=${PATHS:-1024}
+resolution=32
+maps=(rooitou_park_1k st_fagans_interior_1k studio_small_03_1k venice_sunset_1k)
+declare -A scene_args=(
+    [bunny]="testdata/meshes/bunny.ply --ground-plane"
+    [box]="testdata/scenes/bunny_in_box.json"
+)
+start_load=$(uptime)
+# Relative RMS of A against TRUTH, two (V, 3) .npy files.
+rel() {
+    python3 -c 'import numpy as np, sys
+a, t = np.load(sys.argv[1]).astype(float), np.load(sys.argv[2]).astype(float)
+print(f"{np.sqrt(np.mean((a - t) ** 2) / np.mean(t ** 2)):.4f}")' "$1" "$2"
+}
+for s in bunny box; do
+    # shellcheck disable=SC2086
+    read -r -a sa <<<"${scene_args[$s]}"
+    for b in 0 1 2 3; do
+        timed "pre-$s-$b" relight precompute "${sa[@]}" --param cube --resolution $resolution \
+            --bounces $b -o "$work/$s-$b.hsr"
+    done
+    for m in "${maps[@]}"; do
+        env=testdata/envmaps/$m.hdr
+        timed "pt-$s-$m" relight reference "${sa[@]}" --env "$env" --resolution $resolution \
+            --path-trace "$paths" --bounces 3 --seed 1 --stderr "$work/se-$s-$m.npy" \
+            --vertices "$work/pt-$s-$m.npy"
+        for b in 0 1 2 3; do
+            timed "gather-$s-$m-$b" relight reference "${sa[@]}" --env "$env" \
+                --resolution $resolution --bounces $b --vertices "$work/gather-$s-$m-$b.npy"
+            timed "render-$s-$m-$b" relight render "$work/$s-$b.hsr" --env "$env" \
+                --vertices "$work/haar-$s-$m-$b.npy"
+        done
+        timed "direct-only-$s-$m" relight render "$work/$s-3.hsr" --env "$env" --direct-only \
+            --vertices "$work/haar-direct-$s-$m.npy"
+    done
+done
+echo "# Interreflected light against two truths"
+echo
+echo "Made by \`scripts/bounces.sh > results/relight/bounces.md\` on $(nproc) cores;"
+echo "load when it started (\`uptime\`): \`$start_load\`"
+echo
+echo "The truth is the path tracer (\`relight reference --path-trace $paths --bounces 3 --seed 1\`:"
+echo "$paths cosine-weighted paths a vertex, depth 3, the environment downsampled to"
+echo "$resolution x $((2 * resolution))). Errors are relative RMS over vertices and channels,"
+echo "\`sqrt(mean((x - truth)^2) / mean(truth^2))\`; \`gather B\` is \`relight reference --bounces B\`"
+echo "(the pixel-domain gather over the $resolution x $((2 * resolution)) texel rays), \`Haar B\` the render"
+echo "of a cache precomputed with \`--bounces B\` at cube 6 x ${resolution}^2, every coefficient kept."
+echo
+echo "| scene | map | path tracer's RMS standard error / RMS radiance | gather 0 (direct only) | gather 1 | gather 2 | gather 3 | Haar 0 | Haar 1 | Haar 2 | Haar 3 |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
+for s in bunny box; do
+    for m in "${maps[@]}"; do
+        se=$(python3 -c 'import numpy as np, sys
+s, t = np.load(sys.argv[1]).astype(float), np.load(sys.argv[2]).astype(float)
+print(f"{np.sqrt(np.mean(s ** 2) / np.mean(t ** 2)):.4f}")' "$work/se-$s-$m.npy" "$work/pt-$s-$m.npy")
+        row="| $s | $m | $se"
+        for b in 0 1 2 3; do row+=" | $(rel "$work/gather-$s-$m-$b.npy" "$work/pt-$s-$m.npy")"; done
+        for b in 0 1 2 3; do row+=" | $(rel "$work/haar-$s-$m-$b.npy" "$work/pt-$s-$m.npy")"; done
+        echo "$row |"
+    done
+done
+echo
+echo "## Precomputation for each B (cube 6 x ${resolution}^2)"
+echo
+echo "| step | wall (m:ss) | CPU s | peak resident MiB | what it reports |"
+echo "|---|---|---|---|---|"
+for s in bunny box; do for b in 0 1 2 3; do step_row "pre-$s-$b"; done; done
+echo
+echo "## Frame time, bounces on and off (a cache of 3 bounces; Rooitou Park)"
+echo
+echo "| step | wall (m:ss) | CPU s | peak resident MiB | what it reports |"
+echo "|---|---|---|---|---|"
+for s in bunny box; do
+    step_row "render-$s-rooitou_park_1k-3"
+    step_row "direct-only-$s-rooitou_park_1k"
+done
+echo
+echo "## The gather against the path tracer as the ground gets denser (bunny, Rooitou Park, 1 bounce)"
+echo
+if "$hs" relight reference --help | grep -q -- --ground-cells; then
+    echo "| ground cells a side | vertices | gather 1 against path tracer (depth 1) | path tracer's RMS standard error / RMS |"
+    echo "|---|---|---|---|"
+    env=testdata/envmaps/rooitou_park_1k.hdr
+    for g in 16 32 64 128; do
+        a=(relight reference testdata/meshes/bunny.ply --ground-plane --ground-cells "$g" --env "$env" --resolution $resolution)
+        "$hs" "${a[@]}" --bounces 1 --vertices "$work/g-$g.npy" >&2
+        "$hs" "${a[@]}" --bounces 1 --path-trace "$paths" --seed 1 --stderr "$work/gse-$g.npy" \
+            --vertices "$work/gpt-$g.npy" >&2
+        v=$(python3 -c 'import numpy as np, sys; print(np.load(sys.argv[1]).shape[0])' "$work/g-$g.npy")
+        se=$(python3 -c 'import numpy as np, sys
+s, t = np.load(sys.argv[1]).astype(float), np.load(sys.argv[2]).astype(float)
+print(f"{np.sqrt(np.mean(s ** 2) / np.mean(t ** 2)):.4f}")' "$work/gse-$g.npy" "$work/gpt-$g.npy")
+        echo "| $g | $v | $(rel "$work/g-$g.npy" "$work/gpt-$g.npy") | $se |"
+    done
+else
+    echo "Not measured: this build has no \`--ground-cells\`."
+fi
+# The picture triple: the bunny in the box under Rooitou Park, one view.
+env=testdata/envmaps/rooitou_park_1k.hdr
+"$hs" relight render "$work/box-3.hsr" --env "$env" --direct-only -o results/relight/bounces_direct.png --force >&2
+"$hs" relight render "$work/box-3.hsr" --env "$env" -o results/relight/bounces_bounced.png --force >&2
+"$hs" relight reference testdata/scenes/bunny_in_box.json --env "$env" --resolution $resolution \
+    --path-trace "$paths" --bounces 3 --seed 1 --vertices "$work/triple.npy" \
+    -o results/relight/bounces_paths.png --force >&2
+echo
+echo "Pictures: \`bounces_direct.png\` (direct only), \`bounces_bounced.png\` (3 bounces),"
+echo "\`bounces_paths.png\` (the path tracer), the bunny in the box under Rooitou Park."
+echo
+echo "Load when it ended: \`$(uptime)\`"
