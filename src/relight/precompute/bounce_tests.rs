@@ -362,3 +362,28 @@ fn refuses_what_it_cannot_gather() {
     let again = bounce_range(&mesh, &bvh, &options, albedo.view(), &direct, Some(&one), 1, 0..54);
     assert!(again.is_err());
 }
+
+#[test]
+fn zz_debug() {
+    let s = box_sums(1.0);
+    eprintln!("box1 {s:?}");
+    eprintln!("box.5 {:?}", box_sums(0.5));
+    let mesh = inward_box();
+    let options = VisibilityOptions::new(cube(4));
+    let mut direct = TransportSet::new(options.param, Selection::All);
+    direct.push(ndarray::Array3::ones((6, 4, 4)).view()).unwrap();
+    eprintln!("ws {} {:?} n={}", white_sky(&direct, 0), direct.coefficients(0), mesh.vertex_count());
+    let mesh = Generator::Sphere { cells: 6 }.mesh().unwrap();
+    let bvh = SceneBvh::new(&mesh);
+    let eps = ray_offset(&mesh);
+    let rays = RaySet::new(&options);
+    let (o, n) = origin_and_normal(&mesh, 5, eps);
+    let (mut hits, mut back) = (0, 0);
+    rays.for_each(5, n, |d, _| {
+        let mut h = [None];
+        bvh.closest_hits_from(f32x3(o), &[d], f32::INFINITY, &mut h);
+        if let Some(h) = h[0] { hits += 1; let _ = h; }
+        back += 1;
+    });
+    eprintln!("sphere hits {hits} of {back} eps {eps}");
+}
