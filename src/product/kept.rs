@@ -47,7 +47,11 @@ pub fn kept_coefficients<T: Sample>(
         let out = out.index_axis_mut(Axis(2), 0);
         pyramid::forward_into(plane, levels, Normalization::Orthonormal, out, &mut work)?;
     }
-    kept_of_coefficients(coefficients.index_axis_move(Axis(3), 0).view(), layout, selection)
+    kept_of_coefficients(
+        coefficients.index_axis_move(Axis(3), 0).view(),
+        layout,
+        selection,
+    )
 }
 
 /// What [`kept_coefficients`] keeps of `coefficients`, already transformed `(faces, S, S)`

@@ -62,6 +62,7 @@ use crate::faces::integrate::layout;
 use crate::product::Selection;
 use crate::product::kept::kept_of_coefficients;
 use crate::progress::Task;
+use crate::relight::Mesh;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::material::brdf::check_albedo;
 use crate::relight::precompute::raycast::{Hit, SceneBvh};
@@ -70,7 +71,6 @@ use crate::relight::precompute::visibility::{
     BATCH, PrecomputeReport, RaySet, VisibilityOptions, f32x3, origin_and_normal, ray_offset,
 };
 use crate::relight::scene::mesh::{cross, dot, sub};
-use crate::relight::Mesh;
 use crate::{Error, Result};
 
 /// The most bounces a precomputation gathers (`--bounces`).
@@ -157,27 +157,15 @@ impl BouncedTransport {
 
     /// Haar coefficients stored, all channels.
     pub fn coefficient_count(&self) -> usize {
-        self.channels.iter().map(TransportSet::coefficient_count).sum()
+        self.channels
+            .iter()
+            .map(TransportSet::coefficient_count)
+            .sum()
     }
 
     /// Bytes held, all channels.
     pub fn stored_bytes(&self) -> usize {
         self.channels.iter().map(TransportSet::stored_bytes).sum()
-    }
-
-    /// Appends `other`'s vertices after these (the merge of shards): the same bounces and
-    /// channels.
-    pub(crate) fn append(&mut self, other: &BouncedTransport) -> Result<()> {
-        if (self.bounces, self.channels.len()) != (other.bounces, other.channels.len()) {
-            return Err(Error::parameter(
-                "bounced transport",
-                "only sums of the same bounces and channels are joined",
-            ));
-        }
-        for (mine, theirs) in self.channels.iter_mut().zip(&other.channels) {
-            mine.append(theirs)?;
-        }
-        Ok(())
     }
 }
 
@@ -275,7 +263,7 @@ pub fn bounce_range(
             let c = l.channel(0);
             ((l.vertex_count(), l.is_grey(), c.param(), c.keep(), bands(c))
                 != (count, grey, direct.param(), direct.keep(), bands(direct)))
-            .then(|| "the lower bounces were made for other vertices, albedo or options".into())
+                .then(|| "the lower bounces were made for other vertices, albedo or options".into())
         })
     };
     if let Some(why) = why {
@@ -285,7 +273,13 @@ pub fn bounce_range(
     let (weights, rays) = hit_weights(mesh, bvh, options, albedo, grey, vertices.clone())?;
     let mut sum = lower.cloned();
     for bounce in from + 1..=bounces {
-        sum = Some(gather(&weights, direct, sum.as_ref(), bounce, options.progress)?);
+        sum = Some(gather(
+            &weights,
+            direct,
+            sum.as_ref(),
+            bounce,
+            options.progress,
+        )?);
     }
     let sum = sum.expect("at least one bounce");
     let report = PrecomputeReport {
@@ -310,7 +304,10 @@ struct HitWeights {
 impl HitWeights {
     fn row(&self, k: usize) -> (&[u32], &[f32]) {
         let (a, b) = (self.offsets[k], self.offsets[k + 1]);
-        (&self.hits[a..b], &self.weights[a * self.channels..b * self.channels])
+        (
+            &self.hits[a..b],
+            &self.weights[a * self.channels..b * self.channels],
+        )
     }
 
     fn len(&self) -> usize {
@@ -536,10 +533,9 @@ fn gather(
                                 }
                             }
                         }
-                        let coefficients =
-                            Array3::from_shape_fn((faces, s, s), |(f, r, col)| {
-                                dense[(f * s + r) * s + col] as f32
-                            });
+                        let coefficients = Array3::from_shape_fn((faces, s, s), |(f, r, col)| {
+                            dense[(f * s + r) * s + col] as f32
+                        });
                         let (indices, coefficients) =
                             kept_of_coefficients(coefficients.view(), layout(param), keep)?;
                         bar.advance(1);
