@@ -39,7 +39,7 @@ pub fn kept_coefficients<T: Sample>(
     let (faces, s) = check_face_array(pixels.shape(), 1, "pixels")?;
     ensure_finite(&pixels)?;
     let levels = s.trailing_zeros() as usize;
-    let limit = selection_limit(faces, s, selection)?;
+    selection_limit(faces, s, selection)?;
     let mut coefficients = Array4::zeros(pixels.raw_dim());
     let mut work = Vec::new();
     for (face, mut out) in pixels.outer_iter().zip(coefficients.outer_iter_mut()) {
@@ -47,10 +47,29 @@ pub fn kept_coefficients<T: Sample>(
         let out = out.index_axis_mut(Axis(2), 0);
         pyramid::forward_into(plane, levels, Normalization::Orthonormal, out, &mut work)?;
     }
+    kept_of_coefficients(
+        coefficients.index_axis_move(Axis(3), 0).view(),
+        layout,
+        selection,
+    )
+}
+
+/// What [`kept_coefficients`] keeps of `coefficients`, already transformed `(faces, S, S)`
+/// (the face-Mallat layout): every face's non-zero scaling coefficient and the non-zero
+/// details `selection` picks, as flat indices and values. The bounces' gather truncates its
+/// sums of transformed transport with it, by the rule the direct transport was truncated by.
+pub(crate) fn kept_of_coefficients<T: Sample>(
+    coefficients: ArrayView3<'_, T>,
+    layout: FaceLayout,
+    selection: Selection,
+) -> Result<(Vec<u32>, Vec<T>)> {
+    let coefficients = coefficients.insert_axis(Axis(3));
+    let (faces, s) = check_face_array(coefficients.shape(), 1, "coefficients")?;
+    let limit = selection_limit(faces, s, selection)?;
     let kept = match selection {
         Selection::All => None,
         _ => Some(kept_mask::<T, 1>(
-            coefficients.view(),
+            coefficients,
             faces,
             s,
             layout,
@@ -58,7 +77,8 @@ pub fn kept_coefficients<T: Sample>(
             limit,
         )),
     };
-    let flat = coefficients.as_slice().expect("fresh array is contiguous");
+    let standard = coefficients.as_standard_layout();
+    let flat = standard.as_slice().expect("standard layout");
     let mut indices = Vec::new();
     let mut values = Vec::new();
     for (i, &c) in flat.iter().enumerate() {

@@ -11,6 +11,7 @@
 //! whose vertices would not fit in [`PrecomputeOptions::budget`] is refused from its count,
 //! before the BVH or any transport is built.
 
+pub mod bounce;
 pub mod embree;
 mod packet;
 pub mod raycast;

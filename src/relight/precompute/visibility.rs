@@ -89,7 +89,7 @@ impl VisibilityOptions {
         }
     }
 
-    fn check(&self) -> Result<()> {
+    pub(crate) fn check(&self) -> Result<()> {
         if !(1..=64).contains(&self.samples) {
             return Err(Error::parameter(
                 "visibility samples",
@@ -230,10 +230,9 @@ pub fn vertex_range(
     }
     let start = Instant::now();
     let param = options.param;
-    let directions = texel_directions(param);
-    let order = block_order(param);
+    let rays = RaySet::new(options);
+    let directions = &rays.directions;
     let eps = ray_offset(mesh);
-    let s = param.face_size();
     let samples = options.samples;
     let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
     let mut set = encoder.empty_set()?;
@@ -251,32 +250,14 @@ pub fn vertex_range(
                     rays: 0,
                 };
                 batch.scratch.escaped.fill(0);
-                for &t in &order {
-                    if dot(n, directions[t]) <= 0.0 {
-                        continue;
-                    }
-                    if samples == 1 {
-                        batch.push(f32x3(directions[t]), t);
-                        continue;
-                    }
-                    let (face, row, col) = (t / (s * s), (t / s) % s, t % s);
-                    for k in 0..samples * samples {
-                        let (ju, jv) = jitter(options.seed, v, t, k);
-                        let r = row as f64 + ((k / samples) as f64 + ju) / samples as f64;
-                        let c = col as f64 + ((k % samples) as f64 + jv) / samples as f64;
-                        let d = param.point(face, r, c);
-                        if dot(n, d) > 0.0 {
-                            batch.push(f32x3(d), t);
-                        }
-                    }
-                }
+                rays.for_each(v, n, |d, t| batch.push(d, t));
                 batch.flush();
                 let rays = batch.rays;
                 let Scratch {
                     values, escaped, ..
                 } = scratch;
                 let flat = values.as_slice_mut().expect("fresh array is contiguous");
-                for (t, (value, &w)) in flat.iter_mut().zip(&directions).enumerate() {
+                for (t, (value, &w)) in flat.iter_mut().zip(directions).enumerate() {
                     let cos = dot(n, w);
                     *value = if cos <= 0.0 {
                         0.0
@@ -305,6 +286,54 @@ pub fn vertex_range(
     Ok((set, report))
 }
 
+/// The rays a vertex casts (the [module docs](self)): the texel centres above its horizon,
+/// or with `S > 1` their `S x S` jittered sub-rays above it, in [`block_order`]. Visibility
+/// and the bounces' gather ([`bounce`](super::bounce)) cast the same set.
+pub(crate) struct RaySet {
+    param: Parameterization,
+    /// Texel centre directions, by texel index.
+    pub(crate) directions: Vec<[f64; 3]>,
+    order: Vec<usize>,
+    samples: usize,
+    seed: u64,
+}
+
+impl RaySet {
+    pub(crate) fn new(options: &VisibilityOptions) -> Self {
+        RaySet {
+            param: options.param,
+            directions: texel_directions(options.param),
+            order: block_order(options.param),
+            samples: options.samples,
+            seed: options.seed,
+        }
+    }
+
+    /// Calls `ray(direction, texel)` for every ray vertex `v` (unit normal `n`) casts.
+    pub(crate) fn for_each(&self, v: usize, n: [f64; 3], mut ray: impl FnMut([f32; 3], usize)) {
+        let (s, samples) = (self.param.face_size(), self.samples);
+        for &t in &self.order {
+            if dot(n, self.directions[t]) <= 0.0 {
+                continue;
+            }
+            if samples == 1 {
+                ray(f32x3(self.directions[t]), t);
+                continue;
+            }
+            let (face, row, col) = (t / (s * s), (t / s) % s, t % s);
+            for k in 0..samples * samples {
+                let (ju, jv) = jitter(self.seed, v, t, k);
+                let r = row as f64 + ((k / samples) as f64 + ju) / samples as f64;
+                let c = col as f64 + ((k % samples) as f64 + jv) / samples as f64;
+                let d = self.param.point(face, r, c);
+                if dot(n, d) > 0.0 {
+                    ray(f32x3(d), t);
+                }
+            }
+        }
+    }
+}
+
 /// Texel indices face by face in [`BLOCK`] x [`BLOCK`] blocks (row-major inside a block and
 /// across blocks): consecutive rays of a vertex then point at neighbouring texels, so a packet
 /// of them is a narrow cone.
@@ -330,7 +359,7 @@ const BLOCK: usize = 4;
 
 /// The rays cast per call of [`Occlusion::occluded_from`]: a bound on the buffer whatever the
 /// samples per texel.
-const BATCH: usize = 1024;
+pub(crate) const BATCH: usize = 1024;
 
 /// One thread's working memory, reused from vertex to vertex.
 struct Scratch {

@@ -1,0 +1,567 @@
+//! Interreflected transport: light that reaches a vertex after bouncing off the scene's
+//! Lambertian surfaces, gathered in the Haar basis (issue 51's contract).
+//!
+//! **What is computed.** Bounce 0 is the direct transport `T0_v` ([`TransportSet`]). Bounce
+//! `b + 1` gathers, over the rays visibility casts (the texel directions `u` of the
+//! transport's parameterisation, origins `eps` off the surface along the normal, and with
+//! `S > 1` the same `S x S` jittered sub-rays, each weighing `1 / S^2`), the bounce-`b`
+//! transport of the **closest** surface each ray hits:
+//!
+//! `T(b+1)_v = sum over rays u that hit of max(0, n_v . u) dOmega_u / S^2 x (rho_hit / pi) x interp_hit(Tb)`
+//!
+//! the rendering equation's one-bounce operator on a Lambertian surface (Kajiya 1986) as
+//! Sloan, Kautz and Snyder (2002, section 5) gather their interreflected transfer. The cosine
+//! and the solid angle are those of the texel's centre, as in visibility. `interp_hit`
+//! interpolates the hit triangle's three vertices' transport barycentrically (the [`Hit`]'s
+//! `(1 - u - v, u, v)`), and `rho_hit` their RGB albedo the same way. A ray whose hit
+//! triangle's winding normal `(p1 - p0) x (p2 - p0)` points along it (`>= 0`: a back face)
+//! contributes zero, and so does a jittered sub-ray below the horizon (it is not cast).
+//! [`SceneBvh`] holds one triangle of each set of duplicates (the same three corners in any
+//! order) and none of zero area, and a hit names the mesh triangle it stands for: of a pair of
+//! opposite-facing duplicates (a two-sided sheet) the first in the mesh's order answers, so
+//! light bounces off the side it faces and the other side gathers nothing from it.
+//!
+//! **Linearity.** Every bounce is a sum of whole transport vectors indexed like `T0` by the
+//! environment's texels (light from texel `s` reaches the hit and bounces to `v`), so it is
+//! formed from Haar coefficients directly (the transform is linear), and the bounced sum obeys
+//! `T1 + ... + T(b+1) = G(T0 + T1 + ... + Tb)`, `G` the gather above. The sum is therefore
+//! built bounce by bounce from the direct transport and the previous sum only: what a cache
+//! with `b` bounces stores, so a shard can add bounce `b + 1` from the merged cache of `b`
+//! ([`bounce_range`]).
+//!
+//! **Sharing work.** A vertex's rays are cast once and folded into weights per hit vertex,
+//! `W_c[v][i] = sum over rays hitting a triangle with corner i of w_ray beta_i rho_hit,c / pi`
+//! (`beta_i` the corner's barycentric weight); then one sparse row combination per distinct
+//! hit vertex, `sum_i W_c[v][i] (T0_i + S_i,c)`, accumulated densely in f64 and truncated.
+//! The weights are kept between bounces, so `B` bounces cast each ray once.
+//!
+//! **Channels.** `rho_hit` is baked in, so the bounced sum is per channel: three sparse
+//! vectors a vertex ([`BouncedTransport::channels`] has three sets, R, G, B), or one when every
+//! vertex's albedo is grey (its three values bit-equal: one set, used for all three
+//! channels). The count of sets is what a reader goes by ([`BouncedTransport::is_grey`]).
+//!
+//! **Truncation.** The bounced sum of every channel is truncated with the direct transport's
+//! [`Selection`] (`--keep-visibility`) after each bounce, by the rule that truncated `T0`, and
+//! bounce `b + 1` gathers the **truncated** quantities: the stored `T0` and the stored sum of
+//! bounce `b`, `S(b+1) = keep(G(T0~ + S(b)~))`. With every coefficient kept, this is the
+//! exact sum. The spherical-harmonic transfer (when the direct set carries it) is gathered
+//! the same way with the same weights, untruncated: Sloan, Kautz and Snyder's (2002)
+//! interreflected transfer vectors.
+//!
+//! **Limits.** Lambertian scenes only: the rendered radiance is `rho_v / pi x <T0_v + S_v,c,
+//! L_c>`, so a cache with bounces renders with its stored albedo alone. At most
+//! [`MAX_BOUNCES`].
+
+use std::ops::Range;
+use std::time::Instant;
+
+use ndarray::{Array3, ArrayView2};
+use rayon::prelude::*;
+
+use crate::faces::integrate::layout;
+use crate::product::Selection;
+use crate::product::kept::kept_of_coefficients;
+use crate::progress::Task;
+use crate::relight::Mesh;
+use crate::relight::harmonics::ShTransfer;
+use crate::relight::material::brdf::check_albedo;
+use crate::relight::precompute::raycast::{Hit, SceneBvh};
+use crate::relight::precompute::transport::{Encoded, TransportSet};
+use crate::relight::precompute::visibility::{
+    BATCH, PrecomputeReport, RaySet, VisibilityOptions, f32x3, origin_and_normal, ray_offset,
+};
+use crate::relight::scene::mesh::{cross, dot, sub};
+use crate::{Error, Result};
+
+/// The most bounces a precomputation gathers (`--bounces`).
+pub const MAX_BOUNCES: usize = 8;
+
+/// The bounced sum `T1 + ... + TB` of a range of vertices, per channel; see the
+/// [module docs](self).
+///
+/// ```
+/// use haarshift::relight::precompute::bounce::{BouncedTransport, bounce_range};
+/// use haarshift::relight::{Generator, SceneBvh, VisibilityOptions, vertex_major};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// use ndarray::Array2;
+/// let mesh = Generator::Sphere { cells: 2 }.mesh().unwrap();
+/// let options = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap());
+/// let bvh = SceneBvh::new(&mesh);
+/// let (direct, _) = vertex_major(&mesh, &bvh, &options).unwrap();
+/// let albedo = Array2::from_elem((54, 3), 0.5f32);
+/// let all = 0..54;
+/// let (bounced, _) = bounce_range(&mesh, &bvh, &options, albedo.view(), &direct, None, 2, all).unwrap();
+/// assert_eq!((bounced.bounces(), bounced.is_grey(), bounced.vertex_count()), (2, true, 54));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct BouncedTransport {
+    bounces: usize,
+    channels: Vec<TransportSet>,
+}
+
+impl BouncedTransport {
+    /// The sum of `bounces` bounces (1 to [`MAX_BOUNCES`]) from its channels' sets: one
+    /// (grey) or three (R, G, B), of the same vertices, parameterisation, truncation and
+    /// spherical-harmonic bands.
+    ///
+    /// ```
+    /// use haarshift::product::Selection;
+    /// use haarshift::relight::TransportSet;
+    /// use haarshift::relight::precompute::bounce::BouncedTransport;
+    /// use haarshift::faces::{ParamKind, Parameterization};
+    /// let set = TransportSet::new(Parameterization::new(ParamKind::Cube, 4).unwrap(), Selection::All);
+    /// assert!(BouncedTransport::new(1, vec![set.clone()]).unwrap().is_grey());
+    /// assert!(BouncedTransport::new(1, vec![set.clone(), set.clone()]).is_err());
+    /// assert!(BouncedTransport::new(9, vec![set]).is_err());
+    /// ```
+    pub fn new(bounces: usize, channels: Vec<TransportSet>) -> Result<Self> {
+        check_bounces(bounces)?;
+        let alike = |a: &TransportSet, b: &TransportSet| {
+            let bands = |s: &TransportSet| s.sh().map(ShTransfer::bands);
+            (a.param(), a.keep(), bands(a), a.vertex_count())
+                == (b.param(), b.keep(), bands(b), b.vertex_count())
+        };
+        if !matches!(channels.len(), 1 | 3) || !channels.iter().all(|c| alike(c, &channels[0])) {
+            return Err(Error::parameter(
+                "bounced transport",
+                "one set (grey albedo) or three (R, G, B) of the same vertices and parameters",
+            ));
+        }
+        Ok(BouncedTransport { bounces, channels })
+    }
+
+    /// Bounces summed.
+    pub fn bounces(&self) -> usize {
+        self.bounces
+    }
+
+    /// The sets stored: one when every albedo is grey, else R, G and B.
+    pub fn channels(&self) -> &[TransportSet] {
+        &self.channels
+    }
+
+    /// Whether one set serves all three channels.
+    pub fn is_grey(&self) -> bool {
+        self.channels.len() == 1
+    }
+
+    /// The set of colour channel `c` (0, 1, 2: R, G, B; the one set when grey).
+    pub fn channel(&self, c: usize) -> &TransportSet {
+        &self.channels[c.min(self.channels.len() - 1)]
+    }
+
+    /// Vertices held.
+    pub fn vertex_count(&self) -> usize {
+        self.channels[0].vertex_count()
+    }
+
+    /// Haar coefficients stored, all channels.
+    pub fn coefficient_count(&self) -> usize {
+        self.channels
+            .iter()
+            .map(TransportSet::coefficient_count)
+            .sum()
+    }
+
+    /// Bytes held, all channels.
+    pub fn stored_bytes(&self) -> usize {
+        self.channels.iter().map(TransportSet::stored_bytes).sum()
+    }
+}
+
+/// Refuses a bounce count outside `1..=MAX_BOUNCES`.
+pub(crate) fn check_bounces(bounces: usize) -> Result<()> {
+    if (1..=MAX_BOUNCES).contains(&bounces) {
+        return Ok(());
+    }
+    Err(Error::parameter(
+        "bounces",
+        format!("{bounces}: must be 0 to {MAX_BOUNCES}"),
+    ))
+}
+
+/// Whether every vertex's albedo is grey (R, G and B bit-equal): the bounced sum is then one
+/// set.
+///
+/// ```
+/// use haarshift::relight::precompute::bounce::is_grey;
+/// use ndarray::array;
+/// assert!(is_grey(array![[0.5f32, 0.5, 0.5], [0.8, 0.8, 0.8]].view()));
+/// assert!(!is_grey(array![[0.5f32, 0.5, 0.5], [0.8, 0.8, 0.7]].view()));
+/// ```
+pub fn is_grey(albedo: ArrayView2<'_, f32>) -> bool {
+    albedo
+        .rows()
+        .into_iter()
+        .all(|r| r.iter().all(|x| x.to_bits() == r[0].to_bits()))
+}
+
+/// The bounced sum of `bounces` bounces of the vertices `vertices`, from the direct transport
+/// `direct` of **every** vertex (made with `options`) and, when given, `lower`: the bounced
+/// sum of fewer bounces of every vertex (a merged cache's), which it continues; see the
+/// [module docs](self). A range short of the whole mesh adds one bounce only (bounce `b + 1`
+/// of one vertex needs bounce `b` of all), so a sharded run goes bounce by bounce with a merge
+/// between. The report counts the rays cast (each once, whatever the bounces).
+///
+/// ```
+/// use haarshift::relight::precompute::bounce::bounce_range;
+/// use haarshift::relight::{Generator, SceneBvh, VisibilityOptions, vertex_major};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// use ndarray::Array2;
+/// let mesh = Generator::Sphere { cells: 2 }.mesh().unwrap();
+/// let options = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap());
+/// let bvh = SceneBvh::new(&mesh);
+/// let (direct, _) = vertex_major(&mesh, &bvh, &options).unwrap();
+/// let albedo = Array2::from_elem((54, 3), 0.5f32);
+/// let run = |lower, b, range| bounce_range(&mesh, &bvh, &options, albedo.view(), &direct, lower, b, range);
+/// let (two, _) = run(None, 2, 0..54).unwrap();
+/// let (one, _) = run(None, 1, 0..54).unwrap();
+/// let (part, _) = run(Some(&one), 2, 10..20).unwrap(); // shard of bounce 2 from bounce 1
+/// assert_eq!(part.channel(0).coefficients(3), two.channel(0).coefficients(13));
+/// assert!(run(None, 2, 10..20).is_err()); // two bounces of a part at once
+/// ```
+#[allow(clippy::too_many_arguments)]
+pub fn bounce_range(
+    mesh: &Mesh,
+    bvh: &SceneBvh,
+    options: &VisibilityOptions,
+    albedo: ArrayView2<'_, f32>,
+    direct: &TransportSet,
+    lower: Option<&BouncedTransport>,
+    bounces: usize,
+    vertices: Range<usize>,
+) -> Result<(BouncedTransport, PrecomputeReport)> {
+    options.check()?;
+    check_bounces(bounces)?;
+    check_albedo(albedo)?;
+    let count = mesh.vertex_count();
+    let grey = is_grey(albedo);
+    let from = lower.map_or(0, BouncedTransport::bounces);
+    let whole = vertices == (0..count);
+    let why = if albedo.nrows() != count || direct.vertex_count() != count {
+        Some(format!(
+            "the albedo and the direct transport must have the mesh's {count} vertices"
+        ))
+    } else if (direct.param(), direct.keep()) != (options.param, options.keep) {
+        Some("the direct transport was made with other directions or truncation".into())
+    } else if vertices.start > vertices.end || vertices.end > count {
+        Some(format!(
+            "vertices {}..{} of {count}",
+            vertices.start, vertices.end
+        ))
+    } else if from >= bounces {
+        Some(format!("{bounces} bounces asked for from a sum of {from}"))
+    } else if !whole && bounces - from > 1 {
+        Some(format!(
+            "a part of the vertices adds one bounce at a time (bounce {} of all vertices is \
+             needed first)",
+            bounces - 1
+        ))
+    } else {
+        lower.and_then(|l| {
+            let bands = |s: &TransportSet| s.sh().map(ShTransfer::bands);
+            let c = l.channel(0);
+            ((l.vertex_count(), l.is_grey(), c.param(), c.keep(), bands(c))
+                != (count, grey, direct.param(), direct.keep(), bands(direct)))
+                .then(|| "the lower bounces were made for other vertices, albedo or options".into())
+        })
+    };
+    if let Some(why) = why {
+        return Err(Error::parameter("bounces", why));
+    }
+    let start = Instant::now();
+    let (weights, rays) = hit_weights(mesh, bvh, options, albedo, grey, vertices.clone())?;
+    let mut sum = lower.cloned();
+    for bounce in from + 1..=bounces {
+        sum = Some(gather(
+            &weights,
+            direct,
+            sum.as_ref(),
+            bounce,
+            options.progress,
+        )?);
+    }
+    let sum = sum.expect("at least one bounce");
+    let report = PrecomputeReport {
+        rays,
+        seconds: start.elapsed().as_secs_f64(),
+        working_bytes: weights.bytes() + rayon::current_num_threads() * count * 16,
+        tracer: Some(bvh.tracer()),
+    };
+    Ok((sum, report))
+}
+
+/// The weights per hit vertex of a range of vertices, `W_c[v][i]` (see the
+/// [module docs](self)), as sparse rows: row `k` is vertex `first + k`, its hit vertices
+/// ascending, `channels` weights each.
+struct HitWeights {
+    channels: usize,
+    offsets: Vec<usize>,
+    hits: Vec<u32>,
+    weights: Vec<f32>,
+}
+
+impl HitWeights {
+    fn row(&self, k: usize) -> (&[u32], &[f32]) {
+        let (a, b) = (self.offsets[k], self.offsets[k + 1]);
+        (
+            &self.hits[a..b],
+            &self.weights[a * self.channels..b * self.channels],
+        )
+    }
+
+    fn len(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    fn bytes(&self) -> usize {
+        self.offsets.len() * 8 + self.hits.len() * 4 + self.weights.len() * 4
+    }
+}
+
+/// Casts every ray of `vertices` and folds the front-face hits into [`HitWeights`], with the
+/// rays cast.
+fn hit_weights(
+    mesh: &Mesh,
+    bvh: &SceneBvh,
+    options: &VisibilityOptions,
+    albedo: ArrayView2<'_, f32>,
+    grey: bool,
+    vertices: Range<usize>,
+) -> Result<(HitWeights, u64)> {
+    let channels = if grey { 1 } else { 3 };
+    let rays = RaySet::new(options);
+    let eps = ray_offset(mesh);
+    let weights = options.param.solid_angles();
+    let per_ray = 1.0 / (options.samples * options.samples) as f64 / std::f64::consts::PI;
+    let bar = Task::begin(options.progress, "bounce rays", vertices.len());
+    let rows: Vec<(Vec<u32>, Vec<f32>, u64)> = vertices
+        .into_par_iter()
+        .map_init(
+            || Folder::new(mesh.vertex_count(), channels),
+            |folder, v| {
+                let (origin, n) = origin_and_normal(mesh, v, eps);
+                let mut cast = Cast {
+                    mesh,
+                    bvh,
+                    albedo,
+                    origin: f32x3(origin),
+                    folder,
+                    rays: 0,
+                };
+                let solid = weights.as_slice().expect("fresh array is contiguous");
+                rays.for_each(v, n, |d, t| {
+                    let w = dot(n, rays.directions[t]) * solid[t] * per_ray;
+                    cast.push(d, w);
+                });
+                cast.flush();
+                let rays = cast.rays;
+                let (hits, w) = folder.take();
+                bar.advance(1);
+                (hits, w, rays)
+            },
+        )
+        .collect();
+    let mut out = HitWeights {
+        channels,
+        offsets: vec![0],
+        hits: Vec::new(),
+        weights: Vec::new(),
+    };
+    let mut cast = 0;
+    for (hits, w, r) in rows {
+        out.hits.extend_from_slice(&hits);
+        out.weights.extend_from_slice(&w);
+        out.offsets.push(out.hits.len());
+        cast += r;
+    }
+    Ok((out, cast))
+}
+
+/// One thread's weights per hit vertex, dense over the mesh's vertices with the list of those
+/// touched, reused from vertex to vertex.
+struct Folder {
+    channels: usize,
+    dense: Vec<f64>,
+    touched: Vec<u32>,
+    seen: Vec<bool>,
+    directions: Vec<[f32; 3]>,
+    ray_weights: Vec<f64>,
+    hits: Vec<Option<Hit>>,
+}
+
+impl Folder {
+    fn new(vertices: usize, channels: usize) -> Self {
+        Folder {
+            channels,
+            dense: vec![0.0; vertices * channels],
+            touched: Vec::new(),
+            seen: vec![false; vertices],
+            directions: Vec::with_capacity(BATCH),
+            ray_weights: Vec::with_capacity(BATCH),
+            hits: vec![None; BATCH],
+        }
+    }
+
+    fn add(&mut self, vertex: u32, weights: [f64; 3]) {
+        let i = vertex as usize;
+        if !self.seen[i] {
+            self.seen[i] = true;
+            self.touched.push(vertex);
+        }
+        let c = self.channels;
+        for (d, w) in self.dense[i * c..(i + 1) * c].iter_mut().zip(weights) {
+            *d += w;
+        }
+    }
+
+    /// The touched vertices ascending with their weights (f32), the state cleared.
+    fn take(&mut self) -> (Vec<u32>, Vec<f32>) {
+        self.touched.sort_unstable();
+        let c = self.channels;
+        let mut weights = Vec::with_capacity(self.touched.len() * c);
+        for &i in &self.touched {
+            let i = i as usize;
+            weights.extend(self.dense[i * c..(i + 1) * c].iter().map(|&w| w as f32));
+            self.dense[i * c..(i + 1) * c].fill(0.0);
+            self.seen[i] = false;
+        }
+        (std::mem::take(&mut self.touched), weights)
+    }
+}
+
+/// The rays of one vertex, cast [`BATCH`] at a time into its [`Folder`].
+struct Cast<'a> {
+    mesh: &'a Mesh,
+    bvh: &'a SceneBvh,
+    albedo: ArrayView2<'a, f32>,
+    origin: [f32; 3],
+    folder: &'a mut Folder,
+    rays: u64,
+}
+
+impl Cast<'_> {
+    fn push(&mut self, direction: [f32; 3], weight: f64) {
+        self.folder.directions.push(direction);
+        self.folder.ray_weights.push(weight);
+        if self.folder.directions.len() == BATCH {
+            self.flush();
+        }
+    }
+
+    fn flush(&mut self) {
+        let n = self.folder.directions.len();
+        let mut hits = std::mem::take(&mut self.folder.hits);
+        let directions = std::mem::take(&mut self.folder.directions);
+        (self.bvh).closest_hits_from(self.origin, &directions, f32::INFINITY, &mut hits[..n]);
+        let (p, triangles) = (self.mesh.positions(), self.mesh.triangles());
+        for k in 0..n {
+            let Some(hit) = hits[k] else { continue };
+            let corners = triangles[hit.triangle];
+            let at = |c: u32| {
+                let r = p.row(c as usize);
+                [r[0], r[1], r[2]]
+            };
+            let [a, b, c] = corners.map(at);
+            let winding = cross(sub(b, a), sub(c, a));
+            if dot(winding, directions[k].map(f64::from)) >= 0.0 {
+                continue; // the back of the triangle
+            }
+            let (u, v) = (f64::from(hit.u), f64::from(hit.v));
+            let beta = [1.0 - u - v, u, v];
+            let mut rho = [0.0; 3];
+            for (&corner, &bk) in corners.iter().zip(&beta) {
+                let albedo = self.albedo.row(corner as usize);
+                for (r, &x) in rho.iter_mut().zip(albedo) {
+                    *r += bk * f64::from(x);
+                }
+            }
+            let w = self.folder.ray_weights[k];
+            for (&corner, &bk) in corners.iter().zip(&beta) {
+                self.folder.add(corner, rho.map(|r| w * bk * r));
+            }
+        }
+        self.rays += n as u64;
+        self.folder.hits = hits;
+        self.folder.directions = directions;
+        self.folder.directions.clear();
+        self.folder.ray_weights.clear();
+    }
+}
+
+/// One more bounce: `keep(G(T0~ + lower~))` per channel for the rows of `weights`, from the
+/// direct transport and the lower sum of every vertex.
+fn gather(
+    weights: &HitWeights,
+    direct: &TransportSet,
+    lower: Option<&BouncedTransport>,
+    bounce: usize,
+    progress: bool,
+) -> Result<BouncedTransport> {
+    let param = direct.param();
+    let (faces, s) = (param.faces(), param.face_size());
+    let keep: Selection = direct.keep();
+    let bands = direct.sh().map(ShTransfer::bands);
+    let sh_len = bands.map_or(0, |b| b * b);
+    let channels = weights.channels;
+    let label = format!("bounce {bounce} (gather)");
+    let bar = Task::begin(progress, &label, weights.len() * channels);
+    fn sh_row(set: &TransportSet, i: usize, len: usize) -> &[f32] {
+        set.sh()
+            .map_or(&[][..], |t| &t.as_slice()[i * len..(i + 1) * len])
+    }
+    let rows: Vec<Result<Vec<Encoded>>> = (0..weights.len())
+        .into_par_iter()
+        .map_init(
+            || (vec![0.0f64; param.texels()], vec![0.0f64; sh_len]),
+            |(dense, sh), k| {
+                let (hits, w) = weights.row(k);
+                (0..channels)
+                    .map(|c| {
+                        dense.fill(0.0);
+                        sh.fill(0.0);
+                        let sets = std::iter::once(direct).chain(lower.map(|l| l.channel(c)));
+                        for set in sets {
+                            for (j, &i) in hits.iter().enumerate() {
+                                let wi = f64::from(w[j * channels + c]);
+                                let (indices, values) = set.coefficients(i as usize);
+                                for (&t, &x) in indices.iter().zip(values) {
+                                    dense[t as usize] += wi * f64::from(x);
+                                }
+                                for (o, &x) in sh.iter_mut().zip(sh_row(set, i as usize, sh_len)) {
+                                    *o += wi * f64::from(x);
+                                }
+                            }
+                        }
+                        let coefficients = Array3::from_shape_fn((faces, s, s), |(f, r, col)| {
+                            dense[(f * s + r) * s + col] as f32
+                        });
+                        let (indices, coefficients) =
+                            kept_of_coefficients(coefficients.view(), layout(param), keep)?;
+                        bar.advance(1);
+                        Ok(Encoded {
+                            indices,
+                            coefficients,
+                            sh: sh.iter().map(|&x| x as f32).collect(),
+                        })
+                    })
+                    .collect()
+            },
+        )
+        .collect();
+    let empty = || match bands {
+        Some(b) => TransportSet::with_sh(param, keep, b),
+        None => Ok(TransportSet::new(param, keep)),
+    };
+    let mut sets = (0..channels).map(|_| empty()).collect::<Result<Vec<_>>>()?;
+    for row in rows {
+        for (set, vertex) in sets.iter_mut().zip(row?) {
+            set.extend(&vertex);
+        }
+    }
+    BouncedTransport::new(bounce, sets)
+}
+
+#[cfg(test)]
+#[path = "bounce_tests.rs"]
+mod tests;
