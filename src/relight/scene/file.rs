@@ -412,7 +412,7 @@ impl SceneFile {
     /// ```
     /// use haarshift::relight::SceneFile;
     /// let file = |json: &str| serde_json::from_str::<SceneFile>(json).unwrap();
-    /// let objects = r#""objects": [{"generator": {"sphere": {}}}]"#;
+    /// let objects = r#""objects": [{"generator": {"sphere": {"cells": 2}}}]"#;
     /// assert_eq!(file(&format!("{{{objects}, \"ground_plane\": true}}")).ground_cells().unwrap(), Some(32));
     /// let dense = file(&format!("{{{objects}, \"ground_plane\": true, \"ground_cells\": 64}}"));
     /// assert_eq!(dense.ground_cells().unwrap(), Some(64));

@@ -146,7 +146,7 @@ impl Scene {
     /// asset.albedo = Some(ndarray::Array2::from_elem((24, 3), 0.25));
     /// let scene = Scene::from_asset(asset, true).unwrap();
     /// assert_eq!(scene.albedo.row(0).to_vec(), vec![0.25; 3]);
-    /// assert_eq!(scene.albedo.row(24).to_vec(), haarshift::relight::GROUND_ALBEDO.to_vec());
+    /// assert_eq!(scene.albedo.row(24).to_vec(), haarshift::relight::scene::GROUND_ALBEDO.to_vec());
     /// ```
     pub fn from_asset(asset: MeshAsset, ground_plane: bool) -> Result<Scene> {
         let v = asset.mesh.vertex_count();

@@ -29,6 +29,7 @@ use std::path::Path;
 
 use ndarray::Array2;
 
+use crate::Result;
 use crate::relight::scene::asset::MeshAsset;
 use crate::relight::scene::asset_path::{AssetSource, read_limited, resolve};
 use crate::relight::scene::file::DEFAULT_ALBEDO;
@@ -37,7 +38,6 @@ use crate::relight::scene::mtl::{MtlMaterial, read_mtl};
 use crate::relight::scene::texture::{Filter, Wrap};
 use crate::relight::scene::validate::MemoryBudget;
 use crate::relight::{Mesh, SceneError};
-use crate::{Error, Result};
 
 /// Reads an OBJ file (and the libraries it names) within `budget`'s byte limit.
 pub(crate) fn read_obj(path: &Path, budget: &MemoryBudget) -> Result<MeshAsset> {
@@ -151,7 +151,9 @@ fn parse_obj(text: &str, dir: &Path, memory_limit: u64) -> Result<MeshAsset> {
                         None => None,
                         Some(t) if (0..uvs.len() as i64).contains(&t) => Some(t as u32),
                         Some(_) => {
-                            return Err(bad("a texture coordinate index beyond the vt read so far"));
+                            return Err(bad(
+                                "a texture coordinate index beyond the vt read so far",
+                            ));
                         }
                     };
                     polygon.push(Corner {
@@ -190,9 +192,9 @@ fn parse_obj(text: &str, dir: &Path, memory_limit: u64) -> Result<MeshAsset> {
         .iter()
         .map(|(name, line)| {
             materials.iter().find(|m| m.name == *name).ok_or_else(|| {
-                Error::from(corrupt(format!(
+                corrupt(format!(
                     "line {line}: usemtl {name:?} names no material of the file's libraries"
-                )))
+                ))
             })
         })
         .collect::<Result<_>>()?;

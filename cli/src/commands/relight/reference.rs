@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 use haarshift::io::write_npy;
 use haarshift::relight::light::environment::Environment;
-use haarshift::relight::shade::reference::interreflection::{self, check_bounces};
+use haarshift::relight::shade::reference::interreflection::{
+    self, check_bounces, check_lambertian,
+};
 use haarshift::relight::shade::reference::path_trace::{PathTraceOptions, path_trace};
 use haarshift::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
 use haarshift::relight::{Brdf, Scene, SceneBvh};
@@ -170,12 +172,7 @@ fn interreflected(
     camera: &Camera,
 ) -> Result<()> {
     check_bounces(args.bounces)?;
-    if !brdf.is_lambert() {
-        return Err(haarshift::Error::parameter(
-            "brdf",
-            format!("{brdf}: bounces and paths take Lambertian scenes only"),
-        ));
-    }
+    check_lambertian(brdf)?;
     let lighting = env.lat_long(args.resolution, rotation)?;
     let bvh = SceneBvh::new(&scene.mesh);
     let (radiance, mut text) = match args.path_trace {

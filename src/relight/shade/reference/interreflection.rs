@@ -40,7 +40,7 @@ use super::{ReferenceOptions, ReferenceReport, ReferenceVisibility, lit_texels};
 use crate::progress::Task;
 use crate::relight::precompute::visibility::{f32x3, origin_and_normal, ray_offset};
 use crate::relight::scene::mesh::{cross, dot, sub};
-use crate::relight::{Mesh, SceneBvh};
+use crate::relight::{Brdf, Mesh, SceneBvh};
 use crate::sphere::LatLongMap;
 use crate::{Error, Result};
 
@@ -107,7 +107,7 @@ impl Gather {
         let (p, triangles) = (mesh.positions(), mesh.triangles());
         let corner = |i: u32| [0, 1, 2].map(|k| p[[i as usize, k]]);
         let bar = Task::begin(progress, "reference bounces (rays)", mesh.vertex_count());
-        let rows: Vec<(Vec<(u32, [f64; 3])>, u64)> = (0..mesh.vertex_count())
+        let rows: Vec<(GatherRow, u64)> = (0..mesh.vertex_count())
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Vec::new(), Vec::new()),
@@ -199,6 +199,9 @@ fn merge_columns(mut row: Vec<(u32, [f64; 3])>) -> Vec<(u32, [f64; 3])> {
     out
 }
 
+/// One vertex's gather row: the hit vertices and their RGB weights.
+type GatherRow = Vec<(u32, [f64; 3])>;
+
 /// The reference radiance of a Lambertian scene with `bounces` bounces of interreflected light
 /// (see the [module docs](self)): `albedo` `(V, 3)`, `lighting` an `N x 2N` lat-long map, gray
 /// or RGB, already rotated; `bounces` at most [`MAX_BOUNCES`]. With `bounces = 0` no gather
@@ -212,7 +215,7 @@ fn merge_columns(mut row: Vec<(u32, [f64; 3])>) -> Vec<(u32, [f64; 3])> {
 /// // A floor and a wall at a right angle: the wall's light reaches the floor.
 /// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0],
 ///                          [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]],
-///                   vec![[0, 2, 1], [3, 4, 5]], None).unwrap();
+///                   vec![[0, 1, 2], [3, 5, 4]], None).unwrap();
 /// let sky = LatLongMap::<f64>::from_fn(16, 1, |_, o| o[0] = 1.0).unwrap();
 /// let albedo = Array2::from_elem((6, 3), 0.5f32);
 /// let bvh = SceneBvh::new(&m);
@@ -277,6 +280,25 @@ pub fn check_bounces(bounces: usize) -> Result<()> {
         return Err(Error::parameter(
             "bounces",
             format!("{bounces}: must be 0 to {MAX_BOUNCES}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a material other than Lambert's: the gather and the path tracer bounce light off
+/// Lambertian surfaces only (issue 51's contract).
+///
+/// ```
+/// use haarshift::relight::Brdf;
+/// use haarshift::relight::shade::reference::interreflection::check_lambertian;
+/// assert!(check_lambertian(&Brdf::Lambert).is_ok());
+/// assert!(check_lambertian(&Brdf::Phong { exponent: 30.0 }).is_err());
+/// ```
+pub fn check_lambertian(brdf: &Brdf) -> Result<()> {
+    if !brdf.is_lambert() {
+        return Err(Error::parameter(
+            "brdf",
+            format!("{brdf}: bounces and paths take Lambertian scenes only"),
         ));
     }
     Ok(())

@@ -138,9 +138,8 @@ fn brute_force(
     let mut u = u0;
     for _ in 0..bounces {
         let mut next = Array2::<f64>::zeros((vertices, 3));
-        for c in 0..3 {
-            let col = w[c].dot(&u.column(c));
-            next.column_mut(c).assign(&col);
+        for (c, wc) in w.iter().enumerate() {
+            next.column_mut(c).assign(&wc.dot(&u.column(c)));
         }
         out.push(next.clone());
         u = next;

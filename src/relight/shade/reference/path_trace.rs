@@ -159,7 +159,7 @@ fn surface_at(
     let position = mix(&|k, c| p[[tri[k] as usize, c]]);
     let normal = mix(&|k, c| n[[tri[k] as usize, c]]);
     let len = dot(normal, normal).sqrt();
-    if !(len > 0.0) {
+    if len.is_nan() || len <= 0.0 {
         return None; // opposite normals cancelling: no hemisphere to sample
     }
     let normal = normal.map(|x| x / len);
