@@ -16,6 +16,7 @@ use haarshift::render::view::ViewSpec;
 use haarshift::render::{render_format, write_render};
 use haarshift::sphere::SphereRotation;
 use haarshift::{Result, SampleDepth};
+use ndarray::ArrayView2;
 
 use super::flags::{CameraFlags, LightFlags, MaterialFlags, SceneFlags, rotation};
 use crate::commands::{print, refuse_outputs};
@@ -141,24 +142,23 @@ pub fn run(args: Args) -> Result<()> {
         &args.vertices,
         args.force,
     )?;
-    let mut text = format!(
+    let text = format!(
         "{}: ({}, 3) {} (lighting downsampled in {:.1} ms)\n",
         args.vertices.display(),
         scene.mesh.vertex_count(),
         shading.description,
         shading.timing.encode_seconds * 1e3,
     );
-    if let Some(path) = &args.output {
-        let image = view.draw(&camera, &scene.mesh, radiance.view(), &env, &rotation)?;
-        write_render(&image, path, args.camera.exposure, args.force)?;
-        text += &format!(
-            "{}: {} x {} image\n",
-            path.display(),
-            args.camera.width,
-            args.camera.height
-        );
-    }
-    print(&text)
+    finish(
+        &args,
+        &scene,
+        radiance.view(),
+        &env,
+        &rotation,
+        &view,
+        &camera,
+        text,
+    )
 }
 
 /// `--bounces B` by the gather, or `--path-trace N`: Lambertian only.
@@ -244,8 +244,33 @@ fn interreflected(
             scene.mesh.vertex_count()
         );
     }
+    finish(
+        args,
+        scene,
+        radiance.view(),
+        env,
+        rotation,
+        view,
+        camera,
+        text,
+    )
+}
+
+/// Draws the image `--output` asks for (the same for every way the radiance was computed) and
+/// prints what was written.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    args: &Args,
+    scene: &Scene,
+    radiance: ArrayView2<'_, f32>,
+    env: &Environment,
+    rotation: &SphereRotation,
+    view: &ViewSpec,
+    camera: &Camera,
+    mut text: String,
+) -> Result<()> {
     if let Some(path) = &args.output {
-        let image = view.draw(camera, &scene.mesh, radiance.view(), env, rotation)?;
+        let image = view.draw(camera, &scene.mesh, radiance, env, rotation)?;
         write_render(&image, path, args.camera.exposure, args.force)?;
         text += &format!(
             "{}: {} x {} image\n",
