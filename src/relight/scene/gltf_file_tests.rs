@@ -436,8 +436,6 @@ fn counts_and_textures_beyond_the_budget_are_refused_before_they_are_read() {
 }
 
 #[test]
-#[ignore = "known defect (issue 52): vertex 166 of bunny_boxes.obj takes 0.83, 0.49, 0.30 where \
-            the glTF and the PLY oracle give 0.87, 0.79, 0.57; every other vertex agrees"]
 fn the_obj_with_mtl_reads_the_glb_s_albedo() {
     let glb = MeshAsset::load(&meshes("bunny_boxes.glb")).unwrap();
     let albedo = glb.albedo.as_ref().unwrap();

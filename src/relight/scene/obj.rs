@@ -87,12 +87,20 @@ fn parse_obj(text: &str, dir: &Path, memory_limit: u64) -> Result<MeshAsset> {
             Some("v") => positions.extend(numbers(words, 3)?),
             Some("vn") => file_normals.extend(numbers(words, 3)?),
             Some("vt") => {
-                let mut uv = numbers(words, 1)?;
-                uv.resize(2, 0.0);
-                if uv.iter().any(|x| !x.is_finite()) {
-                    return Err(bad("a texture coordinate is not finite"));
+                // `vt u [v [w]]`: v defaults to 0, w (a 3D texture's) is ignored.
+                let uv: Vec<f64> = words
+                    .take(2)
+                    .map(|w| w.parse::<f64>())
+                    .collect::<Result<_, _>>()
+                    .map_err(|_| bad("a texture coordinate is not a number"))?;
+                match uv[..] {
+                    [] => return Err(bad("too few coordinates")),
+                    _ if uv.iter().any(|x| !x.is_finite()) => {
+                        return Err(bad("a texture coordinate is not finite"));
+                    }
+                    [u] => uvs.push([u, 0.0]),
+                    [u, v, ..] => uvs.push([u, v]),
                 }
-                uvs.push([uv[0], uv[1]]);
             }
             Some("mtllib") => {
                 for name in words {

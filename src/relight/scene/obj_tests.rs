@@ -162,3 +162,26 @@ fn ply_colours_are_srgb_as_bytes_and_linear_as_floats() {
     let e = MeshAsset::load(&floats).unwrap_err().to_string();
     assert!(e.contains("vertex 0: a float green outside [0, 1]"), "{e}");
 }
+
+#[test]
+fn a_texture_coordinate_s_v_is_read_and_points_up() {
+    use image::ImageEncoder;
+    // A 1 x 2 texture: row 0 (the image's top) black, row 1 white.
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(
+            &[0, 0, 0, 255, 255, 255],
+            1,
+            2,
+            image::ExtendedColorType::Rgb8,
+        )
+        .unwrap();
+    let mtl = b"newmtl tex\nKd 1 1 1\nmap_Kd t.png\n";
+    // v = 0.75 is the top row's centre, v = 0.25 the bottom's; `vt u` alone has v = 0, the
+    // bottom edge, half way between the bottom row and the top one it wraps to.
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.75\nvt 0.5 0.25 0.9\nvt 0.5\n\
+               usemtl tex\nf 1/1 2/2 3/3\n";
+    let (asset, _dir) = read(&[("x.obj", obj.as_bytes()), ("m.mtl", mtl), ("t.png", &png)]);
+    let a = asset.unwrap().albedo.unwrap();
+    assert_eq!(a.column(0).to_vec(), vec![0.0, 1.0, 0.5]);
+}
