@@ -15,11 +15,12 @@ use haarshift::relight::dynamic::fields::OcclusionField;
 use haarshift::relight::dynamic::motion::MotionPath;
 use haarshift::relight::light::environment::Environment;
 use haarshift::relight::material::merl::MerlBrdf;
+use haarshift::relight::scene::MeshAsset;
 use haarshift::relight::scene::validate::{MemoryBudget, check_ground_extent};
 use haarshift::relight::{Mesh, Scene, SceneCache, add_ground_plane};
 
 /// The fuzz targets: one per reader and validated structure.
-pub const TARGETS: [&str; 15] = [
+pub const TARGETS: [&str; 17] = [
     "png",
     "jpeg",
     "tiff",
@@ -29,6 +30,8 @@ pub const TARGETS: [&str; 15] = [
     "coefficients",
     "ply",
     "obj",
+    "gltf",
+    "mtl",
     "scene",
     "motion",
     "hsr",
@@ -45,6 +48,13 @@ const SCENE_BUDGET: MemoryBudget = MemoryBudget {
     per_vertex: 0,
     shards: 1,
 };
+
+/// The texture a fuzzed glTF or MTL may name (`checker.png`, 81 bytes).
+const CHECKER_PNG: &[u8] = include_bytes!("../testdata/meshes/checker.png");
+
+/// The OBJ whose library (`in.mtl`) the `mtl` target fuzzes.
+const MTL_USER: &[u8] = b"mtllib in.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\n\
+    usemtl m\nf 1/1 2/2 3/3\n";
 
 /// A fresh directory for one input.
 fn scratch() -> PathBuf {
@@ -97,6 +107,22 @@ pub fn run(target: &str, bytes: &[u8]) {
         "ply" | "obj" => {
             if let Ok(mesh) = Mesh::load(&put(&dir, &format!("in.{target}"), bytes)) {
                 exercise(&mesh);
+            }
+        }
+        "gltf" | "mtl" => {
+            // The files an asset may name beside it: a 4 x 4 texture.
+            put(&dir, "checker.png", CHECKER_PNG);
+            let path = if target == "mtl" {
+                // The input is the library of a fixed textured triangle that uses material `m`.
+                put(&dir, "in.mtl", bytes);
+                put(&dir, "in.obj", MTL_USER)
+            } else if bytes.starts_with(b"glTF") {
+                put(&dir, "in.glb", bytes)
+            } else {
+                put(&dir, "in.gltf", bytes)
+            };
+            if let Ok(asset) = MeshAsset::load_within(&path, &SCENE_BUDGET) {
+                exercise(&asset.mesh);
             }
         }
         "scene" => {

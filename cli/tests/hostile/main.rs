@@ -17,6 +17,8 @@ mod common;
 
 use common::{p, testdata, text};
 
+mod assets;
+
 /// What a child cost: CPU seconds (user + system) and peak resident bytes.
 struct Cost {
     cpu: f64,
