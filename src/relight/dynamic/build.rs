@@ -11,7 +11,7 @@ use crate::relight::precompute::sparse::SparseRows;
 use crate::relight::precompute::visibility::{VisibilityOptions, ray_offset, vertex_major};
 use crate::relight::scene::shapes::merge;
 use crate::relight::scene::validate::MemoryBudget;
-use crate::relight::scene::{SceneFile, ground_plane_under};
+use crate::relight::scene::{MeshAsset, SceneFile, ground_plane_under};
 use crate::relight::shade::glossy::GlossyOptions;
 use crate::relight::{Generator, Mesh, SceneBvh, SceneError};
 use crate::{Error, Result};
@@ -58,7 +58,7 @@ impl DynamicScene {
             file.check_memory(&MemoryBudget::default())?;
             let shapes = Shapes::of(&file, dir)?;
             let mut report = BuildReport::default();
-            for i in shard.range(shapes.meshes.len()) {
+            for i in shard.range(shapes.assets.len()) {
                 shapes.field(i, Some(&mut *store), &options.field, &mut report)?;
             }
             Ok(report)
@@ -163,7 +163,12 @@ impl DynamicScene {
                 }
                 other => other,
             })?;
-            placed.push((shape, placement, object.material.albedo()?, brdf));
+            placed.push((
+                shape,
+                placement,
+                object.albedo(&shapes.assets[shape])?,
+                brdf,
+            ));
         }
         // Validated before any field is built (relight::validate).
         if let Some(camera) = &file.camera {
@@ -171,14 +176,14 @@ impl DynamicScene {
         }
         let meshes = placed
             .iter()
-            .map(|(shape, p, _, _)| place_mesh(&shapes.meshes[*shape], p, param))
+            .map(|(shape, p, _, _)| place_mesh(&shapes.assets[*shape].mesh, p, param))
             .collect::<Result<Vec<Mesh>>>()?;
         let objects_mesh = merge(meshes.iter().cloned());
         let ground = file
             .ground_cells()?
             .map(|cells| ground_plane_under(&objects_mesh.bounds(), cells))
             .transpose()?;
-        let fields = (0..shapes.meshes.len())
+        let fields = (0..shapes.assets.len())
             .map(|i| {
                 let field = shapes.field(i, store.as_deref_mut(), &options.field, &mut report)?;
                 Ok(Arc::new(field))
@@ -228,7 +233,7 @@ impl DynamicScene {
         let mut scene = DynamicScene {
             options: *options,
             lift: ray_offset(&all),
-            shapes: shapes.meshes,
+            shapes: shapes.assets.into_iter().map(|a| a.mesh).collect(),
             fields,
             objects,
             ground,
@@ -248,8 +253,8 @@ impl DynamicScene {
 
 /// A scene file's distinct shapes: objects with the same mesh file or generator share one.
 struct Shapes {
-    /// Each shape's mesh, in order of first use.
-    meshes: Vec<Mesh>,
+    /// Each shape's mesh and the colour its file carries, in order of first use.
+    assets: Vec<MeshAsset>,
     /// Where each came from: the mesh file or the generator.
     sources: Vec<(Option<PathBuf>, Option<Generator>)>,
     /// Each object's shape.
@@ -260,7 +265,7 @@ impl Shapes {
     /// The shapes of `file`, mesh paths relative to `dir`.
     fn of(file: &SceneFile, dir: &Path) -> Result<Self> {
         let mut shapes = Shapes {
-            meshes: Vec::new(),
+            assets: Vec::new(),
             sources: Vec::new(),
             of_object: Vec::with_capacity(file.objects.len()),
         };
@@ -269,9 +274,11 @@ impl Shapes {
             let shape = match shapes.sources.iter().position(|s| *s == source) {
                 Some(i) => i,
                 None => {
-                    shapes.meshes.push(object.shape(dir, k)?);
+                    shapes
+                        .assets
+                        .push(object.asset(dir, k, &MemoryBudget::default())?);
                     shapes.sources.push(source);
-                    shapes.meshes.len() - 1
+                    shapes.assets.len() - 1
                 }
             };
             shapes.of_object.push(shape);
@@ -288,7 +295,7 @@ impl Shapes {
         options: &FieldOptions,
         report: &mut BuildReport,
     ) -> Result<OcclusionField> {
-        let mesh = &self.meshes[i];
+        let mesh = &self.assets[i].mesh;
         let (path, generator) = &self.sources[i];
         let stored = store.is_some();
         let (field, origin) = match store {

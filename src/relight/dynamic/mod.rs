@@ -21,6 +21,11 @@
 //! vertex's exact frame) in Haar coefficients; [`reference`](DynamicScene::reference) evaluates
 //! the BRDF analytically per texel. The ground plane stays Lambertian.
 //!
+//! **Albedo per vertex.** `a` is the object's material albedo times the colour its mesh file
+//! carries at the vertex (a glTF's base colour and texture, an OBJ's MTL, a PLY's colours:
+//! [`SceneObject::albedo`](crate::relight::SceneObject::albedo)), as in a static scene; a
+//! clone keeps the albedo of the object it copies.
+//!
 //! **Own transport and the ground.** An object's `T_v` is precomputed at its placement in the
 //! scene file, against itself and the ground plane (when the scene has one), exactly as
 //! [`vertex_major`] does for a static scene. Moving the object keeps it; turning it by `k`
@@ -72,7 +77,9 @@ struct Object {
     /// Where its own transport was computed.
     rest: Placement,
     placement: Placement,
-    albedo: [f32; 3],
+    /// Per vertex of its shape, `(V, 3)`: the material's albedo times the colour its mesh
+    /// file carries ([`SceneObject::albedo`](crate::relight::SceneObject::albedo)).
+    albedo: Array2<f32>,
     /// Its material's BRDF, with the orientation that brings it into vertex frames (`None`:
     /// Lambertian).
     brdf: Brdf,
@@ -341,19 +348,15 @@ impl DynamicScene {
 
     /// The albedo of every vertex of [`mesh`](Self::mesh), `(V, 3)`.
     pub fn albedo(&self) -> Array2<f32> {
-        let mut rows = Vec::with_capacity(self.vertex_count());
-        for o in &self.objects {
-            rows.extend(std::iter::repeat_n(
-                o.albedo,
-                self.shapes[o.shape].vertex_count(),
-            ));
-        }
-        if let Some((g, _)) = &self.ground {
-            rows.extend(std::iter::repeat_n(
-                crate::relight::scene::GROUND_ALBEDO,
-                g.vertex_count(),
-            ));
-        }
+        let ground = self.ground.iter().flat_map(|(g, _)| {
+            std::iter::repeat_n(crate::relight::scene::GROUND_ALBEDO, g.vertex_count())
+        });
+        let rows: Vec<[f32; 3]> = self
+            .objects
+            .iter()
+            .flat_map(|o| o.albedo.rows().into_iter().map(|r| [r[0], r[1], r[2]]))
+            .chain(ground)
+            .collect();
         Array2::from_shape_fn((rows.len(), 3), |(v, c)| rows[v][c])
     }
 }
