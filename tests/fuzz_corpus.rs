@@ -5,12 +5,14 @@
 #[path = "../fuzz/harness.rs"]
 mod harness;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
 
 #[test]
 fn every_corpus_input_and_crash_replays_without_a_panic() {
     let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz");
-    let mut total = 0;
+    let mut inputs: Vec<(&str, PathBuf)> = Vec::new();
     for target in harness::TARGETS {
         let mut seeds = 0;
         for kind in ["corpus", "artifacts"] {
@@ -18,15 +20,22 @@ fn every_corpus_input_and_crash_replays_without_a_panic() {
                 continue;
             };
             for entry in entries {
-                let path = entry.unwrap().path();
-                let bytes = std::fs::read(&path).unwrap();
-                let replay = std::panic::catch_unwind(|| harness::run(target, &bytes));
-                assert!(replay.is_ok(), "{target}: {} panics", path.display());
+                inputs.push((target, entry.unwrap().path()));
                 seeds += usize::from(kind == "corpus");
-                total += 1;
             }
         }
         assert!(seeds > 0, "{target} has no seed corpus");
     }
-    assert!(total >= harness::TARGETS.len());
+    assert!(inputs.len() >= harness::TARGETS.len());
+    // Some 15,000 inputs of milliseconds each: replayed on every core.
+    let panics: Vec<String> = inputs
+        .par_iter()
+        .filter_map(|(target, path)| {
+            let bytes = std::fs::read(path).unwrap();
+            std::panic::catch_unwind(|| harness::run(target, &bytes))
+                .is_err()
+                .then(|| format!("{target}: {}", path.display()))
+        })
+        .collect();
+    assert!(panics.is_empty(), "these inputs panic: {panics:?}");
 }
