@@ -11,8 +11,6 @@
 
 use std::path::{Component, Path, PathBuf};
 
-use base64::Engine;
-
 use crate::relight::SceneError;
 use crate::{Error, Result};
 
@@ -144,12 +142,12 @@ fn percent_decode(uri: &str) -> Option<String> {
 
 /// The bytes of a `data:` URI's remainder `[MEDIATYPE][;base64],DATA` (RFC 2397); only
 /// base64 data is accepted, as glTF writers emit.
-fn decode_data_uri(rest: &str) -> Option<Vec<u8>> {
+pub(crate) fn decode_data_uri(rest: &str) -> Option<Vec<u8>> {
     let (header, data) = rest.split_once(',')?;
     if !header.ends_with(";base64") {
         return None;
     }
-    base64::engine::general_purpose::STANDARD.decode(data).ok()
+    data_encoding::BASE64.decode(data.as_bytes()).ok()
 }
 
 #[cfg(test)]

@@ -1,6 +1,5 @@
 use std::path::{Path, PathBuf};
 
-use base64::Engine;
 use serde_json::{Value, json};
 
 use super::*;
@@ -27,7 +26,7 @@ fn triangle(extra: &[f32], patch: impl FnOnce(&mut Value)) -> Value {
     }
     let uri = format!(
         "data:application/octet-stream;base64,{}",
-        base64::engine::general_purpose::STANDARD.encode(&bytes)
+        data_encoding::BASE64.encode(&bytes)
     );
     let mut doc = json!({
         "asset": {"version": "2.0"},
@@ -346,8 +345,8 @@ fn indices_beyond_the_vertices_and_nan_positions_are_refused() {
     // Index 7 in a triangle of 3 vertices; a NaN as the second vertex's y.
     let mut doc = triangle(&[], |_| {});
     let uri = doc["buffers"][0]["uri"].as_str().unwrap().to_owned();
-    let mut bytes = base64::engine::general_purpose::STANDARD
-        .decode(uri.split_once(',').unwrap().1)
+    let mut bytes = data_encoding::BASE64
+        .decode(uri.split_once(',').unwrap().1.as_bytes())
         .unwrap();
     let mut bad_index = bytes.clone();
     bad_index[38..40].copy_from_slice(&7u16.to_le_bytes());
@@ -358,7 +357,7 @@ fn indices_beyond_the_vertices_and_nan_positions_are_refused() {
     ] {
         doc["buffers"][0]["uri"] = json!(format!(
             "data:application/octet-stream;base64,{}",
-            base64::engine::general_purpose::STANDARD.encode(&data)
+            data_encoding::BASE64.encode(&data)
         ));
         let e = refusal(&doc);
         assert!(
@@ -417,7 +416,7 @@ fn counts_and_textures_beyond_the_budget_are_refused_before_they_are_read() {
         })
     };
     let huge = textured(
-        json!({"uri": format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(&png))}),
+        json!({"uri": format!("data:image/png;base64,{}", data_encoding::BASE64.encode(&png))}),
     );
     let e = refusal(&huge);
     assert!(e.contains("image 0: ") && e.contains("memory limit"), "{e}");

@@ -58,7 +58,7 @@
 //! * `camera` (optional): position, look-at point, vertical field of view in degrees.
 
 mod asset;
-mod asset_path;
+pub(crate) mod asset_path;
 pub mod cache;
 pub mod cache_shard;
 mod file;

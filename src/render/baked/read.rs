@@ -8,6 +8,7 @@ use gltf::Semantic;
 use gltf::accessor::{DataType, Dimensions};
 use ndarray::Array2;
 
+use crate::relight::scene::asset_path::decode_data_uri;
 use crate::{Error, Result};
 
 /// A baked glTF's first primitive, as stored: every attribute f32 `(V, 3)`, the triangles
@@ -73,7 +74,10 @@ impl BakedGltf {
                 gltf::buffer::Source::Bin => blob
                     .map(<[u8]>::to_vec)
                     .ok_or("the buffer names a BIN chunk the file does not have")?,
-                gltf::buffer::Source::Uri(uri) => decode_data_uri(uri)?,
+                gltf::buffer::Source::Uri(uri) => uri
+                    .strip_prefix("data:")
+                    .and_then(decode_data_uri)
+                    .ok_or("the buffer is not embedded (a base64 data: URI)")?,
             },
             (None, _) => return Err("no buffer".into()),
         };
@@ -161,15 +165,4 @@ fn read_words(
         .chunks_exact(4)
         .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
         .collect())
-}
-
-/// The bytes of a base64 `data:` URI (the only external source a baked `.gltf` has).
-fn decode_data_uri(uri: &str) -> std::result::Result<Vec<u8>, String> {
-    let (_, data) = uri
-        .strip_prefix("data:")
-        .and_then(|rest| rest.split_once(";base64,"))
-        .ok_or("the buffer is not embedded (a base64 data: URI)")?;
-    data_encoding::BASE64
-        .decode(data.as_bytes())
-        .map_err(|e| format!("the buffer's base64: {e}"))
 }
