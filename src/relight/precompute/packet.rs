@@ -213,7 +213,7 @@ impl PacketBvh {
         direction: [f32; 3],
         t_max: f32,
     ) -> Option<(u32, f32, f32, f32)> {
-        let mut rays = Rays::<1> {
+        let rays = Rays::<1> {
             d: direction.map(|x| [x]),
             inv: direction.map(|x| [1.0 / x]),
             t_max: [t_max],
@@ -222,14 +222,44 @@ impl PacketBvh {
             span: None,
             parallel: direction.contains(&0.0),
         };
-        let mut best = None;
-        let mut stack = Vec::with_capacity(self.stack);
-        let (lo, hi, root) = self.root;
-        if box_lanes(lo, hi, origin, &rays) != 0 {
-            stack.push(root);
+        if self.stack <= SMALL_STACK {
+            self.closest(
+                origin,
+                direction,
+                rays,
+                &mut [Child::default(); SMALL_STACK],
+            )
+        } else {
+            self.closest(
+                origin,
+                direction,
+                rays,
+                &mut vec![Child::default(); self.stack],
+            )
         }
+    }
+
+    /// [`closest_hit`](Self::closest_hit)'s traversal, `stack` (at least the tree's depth
+    /// plus one entries) its scratch.
+    #[inline(always)]
+    fn closest(
+        &self,
+        origin: [f32; 3],
+        direction: [f32; 3],
+        mut rays: Rays<1>,
+        stack: &mut [Child],
+    ) -> Option<(u32, f32, f32, f32)> {
+        let mut best = None;
+        let (lo, hi, root) = self.root;
+        if box_lanes(lo, hi, origin, &rays) == 0 {
+            return None;
+        }
+        stack[0] = root;
+        let mut top = 1;
         // Depth first; a box is opened only while it may hold a hit nearer than the best.
-        while let Some(child) = stack.pop() {
+        while top > 0 {
+            top -= 1;
+            let child = stack[top];
             if child.count > 0 {
                 let first = child.index as usize;
                 for (i, tri) in self.triangles[first..first + child.count as usize]
@@ -249,7 +279,8 @@ impl PacketBvh {
                 let lo = [node.lo[0][c], node.lo[1][c], node.lo[2][c]];
                 let hi = [node.hi[0][c], node.hi[1][c], node.hi[2][c]];
                 if box_lanes(lo, hi, origin, &rays) != 0 {
-                    stack.push(node.child[c]);
+                    stack[top] = node.child[c];
+                    top += 1;
                 }
             }
         }
@@ -324,7 +355,7 @@ impl PacketBvh {
 }
 
 /// Trees no deeper than this trace with a stack on the call's frame (others allocate one per
-/// packet, which only a degenerate tree needs).
+/// packet or closest-hit ray, which only a degenerate tree needs).
 const SMALL_STACK: usize = 128;
 
 /// The corners of node `id` of `bvh2`.
