@@ -167,6 +167,21 @@ impl BouncedTransport {
     pub fn stored_bytes(&self) -> usize {
         self.channels.iter().map(TransportSet::stored_bytes).sum()
     }
+
+    /// Appends every vertex of `other` after this sum's (the merge of shards): both must sum
+    /// the same bounces in as many channels of the same parameters.
+    pub(crate) fn append(&mut self, other: &BouncedTransport) -> Result<()> {
+        if (self.bounces, self.channels.len()) != (other.bounces, other.channels.len()) {
+            return Err(Error::parameter(
+                "bounced transport",
+                "only sums of the same bounces and channels are joined",
+            ));
+        }
+        for (mine, theirs) in self.channels.iter_mut().zip(&other.channels) {
+            mine.append(theirs)?;
+        }
+        Ok(())
+    }
 }
 
 /// Refuses a bounce count outside `1..=MAX_BOUNCES`.
@@ -282,11 +297,13 @@ pub fn bounce_range(
         )?);
     }
     let sum = sum.expect("at least one bounce");
+    let seconds = start.elapsed().as_secs_f64();
     let report = PrecomputeReport {
         rays,
-        seconds: start.elapsed().as_secs_f64(),
+        seconds,
         working_bytes: weights.bytes() + rayon::current_num_threads() * count * 16,
         tracer: Some(bvh.tracer()),
+        bounce_seconds: seconds,
     };
     Ok((sum, report))
 }

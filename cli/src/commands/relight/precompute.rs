@@ -41,6 +41,14 @@ Examples:
   haarshift relight precompute testdata/scenes/cubes.json --param cube --resolution 64 -o cubes.hsr
   haarshift relight precompute scene.json --order direction --map-size 2048 -o scene.hsr
   haarshift relight precompute bunny.ply --ray-tracer packets -o bunny.hsr   # not Embree
+  haarshift relight precompute testdata/scenes/bunny_in_box.json --bounces 2 -o box.hsr
+
+With --bounces B, B bounces of interreflected light (Lambertian) are gathered over the same
+rays: each ray that hits the front of a triangle brings the bounce-before transport of the
+hit point (interpolated over the triangle's corners) times its albedo / pi; the sum of the B
+bounces is stored beside the direct transport (one set when every albedo is grey, else R, G,
+B), and `relight render` shows it unless given --direct-only. The albedo is baked in, so a
+render of such a cache refuses --albedo and glossy BRDFs.
 
 Sharded across machines (vertex order only): shard I of N computes the vertices
 [I x V / N, (I + 1) x V / N) against the whole scene, with the bits an unsharded run gives
@@ -105,6 +113,11 @@ pub struct Args {
     #[arg(long, value_name = "B")]
     pub sh_bands: Option<usize>,
 
+    /// Also gather B bounces of interreflected light (0 to 8; Lambertian scenes, --order
+    /// vertex) over the same rays, stored beside the direct transport
+    #[arg(long, value_name = "B", default_value_t = 0)]
+    pub bounces: usize,
+
     #[command(flatten)]
     pub shard: ShardFlags,
 
@@ -139,6 +152,7 @@ pub fn run(args: Args) -> Result<()> {
         map_size: args.map_size,
         memory_limit: args.scene.memory_limit,
         ray_tracer: args.ray_tracer.unwrap_or_else(RayTracer::best),
+        bounces: args.bounces,
     };
     options.check()?;
     let scene = args.scene.load_within(options.budget(shard))?;
@@ -147,7 +161,16 @@ pub fn run(args: Args) -> Result<()> {
         None => {
             let (cache, report) = precompute(scene, &options)?;
             let file_bytes = cache.write(&args.output, args.force)?;
-            (String::new(), cache.transport, file_bytes, report)
+            let what = cache.bounced.as_ref().map_or(String::new(), |b| {
+                format!(
+                    " (and {} bounces: {} sets, {} coefficients, {:.3} s)",
+                    b.bounces(),
+                    b.channels().len(),
+                    b.coefficient_count(),
+                    report.bounce_seconds
+                )
+            });
+            (what, cache.transport, file_bytes, report)
         }
         Some(shard) => {
             let range = shard.range(vertices);
