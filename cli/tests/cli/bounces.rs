@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use crate::common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata};
+use crate::viewer::{Client, ViewProcess};
 
 fn read(path: &Path) -> ndarray::Array2<f32> {
     ndarray_npy::read_npy(path).unwrap()
@@ -102,6 +103,21 @@ fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
         fails_cleanly(&args, needles);
         assert!(!refused.exists());
     }
+    // The viewer offers the bounce cache's own material only: the scene packet says so (the
+    // page greys its menu) and a state asking for another is refused in one line.
+    let view = ViewProcess::start(&[p(&b2), "--env", p(&env)]);
+    let address = view.url.trim_end_matches('/');
+    let mut page = Client::connect(&view.url, Some(address)).unwrap();
+    let (kind, scene_header, _) = page.packet();
+    assert_eq!((kind, &scene_header["bounces"]), (1, &2.into()));
+    assert_eq!(page.packet().0, 2);
+    page.send(r#"{"type": "state", "seq": 1, "brdf": "phong:10"}"#);
+    page.refused("2 bounces of light");
+    page.send(r#"{"type": "state", "seq": 2, "basis": "haar"}"#);
+    let (kind, frame, _) = page.packet();
+    assert_eq!((kind, &frame["seq"]), (3, &2.into()));
+    drop(page);
+    drop(view);
     let image = out("s.png");
     let args = ["relight", "scene", p(&scene), "-o", p(&image), "--bounces", "1"];
     fails_cleanly(&args, &["bounces", "static scenes"]);

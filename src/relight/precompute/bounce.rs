@@ -48,6 +48,14 @@
 //! the same way with the same weights, untruncated: Sloan, Kautz and Snyder's (2002)
 //! interreflected transfer vectors.
 //!
+//! **Where it goes.** [`precompute`](super::precompute) with
+//! [`PrecomputeOptions::bounces`](super::PrecomputeOptions::bounces) gathers the sum for
+//! every vertex and the cache stores it beside the direct transport
+//! ([`SceneCache::bounced`](crate::relight::SceneCache::bounced)); the Lambertian Haar and
+//! spherical-harmonic shaders add it ([`ShadingInput::bounced`](crate::relight::shade::ShadingInput::bounced)).
+//! Sharded, [`precompute_bounce_shard`](super::precompute_bounce_shard) adds one bounce to a
+//! shard's vertices from the merged cache of the bounce before.
+//!
 //! **Limits.** Lambertian scenes only: the rendered radiance is `rho_v / pi x <T0_v + S_v,c,
 //! L_c>`, so a cache with bounces renders with its stored albedo alone. At most
 //! [`MAX_BOUNCES`].

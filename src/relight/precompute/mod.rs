@@ -302,7 +302,7 @@ pub fn precompute_shard(
         return Err(Error::parameter(
             "bounces",
             "bounce b + 1 of a shard's vertices needs bounce b of every vertex: shard without \
-             --bounces, merge, then add the bounces to the whole cache",
+             --bounces, merge, then add one bounce at a time with --bounce-from MERGED.hsr",
         ));
     }
     let (transport, report) = transport(&scene, options, Some(shard))?;
@@ -313,6 +313,93 @@ pub fn precompute_shard(
         scene.albedo,
         transport,
     )?;
+    part.environment = scene.environment;
+    part.camera = scene.camera;
+    Ok((part, report))
+}
+
+/// Shard `shard` of one more bounce: the direct transport of its vertices copied from
+/// `merged` (the merged cache of `options.bounces - 1` bounces of `scene`, made with
+/// `options`), and the bounced sum of `options.bounces` bounces of its vertices gathered from
+/// `merged`'s transport and bounced sum of every vertex ([`bounce::bounce_range`]). The
+/// shards of each bounce, merged ([`merge_shards`](crate::relight::merge_shards)), make the
+/// cache the next bounce starts from, and the last merge is the cache an unsharded
+/// `--bounces` run writes, byte for byte: bounce `b + 1` of a vertex needs bounce `b` of
+/// every vertex, so shards go bounce by bounce with a merge between.
+///
+/// ```
+/// use haarshift::relight::precompute::{PrecomputeOptions, precompute, precompute_bounce_shard};
+/// use haarshift::relight::precompute::shard::Shard;
+/// use haarshift::relight::{Generator, Scene, VisibilityOptions};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// let scene = || Scene::from_mesh(Generator::OpenBox { cells: 1 }.mesh().unwrap(), false).unwrap();
+/// let mut options = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap()));
+/// let (direct, _) = precompute(scene(), &options).unwrap();
+/// options.bounces = 1;
+/// let (part, _) = precompute_bounce_shard(scene(), &options, Shard::new(1, 2).unwrap(), &direct).unwrap();
+/// let (whole, _) = precompute(scene(), &options).unwrap();
+/// let (first, bounced) = (part.record.first, part.bounced.unwrap());
+/// assert_eq!(bounced.channel(0).coefficients(0), whole.bounced.unwrap().channel(0).coefficients(first));
+/// options.bounces = 2; // two bounces on from a cache of none
+/// assert!(precompute_bounce_shard(scene(), &options, Shard::new(1, 2).unwrap(), &direct).is_err());
+/// ```
+pub fn precompute_bounce_shard(
+    scene: Scene,
+    options: &PrecomputeOptions,
+    shard: Shard,
+    merged: &SceneCache,
+) -> Result<(CacheShard, PrecomputeReport)> {
+    options.check()?;
+    let from = merged.params.bounces;
+    if options.bounces != from + 1 {
+        return Err(Error::parameter(
+            "bounces",
+            format!(
+                "{}: a shard adds one bounce to its merged cache's {from}, so give --bounces {}",
+                options.bounces,
+                from + 1
+            ),
+        ));
+    }
+    let tracer = (options.order == Order::Vertex).then_some(options.ray_tracer);
+    let mut params = options.record(scene.ground_cells, tracer);
+    params.bounces = from;
+    let wanted = Provenance {
+        params: &params,
+        mesh: &scene.mesh,
+        albedo: &scene.albedo,
+        environment: scene.environment.as_ref(),
+        camera: scene.camera.as_ref(),
+    };
+    let found = Provenance {
+        params: &merged.params,
+        mesh: &merged.mesh,
+        albedo: &merged.albedo,
+        environment: merged.environment.as_ref(),
+        camera: merged.camera.as_ref(),
+    };
+    if let Some(how) = found.difference(&wanted) {
+        return Err(Error::from(SceneError::ShardMismatch(format!(
+            "the merged cache has {how} than asked for"
+        ))));
+    }
+    let mesh = &scene.mesh;
+    let range = shard.range(mesh.vertex_count());
+    let bvh = SceneBvh::with_tracer(mesh, options.ray_tracer);
+    let (bounced, report) = bounce::bounce_range(
+        mesh,
+        &bvh,
+        &options.visibility,
+        scene.albedo.view(),
+        &merged.transport,
+        merged.bounced.as_ref(),
+        options.bounces,
+        range.clone(),
+    )?;
+    params.bounces = 0; // set again with the bounced sum
+    let transport = merged.transport.part(range)?;
+    let mut part = CacheShard::new(shard, params, scene.mesh, scene.albedo, transport)?;
+    part.set_bounced(bounced)?;
     part.environment = scene.environment;
     part.camera = scene.camera;
     Ok((part, report))
@@ -352,7 +439,9 @@ pub fn shard_is_done(
     // The tracer a rerun would cast with: the one asked for (it fell back only if Embree
     // failed to build the scene, and then the records differ and the shard is recast).
     let tracer = (options.order == Order::Vertex).then_some(options.ray_tracer);
-    let params = options.record(scene.ground_cells, tracer);
+    let mut params = options.record(scene.ground_cells, tracer);
+    // A shard of one more bounce ([`precompute_bounce_shard`]) records its bounces.
+    params.bounces = options.bounces;
     let wanted = Provenance {
         params: &params,
         mesh: &scene.mesh,
