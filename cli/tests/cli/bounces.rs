@@ -54,7 +54,10 @@ fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
     for b in ["1", "2"] {
         let cache = out(&format!("b{b}.hsr"));
         let stdout = precompute(&["--bounces", b], &cache);
-        assert!(stdout.contains(&format!("and {b} bounces: 3 sets")), "{stdout}");
+        assert!(
+            stdout.contains(&format!("and {b} bounces: 3 sets")),
+            "{stdout}"
+        );
         let got = render(&cache, &[], &out("got.npy"));
         let truth = out("truth.npy");
         let mut args = vec!["relight", "reference", p(&scene), "--env", p(&env)];
@@ -76,8 +79,14 @@ fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
         args
     };
     for (extra, needles) in [
-        (&["--albedo", "0.5,0.5,0.5"][..], &["b2.hsr", "--albedo", "2 bounces"][..]),
-        (&["--brdf", "phong:10"], &["b2.hsr", "--brdf phong", "--direct-only"]),
+        (
+            &["--albedo", "0.5,0.5,0.5"][..],
+            &["b2.hsr", "--albedo", "2 bounces"][..],
+        ),
+        (
+            &["--brdf", "phong:10"],
+            &["b2.hsr", "--brdf phong", "--direct-only"],
+        ),
         (&["--basis", "ambient"], &["b2.hsr", "--basis ambient"]),
     ] {
         fails_cleanly(&render_args(extra), needles);
@@ -93,8 +102,16 @@ fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
     .unwrap();
     for (input, extra, needles) in [
         (&scene, &["--bounces", "9"][..], &["bounces", "0 to 8"][..]),
-        (&scene, &["--bounces", "1", "--order", "direction"], &["shadow buffers", "--order vertex"]),
-        (&scene, &["--bounces", "1", "--shard", "0/2"], &["every vertex", "merge"]),
+        (
+            &scene,
+            &["--bounces", "1", "--order", "direction"],
+            &["shadow buffers", "--order vertex"],
+        ),
+        (
+            &scene,
+            &["--bounces", "1", "--shard", "0/2"],
+            &["every vertex", "merge"],
+        ),
         (&glossy, &["--bounces", "1"], &["glossy", "dynamic"]),
     ] {
         let mut args = vec!["relight", "precompute", p(input), "-o", p(&refused)];
@@ -119,6 +136,14 @@ fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
     drop(page);
     drop(view);
     let image = out("s.png");
-    let args = ["relight", "scene", p(&scene), "-o", p(&image), "--bounces", "1"];
+    let args = [
+        "relight",
+        "scene",
+        p(&scene),
+        "-o",
+        p(&image),
+        "--bounces",
+        "1",
+    ];
     fails_cleanly(&args, &["bounces", "static scenes"]);
 }

@@ -51,9 +51,9 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use crate::faces::{ParamKind, Parameterization};
+use crate::io::mapped::Buffer;
 use crate::io::mapped::MappedFile;
 use crate::product::Selection;
-use crate::io::mapped::Buffer;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::precompute::bounce::{BouncedTransport, is_grey};
 use crate::relight::precompute::transport::TransportSet;
@@ -468,7 +468,11 @@ pub(super) fn check_bounced(
                 Some(format!(
                     "the bounced sum has {} set(s) but the albedo is {}",
                     b.channels().len(),
-                    if is_grey(albedo.view()) { "grey" } else { "coloured" }
+                    if is_grey(albedo.view()) {
+                        "grey"
+                    } else {
+                        "coloured"
+                    }
                 ))
             } else {
                 None
@@ -546,8 +550,12 @@ pub(super) fn header(
         triangles: mesh.triangles().len(),
         ground_vertices,
         coefficients: sets.direct.coefficient_count(),
-        bounced_coefficients: (sets.bounced)
-            .map_or(vec![], |b| b.channels().iter().map(TransportSet::coefficient_count).collect()),
+        bounced_coefficients: (sets.bounced).map_or(vec![], |b| {
+            b.channels()
+                .iter()
+                .map(TransportSet::coefficient_count)
+                .collect()
+        }),
         scene_hash: scene_hash(mesh),
         environment: scene_file.0.clone(),
         camera: scene_file.1.clone(),

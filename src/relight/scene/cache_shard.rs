@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 
 use ndarray::Array2;
 
-use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::bounce::BouncedTransport;
+use crate::relight::precompute::shard::Shard;
 use crate::relight::scene::cache::{
     CacheHeader, CacheParams, Parts, Sets, ShardRecord, check_bounced, check_parts, header,
     read_parts, scene_hash, write_parts,

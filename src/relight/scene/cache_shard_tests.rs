@@ -247,7 +247,10 @@ fn sharded_bounces_merged_bounce_by_bounce_are_the_unsharded_cache_byte_for_byte
     let (cache, _) = precompute(scene(), &options).unwrap();
     assert_eq!(cache.bounced.as_ref().unwrap().channels().len(), 3);
     cache.write(&whole, false).unwrap();
-    assert_eq!(std::fs::read(&merged).unwrap(), std::fs::read(&whole).unwrap());
+    assert_eq!(
+        std::fs::read(&merged).unwrap(),
+        std::fs::read(&whole).unwrap()
+    );
     // A merged cache of other options, or two bounces on at once, is refused.
     let from = SceneCache::read(&dir.path().join("b1.hsr")).unwrap();
     let mut other = options;

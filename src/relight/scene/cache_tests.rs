@@ -415,7 +415,10 @@ fn a_bounced_sum_that_does_not_match_is_refused() {
     assert!(e.contains("1 set(s) but the albedo is coloured"), "{e}");
     let short = crate::relight::precompute::bounce::BouncedTransport::new(
         1,
-        vec![TransportSet::new(cache.transport.param(), Selection::Largest(10))],
+        vec![TransportSet::new(
+            cache.transport.param(),
+            Selection::Largest(10),
+        )],
     )
     .unwrap();
     let e = coloured.set_bounced(short).unwrap_err().to_string();
@@ -423,7 +426,11 @@ fn a_bounced_sum_that_does_not_match_is_refused() {
     // A cache whose parameters claim bounces it does not hold.
     let mut params = cache.params.clone();
     params.bounces = 3;
-    let (m, a, t) = (cache.mesh.clone(), cache.albedo.clone(), cache.transport.clone());
+    let (m, a, t) = (
+        cache.mesh.clone(),
+        cache.albedo.clone(),
+        cache.transport.clone(),
+    );
     assert!(SceneCache::new(params, m, a, t).is_err());
 }
 
@@ -454,5 +461,9 @@ fn hostile_bounce_headers_are_refused_without_a_panic() {
     }
     // The untouched header passes through the same rewriting.
     let same = with_header(&good, &header);
-    assert!(parse_bytes(&same).and_then(SceneCache::from_file_parts).is_ok());
+    assert!(
+        parse_bytes(&same)
+            .and_then(SceneCache::from_file_parts)
+            .is_ok()
+    );
 }

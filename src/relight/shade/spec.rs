@@ -231,7 +231,8 @@ impl ShaderSpec {
     pub fn build(&self, input: &ShadingInput<'_>) -> Result<Box<dyn Shader>> {
         self.check()?;
         if let Some(b) = input.bounced
-            && !(self.material.brdf.is_lambert() && matches!(self.method, Method::Haar | Method::Sh))
+            && !(self.material.brdf.is_lambert()
+                && matches!(self.method, Method::Haar | Method::Sh))
         {
             return Err(input.refusal(&format!(
                 "it holds {} bounces of light baked with its albedo and a Lambertian BRDF, which \

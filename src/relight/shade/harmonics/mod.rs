@@ -42,11 +42,11 @@ use rayon::prelude::*;
 
 use std::time::Instant;
 
+use super::lambert::{add_channels, bounced_sets};
 use super::{
     FrameMapping, FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
     Timing, seconds,
 };
-use super::lambert::{add_channels, bounced_sets};
 use crate::relight::harmonics::{ShTransfer, check_bands};
 use crate::relight::material::orient::mirror_directions;
 use crate::relight::{Brdf, Mesh};

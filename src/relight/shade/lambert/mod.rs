@@ -587,7 +587,11 @@ pub(crate) fn bounced_sets<'a>(
 }
 
 /// Adds `part` to `sum` (both `(V, 3)`): every channel, or `channel` alone.
-pub(crate) fn add_channels<T: Sample>(sum: &mut Array2<T>, part: &Array2<T>, channel: Option<usize>) {
+pub(crate) fn add_channels<T: Sample>(
+    sum: &mut Array2<T>,
+    part: &Array2<T>,
+    channel: Option<usize>,
+) {
     for (mut s, p) in sum.rows_mut().into_iter().zip(part.rows()) {
         for c in channel.map_or(0..3, |c| c..c + 1) {
             s[c] = T::from_f64(s[c].as_f64() + p[c].as_f64());
