@@ -515,25 +515,17 @@ fn rendered_bounces_equal_the_pixel_domain_gather_to_1e_6_of_the_rms() {
                 precision,
                 ..ShaderSpec::default()
             };
+            let shade = |input: &ShadingInput<'_>| {
+                let shader = spec.build(input).unwrap().shade(&frame).unwrap();
+                shader.radiance.to_f64()
+            };
             let mut input = ShadingInput::cache(&cache);
-            let got = spec
-                .build(&input)
-                .unwrap()
-                .shade(&frame)
-                .unwrap()
-                .radiance
-                .to_f64();
+            let got = shade(&input);
             let error = relative_rms(&got, &want);
             assert!(error < 1e-6, "{bounces} bounces, {precision}: {error:e}");
             // Direct light alone is the reference's direct light, far from the bounced.
             input.bounced = None;
-            let direct = spec
-                .build(&input)
-                .unwrap()
-                .shade(&frame)
-                .unwrap()
-                .radiance
-                .to_f64();
+            let direct = shade(&input);
             assert!(relative_rms(&direct, &truth.direct) < 1e-6);
             assert!(relative_rms(&direct, &want) > 1e-2, "{bounces}");
         }

@@ -364,21 +364,8 @@ pub fn precompute_bounce_shard(
     let tracer = (options.order == Order::Vertex).then_some(options.ray_tracer);
     let mut params = options.record(scene.ground_cells, tracer);
     params.bounces = from;
-    let wanted = Provenance {
-        params: &params,
-        mesh: &scene.mesh,
-        albedo: &scene.albedo,
-        environment: scene.environment.as_ref(),
-        camera: scene.camera.as_ref(),
-    };
-    let found = Provenance {
-        params: &merged.params,
-        mesh: &merged.mesh,
-        albedo: &merged.albedo,
-        environment: merged.environment.as_ref(),
-        camera: merged.camera.as_ref(),
-    };
-    if let Some(how) = found.difference(&wanted) {
+    let wanted = Provenance::of_scene(&params, &scene);
+    if let Some(how) = Provenance::of_cache(merged).difference(&wanted) {
         return Err(Error::from(SceneError::ShardMismatch(format!(
             "the merged cache has {how} than asked for"
         ))));
@@ -442,13 +429,7 @@ pub fn shard_is_done(
     let mut params = options.record(scene.ground_cells, tracer);
     // A shard of one more bounce ([`precompute_bounce_shard`]) records its bounces.
     params.bounces = options.bounces;
-    let wanted = Provenance {
-        params: &params,
-        mesh: &scene.mesh,
-        albedo: &scene.albedo,
-        environment: scene.environment.as_ref(),
-        camera: scene.camera.as_ref(),
-    };
+    let wanted = Provenance::of_scene(&params, scene);
     let (index, count) = (found.record.index, found.record.count);
     let reason = match found.provenance().difference(&wanted) {
         Some(how) => format!("it holds {how} than asked for"),

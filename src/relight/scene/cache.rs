@@ -326,10 +326,7 @@ impl SceneCache {
     /// assert_eq!(SceneCache::read(&dir.path().join("box.hsr")).unwrap(), cache);
     /// ```
     pub fn set_bounced(&mut self, bounced: BouncedTransport) -> Result<()> {
-        let mut params = self.params.clone();
-        params.bounces = bounced.bounces();
-        check_bounced(&params, &self.albedo, &self.transport, Some(&bounced))?;
-        self.params = params;
+        self.params = bounced_params(&self.params, &self.albedo, &self.transport, &bounced)?;
         self.bounced = Some(bounced);
         Ok(())
     }
@@ -434,6 +431,20 @@ impl Sets<'_> {
         let bounced = self.bounced.map_or(&[][..], BouncedTransport::channels);
         std::iter::once(self.direct).chain(bounced)
     }
+}
+
+/// `params` recording `bounced`'s bounces, once [`check_bounced`] accepts it beside
+/// `transport` and `albedo`.
+pub(super) fn bounced_params(
+    params: &CacheParams,
+    albedo: &Array2<f32>,
+    transport: &TransportSet,
+    bounced: &BouncedTransport,
+) -> Result<CacheParams> {
+    let mut params = params.clone();
+    params.bounces = bounced.bounces();
+    check_bounced(&params, albedo, transport, Some(bounced))?;
+    Ok(params)
 }
 
 /// Checks that `bounced` (with `params.bounces` bounces, none when absent) has the vertices,

@@ -16,11 +16,11 @@ use ndarray::Array2;
 use crate::relight::precompute::bounce::BouncedTransport;
 use crate::relight::precompute::shard::Shard;
 use crate::relight::scene::cache::{
-    CacheHeader, CacheParams, Parts, Sets, ShardRecord, check_bounced, check_parts, header,
-    read_parts, scene_hash, write_parts,
+    CacheHeader, CacheParams, Parts, Sets, ShardRecord, bounced_params, check_bounced, check_parts,
+    header, read_parts, scene_hash, write_parts,
 };
 use crate::relight::scene::{CameraSpec, EnvironmentSpec};
-use crate::relight::{Mesh, SceneCache, SceneError, TransportSet};
+use crate::relight::{Mesh, Scene, SceneCache, SceneError, TransportSet};
 use crate::{Error, Result};
 
 /// One shard of a scene cache; see the [module docs](self).
@@ -94,10 +94,7 @@ impl CacheShard {
     /// Stores the bounced sum of the shard's vertices and records its bounces, checked as
     /// [`SceneCache::set_bounced`] checks a whole cache's.
     pub fn set_bounced(&mut self, bounced: BouncedTransport) -> Result<()> {
-        let mut params = self.params.clone();
-        params.bounces = bounced.bounces();
-        check_bounced(&params, &self.albedo, &self.transport, Some(&bounced))?;
-        self.params = params;
+        self.params = bounced_params(&self.params, &self.albedo, &self.transport, &bounced)?;
         self.bounced = Some(bounced);
         Ok(())
     }
@@ -176,7 +173,29 @@ pub(crate) struct Provenance<'a> {
     pub camera: Option<&'a CameraSpec>,
 }
 
-impl Provenance<'_> {
+impl<'a> Provenance<'a> {
+    /// What `scene` precomputed with `params` is made from.
+    pub(crate) fn of_scene(params: &'a CacheParams, scene: &'a Scene) -> Self {
+        Provenance {
+            params,
+            mesh: &scene.mesh,
+            albedo: &scene.albedo,
+            environment: scene.environment.as_ref(),
+            camera: scene.camera.as_ref(),
+        }
+    }
+
+    /// What a whole cache was made from.
+    pub(crate) fn of_cache(cache: &'a SceneCache) -> Self {
+        Provenance {
+            params: &cache.params,
+            mesh: &cache.mesh,
+            albedo: &cache.albedo,
+            environment: cache.environment.as_ref(),
+            camera: cache.camera.as_ref(),
+        }
+    }
+
     /// How `self` differs from `other` (the first difference, as `self`'s value then
     /// `other`'s), or `None` when they are the same.
     pub(crate) fn difference(&self, other: &Provenance<'_>) -> Option<String> {
