@@ -47,10 +47,10 @@ for s in bunny box; do
             timed "gather-$s-$m-$b" relight reference "${sa[@]}" --env "$env" \
                 --resolution $resolution --bounces $b --vertices "$work/gather-$s-$m-$b.npy"
             timed "render-$s-$m-$b" relight render "$work/$s-$b.hsr" --env "$env" \
-                --vertices "$work/haar-$s-$m-$b.npy"
+                --vertices "$work/haar-$s-$m-$b.npy" --width 64 --height 48 -o "$work/r.png" --force
         done
         timed "direct-only-$s-$m" relight render "$work/$s-3.hsr" --env "$env" --direct-only \
-            --vertices "$work/haar-direct-$s-$m.npy"
+            --vertices "$work/haar-direct-$s-$m.npy" --width 64 --height 48 -o "$work/r.png" --force
     done
 done
 echo "# Interreflected light against two truths"
