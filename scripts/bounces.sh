@@ -6,17 +6,19 @@
 # the path tracer (`relight reference --path-trace`, depth 3) is the truth; against it the
 # relative RMS error over vertices of the pixel-domain gather (`relight reference --bounces B`)
 # and of the Haar render of a cache precomputed with `--bounces B` (all coefficients kept,
-# cube 6 x 32^2), B = 0 (direct only) to 3; precompute time and peak memory for each B; frame
-# time with bounces on and off (`relight render --direct-only`); and, where the build has
-# `--ground-cells`, the gather's difference from the path tracer as the ground gets denser.
-# Needs a build with `relight precompute --bounces`. Also writes the picture triple
-# results/relight/bounces_{direct,bounced,paths}.png (the bunny in the box, Rooitou Park).
+# cube 6 x 16^2 by default: RESOLUTION=N to change), B = 0 (direct only) to 3; precompute time
+# and peak memory for each B; frame time with bounces on and off (`relight render
+# --direct-only`); the speed target's ratio, `--bounces 1` against direct precomputation of
+# the bunny on its ground at cube 6 x 32^2; and, where the build has `--ground-cells`, the
+# gather's difference from the path tracer as the ground gets denser. Also writes the picture
+# triple results/relight/bounces_{direct,bounced,paths}.png (the bunny in the box, Rooitou
+# Park). Low resolutions and PATHS=256 keep the run to minutes on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # shellcheck source=scripts/timing.sh
 source scripts/timing.sh
-paths=${PATHS:-1024}
-resolution=32
+paths=${PATHS:-256}
+resolution=${RESOLUTION:-16}
 maps=(rooitou_park_1k st_fagans_interior_1k studio_small_03_1k venice_sunset_1k)
 declare -A scene_args=(
     [bunny]="testdata/meshes/bunny.ply --ground-plane"
@@ -45,10 +47,10 @@ for s in bunny box; do
             timed "gather-$s-$m-$b" relight reference "${sa[@]}" --env "$env" \
                 --resolution $resolution --bounces $b --vertices "$work/gather-$s-$m-$b.npy"
             timed "render-$s-$m-$b" relight render "$work/$s-$b.hsr" --env "$env" \
-                --vertices "$work/haar-$s-$m-$b.npy"
+                --vertices "$work/haar-$s-$m-$b.npy" --width 64 --height 48 -o "$work/r.png" --force
         done
         timed "direct-only-$s-$m" relight render "$work/$s-3.hsr" --env "$env" --direct-only \
-            --vertices "$work/haar-direct-$s-$m.npy"
+            --vertices "$work/haar-direct-$s-$m.npy" --width 64 --height 48 -o "$work/r.png" --force
     done
 done
 echo "# Interreflected light against two truths"
@@ -91,6 +93,22 @@ for s in bunny box; do
     step_row "render-$s-rooitou_park_1k-3"
     step_row "direct-only-$s-rooitou_park_1k"
 done
+echo
+echo "## Speed: one bounce against the direct precomputation (bunny on its ground, cube 6 x 32^2)"
+echo
+echo "| step | wall (m:ss) | CPU s | peak resident MiB | what it reports |"
+echo "|---|---|---|---|---|"
+for b in 0 1; do
+    timed "speed-$b" relight precompute testdata/meshes/bunny.ply --ground-plane --param cube \
+        --resolution 32 --bounces $b -o "$work/speed-$b.hsr"
+    step_row "speed-$b"
+done
+seconds() { python3 -c 'import sys; h, m, s = ([0, 0] + sys.argv[1].split(":"))[-3:]; print(3600 * float(h) + 60 * float(m) + float(s))' "$1"; }
+w0=$(seconds "$(field speed-0 'Elapsed (wall clock)')")
+w1=$(seconds "$(field speed-1 'Elapsed (wall clock)')")
+echo
+echo "Wall time of \`--bounces 1\` over the direct run's: $(python3 -c "print(f'{$w1 / $w0:.2f}')")x"
+echo "(target at most 3x); peak memory $(peak_mib speed-1) MiB against $(peak_mib speed-0) MiB."
 echo
 echo "## The gather against the path tracer as the ground gets denser (bunny, Rooitou Park, 1 bounce)"
 echo

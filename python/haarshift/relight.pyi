@@ -46,6 +46,8 @@ class Cache:
     def param(self) -> Tuple[str, int]: ...
     @property
     def sh_bands(self) -> Optional[int]: ...
+    @property
+    def bounces(self) -> int: ...
 
 @overload
 def precompute(
@@ -63,6 +65,7 @@ def precompute(
     shard: None = None,
     output: Union[str, "os.PathLike[str]", None] = None,
     force: bool = False,
+    bounces: int = 0,
 ) -> Cache:
     """Precomputes a mesh or scene file as `haarshift relight precompute` does."""
 

@@ -189,6 +189,20 @@ impl Cache {
         py.detach(|| self.cache.write(&path, force)).or_raise()
     }
 
+    /// The bounces of interreflected light the cache holds beside its direct transport (0:
+    /// direct light alone).
+    ///
+    /// >>> import json, os, tempfile, haarshift
+    /// >>> d = tempfile.mkdtemp(); path = os.path.join(d, "box.json")
+    /// >>> with open(path, "w") as f:
+    /// ...     json.dump({"objects": [{"generator": {"box": {"cells": 1}}}]}, f)
+    /// >>> haarshift.relight.precompute(path, resolution=4, bounces=2).bounces
+    /// 2
+    #[getter]
+    fn bounces(&self) -> usize {
+        self.cache.params.bounces
+    }
+
     /// The number of vertices, the ground plane's (if any) last.
     #[getter]
     fn vertex_count(&self) -> usize {
@@ -277,6 +291,11 @@ impl Cache {
 /// `"packets"` (haarshift's own, always available); the two answer alike except on rays
 /// through a triangle's edge. The cache records the one that cast (`Cache.ray_tracer`).
 ///
+/// `bounces` (0 to 8) also gathers that many bounces of interreflected light over the same
+/// rays and stores their sum beside the transport (`Cache.bounces`); not with `shard=` (a
+/// shard's next bounce needs the merged cache of the last: `haarshift relight precompute
+/// --bounce-from`).
+///
 /// >>> import json, os, tempfile, haarshift
 /// >>> d = tempfile.mkdtemp(); path = os.path.join(d, "ball.json")
 /// >>> with open(path, "w") as f:
@@ -288,7 +307,7 @@ impl Cache {
 /// >>> open(os.path.join(d, "ball.hsr"), "rb").read() == open(os.path.join(d, "whole.hsr"), "rb").read()
 /// True
 #[pyfunction]
-#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, ground_cells = None, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, shard = None, output = None, force = false, ray_tracer = None))]
+#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, ground_cells = None, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, shard = None, output = None, force = false, ray_tracer = None, bounces = 0))]
 #[allow(clippy::too_many_arguments)] // the keyword arguments of one Python function
 fn precompute(
     py: Python<'_>,
@@ -306,6 +325,7 @@ fn precompute(
     output: Option<PathBuf>,
     force: bool,
     ray_tracer: Option<&str>,
+    bounces: usize,
 ) -> PyResult<Py<PyAny>> {
     let param = Parameterization::new(parse::<ParamKind>(param)?, resolution).or_raise()?;
     let mut visibility = VisibilityOptions::new(param);
@@ -315,6 +335,7 @@ fn precompute(
     visibility.keep = keep_visibility.map_or(Selection::All, Selection::Largest);
     let mut options = PrecomputeOptions::new(visibility);
     options.order = parse::<Order>(order)?;
+    options.bounces = bounces;
     if let Some(tracer) = ray_tracer {
         options.ray_tracer = parse::<RayTracer>(tracer)?;
     }

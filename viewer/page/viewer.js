@@ -479,6 +479,14 @@ function setupControls(scene) {
   };
   $('material').onchange = material;
   $('exponent').onchange = material;
+  // A cache with bounced light baked its albedo and a Lambertian BRDF in: the menu is fixed
+  // (the server refuses any other material too).
+  if (scene.bounces) {
+    for (const id of ['material', 'exponent']) {
+      $(id).disabled = true;
+      $(id).title = `fixed: the cache holds ${scene.bounces} bounces of light gathered with its albedo`;
+    }
+  }
   $('light_rotation').value = state.light_rotation;
   $('light_rotation').onchange = () => { state.light_rotation = $('light_rotation').value; send(); };
   $('brdf_rotation').value = state.brdf_rotation;

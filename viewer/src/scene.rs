@@ -237,6 +237,10 @@ impl ViewedScene {
         let mesh = self.mesh();
         let param = self.param();
         let bounds = mesh.bounds();
+        let bounces = match &self.source {
+            Source::Cache(cache) => cache.params.bounces,
+            Source::Dynamic(_) => 0,
+        };
         let (object_vertices, stored, sh_bands, dynamic) = match &self.source {
             Source::Cache(cache) => (
                 cache.object_vertices(),
@@ -276,6 +280,7 @@ impl ViewedScene {
             "levels": param.face_size().trailing_zeros(),
             "stored_coefficients": stored,
             "sh_bands": sh_bands,
+            "bounces": bounces,
             "dynamic": dynamic,
             "measured": self.measured.iter().map(|(name, brdf)| json!({
                 "name": name,

@@ -469,6 +469,22 @@ impl Session {
             ));
         }
         let brdf = self.scene.brdf(&state.brdf)?;
+        // A cache's bounced light was gathered with its albedo and a Lambertian BRDF: its
+        // material menu offers nothing else.
+        if let Ok(cache) = self.scene.cache("a shader")
+            && let Some(b) = &cache.bounced
+            && !brdf.is_lambert()
+        {
+            return Err(Error::parameter(
+                "brdf",
+                format!(
+                    "{}: this cache holds {} bounces of light gathered with its albedo and a \
+                     Lambertian BRDF, so its material is fixed",
+                    state.brdf,
+                    b.bounces()
+                ),
+            ));
+        }
         self.check_budgets(state)?;
         let material = GlossyOptions {
             brdf: brdf.clone(),

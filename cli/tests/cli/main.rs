@@ -7,6 +7,7 @@
 mod common;
 
 mod bake;
+mod bounces;
 mod compute_precision;
 mod deploy;
 mod experiment;

@@ -353,7 +353,7 @@ pub struct Client(tungstenite::WebSocket<std::net::TcpStream>);
 
 impl Client {
     /// Connects to `/ws` (its `Host` the url's), with an `Origin` header when given.
-    fn connect(url: &str, origin: Option<&str>) -> Result<Client, tungstenite::Error> {
+    pub fn connect(url: &str, origin: Option<&str>) -> Result<Client, tungstenite::Error> {
         use tungstenite::client::IntoClientRequest;
         let address = url.trim_start_matches("http://").trim_end_matches('/');
         let stream = std::net::TcpStream::connect(address).unwrap();

@@ -48,6 +48,14 @@
 //! the same way with the same weights, untruncated: Sloan, Kautz and Snyder's (2002)
 //! interreflected transfer vectors.
 //!
+//! **Where it goes.** [`precompute`](super::precompute) with
+//! [`PrecomputeOptions::bounces`](super::PrecomputeOptions::bounces) gathers the sum for
+//! every vertex and the cache stores it beside the direct transport
+//! ([`SceneCache::bounced`](crate::relight::SceneCache::bounced)); the Lambertian Haar and
+//! spherical-harmonic shaders add it ([`ShadingInput::bounced`](crate::relight::shade::ShadingInput::bounced)).
+//! Sharded, [`precompute_bounce_shard`](super::precompute_bounce_shard) adds one bounce to a
+//! shard's vertices from the merged cache of the bounce before.
+//!
 //! **Limits.** Lambertian scenes only: the rendered radiance is `rho_v / pi x <T0_v + S_v,c,
 //! L_c>`, so a cache with bounces renders with its stored albedo alone. At most
 //! [`MAX_BOUNCES`].
@@ -167,6 +175,21 @@ impl BouncedTransport {
     pub fn stored_bytes(&self) -> usize {
         self.channels.iter().map(TransportSet::stored_bytes).sum()
     }
+
+    /// Appends every vertex of `other` after this sum's (the merge of shards): both must sum
+    /// the same bounces in as many channels of the same parameters.
+    pub(crate) fn append(&mut self, other: &BouncedTransport) -> Result<()> {
+        if (self.bounces, self.channels.len()) != (other.bounces, other.channels.len()) {
+            return Err(Error::parameter(
+                "bounced transport",
+                "only sums of the same bounces and channels are joined",
+            ));
+        }
+        for (mine, theirs) in self.channels.iter_mut().zip(&other.channels) {
+            mine.append(theirs)?;
+        }
+        Ok(())
+    }
 }
 
 /// Refuses a bounce count outside `1..=MAX_BOUNCES`.
@@ -282,11 +305,13 @@ pub fn bounce_range(
         )?);
     }
     let sum = sum.expect("at least one bounce");
+    let seconds = start.elapsed().as_secs_f64();
     let report = PrecomputeReport {
         rays,
-        seconds: start.elapsed().as_secs_f64(),
+        seconds,
         working_bytes: weights.bytes() + rayon::current_num_threads() * count * 16,
         tracer: Some(bvh.tracer()),
+        bounce_seconds: seconds,
     };
     Ok((sum, report))
 }

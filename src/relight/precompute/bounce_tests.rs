@@ -453,3 +453,144 @@ fn refuses_what_it_cannot_gather() {
     );
     assert!(again.is_err());
 }
+
+/// `(rms of got - want) / rms of want`.
+fn relative_rms(got: &Array2<f64>, want: &Array2<f64>) -> f64 {
+    let diff: f64 = got.iter().zip(want).map(|(g, w)| (g - w).powi(2)).sum();
+    let norm: f64 = want.iter().map(|w| w * w).sum();
+    (diff / norm).sqrt()
+}
+
+#[test]
+fn rendered_bounces_equal_the_pixel_domain_gather_to_1e_6_of_the_rms() {
+    use crate::relight::Scene;
+    use crate::relight::light::environment::Environment;
+    use crate::relight::precompute::{PrecomputeOptions, precompute};
+    use crate::relight::shade::reference::interreflection::interreflected;
+    use crate::relight::shade::{FrameSpec, Precision, ShaderSpec, ShadingInput};
+    use crate::sphere::{LatLongMap, SphereRotation};
+    // An open box (concave) under a sky brighter above and redder to one side, with a
+    // coloured albedo so that the three channels of the bounced sum differ.
+    let mut scene =
+        Scene::from_mesh(Generator::OpenBox { cells: 2 }.mesh().unwrap(), false).unwrap();
+    let v = scene.mesh.vertex_count();
+    scene.albedo = Array2::from_shape_fn((v, 3), |(i, c)| {
+        0.4 + 0.15 * c as f32 + 0.02 * (i % 7) as f32
+    });
+    let sky = LatLongMap::<f64>::from_fn(8, 3, |d, o| {
+        o.copy_from_slice(&[
+            1.0 + d[1] + 0.5 * d[0].max(0.0),
+            1.0 + d[1],
+            0.7 + 0.3 * d[2],
+        ]);
+    })
+    .unwrap();
+    let env = Environment::new(sky);
+    let frame = FrameSpec {
+        environment: &env,
+        rotation: SphereRotation::identity(),
+        eye: None,
+    };
+    let lighting = env.lat_long(8, &SphereRotation::identity()).unwrap();
+    let mut options = PrecomputeOptions::new(VisibilityOptions::new(
+        Parameterization::new(ParamKind::LatLong, 8).unwrap(),
+    ));
+    for bounces in [1, 2] {
+        options.bounces = bounces;
+        let (cache, _) = precompute(scene.clone(), &options).unwrap();
+        assert_eq!(cache.bounced.as_ref().unwrap().channels().len(), 3);
+        let bvh = SceneBvh::with_tracer(&cache.mesh, options.ray_tracer);
+        let truth = interreflected(
+            &cache.mesh,
+            &bvh,
+            cache.albedo.view(),
+            &lighting,
+            bounces,
+            false,
+        )
+        .unwrap();
+        let want = truth.radiance(bounces);
+        for precision in [Precision::F32, Precision::F64] {
+            let spec = ShaderSpec {
+                precision,
+                ..ShaderSpec::default()
+            };
+            let shade = |input: &ShadingInput<'_>| {
+                let shader = spec.build(input).unwrap().shade(&frame).unwrap();
+                shader.radiance.to_f64()
+            };
+            let mut input = ShadingInput::cache(&cache);
+            let got = shade(&input);
+            let error = relative_rms(&got, &want);
+            assert!(error < 1e-6, "{bounces} bounces, {precision}: {error:e}");
+            // Direct light alone is the reference's direct light, far from the bounced.
+            input.bounced = None;
+            let direct = shade(&input);
+            assert!(relative_rms(&direct, &truth.direct) < 1e-6);
+            assert!(relative_rms(&direct, &want) > 1e-2, "{bounces}");
+        }
+    }
+}
+
+#[test]
+fn bounced_harmonic_transfer_shades_as_its_haar_sum_with_every_band() {
+    use crate::relight::Scene;
+    use crate::relight::light::environment::Environment;
+    use crate::relight::precompute::{PrecomputeOptions, precompute};
+    use crate::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
+    use crate::sphere::{LatLongMap, SphereRotation};
+    // A sky of degree 1 is exact in two bands, so the spherical harmonics' radiance with its
+    // bounced transfer approaches the Haar one's; without the bounced transfer it does not.
+    let scene = Scene::from_mesh(Generator::OpenBox { cells: 2 }.mesh().unwrap(), false).unwrap();
+    let sky = LatLongMap::<f64>::from_fn(16, 3, |d, o| o.fill(1.0 + 0.5 * d[1])).unwrap();
+    let env = Environment::new(sky);
+    let frame = FrameSpec {
+        environment: &env,
+        rotation: SphereRotation::identity(),
+        eye: None,
+    };
+    let mut visibility =
+        VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 16).unwrap());
+    visibility.sh_bands = Some(2);
+    let mut options = PrecomputeOptions::new(visibility);
+    options.bounces = 1;
+    let (cache, _) = precompute(scene, &options).unwrap();
+    let shade = |method, bounced: bool| {
+        let mut input = ShadingInput::cache(&cache);
+        if !bounced {
+            input.bounced = None;
+        }
+        let spec = ShaderSpec {
+            method,
+            ..ShaderSpec::default()
+        };
+        spec.build(&input)
+            .unwrap()
+            .shade(&frame)
+            .unwrap()
+            .radiance
+            .to_f64()
+    };
+    let (haar, sh) = (shade(Method::Haar, true), shade(Method::Sh, true));
+    let (haar0, sh0) = (shade(Method::Haar, false), shade(Method::Sh, false));
+    let with = relative_rms(&sh, &haar);
+    assert!(with < 1e-3, "{with:e}");
+    assert!(relative_rms(&sh0, &haar0) < 1e-3);
+    assert!(relative_rms(&sh0, &haar) > 10.0 * with);
+    // Other methods refuse a bounced input; with the sum dropped they shade.
+    for method in [Method::Reference, Method::Ambient] {
+        let spec = ShaderSpec {
+            method,
+            ..ShaderSpec::default()
+        };
+        let e = spec
+            .build(&ShadingInput::cache(&cache))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("1 bounces of light baked"), "{e}");
+    }
+    let mut glossy = ShaderSpec::default();
+    glossy.material.brdf = "phong:10".parse().unwrap();
+    assert!(glossy.build(&ShadingInput::cache(&cache)).is_err());
+}

@@ -2,7 +2,9 @@
 //! visibility in the chosen loop order ([`vertex_major`](visibility::vertex_major) through a
 //! [`SceneBvh`], or [`direction_major`] with shadow buffers), the transport of every vertex, and
 //! the [`SceneCache`] that records how it was made; or one [`shard`] of the vertices of a
-//! precomputation split across machines ([`precompute_shard`], a [`CacheShard`]).
+//! precomputation split across machines ([`precompute_shard`], a [`CacheShard`]). With
+//! [`PrecomputeOptions::bounces`] `B > 0` the direct transport is followed by the bounced sum
+//! of `B` bounces of interreflected light ([`bounce`]), gathered over the same rays.
 //!
 //! **Limits.** A precomputation holds one `(faces, S, S)` array of f32 per thread and, in the
 //! direction order, one bit per (vertex, direction); a transport of more than [`MAX_TEXELS`]
@@ -76,6 +78,9 @@ pub struct PrecomputeOptions {
     pub memory_limit: u64,
     /// The ray tracer of [`Order::Vertex`] ([`RayTracer::best`] unless changed).
     pub ray_tracer: RayTracer,
+    /// Bounces of interreflected light, 0 to [`MAX_BOUNCES`](bounce::MAX_BOUNCES) (0: direct
+    /// light alone); the vertex order only.
+    pub bounces: usize,
 }
 
 impl PrecomputeOptions {
@@ -88,10 +93,13 @@ impl PrecomputeOptions {
             map_size: DEFAULT_MAP_SIZE,
             memory_limit: DEFAULT_MEMORY_LIMIT,
             ray_tracer: RayTracer::best(),
+            bounces: 0,
         }
     }
 
-    /// Refuses a transport of more than [`MAX_TEXELS`] texels, before any scene is read.
+    /// Refuses a transport of more than [`MAX_TEXELS`] texels, and bounces beyond
+    /// [`MAX_BOUNCES`](bounce::MAX_BOUNCES) or in the direction order (a shadow buffer says
+    /// whether a ray is blocked, not what it hits), before any scene is read.
     ///
     /// ```
     /// use haarshift::relight::precompute::PrecomputeOptions;
@@ -100,8 +108,24 @@ impl PrecomputeOptions {
     /// let huge = Parameterization::new(ParamKind::LatLong, 4096).unwrap();
     /// let err = PrecomputeOptions::new(VisibilityOptions::new(huge)).check().unwrap_err();
     /// assert!(err.to_string().contains("resolution"));
+    /// let mut bounced = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 8).unwrap()));
+    /// bounced.bounces = 9;
+    /// assert!(bounced.check().unwrap_err().to_string().contains("0 to 8"));
+    /// bounced.bounces = 2;
+    /// bounced.order = haarshift::relight::precompute::Order::Direction;
+    /// assert!(bounced.check().unwrap_err().to_string().contains("shadow buffers"));
     /// ```
     pub fn check(&self) -> Result<()> {
+        if self.bounces > 0 {
+            bounce::check_bounces(self.bounces)?;
+            if self.order == Order::Direction {
+                return Err(Error::parameter(
+                    "bounces",
+                    "the direction order's shadow buffers say whether a ray is blocked, not \
+                     what it hits, so they gather no bounces: use --order vertex",
+                ));
+            }
+        }
         if let Some(why) = self.ray_tracer.unavailable() {
             return Err(Error::parameter(
                 "ray tracer",
@@ -127,7 +151,8 @@ impl PrecomputeOptions {
     /// coefficients its selection can keep (every texel's unless it keeps a count), 8 bytes
     /// each (`u32` index, `f32` value) held twice (the vertices' rows, then the gathered set
     /// and the file's bytes), its row's 80 bytes of bookkeeping, the spherical-harmonic
-    /// transfer, and in the direction order one bit per texel. The direction order's shadow
+    /// transfer, with bounces as much again for each of three channels of the bounced sum,
+    /// and in the direction order one bit per texel. The direction order's shadow
     /// buffers (one per thread, `4 M^2` bytes) are not per vertex and not counted. With a
     /// `shard` of `N`, each vertex's mesh is held but the transport of only the largest
     /// `N`-th of them.
@@ -161,6 +186,7 @@ impl PrecomputeOptions {
             Order::Vertex => 0,
             Order::Direction => texels.div_ceil(8),
         };
+        let sets = if self.bounces > 0 { 4 } else { 1 };
         MemoryBudget {
             limit: self.memory_limit,
             shards: shard.map_or(1, |s| s.count() as u64),
@@ -168,6 +194,7 @@ impl PrecomputeOptions {
                 .saturating_mul(2 * 8)
                 .saturating_add(80)
                 .saturating_add(sh.saturating_mul(2))
+                .saturating_mul(sets)
                 .saturating_add(bits),
         }
     }
@@ -187,6 +214,7 @@ impl PrecomputeOptions {
             ground_cells,
             sh_bands: v.sh_bands,
             ray_tracer: tracer.map(|t| t.to_string()),
+            bounces: 0,
         }
     }
 }
@@ -204,6 +232,13 @@ impl PrecomputeOptions {
 /// let (cache, report) = precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(param))).unwrap();
 /// assert_eq!(cache.transport.vertex_count(), 54 + 1089);
 /// assert!(cache.params.ground_plane && report.rays > 0);
+/// let mut options = PrecomputeOptions::new(VisibilityOptions::new(param));
+/// options.bounces = 1; // and light that bounces once off the ground and the sphere
+/// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), true).unwrap();
+/// let (bounced, report) = precompute(scene, &options).unwrap();
+/// assert_eq!((bounced.params.bounces, bounced.transport, bounced.bounced.unwrap().is_grey()),
+///            (1, cache.transport, true));
+/// assert!(report.bounce_seconds > 0.0 && report.seconds > report.bounce_seconds);
 /// let huge = Parameterization::new(ParamKind::LatLong, 4096).unwrap();
 /// let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
 /// assert!(precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(huge))).is_err());
@@ -212,13 +247,29 @@ pub fn precompute(
     scene: Scene,
     options: &PrecomputeOptions,
 ) -> Result<(SceneCache, PrecomputeReport)> {
-    let (transport, report) = transport(&scene, options, None)?;
+    let (transport, mut report) = transport(&scene, options, None)?;
     let mut cache = SceneCache::new(
         options.record(scene.ground_cells, report.tracer),
         scene.mesh,
         scene.albedo,
         transport,
     )?;
+    if options.bounces > 0 {
+        let bvh = SceneBvh::with_tracer(&cache.mesh, options.ray_tracer);
+        let all = 0..cache.mesh.vertex_count();
+        let (bounced, b) = bounce::bounce_range(
+            &cache.mesh,
+            &bvh,
+            &options.visibility,
+            cache.albedo.view(),
+            &cache.transport,
+            None,
+            options.bounces,
+            all,
+        )?;
+        cache.set_bounced(bounced)?;
+        report = report.followed_by(&b);
+    }
     cache.environment = scene.environment;
     cache.camera = scene.camera;
     Ok((cache, report))
@@ -247,6 +298,13 @@ pub fn precompute_shard(
     options: &PrecomputeOptions,
     shard: Shard,
 ) -> Result<(CacheShard, PrecomputeReport)> {
+    if options.bounces > 0 {
+        return Err(Error::parameter(
+            "bounces",
+            "bounce b + 1 of a shard's vertices needs bounce b of every vertex: shard without \
+             --bounces, merge, then add one bounce at a time with --bounce-from MERGED.hsr",
+        ));
+    }
     let (transport, report) = transport(&scene, options, Some(shard))?;
     let mut part = CacheShard::new(
         shard,
@@ -255,6 +313,80 @@ pub fn precompute_shard(
         scene.albedo,
         transport,
     )?;
+    part.environment = scene.environment;
+    part.camera = scene.camera;
+    Ok((part, report))
+}
+
+/// Shard `shard` of one more bounce: the direct transport of its vertices copied from
+/// `merged` (the merged cache of `options.bounces - 1` bounces of `scene`, made with
+/// `options`), and the bounced sum of `options.bounces` bounces of its vertices gathered from
+/// `merged`'s transport and bounced sum of every vertex ([`bounce::bounce_range`]). The
+/// shards of each bounce, merged ([`merge_shards`](crate::relight::merge_shards)), make the
+/// cache the next bounce starts from, and the last merge is the cache an unsharded
+/// `--bounces` run writes, byte for byte: bounce `b + 1` of a vertex needs bounce `b` of
+/// every vertex, so shards go bounce by bounce with a merge between.
+///
+/// ```
+/// use haarshift::relight::precompute::{PrecomputeOptions, precompute, precompute_bounce_shard};
+/// use haarshift::relight::precompute::shard::Shard;
+/// use haarshift::relight::{Generator, Scene, VisibilityOptions};
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// let scene = || Scene::from_mesh(Generator::OpenBox { cells: 1 }.mesh().unwrap(), false).unwrap();
+/// let mut options = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap()));
+/// let (direct, _) = precompute(scene(), &options).unwrap();
+/// options.bounces = 1;
+/// let (part, _) = precompute_bounce_shard(scene(), &options, Shard::new(1, 2).unwrap(), &direct).unwrap();
+/// let (whole, _) = precompute(scene(), &options).unwrap();
+/// let (first, bounced) = (part.record.first, part.bounced.unwrap());
+/// assert_eq!(bounced.channel(0).coefficients(0), whole.bounced.unwrap().channel(0).coefficients(first));
+/// options.bounces = 2; // two bounces on from a cache of none
+/// assert!(precompute_bounce_shard(scene(), &options, Shard::new(1, 2).unwrap(), &direct).is_err());
+/// ```
+pub fn precompute_bounce_shard(
+    scene: Scene,
+    options: &PrecomputeOptions,
+    shard: Shard,
+    merged: &SceneCache,
+) -> Result<(CacheShard, PrecomputeReport)> {
+    options.check()?;
+    let from = merged.params.bounces;
+    if options.bounces != from + 1 {
+        return Err(Error::parameter(
+            "bounces",
+            format!(
+                "{}: a shard adds one bounce to its merged cache's {from}, so give --bounces {}",
+                options.bounces,
+                from + 1
+            ),
+        ));
+    }
+    let tracer = (options.order == Order::Vertex).then_some(options.ray_tracer);
+    let mut params = options.record(scene.ground_cells, tracer);
+    params.bounces = from;
+    let wanted = Provenance::of_scene(&params, &scene);
+    if let Some(how) = Provenance::of_cache(merged).difference(&wanted) {
+        return Err(Error::from(SceneError::ShardMismatch(format!(
+            "the merged cache has {how} than asked for"
+        ))));
+    }
+    let mesh = &scene.mesh;
+    let range = shard.range(mesh.vertex_count());
+    let bvh = SceneBvh::with_tracer(mesh, options.ray_tracer);
+    let (bounced, report) = bounce::bounce_range(
+        mesh,
+        &bvh,
+        &options.visibility,
+        scene.albedo.view(),
+        &merged.transport,
+        merged.bounced.as_ref(),
+        options.bounces,
+        range.clone(),
+    )?;
+    params.bounces = 0; // set again with the bounced sum
+    let transport = merged.transport.part(range)?;
+    let mut part = CacheShard::new(shard, params, scene.mesh, scene.albedo, transport)?;
+    part.set_bounced(bounced)?;
     part.environment = scene.environment;
     part.camera = scene.camera;
     Ok((part, report))
@@ -294,14 +426,10 @@ pub fn shard_is_done(
     // The tracer a rerun would cast with: the one asked for (it fell back only if Embree
     // failed to build the scene, and then the records differ and the shard is recast).
     let tracer = (options.order == Order::Vertex).then_some(options.ray_tracer);
-    let params = options.record(scene.ground_cells, tracer);
-    let wanted = Provenance {
-        params: &params,
-        mesh: &scene.mesh,
-        albedo: &scene.albedo,
-        environment: scene.environment.as_ref(),
-        camera: scene.camera.as_ref(),
-    };
+    let mut params = options.record(scene.ground_cells, tracer);
+    // A shard of one more bounce ([`precompute_bounce_shard`]) records its bounces.
+    params.bounces = options.bounces;
+    let wanted = Provenance::of_scene(&params, scene);
     let (index, count) = (found.record.index, found.record.count);
     let reason = match found.provenance().difference(&wanted) {
         Some(how) => format!("it holds {how} than asked for"),

@@ -172,6 +172,36 @@ impl TransportSet {
         Ok(())
     }
 
+    /// The vertices `vertices` of this set as a set of their own (a shard's rows of a whole
+    /// cache's transport).
+    pub(crate) fn part(&self, vertices: std::ops::Range<usize>) -> Result<TransportSet> {
+        if vertices.start > vertices.end || vertices.end > self.vertex_count() {
+            return Err(Error::parameter(
+                "vertices",
+                format!(
+                    "{}..{} of a set of {}",
+                    vertices.start,
+                    vertices.end,
+                    self.vertex_count()
+                ),
+            ));
+        }
+        let mut out = match &self.sh {
+            Some(t) => TransportSet::with_sh(self.param, self.keep, t.bands())?,
+            None => TransportSet::new(self.param, self.keep),
+        };
+        for v in vertices.clone() {
+            let (indices, values) = self.coefficients(v);
+            out.rows.push(indices, values);
+        }
+        if let (Some(mine), Some(theirs)) = (&mut out.sh, &self.sh) {
+            let n = theirs.bands() * theirs.bands();
+            let rows = &theirs.as_slice()[vertices.start * n..vertices.end * n];
+            rows.chunks_exact(n).for_each(|row| mine.push(row));
+        }
+        Ok(out)
+    }
+
     /// The spherical-harmonic transfer, when the set was made with it.
     pub fn sh(&self) -> Option<&ShTransfer> {
         self.sh.as_ref()

@@ -119,6 +119,23 @@ pub struct PrecomputeReport {
     /// The ray tracer that answered ([`Occlusion::tracer`]; `None` for the shadow-buffer order
     /// and for an [`Occlusion`] of the caller's own).
     pub tracer: Option<RayTracer>,
+    /// Of [`seconds`](Self::seconds), those gathering bounces of interreflected light
+    /// ([`bounce`](super::bounce); 0 without).
+    pub bounce_seconds: f64,
+}
+
+impl PrecomputeReport {
+    /// This report and then `next`'s (a later stage of the same precomputation): rays and
+    /// seconds added, bounce seconds too, the larger working memory, this tracer.
+    pub(crate) fn followed_by(&self, next: &PrecomputeReport) -> PrecomputeReport {
+        PrecomputeReport {
+            rays: self.rays + next.rays,
+            seconds: self.seconds + next.seconds,
+            working_bytes: self.working_bytes.max(next.working_bytes),
+            tracer: self.tracer,
+            bounce_seconds: self.bounce_seconds + next.bounce_seconds,
+        }
+    }
 }
 
 /// The distance rays start off their surface: `1e-4 x` the bounding-box diagonal.
@@ -282,6 +299,7 @@ pub fn vertex_range(
         seconds: start.elapsed().as_secs_f64(),
         working_bytes: rayon::current_num_threads() * Scratch::bytes(param) + encoder.bytes(),
         tracer: occlusion.tracer(),
+        bounce_seconds: 0.0,
     };
     Ok((set, report))
 }
@@ -513,6 +531,7 @@ pub fn direction_major(
         seconds: start.elapsed().as_secs_f64(),
         working_bytes: bits_bytes + maps_bytes + encoder.bytes(),
         tracer: None,
+        bounce_seconds: 0.0,
     };
     Ok((set, report))
 }

@@ -13,6 +13,7 @@
 //! | | positions `V x 3` f64, normals `V x 3` f64, triangles `T x 3` u32, albedo `V x 3` f32 |
 //! | | transport: offsets `V + 1` u64, indices `N` u32, values `N` f32 ([`TransportSet`]) |
 //! | | with `sh_bands = B` in the parameters: the spherical-harmonic transfer `V x B^2` f32 ([`ShTransfer`]) |
+//! | | with `bounces > 0` in the parameters, for each of the [`CacheHeader::bounced_coefficients`] (one set when the albedo is grey, else R, G, B): the bounced sum's offsets, indices, values and transfer, as the transport's ([`BouncedTransport`]) |
 //!
 //! Each array starts at a file offset that is a multiple of 8, zero bytes filling the gap
 //! before it, so that [`SceneCache::read`] can map the file and read the transport in place:
@@ -29,7 +30,11 @@
 //! environment and camera in the header; version 3 the shard record; version 4 the aligned
 //! arrays; version 5 the ray tracer in the parameters; version 6 the ground plane's cells per
 //! side in the parameters ([`CacheParams::ground_cells`]), its vertex count in the header
-//! ([`CacheHeader::ground_vertices`], the trailing block the glossy shaders keep Lambertian).
+//! ([`CacheHeader::ground_vertices`], the trailing block the glossy shaders keep Lambertian),
+//! and the bounced sum of interreflected light ([`CacheParams::bounces`],
+//! [`CacheHeader::bounced_coefficients`] and their sections). Both bounce fields are left out
+//! of the header when there are no bounces, so a cache of direct light alone is byte for byte
+//! what it was before they existed, and such a file reads as having none.
 //! A file of another version is refused, never guessed at.
 //!
 //! **Checks on reading**, in this order, each a [`SceneError`]: the magic (else "not a scene
@@ -46,9 +51,11 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use crate::faces::{ParamKind, Parameterization};
+use crate::io::mapped::Buffer;
 use crate::io::mapped::MappedFile;
 use crate::product::Selection;
 use crate::relight::harmonics::ShTransfer;
+use crate::relight::precompute::bounce::{BouncedTransport, is_grey};
 use crate::relight::precompute::transport::TransportSet;
 use crate::relight::scene::framed::{Format, Reader};
 use crate::relight::scene::{CameraSpec, EnvironmentSpec};
@@ -131,6 +138,14 @@ pub struct CacheParams {
     /// or `packets`; `None` for the direction order's shadow buffers). Shards merge only when
     /// they agree on it: the two may answer a ray through an edge differently.
     pub ray_tracer: Option<String>,
+    /// Bounces of interreflected light summed in [`SceneCache::bounced`] (`--bounces B`);
+    /// 0, and then left out of the header, for direct light alone.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bounces: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl CacheParams {
@@ -141,7 +156,7 @@ impl CacheParams {
     /// use haarshift::relight::{CacheParams, KeepRecord};
     /// let mut p = CacheParams { param: "cube".into(), resolution: 4, keep: KeepRecord::All,
     ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: true,
-    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None };
+    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None, bounces: 0 };
     /// assert_eq!(p.grid_ground_vertices(), 65 * 65);
     /// (p.ground_plane, p.ground_cells) = (false, None);
     /// assert_eq!(p.grid_ground_vertices(), 0);
@@ -166,6 +181,10 @@ pub struct CacheHeader {
     pub ground_vertices: usize,
     /// Stored transport coefficients, all vertices.
     pub coefficients: usize,
+    /// With bounces, the coefficients of each set of the bounced sum: one entry when every
+    /// albedo is grey, else three (R, G, B); empty, and left out, without bounces.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bounced_coefficients: Vec<usize>,
     /// [`scene_hash`] of the mesh.
     pub scene_hash: u32,
     /// The scene file's lighting (path resolved when the scene was read), if it had one.
@@ -202,7 +221,7 @@ pub struct ShardRecord {
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
 ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
-///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()) };
+///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()), bounces: 0 };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");
@@ -220,6 +239,9 @@ pub struct SceneCache {
     pub albedo: Array2<f32>,
     /// Every vertex's transport.
     pub transport: TransportSet,
+    /// The bounced sum `T1 + ... + TB` of every vertex, when precomputed with bounces
+    /// ([`set_bounced`](Self::set_bounced); [`SceneCache::new`] leaves it `None`).
+    pub bounced: Option<BouncedTransport>,
     /// The scene file's lighting, used when a render names none ([`SceneCache::new`] leaves
     /// it `None`).
     pub environment: Option<EnvironmentSpec>,
@@ -267,35 +289,63 @@ impl SceneCache {
                 ),
             ));
         }
+        check_bounced(&params, &albedo, &transport, None)?;
         Ok(SceneCache {
             params,
             mesh,
             albedo,
             transport,
+            bounced: None,
             environment: None,
             camera: None,
             ground_vertices,
         })
     }
 
+    /// Stores the bounced sum of every vertex ([`bounce_range`](crate::relight::precompute::bounce::bounce_range)
+    /// over all of them, from this cache's transport) and records its bounces in the
+    /// parameters, after checking that it has the transport's vertices, parameterisation,
+    /// truncation and bands, and one set exactly when the albedo is grey.
+    ///
+    /// ```
+    /// use haarshift::relight::precompute::{PrecomputeOptions, precompute};
+    /// use haarshift::relight::precompute::bounce::bounce_range;
+    /// use haarshift::relight::{Generator, Scene, SceneBvh, SceneCache, VisibilityOptions};
+    /// use haarshift::faces::{ParamKind, Parameterization};
+    /// let scene = Scene::from_mesh(Generator::OpenBox { cells: 1 }.mesh().unwrap(), false).unwrap();
+    /// let options = VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
+    /// let (mut cache, _) = precompute(scene, &PrecomputeOptions::new(options)).unwrap();
+    /// let bvh = SceneBvh::new(&cache.mesh);
+    /// let all = 0..cache.mesh.vertex_count();
+    /// let (bounced, _) = bounce_range(&cache.mesh, &bvh, &options, cache.albedo.view(),
+    ///                                 &cache.transport, None, 2, all).unwrap();
+    /// cache.set_bounced(bounced).unwrap();
+    /// assert_eq!(cache.params.bounces, 2);
+    /// let dir = tempfile::tempdir().unwrap();
+    /// cache.write(&dir.path().join("box.hsr"), false).unwrap();
+    /// assert_eq!(SceneCache::read(&dir.path().join("box.hsr")).unwrap(), cache);
+    /// ```
+    pub fn set_bounced(&mut self, bounced: BouncedTransport) -> Result<()> {
+        self.params = bounced_params(&self.params, &self.albedo, &self.transport, &bounced)?;
+        self.bounced = Some(bounced);
+        Ok(())
+    }
+
     /// Writes the cache to `path` atomically (an existing file only with `force`); returns
     /// the file's size in bytes.
     pub fn write(&self, path: &Path, force: bool) -> Result<u64> {
+        let sets = Sets {
+            direct: &self.transport,
+            bounced: self.bounced.as_ref(),
+        };
         let header = header(
             &self.params,
             &self.mesh,
-            &self.transport,
+            sets,
             (&self.environment, &self.camera),
             (self.ground_vertices, None),
         );
-        write_parts(
-            path,
-            force,
-            &header,
-            &self.mesh,
-            &self.albedo,
-            &self.transport,
-        )
+        write_parts(path, force, &header, &self.mesh, &self.albedo, sets)
     }
 
     /// The vertices of the scene's objects: all but the ground plane's, which stays
@@ -333,7 +383,13 @@ impl SceneCache {
         if let Some(shard) = header.shard {
             return Err(SceneError::CacheIsShard(shard).into());
         }
-        let mut cache = SceneCache::new(header.params, parts.mesh, parts.albedo, parts.transport)?;
+        let mut params = header.params;
+        params.bounces = 0; // set again with the bounced sum, checked against it
+        let mut cache = SceneCache::new(params, parts.mesh, parts.albedo, parts.transport)?;
+        // The reader holds a bounced sum exactly when the parameters give bounces.
+        if let Some(bounced) = parts.bounced {
+            cache.set_bounced(bounced)?;
+        }
         if header.ground_vertices != cache.ground_vertices {
             return Err(SceneError::CacheCorrupt(format!(
                 "its header says {} ground vertices, its ground plane of {:?} cells per side has {}",
@@ -355,6 +411,89 @@ pub(super) struct Parts {
     pub albedo: Array2<f32>,
     /// The transport of the vertices the file holds.
     pub transport: TransportSet,
+    /// Their bounced sum, when the file holds one.
+    pub bounced: Option<BouncedTransport>,
+}
+
+/// The transport sets a cache file holds: the direct transport and, with bounces, the
+/// bounced sum, of the same vertices.
+#[derive(Clone, Copy)]
+pub(super) struct Sets<'a> {
+    /// The direct transport.
+    pub direct: &'a TransportSet,
+    /// The bounced sum.
+    pub bounced: Option<&'a BouncedTransport>,
+}
+
+impl Sets<'_> {
+    /// The sets in the file's order: the direct transport, then each bounced channel.
+    fn all(&self) -> impl Iterator<Item = &TransportSet> {
+        let bounced = self.bounced.map_or(&[][..], BouncedTransport::channels);
+        std::iter::once(self.direct).chain(bounced)
+    }
+}
+
+/// `params` recording `bounced`'s bounces, once [`check_bounced`] accepts it beside
+/// `transport` and `albedo`.
+pub(super) fn bounced_params(
+    params: &CacheParams,
+    albedo: &Array2<f32>,
+    transport: &TransportSet,
+    bounced: &BouncedTransport,
+) -> Result<CacheParams> {
+    let mut params = params.clone();
+    params.bounces = bounced.bounces();
+    check_bounced(&params, albedo, transport, Some(bounced))?;
+    Ok(params)
+}
+
+/// Checks that `bounced` (with `params.bounces` bounces, none when absent) has the vertices,
+/// parameterisation, truncation and bands of `transport`, and one set exactly when `albedo`
+/// is grey.
+pub(super) fn check_bounced(
+    params: &CacheParams,
+    albedo: &Array2<f32>,
+    transport: &TransportSet,
+    bounced: Option<&BouncedTransport>,
+) -> Result<()> {
+    let found = bounced.map_or(0, BouncedTransport::bounces);
+    let why = if params.bounces != found {
+        Some(format!(
+            "they say {} bounces but the bounced sum has {found}",
+            params.bounces
+        ))
+    } else {
+        bounced.and_then(|b| {
+            let bands = |s: &TransportSet| s.sh().map(ShTransfer::bands);
+            let c = b.channel(0);
+            if (c.param(), c.keep(), bands(c), c.vertex_count())
+                != (
+                    transport.param(),
+                    transport.keep(),
+                    bands(transport),
+                    transport.vertex_count(),
+                )
+            {
+                Some("the bounced sum is of other vertices, directions, truncation or bands".into())
+            } else if b.is_grey() != is_grey(albedo.view()) {
+                Some(format!(
+                    "the bounced sum has {} set(s) but the albedo is {}",
+                    b.channels().len(),
+                    if is_grey(albedo.view()) {
+                        "grey"
+                    } else {
+                        "coloured"
+                    }
+                ))
+            } else {
+                None
+            }
+        })
+    };
+    match why {
+        Some(why) => Err(Error::parameter("cache parameters", why)),
+        None => Ok(()),
+    }
 }
 
 /// Checks that `albedo` and `mesh` describe the same vertices, `transport` has `rows` of
@@ -406,13 +545,13 @@ pub(super) fn check_parts(
     Ok(())
 }
 
-/// The header of a file holding `transport` for `mesh` (the scene file's environment and
+/// The header of a file holding the transport `sets` for `mesh` (the scene file's environment and
 /// camera in `scene_file`) whose last `ground_vertices` are the ground plane's, a shard's
 /// when `shard` is given.
 pub(super) fn header(
     params: &CacheParams,
     mesh: &Mesh,
-    transport: &TransportSet,
+    sets: Sets<'_>,
     scene_file: (&Option<EnvironmentSpec>, &Option<CameraSpec>),
     (ground_vertices, shard): (usize, Option<ShardRecord>),
 ) -> CacheHeader {
@@ -421,7 +560,13 @@ pub(super) fn header(
         vertices: mesh.vertex_count(),
         triangles: mesh.triangles().len(),
         ground_vertices,
-        coefficients: transport.coefficient_count(),
+        coefficients: sets.direct.coefficient_count(),
+        bounced_coefficients: (sets.bounced).map_or(vec![], |b| {
+            b.channels()
+                .iter()
+                .map(TransportSet::coefficient_count)
+                .collect()
+        }),
         scene_hash: scene_hash(mesh),
         environment: scene_file.0.clone(),
         camera: scene_file.1.clone(),
@@ -436,26 +581,53 @@ pub(super) fn write_parts(
     header: &CacheHeader,
     mesh: &Mesh,
     albedo: &Array2<f32>,
-    transport: &TransportSet,
+    sets: Sets<'_>,
 ) -> Result<u64> {
-    let (offsets, indices, values) = transport.parts();
     let sizes = [
         mesh.positions().len() * 16,
         mesh.triangles().len() * 12,
         albedo.len() * 4,
-        transport.stored_bytes(),
+        sets.all().map(TransportSet::stored_bytes).sum(),
     ];
     FORMAT.write(path, force, header, sizes.iter().sum(), |body| {
         body.array(mesh.positions().iter().chain(mesh.normals()));
         body.array(mesh.triangles().iter().flatten());
         body.array(albedo);
-        body.array(offsets);
-        body.array(indices);
-        body.array(values);
-        if let Some(sh) = transport.sh() {
-            body.array(sh.as_slice());
+        for set in sets.all() {
+            let (offsets, indices, values) = set.parts();
+            body.array(offsets);
+            body.array(indices);
+            body.array(values);
+            if let Some(sh) = set.sh() {
+                body.array(sh.as_slice());
+            }
         }
     })
+}
+
+/// One transport section as read: offsets, indices, values and transfer.
+type Section = (Buffer<u64>, Buffer<u32>, Buffer<f32>, Option<ShTransfer>);
+
+/// Reads a transport section of `rows` vertices, `n` coefficients and `sh_bands` bands.
+fn read_section(
+    r: &mut Reader<'_>,
+    rows: usize,
+    n: usize,
+    sh_bands: Option<usize>,
+) -> Result<Section> {
+    let overflow = || FORMAT.corrupt("size overflows");
+    let offsets = r.array(rows.checked_add(1).ok_or_else(overflow)?)?;
+    let indices = r.array(n)?;
+    let values = r.array(n)?;
+    let sh = match sh_bands {
+        Some(b) => {
+            let per_vertex = b.checked_mul(b).ok_or_else(overflow)?;
+            let flat = r.values(rows.checked_mul(per_vertex).ok_or_else(overflow)?)?;
+            Some(ShTransfer::from_flat(b, flat)?)
+        }
+        None => None,
+    };
+    Ok((offsets, indices, values, sh))
 }
 
 /// Parses a cache file, whole or shard: the one reader of both. The file is mapped and its
@@ -496,36 +668,49 @@ fn parse_parts(header: CacheHeader, mut r: Reader<'_>) -> Result<(CacheHeader, P
     let triangles = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let albedo =
         Array2::from_shape_vec((v, 3), r.values(triple)?).map_err(|e| r.corrupt(e.to_string()))?;
-    let offsets = r.array(rows.checked_add(1).ok_or_else(overflow)?)?;
-    let indices = r.array(n)?;
-    let values = r.array(n)?;
-    let sh = match header.params.sh_bands {
-        Some(b) => {
-            let per_vertex = b.checked_mul(b).ok_or_else(overflow)?;
-            let flat = r.values(rows.checked_mul(per_vertex).ok_or_else(overflow)?)?;
-            Some(ShTransfer::from_flat(b, flat)?)
-        }
-        None => None,
-    };
-    r.finish("transport")?;
+    let bands = header.params.sh_bands;
+    let direct = read_section(&mut r, rows, n, bands)?;
+    let (bounces, counts) = (header.params.bounces, &header.bounced_coefficients);
+    // Checked before any section is read: a hostile count of sets or bounces is refused
+    // here, not sized into an allocation.
+    if (bounces == 0) != counts.is_empty() || !matches!(counts.len(), 0 | 1 | 3) {
+        return Err(r.corrupt(format!(
+            "{bounces} bounces with {} bounced sets (0 and none, or 1 to 8 and 1 or 3)",
+            counts.len()
+        )));
+    }
+    let bounced = counts
+        .iter()
+        .map(|&n| read_section(&mut r, rows, n, bands))
+        .collect::<Result<Vec<_>>>()?;
+    r.finish(if bounced.is_empty() {
+        "transport"
+    } else {
+        "bounced sum"
+    })?;
     // The normals as written, not normalised again: see `Mesh::stored`.
     let mesh = Mesh::stored(positions, triangles, normals)?;
     let kind: ParamKind = header.params.param.parse()?;
     let param = Parameterization::new(kind, header.params.resolution)?;
-    let transport = TransportSet::from_parts(
-        param,
-        header.params.keep.into(),
-        offsets,
-        indices,
-        values,
-        sh,
-    )?;
+    let keep: Selection = header.params.keep.into();
+    let set = |(offsets, indices, values, sh): Section| {
+        TransportSet::from_parts(param, keep, offsets, indices, values, sh)
+    };
+    let transport = set(direct)?;
+    let bounced = match bounced.is_empty() {
+        true => None,
+        false => {
+            let sets = bounced.into_iter().map(set).collect::<Result<Vec<_>>>()?;
+            Some(BouncedTransport::new(bounces, sets)?)
+        }
+    };
     Ok((
         header,
         Parts {
             mesh,
             albedo,
             transport,
+            bounced,
         },
     ))
 }

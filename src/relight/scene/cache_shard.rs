@@ -13,13 +13,14 @@ use std::path::{Path, PathBuf};
 
 use ndarray::Array2;
 
+use crate::relight::precompute::bounce::BouncedTransport;
 use crate::relight::precompute::shard::Shard;
 use crate::relight::scene::cache::{
-    CacheHeader, CacheParams, Parts, ShardRecord, check_parts, header, read_parts, scene_hash,
-    write_parts,
+    CacheHeader, CacheParams, Parts, Sets, ShardRecord, bounced_params, check_bounced, check_parts,
+    header, read_parts, scene_hash, write_parts,
 };
 use crate::relight::scene::{CameraSpec, EnvironmentSpec};
-use crate::relight::{Mesh, SceneCache, SceneError, TransportSet};
+use crate::relight::{Mesh, Scene, SceneCache, SceneError, TransportSet};
 use crate::{Error, Result};
 
 /// One shard of a scene cache; see the [module docs](self).
@@ -52,6 +53,8 @@ pub struct CacheShard {
     pub albedo: Array2<f32>,
     /// The transport of the vertices `record.first..record.end`, row 0 the first.
     pub transport: TransportSet,
+    /// Their bounced sum, with bounces ([`set_bounced`](Self::set_bounced)).
+    pub bounced: Option<BouncedTransport>,
     /// The scene file's lighting.
     pub environment: Option<EnvironmentSpec>,
     /// The scene file's camera.
@@ -70,6 +73,7 @@ impl CacheShard {
     ) -> Result<Self> {
         let range = shard.range(mesh.vertex_count());
         check_parts(&params, &mesh, &albedo, &transport, range.len())?;
+        check_bounced(&params, &albedo, &transport, None)?;
         Ok(CacheShard {
             record: ShardRecord {
                 index: shard.index(),
@@ -81,29 +85,35 @@ impl CacheShard {
             mesh,
             albedo,
             transport,
+            bounced: None,
             environment: None,
             camera: None,
         })
     }
 
+    /// Stores the bounced sum of the shard's vertices and records its bounces, checked as
+    /// [`SceneCache::set_bounced`] checks a whole cache's.
+    pub fn set_bounced(&mut self, bounced: BouncedTransport) -> Result<()> {
+        self.params = bounced_params(&self.params, &self.albedo, &self.transport, &bounced)?;
+        self.bounced = Some(bounced);
+        Ok(())
+    }
+
     /// Writes the shard to `path` atomically (an existing file only with `force`), by the
     /// writer of whole caches; returns the file's size in bytes.
     pub fn write(&self, path: &Path, force: bool) -> Result<u64> {
+        let sets = Sets {
+            direct: &self.transport,
+            bounced: self.bounced.as_ref(),
+        };
         let header = header(
             &self.params,
             &self.mesh,
-            &self.transport,
+            sets,
             (&self.environment, &self.camera),
             (self.params.grid_ground_vertices(), Some(self.record)),
         );
-        write_parts(
-            path,
-            force,
-            &header,
-            &self.mesh,
-            &self.albedo,
-            &self.transport,
-        )
+        write_parts(path, force, &header, &self.mesh, &self.albedo, sets)
     }
 
     /// Reads a shard, refusing a damaged file, another version or a whole cache.
@@ -118,13 +128,12 @@ impl CacheShard {
         // The reader checked the range against the mesh; it must also be the range the index
         // and count name, so that a merge can trust either.
         let shard = Shard::new(record.index, record.count)?;
-        let mut made = CacheShard::new(
-            shard,
-            header.params,
-            parts.mesh,
-            parts.albedo,
-            parts.transport,
-        )?;
+        let mut params = header.params;
+        params.bounces = 0; // set again with the bounced sum, checked against it
+        let mut made = CacheShard::new(shard, params, parts.mesh, parts.albedo, parts.transport)?;
+        if let Some(bounced) = parts.bounced {
+            made.set_bounced(bounced)?;
+        }
         if made.record != record {
             return Err(SceneError::CacheCorrupt(format!(
                 "shard {shard} records vertices {}..{}, not {}..{}",
@@ -164,7 +173,29 @@ pub(crate) struct Provenance<'a> {
     pub camera: Option<&'a CameraSpec>,
 }
 
-impl Provenance<'_> {
+impl<'a> Provenance<'a> {
+    /// What `scene` precomputed with `params` is made from.
+    pub(crate) fn of_scene(params: &'a CacheParams, scene: &'a Scene) -> Self {
+        Provenance {
+            params,
+            mesh: &scene.mesh,
+            albedo: &scene.albedo,
+            environment: scene.environment.as_ref(),
+            camera: scene.camera.as_ref(),
+        }
+    }
+
+    /// What a whole cache was made from.
+    pub(crate) fn of_cache(cache: &'a SceneCache) -> Self {
+        Provenance {
+            params: &cache.params,
+            mesh: &cache.mesh,
+            albedo: &cache.albedo,
+            environment: cache.environment.as_ref(),
+            camera: cache.camera.as_ref(),
+        }
+    }
+
     /// How `self` differs from `other` (the first difference, as `self`'s value then
     /// `other`'s), or `None` when they are the same.
     pub(crate) fn difference(&self, other: &Provenance<'_>) -> Option<String> {
@@ -232,7 +263,7 @@ pub fn merge_shards(paths: &[PathBuf]) -> Result<SceneCache> {
     // Only the transports are kept: the mesh and albedo are the first shard's.
     let placeholder = TransportSet::new(first.transport.param(), first.transport.keep());
     let own = std::mem::replace(&mut first.transport, placeholder);
-    let mut parts = vec![(first_path, first.record, own)];
+    let mut parts = vec![(first_path, first.record, own, first.bounced.take())];
     for path in rest {
         let shard = CacheShard::read(path)?;
         if let Some(how) = shard.provenance().difference(&first.provenance()) {
@@ -244,17 +275,17 @@ pub fn merge_shards(paths: &[PathBuf]) -> Result<SceneCache> {
             )))
             .in_file(path));
         }
-        parts.push((path, shard.record, shard.transport));
+        parts.push((path, shard.record, shard.transport, shard.bounced));
     }
     // Empty ranges (more shards than vertices) hold nothing and cover nothing.
-    parts.retain(|(_, r, _)| r.first < r.end);
-    parts.sort_by_key(|(_, r, _)| (r.first, r.end));
+    parts.retain(|(_, r, _, _)| r.first < r.end);
+    parts.sort_by_key(|(_, r, _, _)| (r.first, r.end));
     let coverage = |path: &Path, reason: String| {
         Err(Error::from(SceneError::ShardCoverage(reason)).in_file(path))
     };
     let mut covered = 0;
     let mut previous: Option<(&PathBuf, ShardRecord)> = None;
-    for (path, r, _) in &parts {
+    for (path, r, _, _) in &parts {
         if r.first > covered {
             return coverage(
                 path,
@@ -294,13 +325,22 @@ pub fn merge_shards(paths: &[PathBuf]) -> Result<SceneCache> {
             format!("vertices {covered}..{vertices} are in no shard ({after})"),
         );
     }
-    let mut transports = parts.into_iter().map(|(_, _, t)| t);
+    let mut transports = parts.into_iter().map(|(_, _, t, b)| (t, b));
     // Never the fallback: the shards cover at least one vertex here.
-    let mut transport = transports.next().unwrap_or(first.transport);
-    for part in transports {
+    let (mut transport, mut bounced) = transports.next().unwrap_or((first.transport, None));
+    for (part, part_bounced) in transports {
         transport.append(&part)?;
+        // The shards agree on their bounces (a parameter), so each has a sum when any has.
+        if let (Some(sum), Some(more)) = (&mut bounced, &part_bounced) {
+            sum.append(more)?;
+        }
     }
-    let mut cache = SceneCache::new(first.params, first.mesh, first.albedo, transport)?;
+    let mut params = first.params;
+    params.bounces = 0; // set again with the merged bounced sum
+    let mut cache = SceneCache::new(params, first.mesh, first.albedo, transport)?;
+    if let Some(bounced) = bounced {
+        cache.set_bounced(bounced)?;
+    }
     cache.environment = first.environment;
     cache.camera = first.camera;
     Ok(cache)

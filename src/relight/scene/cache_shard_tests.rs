@@ -202,3 +202,62 @@ fn merge_refuses_gaps_overlaps_strangers_and_damage_naming_the_file() {
     );
     assert!(merge_shards(&[]).is_err());
 }
+
+#[test]
+fn sharded_bounces_merged_bounce_by_bounce_are_the_unsharded_cache_byte_for_byte() {
+    use crate::relight::precompute::{precompute_bounce_shard, shard_is_done};
+    let dir = tempfile::tempdir().unwrap();
+    // A coloured albedo: three channels of bounced light.
+    let scene = || {
+        let mut s = box_scene();
+        s.albedo.column_mut(1).fill(0.4);
+        s
+    };
+    let mut options = options();
+    let merged_of = |parts: &[PathBuf], name: &str| {
+        let path = dir.path().join(name);
+        merge_shards(parts).unwrap().write(&path, false).unwrap();
+        path
+    };
+    let direct: Vec<PathBuf> = (0..3)
+        .map(|i| {
+            let path = dir.path().join(format!("d-{i}.hsr"));
+            let (part, _) = precompute_shard(scene(), &options, Shard::new(i, 3).unwrap()).unwrap();
+            part.write(&path, false).unwrap();
+            path
+        })
+        .collect();
+    let mut merged = merged_of(&direct, "b0.hsr");
+    for b in 1..=2 {
+        options.bounces = b;
+        let from = SceneCache::read(&merged).unwrap();
+        let parts: Vec<PathBuf> = (0..3)
+            .map(|i| {
+                let shard = Shard::new(i, 3).unwrap();
+                let (part, _) = precompute_bounce_shard(scene(), &options, shard, &from).unwrap();
+                let path = dir.path().join(format!("b{b}-{i}.hsr"));
+                part.write(&path, false).unwrap();
+                assert!(shard_is_done(&path, &scene(), &options, shard).unwrap());
+                path
+            })
+            .collect();
+        merged = merged_of(&parts, &format!("b{b}.hsr"));
+    }
+    let whole = dir.path().join("whole.hsr");
+    let (cache, _) = precompute(scene(), &options).unwrap();
+    assert_eq!(cache.bounced.as_ref().unwrap().channels().len(), 3);
+    cache.write(&whole, false).unwrap();
+    assert_eq!(
+        std::fs::read(&merged).unwrap(),
+        std::fs::read(&whole).unwrap()
+    );
+    // A merged cache of other options, or two bounces on at once, is refused.
+    let from = SceneCache::read(&dir.path().join("b1.hsr")).unwrap();
+    let mut other = options;
+    other.visibility.seed = 8;
+    let e = precompute_bounce_shard(scene(), &other, Shard::new(0, 3).unwrap(), &from);
+    assert!(e.unwrap_err().to_string().contains("seed"));
+    options.bounces = 3;
+    let e = precompute_bounce_shard(scene(), &options, Shard::new(0, 3).unwrap(), &from);
+    assert!(e.unwrap_err().to_string().contains("give --bounces 2"));
+}

@@ -26,6 +26,7 @@ fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
         ground_cells: Some(32),
         sh_bands,
         ray_tracer: Some("packets".into()),
+        bounces: 0,
     };
     let mut cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
     // The scene file's lighting and camera travel in the header.
@@ -328,4 +329,141 @@ fn a_cache_of_any_scene_reads_back_its_mesh_bit_for_bit() {
         // So the cache is found to be its scene's.
         assert!(SceneCache::read_for(&path, &cache.mesh).is_ok(), "{name}");
     }
+}
+
+/// [`made_with`] and its bounced sum of two bounces (the albedo made coloured first when
+/// `rgb`).
+fn bounced_with(sh_bands: Option<usize>, rgb: bool) -> SceneCache {
+    use crate::relight::precompute::bounce::bounce_range;
+    let mut cache = made_with(2, sh_bands);
+    if rgb {
+        cache.albedo.column_mut(2).fill(0.3);
+    }
+    let param = cache.transport.param();
+    let mut options = VisibilityOptions::new(param);
+    (options.keep, options.sh_bands) = (Selection::Largest(10), sh_bands);
+    let bvh = SceneBvh::new(&cache.mesh);
+    let all = 0..cache.mesh.vertex_count();
+    let (bounced, _) = bounce_range(
+        &cache.mesh,
+        &bvh,
+        &options,
+        cache.albedo.view(),
+        &cache.transport,
+        None,
+        2,
+        all,
+    )
+    .unwrap();
+    cache.set_bounced(bounced).unwrap();
+    cache
+}
+
+/// The header of a cache file's bytes, and where its first array starts.
+fn header_of(bytes: &[u8]) -> (serde_json::Value, usize) {
+    let len = u64::from_le_bytes(bytes[16..24].try_into().unwrap()) as usize;
+    let header = serde_json::from_slice(&bytes[24..24 + len]).unwrap();
+    (header, (24 + len).next_multiple_of(8))
+}
+
+/// `bytes` with its header replaced by `header` (padded, the checksum made right again).
+fn with_header(bytes: &[u8], header: &serde_json::Value) -> Vec<u8> {
+    let (_, first) = header_of(bytes);
+    let json = serde_json::to_vec(header).unwrap();
+    let mut out = bytes[..16].to_vec();
+    out.extend((json.len() as u64).to_le_bytes());
+    out.extend(&json);
+    out.resize(out.len().next_multiple_of(8), 0);
+    out.extend(&bytes[first..]);
+    let checksum = crc32fast::hash(&out[16..]);
+    out[12..16].copy_from_slice(&checksum.to_le_bytes());
+    out
+}
+
+#[test]
+fn bounced_caches_read_back_exactly_grey_and_rgb() {
+    for (rgb, sets) in [(false, 1), (true, 3)] {
+        let cache = bounced_with(Some(2), rgb);
+        let b = cache.bounced.as_ref().unwrap();
+        assert_eq!((cache.params.bounces, b.channels().len()), (2, sets));
+        assert!(b.channel(0).sh().is_some() && b.coefficient_count() > 0);
+        let (_dir, path) = written(&cache);
+        let back = SceneCache::read(&path).unwrap();
+        assert_eq!(back, cache);
+        let channel = back.bounced.as_ref().unwrap().channel(sets - 1);
+        assert_eq!(channel.is_mapped(), cfg!(target_endian = "little"));
+        let (header, _) = header_of(&std::fs::read(&path).unwrap());
+        assert_eq!(header["params"]["bounces"], 2);
+        let counts = header["bounced_coefficients"].as_array().unwrap();
+        assert_eq!(counts.len(), sets);
+    }
+    // A cache without bounces writes neither field: its bytes are those of a cache made
+    // before bounces existed.
+    let (_dir, path) = written(&made(2));
+    let (header, _) = header_of(&std::fs::read(&path).unwrap());
+    assert!(!header.to_string().contains("bounce"), "{header}");
+}
+
+#[test]
+fn a_bounced_sum_that_does_not_match_is_refused() {
+    let cache = bounced_with(None, false);
+    let mut coloured = cache.clone();
+    coloured.albedo.column_mut(0).fill(0.1);
+    let grey = cache.bounced.clone().unwrap();
+    // One set for a coloured albedo, and a sum of fewer vertices.
+    let e = coloured.clone().set_bounced(grey).unwrap_err().to_string();
+    assert!(e.contains("1 set(s) but the albedo is coloured"), "{e}");
+    let short = crate::relight::precompute::bounce::BouncedTransport::new(
+        1,
+        vec![TransportSet::new(
+            cache.transport.param(),
+            Selection::Largest(10),
+        )],
+    )
+    .unwrap();
+    let e = coloured.set_bounced(short).unwrap_err().to_string();
+    assert!(e.contains("other vertices"), "{e}");
+    // A cache whose parameters claim bounces it does not hold.
+    let mut params = cache.params.clone();
+    params.bounces = 3;
+    let (m, a, t) = (
+        cache.mesh.clone(),
+        cache.albedo.clone(),
+        cache.transport.clone(),
+    );
+    assert!(SceneCache::new(params, m, a, t).is_err());
+}
+
+#[test]
+fn hostile_bounce_headers_are_refused_without_a_panic() {
+    let (_dir, path) = written(&bounced_with(Some(2), true));
+    let good = std::fs::read(&path).unwrap();
+    let (header, _) = header_of(&good);
+    let edits: [(&str, serde_json::Value); 8] = [
+        ("bounces", 0.into()),
+        ("bounces", 9.into()),
+        ("bounces", usize::MAX.into()),
+        ("bounced_coefficients", serde_json::json!([])),
+        ("bounced_coefficients", serde_json::json!([1, 2])),
+        ("bounced_coefficients", serde_json::json!([0, 0, 0])),
+        ("bounced_coefficients", serde_json::json!([u64::MAX, 0, 0])),
+        ("bounced_coefficients", serde_json::json!([1, 2, 3, 4])),
+    ];
+    for (field, value) in edits {
+        let mut h = header.clone();
+        match field {
+            "bounces" => h["params"][field] = value.clone(),
+            _ => h[field] = value.clone(),
+        }
+        let bad = with_header(&good, &h);
+        let got = parse_bytes(&bad).and_then(SceneCache::from_file_parts);
+        assert!(got.is_err(), "{field} {value}");
+    }
+    // The untouched header passes through the same rewriting.
+    let same = with_header(&good, &header);
+    assert!(
+        parse_bytes(&same)
+            .and_then(SceneCache::from_file_parts)
+            .is_ok()
+    );
 }

@@ -16,6 +16,7 @@ use crate::product::Selection;
 use crate::relight::light::environment::LightRotation;
 use crate::relight::material::brdf::DEFAULT_ELEVATIONS;
 use crate::relight::material::orient::BrdfRotation;
+use crate::relight::precompute::bounce::BouncedTransport;
 use crate::relight::{Mesh, Scene, SceneCache, TransportSet};
 use crate::{Error, Result};
 
@@ -223,8 +224,24 @@ impl ShaderSpec {
 
     /// The shader of this spec for `input`, prepared (and with
     /// [`fill_cache`](Self::fill_cache), its rotation cache filled).
+    ///
+    /// An input with a bounced sum ([`ShadingInput::bounced`]) is shaded with it by the
+    /// Lambertian Haar and spherical-harmonic shaders, `albedo / pi x <T0 + S_c, L_c>`, and
+    /// refused by every other method and material: its albedo and BRDF are baked into it.
     pub fn build(&self, input: &ShadingInput<'_>) -> Result<Box<dyn Shader>> {
         self.check()?;
+        if let Some(b) = input.bounced
+            && !(self.material.brdf.is_lambert()
+                && matches!(self.method, Method::Haar | Method::Sh))
+        {
+            return Err(input.refusal(&format!(
+                "it holds {} bounces of light baked with its albedo and a Lambertian BRDF, which \
+                 --basis {} with --brdf {} cannot show; --direct-only shows the direct light alone",
+                b.bounces(),
+                self.method,
+                self.material.brdf
+            )));
+        }
         Ok(match (self.method, self.precision) {
             (Method::Haar, precision) if self.material.brdf.is_lambert() => match precision {
                 Precision::F32 | Precision::Q16 => {
@@ -261,6 +278,9 @@ pub struct ShadingInput<'a> {
     pub albedo: ArrayView2<'a, f32>,
     /// Every vertex's transport, when precomputed.
     pub transport: Option<&'a TransportSet>,
+    /// Every vertex's bounced sum, to shade with the transport (a cache precomputed with
+    /// bounces; `None` shows the direct light alone).
+    pub bounced: Option<&'a BouncedTransport>,
     /// Vertices `0..object_vertices` carry the material's BRDF.
     pub object_vertices: usize,
     /// The file the input came from, named by errors about its contents.
@@ -279,19 +299,23 @@ impl<'a> ShadingInput<'a> {
             mesh,
             albedo,
             transport,
+            bounced: None,
             object_vertices,
             origin: None,
         }
     }
 
-    /// A scene cache's mesh, albedo and transport.
+    /// A scene cache's mesh, albedo, transport and bounced sum (when it has one).
     pub fn cache(cache: &'a SceneCache) -> Self {
-        Self::new(
-            &cache.mesh,
-            cache.albedo.view(),
-            Some(&cache.transport),
-            cache.object_vertices(),
-        )
+        ShadingInput {
+            bounced: cache.bounced.as_ref(),
+            ..Self::new(
+                &cache.mesh,
+                cache.albedo.view(),
+                Some(&cache.transport),
+                cache.object_vertices(),
+            )
+        }
     }
 
     /// A scene without a transport (for the reference).

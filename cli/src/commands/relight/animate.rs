@@ -113,7 +113,7 @@ pub fn run(args: Args) -> Result<()> {
     refuse_outputs(&inputs, &output_refs, args.force)?;
     let view = args.camera.view()?;
     let mut cache = SceneCache::read(&args.cache)?;
-    args.material.apply(&mut cache.albedo)?;
+    args.material.apply_to_cache(&mut cache, &args.cache)?;
     let (env, [yaw, pitch, roll]) = args.light.load(cache.environment.as_ref())?;
     let camera = view.camera(cache.camera.as_ref(), &cache.mesh)?;
     let brdf = args.material.brdf()?;

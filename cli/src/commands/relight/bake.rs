@@ -184,7 +184,7 @@ pub fn run(args: Args) -> Result<()> {
         refuse_missing_folder(path)?;
     }
     let mut cache = SceneCache::read(&args.cache)?;
-    args.material.apply(&mut cache.albedo)?;
+    args.material.apply_to_cache(&mut cache, &args.cache)?;
     let light = LightFlags {
         env: args.env.clone(),
         yaw: None,

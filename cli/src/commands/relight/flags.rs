@@ -14,7 +14,7 @@ use haarshift::relight::precompute::shard::{Shard, ShardSpec};
 use haarshift::relight::scene::validate::MemoryBudget;
 use haarshift::relight::shade::glossy::GlossyOptions;
 use haarshift::relight::shade::{LightSpec, Method, Precision, ShadeOptions, ShaderSpec};
-use haarshift::relight::{Brdf, EnvironmentSpec, Scene};
+use haarshift::relight::{Brdf, EnvironmentSpec, Scene, SceneCache};
 use haarshift::render::view::{Backdrop, ViewSpec};
 use haarshift::{Error, Result};
 
@@ -326,6 +326,25 @@ impl MaterialFlags {
             }
         }
         Ok(())
+    }
+}
+
+impl MaterialFlags {
+    /// [`apply`](Self::apply) to a cache read from `path`, refusing `--albedo` when the cache
+    /// holds bounced light (its albedo is baked into the bounced sum; `relight render
+    /// --direct-only` drops the sum first).
+    pub fn apply_to_cache(&self, cache: &mut SceneCache, path: &Path) -> Result<()> {
+        if let (Some(_), Some(b)) = (self.albedo, &cache.bounced) {
+            return Err(Error::Format {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "it holds {} bounces of light made with its own albedo, so --albedo cannot \
+                     change it (--direct-only shows the direct light alone)",
+                    b.bounces()
+                ),
+            });
+        }
+        self.apply(&mut cache.albedo)
     }
 }
 

@@ -7,9 +7,10 @@ use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
 use haarshift::relight::precompute::{
-    DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_shard, shard_is_done,
+    DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_bounce_shard,
+    precompute_shard, shard_is_done,
 };
-use haarshift::relight::{RayTracer, VisibilityOptions};
+use haarshift::relight::{RayTracer, SceneCache, VisibilityOptions};
 
 use super::flags::{SceneFlags, ShardFlags, bytes};
 use crate::commands::{choice, names, print, refuse_outputs};
@@ -41,6 +42,14 @@ Examples:
   haarshift relight precompute testdata/scenes/cubes.json --param cube --resolution 64 -o cubes.hsr
   haarshift relight precompute scene.json --order direction --map-size 2048 -o scene.hsr
   haarshift relight precompute bunny.ply --ray-tracer packets -o bunny.hsr   # not Embree
+  haarshift relight precompute testdata/scenes/bunny_in_box.json --bounces 2 -o box.hsr
+
+With --bounces B, B bounces of interreflected light (Lambertian) are gathered over the same
+rays: each ray that hits the front of a triangle brings the bounce-before transport of the
+hit point (interpolated over the triangle's corners) times its albedo / pi; the sum of the B
+bounces is stored beside the direct transport (one set when every albedo is grey, else R, G,
+B), and `relight render` shows it unless given --direct-only. The albedo is baked in, so a
+render of such a cache refuses --albedo and glossy BRDFs.
 
 Sharded across machines (vertex order only): shard I of N computes the vertices
 [I x V / N, (I + 1) x V / N) against the whole scene, with the bits an unsharded run gives
@@ -51,7 +60,14 @@ Slurm array job (SLURM_ARRAY_TASK_ID, _MIN, _STEP, _COUNT; arrays with gaps are 
 Kubernetes Indexed Job (JOB_COMPLETION_INDEX, with the Job's completions as --shards N):
   haarshift relight precompute scene.json --shard 2/8 -o part-2.hsr
   haarshift relight precompute scene.json --shard auto -o part-$SLURM_ARRAY_TASK_ID.hsr
-  haarshift relight precompute scene.json --shard auto --shards 8 -o part-$JOB_COMPLETION_INDEX.hsr";
+  haarshift relight precompute scene.json --shard auto --shards 8 -o part-$JOB_COMPLETION_INDEX.hsr
+
+Bounces, sharded: bounce b + 1 of a vertex needs bounce b of every vertex, so shards go bounce
+by bounce with a merge between (in Slurm, one array job per bounce, each after the last's
+merge). The last merge is the cache an unsharded --bounces run writes, byte for byte:
+  haarshift relight precompute scene.json --shard 2/8 -o d-2.hsr            # then merge: b0.hsr
+  haarshift relight precompute scene.json --shard 2/8 --bounces 1 --bounce-from b0.hsr -o b1-2.hsr
+  haarshift relight merge b1-*.hsr -o b1.hsr                                # and so on to B";
 
 /// Precompute a scene's per-vertex visibility and transport into a cache file.
 #[derive(clap::Args, Debug)]
@@ -105,6 +121,16 @@ pub struct Args {
     #[arg(long, value_name = "B")]
     pub sh_bands: Option<usize>,
 
+    /// Also gather B bounces of interreflected light (0 to 8; Lambertian scenes, --order
+    /// vertex) over the same rays, stored beside the direct transport
+    #[arg(long, value_name = "B", default_value_t = 0)]
+    pub bounces: usize,
+
+    /// With --shard: add one bounce (--bounces B, B - 1 the merged cache's) to the shard's
+    /// vertices, gathered from the merged cache of every vertex's B - 1 bounces
+    #[arg(long, value_name = "MERGED.hsr", requires = "shard")]
+    pub bounce_from: Option<PathBuf>,
+
     #[command(flatten)]
     pub shard: ShardFlags,
 
@@ -123,7 +149,9 @@ pub fn run(args: Args) -> Result<()> {
     let shard = args.shard.resolve()?;
     // An existing shard is looked at below (a complete one is skipped), once the scene is read.
     let existing_allowed = args.force || shard.is_some();
-    refuse_outputs(&[&args.scene.input], &[&args.output], existing_allowed)?;
+    let mut inputs = vec![args.scene.input.as_path()];
+    inputs.extend(args.bounce_from.as_deref());
+    refuse_outputs(&inputs, &[&args.output], existing_allowed)?;
     let param = Parameterization::new(args.param, args.resolution)?;
     let mut visibility = VisibilityOptions::new(param);
     visibility.samples = args.visibility_samples;
@@ -139,6 +167,7 @@ pub fn run(args: Args) -> Result<()> {
         map_size: args.map_size,
         memory_limit: args.scene.memory_limit,
         ray_tracer: args.ray_tracer.unwrap_or_else(RayTracer::best),
+        bounces: args.bounces,
     };
     options.check()?;
     let scene = args.scene.load_within(options.budget(shard))?;
@@ -147,7 +176,16 @@ pub fn run(args: Args) -> Result<()> {
         None => {
             let (cache, report) = precompute(scene, &options)?;
             let file_bytes = cache.write(&args.output, args.force)?;
-            (String::new(), cache.transport, file_bytes, report)
+            let what = cache.bounced.as_ref().map_or(String::new(), |b| {
+                format!(
+                    " (and {} bounces: {} sets, {} coefficients, {:.3} s)",
+                    b.bounces(),
+                    b.channels().len(),
+                    b.coefficient_count(),
+                    report.bounce_seconds
+                )
+            });
+            (what, cache.transport, file_bytes, report)
         }
         Some(shard) => {
             let range = shard.range(vertices);
@@ -160,7 +198,14 @@ pub fn run(args: Args) -> Result<()> {
                     range.end
                 ));
             }
-            let (part, report) = precompute_shard(scene, &options, shard)?;
+            let (part, report) = match &args.bounce_from {
+                Some(merged) => {
+                    let merged_cache = SceneCache::read(merged)?;
+                    precompute_bounce_shard(scene, &options, shard, &merged_cache)
+                        .map_err(|e| e.in_file(merged))?
+                }
+                None => precompute_shard(scene, &options, shard)?,
+            };
             let file_bytes = part.write(&args.output, args.force)?;
             (what, part.transport, file_bytes, report)
         }

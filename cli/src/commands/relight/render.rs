@@ -26,13 +26,19 @@ environment (or a colour) behind; .png is 8-bit sRGB after --exposure, .exr line
 plane vertices after). The lighting's encoding, the shading and the rasterisation are timed
 separately (preparing the transport, once per scene, apart).
 
+A cache precomputed with --bounces B renders albedo / pi x <T0 + S_c, L_c> per channel c:
+the direct transport T0 and the stored sum S of B bounces (up to four sparse dot products a
+vertex; --basis haar or sh, Lambertian, the cache's albedo); --direct-only renders T0 alone,
+with any material.
+
 Examples:
   haarshift relight render bunny.hsr --env testdata/envmaps/rooitou_park_256x128.npy -o bunny.png
   haarshift relight render bunny.hsr --env park.hdr --yaw 120 --keep-light 200 -o bunny.exr
   haarshift relight render cubes.hsr --env park.hdr --keep-light 194 --keep-visibility 414 -o cubes.png
   haarshift relight render bunny.hsr --env park.hdr --camera 0,1,4 --look-at 0,0.5,0 --fov 35 -o near.png
   haarshift relight render bunny.hsr --env park.hdr --vertices radiance.npy --background 0,0,0 -o b.png
-  haarshift relight render bunny.hsr --env park.hdr --basis sh -o bunny-sh.png   (after --sh-bands)";
+  haarshift relight render bunny.hsr --env park.hdr --basis sh -o bunny-sh.png   (after --sh-bands)
+  haarshift relight render box.hsr --env park.hdr --direct-only -o direct.png   (after --bounces)";
 
 /// Render a precomputed scene under an environment map.
 #[derive(clap::Args, Debug)]
@@ -73,6 +79,11 @@ pub struct Args {
     #[command(flatten)]
     pub camera: CameraFlags,
 
+    /// On a cache precomputed with --bounces, render the direct light alone (the bounced
+    /// sum is shown by default)
+    #[arg(long)]
+    pub direct_only: bool,
+
     /// Replace the outputs if they exist
     #[arg(long)]
     pub force: bool,
@@ -88,7 +99,10 @@ pub fn run(args: Args) -> Result<()> {
     render_format(&args.output)?;
     let view = args.camera.view()?;
     let mut cache = SceneCache::read(&args.cache)?;
-    args.material.apply(&mut cache.albedo)?;
+    if args.direct_only {
+        cache.bounced = None;
+    }
+    args.material.apply_to_cache(&mut cache, &args.cache)?;
     let (env, angles) = args.light.load(cache.environment.as_ref())?;
     let rotation = rotation(angles)?;
     let camera = view.camera(cache.camera.as_ref(), &cache.mesh)?;

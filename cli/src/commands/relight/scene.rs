@@ -142,6 +142,11 @@ pub struct Args {
     /// Replace the outputs if they exist (and field files that do not match)
     #[arg(long)]
     pub force: bool,
+
+    /// Refused: light that bounces is precomputed for static scenes (`relight precompute
+    /// --bounces`); a dynamic scene's objects move, so their interreflections would change
+    #[arg(long, value_name = "B", default_value_t = 0)]
+    pub bounces: usize,
 }
 
 /// `--shard`: this machine's share of the shapes' fields, built (or found) in --fields-dir.
@@ -176,6 +181,14 @@ fn build_fields(args: &Args, shard: Shard) -> Result<()> {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if args.bounces > 0 {
+        return Err(Error::InvalidParameter {
+            name: "bounces",
+            reason: "a dynamic scene's objects move, so their interreflections are not \
+                     precomputed: --bounces is for static scenes (relight precompute --bounces)"
+                .into(),
+        });
+    }
     if let Some(shard) = args.shard.resolve()? {
         return build_fields(&args, shard);
     }

@@ -42,6 +42,7 @@ use rayon::prelude::*;
 
 use std::time::Instant;
 
+use super::lambert::{add_channels, bounced_sets};
 use super::{
     FrameMapping, FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
     Timing, seconds,
@@ -332,6 +333,9 @@ pub fn shade_sh_glossy(
 #[derive(Debug)]
 pub struct ShShader {
     transfer: ShTransfer,
+    /// The bounced sum's transfer (Sloan, Kautz and Snyder 2002's interreflected transfer),
+    /// each with the channel it lights (`None`: a grey set, all); Lambertian only.
+    bounced: Vec<(ShTransfer, Option<usize>)>,
     albedo: Array2<f32>,
     mesh: Mesh,
     object_vertices: usize,
@@ -350,22 +354,25 @@ impl ShShader {
                 "the cache holds no spherical-harmonic transfer: precompute it with --sh-bands B",
             )
         })?;
-        let transfer = match spec.sh_bands {
-            None => stored.clone(),
+        let cut = |stored: &ShTransfer| match spec.sh_bands {
+            None => Ok(stored.clone()),
             Some(bands) if bands <= stored.bands() => ShTransfer::new(
                 bands,
                 stored
                     .coefficients()
                     .slice(ndarray::s![.., ..bands * bands])
                     .to_owned(),
-            )?,
-            Some(bands) => {
-                return Err(Error::parameter(
-                    "sh-bands",
-                    format!("{bands}: the transfer stores {} bands", stored.bands()),
-                ));
-            }
+            ),
+            Some(bands) => Err(Error::parameter(
+                "sh-bands",
+                format!("{bands}: the transfer stores {} bands", stored.bands()),
+            )),
         };
+        let transfer = cut(stored)?;
+        // A bounced sum has the transport's bands (the cache checks it).
+        let bounced = bounced_sets(input)
+            .filter_map(|(set, channel)| set.sh().map(|t| Ok((cut(t)?, channel))))
+            .collect::<Result<_>>()?;
         let phong = match &spec.material.brdf {
             Brdf::Lambert => None,
             Brdf::Phong { exponent } => Some(PhongSh::new(transfer.bands(), *exponent)?),
@@ -373,6 +380,7 @@ impl ShShader {
         };
         Ok(ShShader {
             transfer,
+            bounced,
             albedo: input.albedo.to_owned(),
             mesh: input.mesh.clone(),
             object_vertices: input.object_vertices,
@@ -393,7 +401,14 @@ impl Shader for ShShader {
         let start = Instant::now();
         let albedo = self.albedo.view();
         let radiance = match &self.phong {
-            None => Radiance::F32(shade_sh(&self.transfer, albedo, lighting.view())?),
+            None => {
+                let mut sum = shade_sh(&self.transfer, albedo, lighting.view())?;
+                for (transfer, channel) in &self.bounced {
+                    let part = shade_sh(transfer, albedo, lighting.view())?;
+                    add_channels(&mut sum, &part, *channel);
+                }
+                Radiance::F32(sum)
+            }
             Some(phong) => {
                 let mirror = mirror_directions(&self.mesh, frame.eye()?);
                 Radiance::F64(phong.shade(
@@ -409,8 +424,12 @@ impl Shader for ShShader {
             radiance,
             timing: Timing::unrotated(encode_seconds, seconds(start)),
             description: format!(
-                "spherical harmonics, {bands} bands ({} coefficients)",
-                bands * bands
+                "spherical harmonics, {bands} bands ({} coefficients){}",
+                bands * bands,
+                match self.bounced.len() {
+                    0 => "",
+                    _ => ", with the bounced transfer",
+                }
             ),
             maps: None,
             light_coefficients: Some(bands * bands),

@@ -497,10 +497,14 @@ fn retruncate<T: Sample>(
 
 /// Lambertian Haar shading behind [`Shader`](super::Shader): the transport prepared once
 /// ([`PreparedTransport`], or with [`Precision::Q16`](super::Precision::Q16) a
-/// [`QuantisedTransport`]), each frame's lighting encoded and dotted with it.
+/// [`QuantisedTransport`]), each frame's lighting encoded and dotted with it. With a bounced
+/// sum ([`ShadingInput::bounced`]) each of its sets is prepared alike and dotted too, channel
+/// `c` of the radiance `albedo / pi x (<T0, L_c> + <S_c, L_c>)`: up to four dots a vertex.
 #[derive(Debug)]
 pub struct LambertShader<T> {
     transport: Prepared<T>,
+    /// The bounced sum's sets, each with the channel it lights (`None`: a grey set, all).
+    bounced: Vec<(Prepared<T>, Option<usize>)>,
     encoder: HaarEncoder,
     prepare_seconds: f64,
 }
@@ -512,29 +516,85 @@ enum Prepared<T> {
     Quantised(QuantisedTransport),
 }
 
-impl<T: Sample> LambertShader<T> {
-    /// `input`'s transport prepared with its albedo and `spec`'s truncation (and quantised
-    /// for [`Precision::Q16`](super::Precision::Q16)).
-    pub(crate) fn new(spec: &ShaderSpec, input: &ShadingInput<'_>) -> Result<Self> {
-        let start = std::time::Instant::now();
-        let set = input.transport(spec.method)?;
-        let transport = match spec.precision {
+impl<T: Sample> Prepared<T> {
+    /// `set` prepared with `albedo` and `spec`'s truncation (and quantised for
+    /// [`Precision::Q16`](super::Precision::Q16)).
+    fn new(spec: &ShaderSpec, set: &TransportSet, albedo: ArrayView2<'_, f32>) -> Result<Self> {
+        Ok(match spec.precision {
             super::Precision::Q16 => Prepared::Quantised(QuantisedTransport::new(
-                &PreparedTransport::<f32>::new(set, input.albedo, &spec.shade)?,
+                &PreparedTransport::<f32>::new(set, albedo, &spec.shade)?,
             )),
-            _ => Prepared::Exact(PreparedTransport::new(set, input.albedo, &spec.shade)?),
-        };
-        Ok(LambertShader {
-            encoder: HaarEncoder::new(set.param(), spec.keep_light, spec.light_rotation),
-            transport,
-            prepare_seconds: seconds(start),
+            _ => Prepared::Exact(PreparedTransport::new(set, albedo, &spec.shade)?),
         })
     }
 
     fn vertex_count(&self) -> usize {
-        match &self.transport {
+        match self {
             Prepared::Exact(t) => t.vertex_count(),
             Prepared::Quantised(t) => t.vertex_count(),
+        }
+    }
+
+    /// Shades into `out`; returns what it shaded with.
+    fn shade_into(&self, lighting: &Lighting, out: &mut Array2<T>) -> Result<String> {
+        Ok(match self {
+            Prepared::Exact(t) => {
+                t.shade_into(lighting, out)?;
+                let place = if t.is_mapped() {
+                    " read in place from the cache file"
+                } else {
+                    ""
+                };
+                format!("{} coefficients{place}", t.coefficient_count())
+            }
+            Prepared::Quantised(t) => {
+                t.shade_into(lighting, out)?;
+                format!("{} entries of 16 bits", t.entry_count())
+            }
+        })
+    }
+}
+
+impl<T: Sample> LambertShader<T> {
+    /// `input`'s transport (and bounced sum) prepared with its albedo and `spec`'s truncation
+    /// (and quantised for [`Precision::Q16`](super::Precision::Q16)).
+    pub(crate) fn new(spec: &ShaderSpec, input: &ShadingInput<'_>) -> Result<Self> {
+        let start = std::time::Instant::now();
+        let set = input.transport(spec.method)?;
+        let transport = Prepared::new(spec, set, input.albedo)?;
+        let bounced = bounced_sets(input)
+            .map(|(set, channel)| Ok((Prepared::new(spec, set, input.albedo)?, channel)))
+            .collect::<Result<_>>()?;
+        Ok(LambertShader {
+            encoder: HaarEncoder::new(set.param(), spec.keep_light, spec.light_rotation),
+            transport,
+            bounced,
+            prepare_seconds: seconds(start),
+        })
+    }
+}
+
+/// The sets of `input`'s bounced sum (none without one), each with the channel it lights:
+/// `None` for a grey sum's one set, else 0, 1, 2.
+pub(crate) fn bounced_sets<'a>(
+    input: &ShadingInput<'a>,
+) -> impl Iterator<Item = (&'a TransportSet, Option<usize>)> {
+    let sets = input.bounced.map_or(&[][..], |b| b.channels());
+    let grey = sets.len() == 1;
+    sets.iter()
+        .enumerate()
+        .map(move |(c, set)| (set, (!grey).then_some(c)))
+}
+
+/// Adds `part` to `sum` (both `(V, 3)`): every channel, or `channel` alone.
+pub(crate) fn add_channels<T: Sample>(
+    sum: &mut Array2<T>,
+    part: &Array2<T>,
+    channel: Option<usize>,
+) {
+    for (mut s, p) in sum.rows_mut().into_iter().zip(part.rows()) {
+        for c in channel.map_or(0..3, |c| c..c + 1) {
+            s[c] = T::from_f64(s[c].as_f64() + p[c].as_f64());
         }
     }
 }
@@ -546,22 +606,17 @@ where
     fn shade(&mut self, frame: &FrameSpec<'_>) -> Result<Shading> {
         let (lighting, encode_seconds) = self.encoder.encode(frame)?;
         let start = std::time::Instant::now();
-        let mut radiance = Array2::zeros((self.vertex_count(), 3));
-        let stored = match &self.transport {
-            Prepared::Exact(t) => {
-                t.shade_into(&lighting, &mut radiance)?;
-                let place = if t.is_mapped() {
-                    " read in place from the cache file"
-                } else {
-                    ""
-                };
-                format!("transport {} coefficients{place}", t.coefficient_count())
-            }
-            Prepared::Quantised(t) => {
-                t.shade_into(&lighting, &mut radiance)?;
-                format!("transport {} entries of 16 bits", t.entry_count())
-            }
-        };
+        let mut radiance = Array2::zeros((self.transport.vertex_count(), 3));
+        let mut stored = format!(
+            "transport {}",
+            self.transport.shade_into(&lighting, &mut radiance)?
+        );
+        let mut part = Array2::zeros(radiance.dim());
+        for (k, (set, channel)) in self.bounced.iter().enumerate() {
+            let what = set.shade_into(&lighting, &mut part)?;
+            add_channels(&mut radiance, &part, *channel);
+            stored += &format!("{} {what}", if k == 0 { ", bounced sum" } else { " +" });
+        }
         Ok(Shading {
             radiance: radiance.into(),
             timing: Timing::unrotated(encode_seconds, seconds(start)),
