@@ -15,6 +15,7 @@ pub mod bounce;
 pub mod embree;
 mod packet;
 pub mod raycast;
+pub mod refine;
 pub mod shadowmap;
 pub mod shard;
 pub mod sparse;
@@ -173,7 +174,7 @@ impl PrecomputeOptions {
     }
 
     /// What the cache records of these options.
-    fn record(&self, ground_cells: Option<usize>, tracer: Option<RayTracer>) -> CacheParams {
+    pub(crate) fn record(&self, ground_cells: Option<usize>, tracer: Option<RayTracer>) -> CacheParams {
         let v = &self.visibility;
         CacheParams {
             param: v.param.kind().to_string(),
@@ -187,6 +188,7 @@ impl PrecomputeOptions {
             ground_cells,
             sh_bands: v.sh_bands,
             ray_tracer: tracer.map(|t| t.to_string()),
+            refine: None,
         }
     }
 }

@@ -131,6 +131,24 @@ pub struct CacheParams {
     /// or `packets`; `None` for the direction order's shadow buffers). Shards merge only when
     /// they agree on it: the two may answer a ray through an edge differently.
     pub ray_tracer: Option<String>,
+    /// How the mesh was refined (`relight precompute --refine`), if it was; absent from the
+    /// header of a cache that was not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refine: Option<RefineRecord>,
+}
+
+/// What a cache records of `relight precompute --refine TOL --max-vertices N`
+/// ([`precompute::refine`](crate::relight::precompute::refine)): its mesh is the scene's
+/// refined, and its ground plane's vertices ([`CacheHeader::ground_vertices`]) are the
+/// grid's and the midpoints made on it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RefineRecord {
+    /// `TOL`: the largest relative L2 difference left between an edge's endpoints'
+    /// transports (unless the budget stopped the refinement first).
+    pub tolerance: f64,
+    /// `N`: the most vertices the refined mesh could have.
+    pub max_vertices: usize,
 }
 
 impl CacheParams {
@@ -141,7 +159,7 @@ impl CacheParams {
     /// use haarshift::relight::{CacheParams, KeepRecord};
     /// let mut p = CacheParams { param: "cube".into(), resolution: 4, keep: KeepRecord::All,
     ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: true,
-    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None };
+    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None, refine: None };
     /// assert_eq!(p.grid_ground_vertices(), 65 * 65);
     /// (p.ground_plane, p.ground_cells) = (false, None);
     /// assert_eq!(p.grid_ground_vertices(), 0);
@@ -202,7 +220,7 @@ pub struct ShardRecord {
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
 ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
-///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()) };
+///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()), refine: None };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");
@@ -226,7 +244,8 @@ pub struct SceneCache {
     /// The scene file's camera, likewise.
     pub camera: Option<CameraSpec>,
     /// How many of the last vertices are the ground plane's:
-    /// [`CacheParams::grid_ground_vertices`], set by [`SceneCache::new`].
+    /// [`CacheParams::grid_ground_vertices`], set by [`SceneCache::new`]; in a refined cache
+    /// ([`CacheParams::refine`]) the grid's and the midpoints on it.
     pub ground_vertices: usize,
 }
 
@@ -334,6 +353,11 @@ impl SceneCache {
             return Err(SceneError::CacheIsShard(shard).into());
         }
         let mut cache = SceneCache::new(header.params, parts.mesh, parts.albedo, parts.transport)?;
+        // Refinement adds midpoints to the ground's grid, never takes its vertices away.
+        let refined_ground = cache.ground_vertices..=cache.mesh.vertex_count();
+        if cache.params.refine.is_some() && refined_ground.contains(&header.ground_vertices) {
+            cache.ground_vertices = header.ground_vertices;
+        }
         if header.ground_vertices != cache.ground_vertices {
             return Err(SceneError::CacheCorrupt(format!(
                 "its header says {} ground vertices, its ground plane of {:?} cells per side has {}",

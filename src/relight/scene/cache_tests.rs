@@ -26,6 +26,7 @@ fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
         ground_cells: Some(32),
         sh_bands,
         ray_tracer: Some("packets".into()),
+        refine: None,
     };
     let mut cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
     // The scene file's lighting and camera travel in the header.

@@ -6,10 +6,11 @@ use haarshift::Result;
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
+use haarshift::relight::precompute::refine::{Refinement, precompute_refined};
 use haarshift::relight::precompute::{
     DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_shard, shard_is_done,
 };
-use haarshift::relight::{RayTracer, VisibilityOptions};
+use haarshift::relight::{RayTracer, Scene, SceneCache, VisibilityOptions};
 
 use super::flags::{SceneFlags, ShardFlags, bytes};
 use crate::commands::{choice, names, print, refuse_outputs};
@@ -41,6 +42,16 @@ Examples:
   haarshift relight precompute testdata/scenes/cubes.json --param cube --resolution 64 -o cubes.hsr
   haarshift relight precompute scene.json --order direction --map-size 2048 -o scene.hsr
   haarshift relight precompute bunny.ply --ray-tracer packets -o bunny.hsr   # not Embree
+
+Refined where the light needs it (--refine TOL): after the precomputation, every edge whose
+endpoints' transports differ by more than TOL (relative L2, 0 to 2) is split, with its
+neighbours across longer edges (conforming longest-edge bisection: no T-junctions), the new
+vertices precomputed, and so on until every edge is within TOL or the next vertex would pass
+--max-vertices (default 4 x the scene's; then one line says how many edges are left). New
+vertices come after the objects' and after the ground's own, so the ground stays the last
+block; the cache equals a precomputation of the refined mesh. Vertex order only, one ray per
+texel, not with --shard; refine first, then bounce. results/relight/refine.md measures it:
+  haarshift relight precompute bunny.ply --ground-plane --param cube --refine 0.2 --max-vertices 5000 -o bunny.hsr
 
 Sharded across machines (vertex order only): shard I of N computes the vertices
 [I x V / N, (I + 1) x V / N) against the whole scene, with the bits an unsharded run gives
@@ -105,6 +116,15 @@ pub struct Args {
     #[arg(long, value_name = "B")]
     pub sh_bands: Option<usize>,
 
+    /// Split edges whose endpoints' transports differ by more than TOL (relative L2, in
+    /// (0, 2]), precompute the new vertices, and repeat until none does
+    #[arg(long, value_name = "TOL")]
+    pub refine: Option<f64>,
+
+    /// With --refine: the most vertices the refined mesh may have [default: 4 x the scene's]
+    #[arg(long, value_name = "N", requires = "refine")]
+    pub max_vertices: Option<usize>,
+
     #[command(flatten)]
     pub shard: ShardFlags,
 
@@ -141,11 +161,22 @@ pub fn run(args: Args) -> Result<()> {
         ray_tracer: args.ray_tracer.unwrap_or_else(RayTracer::best),
     };
     options.check()?;
+    let refinement = args.refine.map(|tolerance| Refinement {
+        tolerance,
+        max_vertices: args.max_vertices,
+    });
+    if let Some(r) = &refinement {
+        r.check_with(&options, shard)?;
+    }
     let scene = args.scene.load_within(options.budget(shard))?;
-    let (vertices, triangles) = (scene.mesh.vertex_count(), scene.mesh.triangles().len());
+    let (mut vertices, mut triangles) = (scene.mesh.vertex_count(), scene.mesh.triangles().len());
     let (what, transport, file_bytes, report) = match shard {
         None => {
-            let (cache, report) = precompute(scene, &options)?;
+            let (cache, report) = match &refinement {
+                Some(r) => refined(scene, &options, r)?,
+                None => precompute(scene, &options)?,
+            };
+            (vertices, triangles) = (cache.mesh.vertex_count(), cache.mesh.triangles().len());
             let file_bytes = cache.write(&args.output, args.force)?;
             (String::new(), cache.transport, file_bytes, report)
         }
@@ -189,4 +220,26 @@ pub fn run(args: Args) -> Result<()> {
         bytes(file_bytes),
         peak_resident_bytes().map_or("unknown".into(), bytes),
     ))
+}
+
+/// [`precompute_refined`], with its one line on what the refinement did.
+fn refined(
+    scene: Scene,
+    options: &PrecomputeOptions,
+    refinement: &Refinement,
+) -> Result<(SceneCache, haarshift::relight::PrecomputeReport)> {
+    let (cache, report, r) = precompute_refined(scene, options, refinement)?;
+    let end = if r.stopped_by_budget() {
+        format!(
+            "stopped by --max-vertices {} with {} edges above {}",
+            r.max_vertices, r.above, refinement.tolerance
+        )
+    } else {
+        format!("every edge within {}", refinement.tolerance)
+    };
+    print(&format!(
+        "refined {} -> {} vertices ({} of them the ground's) in {} rounds: {end}\n",
+        r.original, r.vertices, r.ground_vertices, r.rounds
+    ))?;
+    Ok((cache, report))
 }

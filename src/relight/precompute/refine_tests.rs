@@ -1,0 +1,153 @@
+use super::*;
+use crate::faces::{ParamKind, Parameterization};
+use crate::product::Selection;
+use crate::relight::precompute::precompute;
+use crate::relight::scene::refine::Bisection;
+use crate::relight::{Generator, RayTracer, VisibilityOptions};
+
+/// A cube sphere of one cell a face on a ground plane of 2 x 2 cells: 24 + 9 vertices.
+fn ball_on_ground() -> Scene {
+    let mut scene = Scene::from_mesh(Generator::Sphere { cells: 1 }.mesh().unwrap(), false).unwrap();
+    scene.add_ground_plane_of(2).unwrap();
+    scene
+}
+
+fn options(order: Order) -> PrecomputeOptions {
+    let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
+    let mut o = PrecomputeOptions::new(VisibilityOptions::new(param));
+    o.ray_tracer = RayTracer::Packets;
+    o.order = order;
+    o
+}
+
+fn refinement(tolerance: f64, max_vertices: usize) -> Refinement {
+    Refinement {
+        tolerance,
+        max_vertices: Some(max_vertices),
+    }
+}
+
+/// Every edge's relative difference in `cache`, largest first.
+fn edge_differences(cache: &SceneCache) -> Vec<f64> {
+    let mut scene = Scene::from_mesh(cache.mesh.clone(), false).unwrap();
+    scene.albedo = cache.albedo.clone();
+    let edges: Vec<Edge> = Bisection::new(&scene).edges().collect();
+    let mut dense = vec![0.0; cache.transport.param().texels()];
+    let mut d: Vec<f64> = (edges.iter())
+        .map(|&(a, b)| relative_difference(&cache.transport, a as usize, b as usize, &mut dense))
+        .collect();
+    d.sort_by(|x, y| y.total_cmp(x));
+    d
+}
+
+#[test]
+fn the_relative_difference_is_the_dense_vectors() {
+    let param = Parameterization::new(ParamKind::Cube, 2).unwrap();
+    let mut set = TransportSet::new(param, Selection::Largest(5));
+    let dense: Vec<ndarray::Array3<f32>> = (0..3)
+        .map(|seed| {
+            ndarray::Array3::from_shape_fn((6, 2, 2), |(f, i, j)| {
+                ((f * 7 + i * 3 + j + seed * 5) % 4) as f32 * 0.25
+            })
+        })
+        .collect();
+    for d in &dense {
+        set.push(d.view()).unwrap();
+    }
+    set.push(ndarray::Array3::zeros((6, 2, 2)).view()).unwrap();
+    let full = |v: usize| {
+        let mut x = vec![0.0f64; 24];
+        let (i, c) = set.coefficients(v);
+        i.iter().zip(c).for_each(|(&i, &c)| x[i as usize] = c.into());
+        x
+    };
+    let mut scratch = vec![0.0; 24];
+    for a in 0..4 {
+        for b in 0..4 {
+            let (x, y) = (full(a), full(b));
+            let norm = |v: &[f64]| v.iter().map(|t| t * t).sum::<f64>().sqrt();
+            let diff: Vec<f64> = x.iter().zip(&y).map(|(p, q)| p - q).collect();
+            let largest = norm(&x).max(norm(&y));
+            let want = if largest == 0.0 { 0.0 } else { norm(&diff) / largest };
+            let got = relative_difference(&set, a, b, &mut scratch);
+            assert!((got - want).abs() < 1e-12, "{a} {b}: {got} {want}");
+            assert!(scratch.iter().all(|&s| s == 0.0));
+        }
+    }
+    // One vertex against the zero vector: 1; against its negative it would be 2, the most.
+    assert!((relative_difference(&set, 0, 3, &mut scratch) - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn refined_cache_is_a_precompute_of_the_refined_mesh() {
+    let scene = ball_on_ground();
+    let o = options(Order::Vertex);
+    let (refined, _, report) = precompute_refined(scene.clone(), &o, &refinement(0.3, 2000)).unwrap();
+    assert!(!report.stopped_by_budget());
+    assert!(report.vertices > 33 + 20 && report.rounds > 2, "{report:?}");
+    let mut again = Scene::from_mesh(refined.mesh.clone(), false).unwrap();
+    again.albedo = refined.albedo.clone();
+    again.ground_plane = true;
+    again.ground_cells = scene.ground_cells;
+    again.ground_vertices = refined.ground_vertices;
+    let (unrefined, _) = precompute(again, &o).unwrap();
+    assert_eq!(unrefined.transport, refined.transport);
+    assert_eq!(unrefined.mesh, refined.mesh);
+    // Every edge is within the tolerance, and the refinement was needed.
+    assert!(edge_differences(&refined)[0] <= 0.3);
+    let (plain, _) = precompute(scene, &o).unwrap();
+    assert!(edge_differences(&plain)[0] > 0.3);
+    // The ground's vertices are the trailing block, the grid's 9 and the midpoints on it.
+    let g = refined.ground_vertices;
+    assert!(g > 9 && report.ground_vertices == g);
+    let positions = refined.mesh.positions();
+    let y = |v: usize| positions[[v, 1]];
+    assert!((report.vertices - g..report.vertices).all(|v| y(v) == -1.0));
+    assert!((0..report.vertices - g).all(|v| refined.albedo[[v, 0]] == 0.8));
+}
+
+#[test]
+fn the_budget_is_never_exceeded_and_what_it_left_is_reported() {
+    let o = options(Order::Vertex);
+    for max in [33, 34, 40, 57] {
+        let (cache, _, report) =
+            precompute_refined(ball_on_ground(), &o, &refinement(0.05, max)).unwrap();
+        assert_eq!(cache.mesh.vertex_count(), max, "{report:?}");
+        assert_eq!((report.vertices, report.max_vertices), (max, max));
+        let above = edge_differences(&cache).iter().filter(|&&d| d > 0.05).count();
+        assert_eq!(report.above, above);
+        assert!(report.stopped_by_budget());
+    }
+}
+
+#[test]
+fn a_refined_cache_reads_back_with_its_ground_vertices() {
+    let o = options(Order::Vertex);
+    let (cache, _, report) = precompute_refined(ball_on_ground(), &o, &refinement(0.5, 60)).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("refined.hsr");
+    cache.write(&path, false).unwrap();
+    let read = SceneCache::read(&path).unwrap();
+    assert_eq!(read, cache);
+    assert_eq!(read.object_vertices(), report.vertices - report.ground_vertices);
+}
+
+#[test]
+fn what_refinement_cannot_be_combined_with_is_refused_before_any_work() {
+    let refuse = |o: &PrecomputeOptions, r: Refinement, why: &str| {
+        let err = precompute_refined(ball_on_ground(), o, &r).unwrap_err().to_string();
+        assert!(err.contains(why), "{err}");
+    };
+    let o = options(Order::Vertex);
+    refuse(&options(Order::Direction), refinement(0.1, 100), "--order direction");
+    let mut jittered = o;
+    jittered.visibility.samples = 2;
+    refuse(&jittered, refinement(0.1, 100), "--visibility-samples");
+    for bad in [0.0, -1.0, 2.01, f64::NAN] {
+        refuse(&o, refinement(bad, 100), "in (0, 2]");
+    }
+    refuse(&o, refinement(0.1, 32), "32 vertices: the scene has 33 already");
+    let mut small = o;
+    small.memory_limit = 1 << 16;
+    refuse(&small, refinement(0.1, 1_000_000), "the refined scene");
+}
