@@ -71,12 +71,32 @@ echo "truth's RMS. Refinement starts from the 32^2 grid, capped at \`--max-verti
 echo "quarter of the 128^2 grid's vertices. Precompute time is the command's wall clock"
 echo "(refinement's rounds, splits and criterion included)."
 echo
-echo "| mesh | vertices | precompute wall (m:ss) | CPU s | per-pixel relative RMS | largest / RMS | what the precomputation reports |"
-echo "|---|---|---|---|---|---|---|"
+echo "| mesh | vertices | of them the ground's | precompute wall (m:ss) | CPU s | per-pixel relative RMS | largest / RMS | what the precomputation reports |"
+echo "|---|---|---|---|---|---|---|---|"
 for r in "${runs[@]}"; do
     report=$(tr '\n' ' ' <"$work/pre-$r.out" | sed "s|$work/||g; s/|/\\\\|/g; s/  */ /g")
-    echo "| $r | $(vertices "$r") | $(field "pre-$r" 'Elapsed (wall clock)') | $(cpu "pre-$r") | $(pixel_error "$r") | $report |"
+    case $r in
+    grid-*) ground=$(((${r#grid-} + 1) ** 2)) ;;
+    *) ground=$(grep -oE '\(([0-9]+) of them the ground' "$work/pre-$r.out" | grep -oE '[0-9]+') ;;
+    esac
+    error=$(pixel_error "$r")
+    echo "${error%% *}" >"$work/$r.error"
+    echo "| $r | $(vertices "$r") | $ground | $(field "pre-$r" 'Elapsed (wall clock)') | $(cpu "pre-$r") | $error | $report |"
 done
+echo
+goal=$(cat "$work/grid-128.error")
+met=()
+for tol in "${tolerances[@]}"; do
+    if python3 -c 'import sys; sys.exit(not float(sys.argv[1]) <= float(sys.argv[2]))' \
+        "$(cat "$work/refine-$tol.error")" "$goal"; then
+        met+=("$tol")
+    fi
+done
+if [ ${#met[@]} -gt 0 ]; then
+    echo "**Goal met** at --refine ${met[*]}: the 128^2 grid's error ($goal) or less with at most $budget vertices."
+else
+    echo "**Goal not met**: no tolerance reaches the 128^2 grid's error ($goal) within $budget vertices."
+fi
 echo
 python3 scripts/refine_figure.py "$work" results/relight/refine.png "$budget" "${runs[@]}"
 echo

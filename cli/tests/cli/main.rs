@@ -15,6 +15,7 @@ mod flags;
 mod ground_cells;
 mod hdr;
 mod ray_tracer;
+mod refine;
 mod readme;
 mod reference_bounces;
 mod relight;

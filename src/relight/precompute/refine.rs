@@ -6,16 +6,26 @@
 //! transports differ by more than `TOL`, precomputes the new vertices, and repeats until no
 //! edge differs by more than `TOL` or the next vertex would exceed the budget.
 //!
-//! **The criterion** is the relative L2 difference of the two endpoints' sparse transport
-//! vectors, `|T_a - T_b| / max(|T_a|, |T_b|)` (the stored Haar coefficients; the transform is
-//! orthonormal, so this is the difference of the weighted visibility x cosine over the sphere's
-//! texels), in `[0, 2]`; an edge whose endpoints both see nothing is never split. Transport,
-//! not the radiance under a probe lighting: a cache is relit under any map and any rotation of
-//! it, and an edge that looks alike under one lighting (a shadow cast away from the probe's
-//! sun, or under a dim part of the sky) is where another lighting's sun draws its shadow. The
-//! transport difference bounds the radiance difference under every lighting `L`:
-//! `|R_a - R_b| <= albedo / pi x |L| x |T_a - T_b|` (Cauchy-Schwarz), so an edge within `TOL`
-//! is within `TOL` of its brighter end under all of them at once.
+//! **The criterion** is the L2 difference of the two endpoints' sparse transport vectors over
+//! the most an endpoint could receive, `|T_a - T_b| / max(|U_a|, |U_b|)`, where `U_v` is the
+//! transport vertex `v` would have with nothing in the way (`max(0, n_v . w) dOmega` over the
+//! texels; the Haar transform is orthonormal, so the norms are the texels'). It lies in
+//! `[0, 2]`, and an edge whose ends receive nothing is never split.
+//!
+//! *Transport, not the radiance under a probe lighting*: a cache is relit under any map and
+//! any rotation of it, and an edge that looks alike under one lighting (a shadow cast away from
+//! the probe's sun, or under a dim part of its sky) is where another lighting's sun draws its
+//! shadow. The transport difference bounds the radiance difference under every lighting `L`:
+//! `|R_a - R_b| <= albedo / pi x |L| x |T_a - T_b| <= TOL x albedo / pi x |L| x |U|`
+//! (Cauchy-Schwarz), a fraction `TOL` of the most an unoccluded vertex could receive under it.
+//!
+//! *Over `|U|`, not over `max(|T_a|, |T_b|)`* (the first design): the image's error is judged
+//! against the scene's radiance, not vertex by vertex (as `relight error` does), and a ratio of
+//! the endpoints' own transports never converges where the transport goes to zero: next to
+//! where an object touches the ground, the ambient occlusion grows about linearly with the
+//! distance, so `T(d)` and `T(2d)` differ by about half of `T(2d)` at every scale, and every
+//! round would split those edges again until the budget is spent there. Over `|U|` such edges
+//! differ by as little as they receive.
 //!
 //! **The splits** are conforming longest-edge bisections
 //! ([`scene::refine`](crate::relight::scene) in the crate's source: every triangle on a split
@@ -35,6 +45,13 @@
 //! otherwise than the old one did; the test `refined_cache_is_a_precompute_of_the_refined_mesh`
 //! compares the two bit for bit.
 //!
+//! **Where it stops.** An edge shorter than [`MIN_EDGE_OFFSETS`] ray offsets is not split,
+//! whatever its difference: below the distance rays start off the surface the transport is
+//! not resolved, and where it jumps (a vertex of a foot whose offset origin is under the
+//! ground sees the sky below it, its neighbour the ground) no length would bring the edge
+//! within `TOL`. The report counts the edges left above `TOL` for it
+//! ([`RefineReport::short`]), and those the budget left ([`RefineReport::above`]).
+//!
 //! **What it is combined with.** The vertex order only: the direction order renders every
 //! vertex into each shadow buffer at once, and a refinement traces a few vertices a round.
 //! One ray per texel only: the stratified jitter is seeded by the vertex's index, which the
@@ -48,7 +65,11 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use crate::relight::precompute::visibility::{PrecomputeReport, vertex_range};
+use crate::faces::Parameterization;
+use crate::relight::precompute::visibility::{
+    PrecomputeReport, ray_offset, texel_directions, vertex_range,
+};
+use crate::relight::scene::mesh::dot;
 use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::{Order, PrecomputeOptions};
 use crate::relight::scene::refine::{Bisection, Edge};
@@ -57,6 +78,12 @@ use crate::{Error, Result};
 
 /// The budget of vertices when none is given: this many times the scene's.
 pub const DEFAULT_GROWTH: usize = 4;
+
+/// The shortest edge that is split, in [`ray_offset`]s: the transport is not resolved below
+/// the distance rays start off the surface (a vertex within it of another surface, such as a
+/// foot's on the ground, starts its rays beyond that surface), so shorter edges are left as
+/// they are whatever their difference.
+pub const MIN_EDGE_OFFSETS: f64 = 16.0;
 
 /// How to refine (`--refine TOL [--max-vertices N]`).
 ///
@@ -71,7 +98,8 @@ pub const DEFAULT_GROWTH: usize = 4;
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Refinement {
-    /// `TOL`: split edges whose endpoints' transports differ by more (relative L2), in `(0, 2]`.
+    /// `TOL`: split edges whose endpoints' transports differ by more than `TOL` times the
+    /// most an endpoint could receive (see the [module docs](self)), in `(0, 2]`.
     pub tolerance: f64,
     /// `N`: the most vertices the refined mesh may have ([`DEFAULT_GROWTH`] times the
     /// scene's when `None`).
@@ -79,8 +107,8 @@ pub struct Refinement {
 }
 
 impl Refinement {
-    /// Refuses a tolerance outside `(0, 2]` (the relative difference of two vectors is at
-    /// most 2; 0 would split forever).
+    /// Refuses a tolerance outside `(0, 2]` (the criterion is at most 2; 0 would split
+    /// forever).
     pub fn check(&self) -> Result<()> {
         if self.tolerance > 0.0 && self.tolerance <= 2.0 {
             return Ok(());
@@ -88,7 +116,7 @@ impl Refinement {
         Err(Error::parameter(
             "refine",
             format!(
-                "{}: the tolerance is a relative difference, in (0, 2]",
+                "{}: the tolerance is a fraction of an unoccluded vertex's transport, in (0, 2]",
                 self.tolerance
             ),
         ))
@@ -170,8 +198,12 @@ pub struct RefineReport {
     pub rounds: usize,
     /// The budget of vertices ([`Refinement::budget`]).
     pub max_vertices: usize,
-    /// Edges still above the tolerance: 0 unless the budget stopped the refinement.
+    /// Edges still above the tolerance and long enough to split: 0 unless the budget stopped
+    /// the refinement.
     pub above: usize,
+    /// Edges above the tolerance left because they are shorter than [`MIN_EDGE_OFFSETS`]
+    /// ray offsets.
+    pub short: usize,
 }
 
 impl RefineReport {
@@ -217,14 +249,23 @@ pub fn precompute_refined(
         let bvh = SceneBvh::with_tracer(&mesh, options.ray_tracer);
         vertex_range(&mesh, &bvh, &options.visibility, vertices)
     };
+    let unoccluded = Unoccluded::new(options.visibility.param);
+    let scales = |bisection: &Bisection, vertices: std::ops::Range<usize>| {
+        (vertices.into_par_iter())
+            .map(|v| unoccluded.norm(bisection.normal(v)))
+            .collect::<Vec<f64>>()
+    };
     let (mut transport, mut report) = trace(&bisection, 0..bisection.vertex_count())?;
-    let (mut rounds, mut above, mut first) = (1, 0, 0u32);
+    let mut scale = scales(&bisection, 0..bisection.vertex_count());
+    let shortest = (MIN_EDGE_OFFSETS * ray_offset(&scene.mesh)).powi(2);
+    let (mut rounds, mut first) = (1, 0u32);
     loop {
         // Edges between two older vertices were judged in an earlier round.
         let judged: Vec<Edge> = (bisection.edges())
             .filter(|&(a, b)| a >= first || b >= first)
+            .filter(|&e| bisection.squared_length(e) >= shortest)
             .collect();
-        let mut marked = differences(&transport, &judged, refinement.tolerance);
+        let mut marked = differences(&transport, &scale, &judged, refinement.tolerance);
         if marked.is_empty() {
             break;
         }
@@ -233,16 +274,20 @@ pub fn precompute_refined(
         if bisection.vertex_count() > made {
             let (set, r) = trace(&bisection, made..bisection.vertex_count())?;
             transport.append(&set)?;
+            scale.extend(scales(&bisection, made..bisection.vertex_count()));
             report = join(report, r)?;
             rounds += 1;
         }
         if stopped {
-            let all: Vec<Edge> = bisection.edges().collect();
-            above = differences(&transport, &all, refinement.tolerance).len();
             break;
         }
         first = made as u32;
     }
+    let all: Vec<Edge> = bisection.edges().collect();
+    let left = differences(&transport, &scale, &all, refinement.tolerance);
+    let short = (left.iter())
+        .filter(|&&(e, _)| bisection.squared_length(e) < shortest)
+        .count();
     let order = bisection.order();
     let refined = bisection.scene(&scene)?;
     let transport = transport.reordered(&order)?;
@@ -262,7 +307,8 @@ pub fn precompute_refined(
         ground_vertices: cache.ground_vertices,
         rounds,
         max_vertices,
-        above,
+        above: left.len() - short,
+        short,
     };
     Ok((cache, report, refine_report))
 }
@@ -274,16 +320,23 @@ fn split_marked(bisection: &mut Bisection, marked: &mut [(Edge, f64)], max_verti
     !marked.iter().all(|&(e, _)| bisection.split(e, max_vertices))
 }
 
-/// Of `edges`, those whose endpoints' transports differ (relative L2, see the
-/// [module docs](self)) by more than `tolerance`, with the difference.
-fn differences(transport: &TransportSet, edges: &[Edge], tolerance: f64) -> Vec<(Edge, f64)> {
+/// Of `edges`, those whose endpoints' transports differ by more than `tolerance` times the
+/// larger of their unoccluded norms `scale` (see the [module docs](self)), with the ratio.
+fn differences(
+    transport: &TransportSet,
+    scale: &[f64],
+    edges: &[Edge],
+    tolerance: f64,
+) -> Vec<(Edge, f64)> {
     let texels = transport.param().texels();
     edges
         .par_iter()
         .map_init(
             || vec![0.0f64; texels],
             |dense, &(a, b)| {
-                let d = relative_difference(transport, a as usize, b as usize, dense);
+                let most = scale[a as usize].max(scale[b as usize]);
+                let d = difference(transport, a as usize, b as usize, dense) / most;
+                // 0 / 0: neither end receives anything, and NaN is never above.
                 (d > tolerance).then_some(((a, b), d))
             },
         )
@@ -291,20 +344,9 @@ fn differences(transport: &TransportSet, edges: &[Edge], tolerance: f64) -> Vec<
         .collect()
 }
 
-/// `|T_a - T_b| / max(|T_a|, |T_b|)` in f64 (0 when both are zero), through `dense`, a zeroed
-/// scratch of one vertex's texels, left zeroed.
-pub(crate) fn relative_difference(
-    transport: &TransportSet,
-    a: usize,
-    b: usize,
-    dense: &mut [f64],
-) -> f64 {
+/// `|T_a - T_b|` in f64, through `dense`, a zeroed scratch of one vertex's texels, left zeroed.
+pub(crate) fn difference(transport: &TransportSet, a: usize, b: usize, dense: &mut [f64]) -> f64 {
     let ((ia, va), (ib, vb)) = (transport.coefficients(a), transport.coefficients(b));
-    let norm = |v: &[f32]| v.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>();
-    let largest = norm(va).max(norm(vb));
-    if largest == 0.0 {
-        return 0.0;
-    }
     for (&i, &x) in ia.iter().zip(va) {
         dense[i as usize] = f64::from(x);
     }
@@ -317,7 +359,31 @@ pub(crate) fn relative_difference(
         squared += dense[i as usize].powi(2);
         dense[i as usize] = 0.0;
     }
-    (squared / largest).sqrt()
+    squared.sqrt()
+}
+
+/// The norm of the transport with nothing in the way, `|U_n|`, for any normal `n`: the
+/// parameterisation's texel directions and solid angles, made once.
+pub(crate) struct Unoccluded {
+    directions: Vec<[f64; 3]>,
+    solid_angles: Vec<f64>,
+}
+
+impl Unoccluded {
+    pub(crate) fn new(param: Parameterization) -> Self {
+        Unoccluded {
+            directions: texel_directions(param),
+            solid_angles: param.solid_angles().iter().copied().collect(),
+        }
+    }
+
+    /// `sqrt(sum_t (max(0, n . w_t) dOmega_t)^2)`.
+    pub(crate) fn norm(&self, n: [f64; 3]) -> f64 {
+        (self.directions.iter().zip(&self.solid_angles))
+            .map(|(&w, &o)| (dot(n, w).max(0.0) * o).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
 }
 
 /// Two rounds' reports as one: the rays summed, the larger working memory, the one tracer.

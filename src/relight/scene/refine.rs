@@ -100,17 +100,30 @@ impl Bisection {
         self.positions.len()
     }
 
+    /// Vertex `v`'s normal.
+    pub(crate) fn normal(&self, v: usize) -> [f64; 3] {
+        self.normals[v]
+    }
+
     /// Every edge, in index order (each with its triangles).
     pub(crate) fn edges(&self) -> impl Iterator<Item = Edge> + '_ {
         self.edges.keys().copied()
     }
 
+    /// The squared length of `e`.
+    pub(crate) fn squared_length(&self, (a, b): Edge) -> f64 {
+        let d = sub(self.positions[a as usize], self.positions[b as usize]);
+        dot(d, d)
+    }
+
     /// The triangles of `e` (none once it has been split).
+    #[cfg(test)]
     pub(crate) fn triangles_of(&self, e: Edge) -> &[u32] {
         self.edges.get(&e).map_or(&[], Vec::as_slice)
     }
 
     /// The triangles, each `[x, y, z]` counter-clockwise as the original was.
+    #[cfg(test)]
     pub(crate) fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
     }
@@ -199,10 +212,7 @@ impl Bisection {
     /// indices.
     fn longest(&self, t: u32) -> Edge {
         let [a, b, c] = self.triangles[t as usize];
-        let key = |(x, y): Edge| {
-            let d = sub(self.positions[x as usize], self.positions[y as usize]);
-            (dot(d, d), x.max(y), x.min(y))
-        };
+        let key = |e: Edge| (self.squared_length(e), e.1, e.0);
         [edge(a, b), edge(b, c), edge(c, a)]
             .into_iter()
             .max_by(|&p, &q| key(p).partial_cmp(&key(q)).expect("finite positions"))

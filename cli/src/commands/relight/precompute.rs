@@ -6,7 +6,7 @@ use haarshift::Result;
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
-use haarshift::relight::precompute::refine::{Refinement, precompute_refined};
+use haarshift::relight::precompute::refine::{MIN_EDGE_OFFSETS, Refinement, precompute_refined};
 use haarshift::relight::precompute::{
     DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_shard, shard_is_done,
 };
@@ -44,10 +44,12 @@ Examples:
   haarshift relight precompute bunny.ply --ray-tracer packets -o bunny.hsr   # not Embree
 
 Refined where the light needs it (--refine TOL): after the precomputation, every edge whose
-endpoints' transports differ by more than TOL (relative L2, 0 to 2) is split, with its
+endpoints' transports differ (L2) by more than TOL times the most an endpoint could receive
+(its transport with nothing in the way; TOL in (0, 2]) is split, with its
 neighbours across longer edges (conforming longest-edge bisection: no T-junctions), the new
 vertices precomputed, and so on until every edge is within TOL or the next vertex would pass
---max-vertices (default 4 x the scene's; then one line says how many edges are left). New
+--max-vertices (default 4 x the scene's; then one line says how many edges are left); edges
+shorter than 16 ray offsets are left as they are. New
 vertices come after the objects' and after the ground's own, so the ground stays the last
 block; the cache equals a precomputation of the refined mesh. Vertex order only, one ray per
 texel, not with --shard; refine first, then bounce. results/relight/refine.md measures it:
@@ -116,8 +118,8 @@ pub struct Args {
     #[arg(long, value_name = "B")]
     pub sh_bands: Option<usize>,
 
-    /// Split edges whose endpoints' transports differ by more than TOL (relative L2, in
-    /// (0, 2]), precompute the new vertices, and repeat until none does
+    /// Split edges whose endpoints' transports differ by more than TOL (in (0, 2]) times the
+    /// most an endpoint could receive, precompute the new vertices, and repeat until none does
     #[arg(long, value_name = "TOL")]
     pub refine: Option<f64>,
 
@@ -229,14 +231,18 @@ fn refined(
     refinement: &Refinement,
 ) -> Result<(SceneCache, haarshift::relight::PrecomputeReport)> {
     let (cache, report, r) = precompute_refined(scene, options, refinement)?;
-    let end = if r.stopped_by_budget() {
+    let tolerance = refinement.tolerance;
+    let mut end = if r.stopped_by_budget() {
         format!(
-            "stopped by --max-vertices {} with {} edges above {}",
-            r.max_vertices, r.above, refinement.tolerance
+            "stopped by --max-vertices {} with {} edges above {tolerance}",
+            r.max_vertices, r.above
         )
     } else {
-        format!("every edge within {}", refinement.tolerance)
+        format!("every edge within {tolerance}")
     };
+    if r.short > 0 {
+        end += &format!(" ({} shorter edges above it left: below {MIN_EDGE_OFFSETS} ray offsets)", r.short);
+    }
     print(&format!(
         "refined {} -> {} vertices ({} of them the ground's) in {} rounds: {end}\n",
         r.original, r.vertices, r.ground_vertices, r.rounds
