@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""The figure of scripts/refine.sh: the same crop (the end of the bunny's shadow) of the
-truth and of each run's render, and below each render its absolute error against the truth
-(4x), as one PNG. Reads WORK/truth.exr and WORK/RUN.exr, converted to arrays by haarshift's
-own `transform` and `inverse` (no EXR reader is needed); numpy and zlib only.
+"""The figure of scripts/refine.sh: the same crop (the bunny's shadow) of a truth and of
+each run's render, and below each render its absolute error against the truth (4x), as one
+PNG. Reads WORK/TRUTH.exr and WORK/RUN.exr, converted to arrays by haarshift's own
+`transform` and `inverse` (no EXR reader is needed); numpy and zlib only.
 
-    python3 scripts/refine_figure.py WORK OUT.png BUDGET RUN...
+    python3 scripts/refine_figure.py WORK OUT.png TRUTH RUN...
 """
 import struct
 import subprocess
@@ -53,8 +53,8 @@ def write_png(path, rgb):
 
 
 def main():
-    work, out, _budget, runs = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
-    truth = image(work, "truth")[ROWS, COLS]
+    work, out, truth_name, runs = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
+    truth = image(work, truth_name)[ROWS, COLS]
     gap = np.ones((truth.shape[0], 4, 3))
     top, bottom = [srgb(truth)], [np.zeros_like(truth)]
     for r in runs:
@@ -64,7 +64,7 @@ def main():
     join = lambda panels: np.concatenate([x for p in panels for x in (p, gap)][:-1], axis=1)
     band = np.ones((4, join(top).shape[1], 3))
     write_png(out, np.concatenate([join(top), band, join(bottom)], axis=0))
-    print(f"Panels, left to right: truth, {', '.join(runs)}.")
+    print(f"Panels, left to right: {truth_name}, {', '.join(runs)}.")
 
 
 if __name__ == "__main__":
