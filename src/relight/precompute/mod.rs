@@ -174,7 +174,11 @@ impl PrecomputeOptions {
     }
 
     /// What the cache records of these options.
-    pub(crate) fn record(&self, ground_cells: Option<usize>, tracer: Option<RayTracer>) -> CacheParams {
+    pub(crate) fn record(
+        &self,
+        ground_cells: Option<usize>,
+        tracer: Option<RayTracer>,
+    ) -> CacheParams {
         let v = &self.visibility;
         CacheParams {
             param: v.param.kind().to_string(),

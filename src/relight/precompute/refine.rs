@@ -75,12 +75,12 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::faces::Parameterization;
+use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::visibility::{
     PrecomputeReport, ray_offset, texel_directions, vertex_range,
 };
-use crate::relight::scene::mesh::dot;
-use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::{Order, PrecomputeOptions};
+use crate::relight::scene::mesh::dot;
 use crate::relight::scene::refine::{Bisection, Edge};
 use crate::relight::{RefineRecord, Scene, SceneBvh, SceneCache, TransportSet};
 use crate::{Error, Result};
@@ -333,9 +333,15 @@ pub fn precompute_refined(
 
 /// Splits the `marked` edges, largest difference first; returns whether the budget stopped
 /// it.
-fn split_marked(bisection: &mut Bisection, marked: &mut [(Edge, f64)], max_vertices: usize) -> bool {
+fn split_marked(
+    bisection: &mut Bisection,
+    marked: &mut [(Edge, f64)],
+    max_vertices: usize,
+) -> bool {
     marked.sort_by(|(e, x), (f, y)| y.total_cmp(x).then(e.cmp(f)));
-    !marked.iter().all(|&(e, _)| bisection.split(e, max_vertices))
+    !marked
+        .iter()
+        .all(|&(e, _)| bisection.split(e, max_vertices))
 }
 
 /// Of `edges`, those whose endpoints' transports differ by more than `tolerance` times the

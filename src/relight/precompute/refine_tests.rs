@@ -8,7 +8,8 @@ use crate::relight::{Generator, RayTracer, VisibilityOptions};
 /// A cube sphere of two cells a face (touching the ground at one vertex) on a ground plane of
 /// 2 x 2 cells: 54 + 9 vertices.
 fn ball_on_ground() -> Scene {
-    let mut scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
+    let mut scene =
+        Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh().unwrap(), false).unwrap();
     scene.add_ground_plane_of(2).unwrap();
     scene
 }
@@ -62,14 +63,21 @@ fn the_difference_is_the_dense_vectors_and_the_scale_an_unoccluded_vertex() {
     let full = |v: usize| {
         let mut x = vec![0.0f64; 24];
         let (i, c) = set.coefficients(v);
-        i.iter().zip(c).for_each(|(&i, &c)| x[i as usize] = c.into());
+        i.iter()
+            .zip(c)
+            .for_each(|(&i, &c)| x[i as usize] = c.into());
         x
     };
     let mut scratch = vec![0.0; 24];
     for a in 0..4 {
         for b in 0..4 {
             let (x, y) = (full(a), full(b));
-            let want = x.iter().zip(&y).map(|(p, q)| (p - q).powi(2)).sum::<f64>().sqrt();
+            let want = x
+                .iter()
+                .zip(&y)
+                .map(|(p, q)| (p - q).powi(2))
+                .sum::<f64>()
+                .sqrt();
             let got = difference(&set, a, b, &mut scratch);
             assert!((got - want).abs() < 1e-12, "{a} {b}: {got} {want}");
             assert!(want > 0.0 || a == b);
@@ -85,9 +93,14 @@ fn the_difference_is_the_dense_vectors_and_the_scale_an_unoccluded_vertex() {
             dot(n, param.texel_direction(f, r, c)).max(0.0) as f32
         });
         open.push(values.view()).unwrap();
-        let norm = (open.coefficients(0).1.iter()).map(|&x| f64::from(x).powi(2)).sum::<f64>();
+        let norm = (open.coefficients(0).1.iter())
+            .map(|&x| f64::from(x).powi(2))
+            .sum::<f64>();
         let want = unoccluded.norm(n);
-        assert!((norm.sqrt() - want).abs() <= 1e-6 * want.max(1e-30), "{n:?}: {want}");
+        assert!(
+            (norm.sqrt() - want).abs() <= 1e-6 * want.max(1e-30),
+            "{n:?}: {want}"
+        );
     }
 }
 
@@ -111,7 +124,10 @@ fn refined_cache_is_a_precompute_of_the_refined_mesh() {
     assert_eq!(unrefined.transport, refined.transport);
     assert_eq!(unrefined.mesh, refined.mesh);
     // Every edge is within the tolerance, and the refinement was needed.
-    let left = edge_differences(&refined).iter().filter(|&&d| d > tolerance).count();
+    let left = edge_differences(&refined)
+        .iter()
+        .filter(|&&d| d > tolerance)
+        .count();
     assert_eq!(left, report.short, "{report:?}");
     let (plain, _) = precompute(scene, &o).unwrap();
     assert!(edge_differences(&plain)[0] > tolerance);
@@ -132,7 +148,10 @@ fn the_budget_is_never_exceeded_and_what_it_left_is_reported() {
             precompute_refined(ball_on_ground(), &o, &refinement(0.05, max)).unwrap();
         assert_eq!(cache.mesh.vertex_count(), max, "{report:?}");
         assert_eq!((report.vertices, report.max_vertices), (max, max));
-        let above = edge_differences(&cache).iter().filter(|&&d| d > 0.05).count();
+        let above = edge_differences(&cache)
+            .iter()
+            .filter(|&&d| d > 0.05)
+            .count();
         assert_eq!(report.above + report.short, above);
         assert!(report.stopped_by_budget());
     }
@@ -141,30 +160,44 @@ fn the_budget_is_never_exceeded_and_what_it_left_is_reported() {
 #[test]
 fn a_refined_cache_reads_back_with_its_ground_vertices() {
     let o = options(Order::Vertex);
-    let (cache, _, report) = precompute_refined(ball_on_ground(), &o, &refinement(0.5, 90)).unwrap();
+    let (cache, _, report) =
+        precompute_refined(ball_on_ground(), &o, &refinement(0.5, 90)).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("refined.hsr");
     cache.write(&path, false).unwrap();
     let read = SceneCache::read(&path).unwrap();
     assert_eq!(read, cache);
-    assert_eq!(read.object_vertices(), report.vertices - report.ground_vertices);
+    assert_eq!(
+        read.object_vertices(),
+        report.vertices - report.ground_vertices
+    );
 }
 
 #[test]
 fn what_refinement_cannot_be_combined_with_is_refused_before_any_work() {
     let refuse = |o: &PrecomputeOptions, r: Refinement, why: &str| {
-        let err = precompute_refined(ball_on_ground(), o, &r).unwrap_err().to_string();
+        let err = precompute_refined(ball_on_ground(), o, &r)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains(why), "{err}");
     };
     let o = options(Order::Vertex);
-    refuse(&options(Order::Direction), refinement(0.1, 100), "--order direction");
+    refuse(
+        &options(Order::Direction),
+        refinement(0.1, 100),
+        "--order direction",
+    );
     let mut jittered = o;
     jittered.visibility.samples = 2;
     refuse(&jittered, refinement(0.1, 100), "--visibility-samples");
     for bad in [0.0, -1.0, 2.01, f64::NAN] {
         refuse(&o, refinement(bad, 100), "in (0, 2]");
     }
-    refuse(&o, refinement(0.1, 62), "62 vertices: the scene has 63 already");
+    refuse(
+        &o,
+        refinement(0.1, 62),
+        "62 vertices: the scene has 63 already",
+    );
     let mut small = o;
     small.memory_limit = 1 << 16;
     refuse(&small, refinement(0.1, 1_000_000), "the refined scene");

@@ -179,7 +179,11 @@ impl TransportSet {
             param: self.param,
             keep: self.keep,
             rows: SparseRows::new(),
-            sh: self.sh.as_ref().map(|t| ShTransfer::empty(t.bands())).transpose()?,
+            sh: self
+                .sh
+                .as_ref()
+                .map(|t| ShTransfer::empty(t.bands()))
+                .transpose()?,
         };
         for &v in order {
             let (indices, values) = self.coefficients(v as usize);

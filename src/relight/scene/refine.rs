@@ -167,7 +167,10 @@ impl Bisection {
     /// vertices, which one of this bisection it is.
     pub(crate) fn order(&self) -> Vec<u32> {
         let original = self.original;
-        let (old, new) = (0..original as u32, original as u32..self.vertex_count() as u32);
+        let (old, new) = (
+            0..original as u32,
+            original as u32..self.vertex_count() as u32,
+        );
         let on = |ground: bool| move |&v: &u32| self.ground[v as usize] == ground;
         (old.clone().filter(on(false)))
             .chain(new.clone().filter(on(false)))
@@ -184,9 +187,8 @@ impl Bisection {
         for (to, &from) in order.iter().enumerate() {
             place[from as usize] = to as u32;
         }
-        let albedo = Array2::from_shape_fn((order.len(), 3), |(v, c)| {
-            self.albedo[order[v] as usize][c]
-        });
+        let albedo =
+            Array2::from_shape_fn((order.len(), 3), |(v, c)| self.albedo[order[v] as usize][c]);
         Ok(Scene {
             mesh: self.mesh_in(&order, &place)?,
             albedo,
@@ -253,7 +255,8 @@ impl Bisection {
         let n = std::array::from_fn(|k| self.normals[a][k] + self.normals[b][k]);
         self.normals.push(unit(n).unwrap_or([0.0; 3]));
         let (ca, cb) = (self.albedo[a], self.albedo[b]);
-        self.albedo.push(std::array::from_fn(|k| 0.5 * (ca[k] + cb[k])));
+        self.albedo
+            .push(std::array::from_fn(|k| 0.5 * (ca[k] + cb[k])));
         self.ground.push(self.ground[a]);
         for t in self.edges.get(&e).cloned().unwrap_or_default() {
             let tri = self.triangles[t as usize];

@@ -78,13 +78,21 @@ fn assert_conforming(b: &Bisection, most: usize) {
             let off = cross(d, w);
             let along = dot(w, d) / dot(d, d);
             let inside = dot(off, off) <= 1e-20 * dot(d, d) && along > 1e-9 && along < 1.0 - 1e-9;
-            assert!(!inside, "vertex {v} lies inside edge ({x}, {y}): a T-junction");
+            assert!(
+                !inside,
+                "vertex {v} lies inside edge ({x}, {y}): a T-junction"
+            );
         }
     }
 }
 
 fn square() -> Mesh {
-    let corners = array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, -1.0], [0.0, 0.0, -1.0]];
+    let corners = array![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 0.0, -1.0],
+        [0.0, 0.0, -1.0]
+    ];
     Mesh::new(corners, vec![[0, 1, 2], [0, 2, 3]], None).unwrap()
 }
 
@@ -120,7 +128,10 @@ fn a_short_edge_waits_for_the_longest_edge_of_its_triangle_and_its_neighbour() {
 
 /// The sum of the triangles' areas (twice).
 fn total_area(b: &Bisection) -> f64 {
-    b.triangles().iter().map(|&t| dot(area(b, t), area(b, t)).sqrt()).sum()
+    b.triangles()
+        .iter()
+        .map(|&t| dot(area(b, t), area(b, t)).sqrt())
+        .sum()
 }
 
 /// The mean of triangle `t`'s corners.
@@ -212,7 +223,17 @@ fn new_vertices_interpolate_normals_and_albedo_and_the_ground_stays_the_trailing
     assert_eq!(&order[v - 5..v - 1], &[6, 7, 8, 9]);
     assert_eq!(order[v - 1] as usize, objects);
     for (k, &from) in order.iter().enumerate() {
-        assert_eq!(refined.mesh.positions().row(k).to_vec(), b.positions[from as usize].to_vec());
+        assert_eq!(
+            refined.mesh.positions().row(k).to_vec(),
+            b.positions[from as usize].to_vec()
+        );
     }
-    assert!(refined.mesh.positions().outer_iter().skip(v - g).all(|p| p[1] == -1.0));
+    assert!(
+        refined
+            .mesh
+            .positions()
+            .outer_iter()
+            .skip(v - g)
+            .all(|p| p[1] == -1.0)
+    );
 }

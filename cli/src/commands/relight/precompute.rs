@@ -241,7 +241,10 @@ fn refined(
         format!("every edge within {tolerance}")
     };
     if r.short > 0 {
-        end += &format!(" ({} shorter edges above it left: below {MIN_EDGE_OFFSETS} ray offsets)", r.short);
+        end += &format!(
+            " ({} shorter edges above it left: below {MIN_EDGE_OFFSETS} ray offsets)",
+            r.short
+        );
     }
     print(&format!(
         "refined {} -> {} vertices ({} of them the ground's) in {} rounds: {end}\n",
