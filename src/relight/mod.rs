@@ -53,7 +53,9 @@ pub use precompute::transport::TransportSet;
 pub use precompute::visibility::{
     PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major, vertex_range,
 };
-pub use scene::cache::{CacheHeader, CacheParams, KeepRecord, SceneCache, ShardRecord, scene_hash};
+pub use scene::cache::{
+    CacheHeader, CacheParams, KeepRecord, RefineRecord, SceneCache, ShardRecord, scene_hash,
+};
 pub use scene::cache_shard::{CacheShard, merge_shards};
 pub use scene::mesh::{Bounds, Mesh};
 pub use scene::{

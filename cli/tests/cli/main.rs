@@ -18,6 +18,7 @@ mod hdr;
 mod ray_tracer;
 mod readme;
 mod reference_bounces;
+mod refine;
 mod relight;
 mod relight_assets;
 mod relight_error;

@@ -17,6 +17,7 @@ pub mod bounce;
 pub mod embree;
 mod packet;
 pub mod raycast;
+pub mod refine;
 pub mod shadowmap;
 pub mod shard;
 pub mod sparse;
@@ -200,7 +201,11 @@ impl PrecomputeOptions {
     }
 
     /// What the cache records of these options.
-    fn record(&self, ground_cells: Option<usize>, tracer: Option<RayTracer>) -> CacheParams {
+    pub(crate) fn record(
+        &self,
+        ground_cells: Option<usize>,
+        tracer: Option<RayTracer>,
+    ) -> CacheParams {
         let v = &self.visibility;
         CacheParams {
             param: v.param.kind().to_string(),
@@ -215,6 +220,7 @@ impl PrecomputeOptions {
             sh_bands: v.sh_bands,
             ray_tracer: tracer.map(|t| t.to_string()),
             bounces: 0,
+            refine: None,
         }
     }
 }
@@ -254,25 +260,37 @@ pub fn precompute(
         scene.albedo,
         transport,
     )?;
-    if options.bounces > 0 {
-        let bvh = SceneBvh::with_tracer(&cache.mesh, options.ray_tracer);
-        let all = 0..cache.mesh.vertex_count();
-        let (bounced, b) = bounce::bounce_range(
-            &cache.mesh,
-            &bvh,
-            &options.visibility,
-            cache.albedo.view(),
-            &cache.transport,
-            None,
-            options.bounces,
-            all,
-        )?;
-        cache.set_bounced(bounced)?;
-        report = report.followed_by(&b);
-    }
+    report = add_bounces(&mut cache, options, report)?;
     cache.environment = scene.environment;
     cache.camera = scene.camera;
     Ok((cache, report))
+}
+
+/// Gathers `options.bounces` bounces over every vertex of `cache` from its direct transport
+/// ([`bounce`]) and stores them in it; `report` followed by the gather's. Nothing without
+/// bounces.
+pub(crate) fn add_bounces(
+    cache: &mut SceneCache,
+    options: &PrecomputeOptions,
+    report: PrecomputeReport,
+) -> Result<PrecomputeReport> {
+    if options.bounces == 0 {
+        return Ok(report);
+    }
+    let bvh = SceneBvh::with_tracer(&cache.mesh, options.ray_tracer);
+    let all = 0..cache.mesh.vertex_count();
+    let (bounced, b) = bounce::bounce_range(
+        &cache.mesh,
+        &bvh,
+        &options.visibility,
+        cache.albedo.view(),
+        &cache.transport,
+        None,
+        options.bounces,
+        all,
+    )?;
+    cache.set_bounced(bounced)?;
+    Ok(report.followed_by(&b))
 }
 
 /// Precomputes shard `shard` of `scene` ([`shard`] module: the vertices

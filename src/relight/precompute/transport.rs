@@ -202,6 +202,30 @@ impl TransportSet {
         Ok(out)
     }
 
+    /// The set with its vertex `order[k]` as its `k`-th (the refined scene's order, from the
+    /// order the refinement made its vertices in).
+    pub(crate) fn reordered(&self, order: &[u32]) -> Result<TransportSet> {
+        let mut set = TransportSet {
+            param: self.param,
+            keep: self.keep,
+            rows: SparseRows::new(),
+            sh: self
+                .sh
+                .as_ref()
+                .map(|t| ShTransfer::empty(t.bands()))
+                .transpose()?,
+        };
+        for &v in order {
+            let (indices, values) = self.coefficients(v as usize);
+            set.rows.push(indices, values);
+            if let (Some(mine), Some(theirs)) = (&mut set.sh, &self.sh) {
+                let len = theirs.bands() * theirs.bands();
+                mine.push(&theirs.as_slice()[v as usize * len..][..len]);
+            }
+        }
+        Ok(set)
+    }
+
     /// The spherical-harmonic transfer, when the set was made with it.
     pub fn sh(&self) -> Option<&ShTransfer> {
         self.sh.as_ref()

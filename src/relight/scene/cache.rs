@@ -142,10 +142,28 @@ pub struct CacheParams {
     /// 0, and then left out of the header, for direct light alone.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub bounces: usize,
+    /// How the mesh was refined (`relight precompute --refine`), if it was; absent from the
+    /// header of a cache that was not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refine: Option<RefineRecord>,
 }
 
 fn is_zero(n: &usize) -> bool {
     *n == 0
+}
+
+/// What a cache records of `relight precompute --refine TOL --max-vertices N`
+/// ([`precompute::refine`](crate::relight::precompute::refine)): its mesh is the scene's
+/// refined, and its ground plane's vertices ([`CacheHeader::ground_vertices`]) are the
+/// grid's and the midpoints made on it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RefineRecord {
+    /// `TOL`: the largest relative L2 difference left between an edge's endpoints'
+    /// transports (unless the budget stopped the refinement first).
+    pub tolerance: f64,
+    /// `N`: the most vertices the refined mesh could have.
+    pub max_vertices: usize,
 }
 
 impl CacheParams {
@@ -156,7 +174,7 @@ impl CacheParams {
     /// use haarshift::relight::{CacheParams, KeepRecord};
     /// let mut p = CacheParams { param: "cube".into(), resolution: 4, keep: KeepRecord::All,
     ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: true,
-    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None, bounces: 0 };
+    ///     ground_cells: Some(64), sh_bands: None, ray_tracer: None, bounces: 0, refine: None };
     /// assert_eq!(p.grid_ground_vertices(), 65 * 65);
     /// (p.ground_plane, p.ground_cells) = (false, None);
     /// assert_eq!(p.grid_ground_vertices(), 0);
@@ -221,7 +239,7 @@ pub struct ShardRecord {
 /// let (transport, _) = vertex_major(&scene.mesh, &SceneBvh::new(&scene.mesh), &options).unwrap();
 /// let params = CacheParams { param: "latlong".into(), resolution: 4, keep: KeepRecord::All,
 ///     samples: 1, seed: 0, order: "vertex".into(), map_size: None, ground_plane: false,
-///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()), bounces: 0 };
+///     ground_cells: None, sh_bands: None, ray_tracer: Some("packets".into()), bounces: 0, refine: None };
 /// let cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("sphere.hsr");
@@ -248,7 +266,8 @@ pub struct SceneCache {
     /// The scene file's camera, likewise.
     pub camera: Option<CameraSpec>,
     /// How many of the last vertices are the ground plane's:
-    /// [`CacheParams::grid_ground_vertices`], set by [`SceneCache::new`].
+    /// [`CacheParams::grid_ground_vertices`], set by [`SceneCache::new`]; in a refined cache
+    /// ([`CacheParams::refine`]) the grid's and the midpoints on it.
     pub ground_vertices: usize,
 }
 
@@ -389,6 +408,11 @@ impl SceneCache {
         // The reader holds a bounced sum exactly when the parameters give bounces.
         if let Some(bounced) = parts.bounced {
             cache.set_bounced(bounced)?;
+        }
+        // Refinement adds midpoints to the ground's grid, never takes its vertices away.
+        let refined_ground = cache.ground_vertices..=cache.mesh.vertex_count();
+        if cache.params.refine.is_some() && refined_ground.contains(&header.ground_vertices) {
+            cache.ground_vertices = header.ground_vertices;
         }
         if header.ground_vertices != cache.ground_vertices {
             return Err(SceneError::CacheCorrupt(format!(

@@ -27,6 +27,7 @@ fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
         sh_bands,
         ray_tracer: Some("packets".into()),
         bounces: 0,
+        refine: None,
     };
     let mut cache = SceneCache::new(params, scene.mesh, scene.albedo, transport).unwrap();
     // The scene file's lighting and camera travel in the header.

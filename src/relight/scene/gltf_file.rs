@@ -64,12 +64,39 @@ fn asset_error(part: impl Into<String>, reason: impl std::fmt::Display) -> Error
     .into()
 }
 
+/// The document in `bytes` (`.glb` by its magic, else JSON), validated by the `gltf` crate.
+fn parse(bytes: &[u8]) -> Result<gltf::Gltf> {
+    let invalid = |e: gltf::Error| SceneError::Corrupt(format!("not a valid glTF 2.0 file: {e}"));
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    // gltf-json 1.4.1's validation indexes a primitive's POSITION accessor before checking
+    // that it exists (mesh.rs, `primitive_validate_hook`), and panics on one that does not:
+    // found by the gltf fuzz target, so checked first.
+    let json = document.into_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = gltf_json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(index) = primitive.attributes.get(&position)
+                && index.value() >= accessors
+            {
+                return Err(SceneError::Corrupt(format!(
+                    "mesh {m}, primitive {p}: its POSITION accessor {} is not among the file's {accessors}",
+                    index.value()
+                ))
+                .into());
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(invalid)?;
+    Ok(gltf::Gltf { document, blob })
+}
+
 /// Reads a `.gltf` or `.glb` file; see the [module docs](self).
 pub(crate) fn read_gltf(path: &Path, budget: &MemoryBudget) -> Result<MeshAsset> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let bytes = read_limited(path, None, budget.limit)?;
-    let gltf = gltf::Gltf::from_slice(&bytes)
-        .map_err(|e| SceneError::Corrupt(format!("not a valid glTF 2.0 file: {e}")))?;
+    let gltf = parse(&bytes)?;
     let buffers = load_buffers(&gltf, dir, budget)?;
     let instances = instances(&gltf.document)?;
     check_counts(&instances, budget)?;

@@ -285,6 +285,16 @@ fn hostile_documents_are_refused_in_one_line_naming_the_part() {
             ],
         ),
         (
+            // gltf-json's own validation panics on this one (checked before it runs).
+            triangle(&[], |d| {
+                d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(2)
+            }),
+            &[
+                "mesh 0, primitive 0",
+                "POSITION accessor 2 is not among the file's 2",
+            ],
+        ),
+        (
             triangle(&[], |d| d["buffers"][0]["uri"] = json!("missing.bin")),
             &["buffer 0", "missing.bin"],
         ),

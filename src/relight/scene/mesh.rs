@@ -344,7 +344,7 @@ const UNIT_TOLERANCE: f64 = 1e-12;
 /// or above 1e154) is first divided by its largest component, so that the result is unit to
 /// a few ulps whatever the magnitude (what [`Mesh::stored`] checks); any other vector gets
 /// plainly `n / |n|`.
-fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
+pub(crate) fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
     let squared = dot(n, n);
     let n = if squared.is_normal() && squared.is_finite() {
         n

@@ -69,6 +69,7 @@ mod ground;
 pub mod mesh;
 mod mtl;
 mod obj;
+pub(crate) mod refine;
 pub(crate) mod shapes;
 pub mod texture;
 pub mod validate;

@@ -6,11 +6,12 @@ use haarshift::Result;
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
+use haarshift::relight::precompute::refine::{MIN_EDGE_OFFSETS, Refinement, precompute_refined};
 use haarshift::relight::precompute::{
     DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_bounce_shard,
     precompute_shard, shard_is_done,
 };
-use haarshift::relight::{RayTracer, SceneCache, VisibilityOptions};
+use haarshift::relight::{RayTracer, Scene, SceneCache, VisibilityOptions};
 
 use super::flags::{SceneFlags, ShardFlags, bytes};
 use crate::commands::{choice, names, print, refuse_outputs};
@@ -50,6 +51,18 @@ hit point (interpolated over the triangle's corners) times its albedo / pi; the 
 bounces is stored beside the direct transport (one set when every albedo is grey, else R, G,
 B), and `relight render` shows it unless given --direct-only. The albedo is baked in, so a
 render of such a cache refuses --albedo and glossy BRDFs.
+
+Refined where the light needs it (--refine TOL): after the precomputation, every edge whose
+endpoints' transports differ (L2) by more than TOL times the most an endpoint could receive
+(its transport with nothing in the way; TOL in (0, 2]) is split, with its
+neighbours across longer edges (conforming longest-edge bisection: no T-junctions), the new
+vertices precomputed, and so on until every edge is within TOL or the next vertex would pass
+--max-vertices (default 4 x the scene's; then one line says how many edges are left); edges
+shorter than 16 ray offsets are left as they are. New
+vertices come after the objects' and after the ground's own, so the ground stays the last
+block; the cache equals a precomputation of the refined mesh. Vertex order only, one ray per
+texel, not with --shard; refine first, then bounce. results/relight/refine.md measures it:
+  haarshift relight precompute bunny.ply --ground-plane --param cube --refine 0.2 --max-vertices 5000 -o bunny.hsr
 
 Sharded across machines (vertex order only): shard I of N computes the vertices
 [I x V / N, (I + 1) x V / N) against the whole scene, with the bits an unsharded run gives
@@ -131,6 +144,15 @@ pub struct Args {
     #[arg(long, value_name = "MERGED.hsr", requires = "shard")]
     pub bounce_from: Option<PathBuf>,
 
+    /// Split edges whose endpoints' transports differ by more than TOL (in (0, 2]) times the
+    /// most an endpoint could receive, precompute the new vertices, and repeat until none does
+    #[arg(long, value_name = "TOL")]
+    pub refine: Option<f64>,
+
+    /// With --refine: the most vertices the refined mesh may have [default: 4 x the scene's]
+    #[arg(long, value_name = "N", requires = "refine")]
+    pub max_vertices: Option<usize>,
+
     #[command(flatten)]
     pub shard: ShardFlags,
 
@@ -170,11 +192,22 @@ pub fn run(args: Args) -> Result<()> {
         bounces: args.bounces,
     };
     options.check()?;
+    let refinement = args.refine.map(|tolerance| Refinement {
+        tolerance,
+        max_vertices: args.max_vertices,
+    });
+    if let Some(r) = &refinement {
+        r.check_with(&options, shard)?;
+    }
     let scene = args.scene.load_within(options.budget(shard))?;
-    let (vertices, triangles) = (scene.mesh.vertex_count(), scene.mesh.triangles().len());
+    let (mut vertices, mut triangles) = (scene.mesh.vertex_count(), scene.mesh.triangles().len());
     let (what, transport, file_bytes, report) = match shard {
         None => {
-            let (cache, report) = precompute(scene, &options)?;
+            let (cache, report) = match &refinement {
+                Some(r) => refined(scene, &options, r)?,
+                None => precompute(scene, &options)?,
+            };
+            (vertices, triangles) = (cache.mesh.vertex_count(), cache.mesh.triangles().len());
             let file_bytes = cache.write(&args.output, args.force)?;
             let what = cache.bounced.as_ref().map_or(String::new(), |b| {
                 format!(
@@ -234,4 +267,33 @@ pub fn run(args: Args) -> Result<()> {
         bytes(file_bytes),
         peak_resident_bytes().map_or("unknown".into(), bytes),
     ))
+}
+
+/// [`precompute_refined`], with its one line on what the refinement did.
+fn refined(
+    scene: Scene,
+    options: &PrecomputeOptions,
+    refinement: &Refinement,
+) -> Result<(SceneCache, haarshift::relight::PrecomputeReport)> {
+    let (cache, report, r) = precompute_refined(scene, options, refinement)?;
+    let tolerance = refinement.tolerance;
+    let mut end = if r.stopped_by_budget() {
+        format!(
+            "stopped by --max-vertices {} with {} edges above {tolerance}",
+            r.max_vertices, r.above
+        )
+    } else {
+        format!("every edge within {tolerance}")
+    };
+    if r.short > 0 {
+        end += &format!(
+            " ({} shorter edges above it left: below {MIN_EDGE_OFFSETS} ray offsets)",
+            r.short
+        );
+    }
+    print(&format!(
+        "refined {} -> {} vertices ({} of them the ground's) in {} rounds: {end}\n",
+        r.original, r.vertices, r.ground_vertices, r.rounds
+    ))?;
+    Ok((cache, report))
 }

@@ -585,6 +585,7 @@ fn a_mapped_cache_shades_in_place_and_equal_to_the_transport_in_memory() {
         sh_bands: None,
         ray_tracer: Some("packets".into()),
         bounces: 0,
+        refine: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("ball.hsr");
