@@ -4,7 +4,8 @@
 #   scripts/refine.sh > results/relight/refine.md
 # The bunny on its ground plane under Rooitou Park, cube 6 x ${RESOLUTION}^2 (default 32),
 # every coefficient kept: ground grids of 32^2, 64^2 and 128^2 cells (`--ground-cells`) and
-# `--refine TOL` from the 32^2 grid at the tolerances $TOLERANCES, each capped at a quarter
+# `--refine TOL` from the 32^2 grid at the tolerances $TOLERANCES (by transport, and by
+# radiance under the map as probe: --refine-light), each capped at a quarter
 # of the 128^2 grid's vertices (the goal's budget). Each is rendered (`relight render`, the
 # default view, 640 x 480, black background) and compared per pixel with the truth: `relight
 # reference` of a dense mesh of the same surface (the bunny midpoint-subdivided twice by
@@ -44,12 +45,19 @@ for cells in 32 64 128; do
     timed "pre-grid-$cells" relight precompute "$mesh" --ground-plane --ground-cells "$cells" \
         --param cube --resolution "$resolution" -o "$work/grid-$cells.hsr"
 done
+# Each tolerance twice: edges judged by their transport (refine-TOL), and by their radiance
+# under the map itself as probe (probe-TOL, --refine-light).
+refined=()
 for tol in "${tolerances[@]}"; do
-    runs+=("refine-$tol")
+    refined+=("refine-$tol" "probe-$tol")
     timed "pre-refine-$tol" relight precompute "$mesh" --ground-plane --param cube \
         --resolution "$resolution" --refine "$tol" --max-vertices "$budget" \
         -o "$work/refine-$tol.hsr"
+    timed "pre-probe-$tol" relight precompute "$mesh" --ground-plane --param cube \
+        --resolution "$resolution" --refine "$tol" --max-vertices "$budget" \
+        --refine-light "$env" -o "$work/probe-$tol.hsr"
 done
+runs+=("${refined[@]}")
 for r in "${runs[@]}"; do
     timed "render-$r" relight render "$work/$r.hsr" "${view[@]}" -o "$work/$r.exr"
     rm "$work/$r.hsr"
@@ -79,7 +87,9 @@ echo "(cube 6 x ${resolution}^2, the same lighting's texels): against it only th
 echo "between vertices is left, against the reference also the lighting's discretisation (the dense"
 echo "cube render is $(pixel_error truth dense | sed 's/ |.*//') from the reference, the floor of every run)."
 echo "Refinement starts from the 32^2 grid, capped at \`--max-vertices $budget\`, a"
-echo "quarter of the 128^2 grid's vertices. Precompute time is the command's wall clock"
+echo "quarter of the 128^2 grid's vertices, its edges judged by their transport (\`refine-TOL\`)"
+echo "or by their radiance under Rooitou Park itself as probe (\`probe-TOL\`, \`--refine-light\`)."
+echo "Precompute time is the command's wall clock"
 echo "(refinement's rounds, splits and criterion included)."
 echo
 echo "| mesh | vertices | of them the ground's | precompute wall (m:ss) | CPU s | per-pixel relative RMS against the reference | largest / RMS | against the dense cube render | largest / RMS | what the precomputation reports |"
@@ -97,21 +107,21 @@ done
 echo
 goal=$(cat "$work/grid-128.error")
 met=()
-for tol in "${tolerances[@]}"; do
+for r in "${refined[@]}"; do
     if python3 -c 'import sys; sys.exit(not float(sys.argv[1]) <= float(sys.argv[2]))' \
-        "$(cat "$work/refine-$tol.error")" "$goal"; then
-        met+=("$tol")
+        "$(cat "$work/$r.error")" "$goal"; then
+        met+=("$r")
     fi
 done
 echo "Where each refinement's new vertices went (from the 32^2 grid's $((objects + 33 * 33))):"
-for tol in "${tolerances[@]}"; do
-    v=$(vertices "refine-$tol")
-    g=$(grep -oE '\(([0-9]+) of them the ground' "$work/pre-refine-$tol.out" | grep -oE '[0-9]+')
-    echo "--refine $tol: $((v - g - objects)) on the bunny, $((g - 33 * 33)) on the ground;"
+for r in "${refined[@]}"; do
+    v=$(vertices "$r")
+    g=$(grep -oE '\(([0-9]+) of them the ground' "$work/pre-$r.out" | grep -oE '[0-9]+')
+    echo "$r: $((v - g - objects)) on the bunny, $((g - 33 * 33)) on the ground;"
 done
 echo
 if [ ${#met[@]} -gt 0 ]; then
-    echo "**Goal met** at --refine ${met[*]}: the 128^2 grid's error ($goal) or less with at most $budget vertices."
+    echo "**Goal met** by ${met[*]}: the 128^2 grid's error ($goal) or less with at most $budget vertices."
 else
     echo "**Goal not met**: no tolerance reaches the 128^2 grid's error ($goal) within $budget vertices."
 fi

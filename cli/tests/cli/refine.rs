@@ -35,14 +35,17 @@ fn refine_refuses_shards_the_direction_order_bad_tolerances_and_small_budgets_in
             &["--refine", "0.1", "--max-vertices", "100"],
             "100 vertices: the scene has 2928 already",
         ),
+        (
+            &["--refine", "0.1", "--refine-light", "missing.hdr"],
+            "missing.hdr",
+        ),
     ];
     for (flags, why) in refused {
         fails_cleanly(&[&head[..], flags].concat(), &[why]);
     }
-    usage_error(
-        &[&head[..], &["--max-vertices", "5000"]].concat(),
-        &["--refine"],
-    );
+    for flags in [&["--max-vertices", "5000"], &["--refine-light", "sky.hdr"]] {
+        usage_error(&[&head[..], flags].concat(), &["--refine"]);
+    }
     assert!(!out.exists());
 }
 

@@ -12,7 +12,16 @@
 //! texels; the Haar transform is orthonormal, so the norms are the texels'). It lies in
 //! `[0, 2]`, and an edge whose ends receive nothing is never split.
 //!
-//! *Transport, not the radiance under a probe lighting*: a cache is relit under any map and
+//! **Under a probe lighting** (`--refine-light ENV`, [`Refinement::probe`]) the criterion is
+//! the RGB difference of the ends' radiances under that lighting over the most an end could
+//! receive from it, `|<T_a, L> - <T_b, L>| / max(|<U_a, L>|, |<U_b, L>|)` (the albedo left
+//! out, `<., L_c>` per channel and `|.|` over the channels; also in `[0, 2]` for a lighting of
+//! no negative texel). It sees what the transport's norm cannot: a sun of one texel is one
+//! texel of the transport, a step of about `dOmega cos / |U|` (0.03 at cube 32) where its
+//! shadow falls, but most of the radiance under a sunny map. It refines for that lighting
+//! unrotated, though: a rotated map's sun casts its shadow where the probe's did not.
+//!
+//! *By default transport, not the radiance under a probe lighting*: a cache is relit under any map and
 //! any rotation of it, and an edge that looks alike under one lighting (a shadow cast away from
 //! the probe's sun, or under a dim part of its sky) is where another lighting's sun draws its
 //! shadow. The transport difference bounds the radiance difference under every lighting `L`:
@@ -57,9 +66,8 @@
 //! that grid's per-pixel error. The criterion is lighting-independent, and that is its limit:
 //! the bunny's coarse normals differ by a large share of `|U|` from vertex to vertex, so the
 //! budget goes there first, while the sun's shadow on the ground is where one texel turns dark,
-//! a step of about `dOmega cos / |U|` (0.03 at cube 32), below any useful tolerance. The
-//! interpolation error (the midpoint's traced transport against the mean of the ends') would
-//! stop spending on smooth normal changes, and a probe lighting's radiance would see the sun.
+//! a step of about `dOmega cos / |U|` (0.03 at cube 32), below any useful tolerance. Under the
+//! map as probe the same budget goes to the sun's shadow first; the file gives both.
 //!
 //! **What it is combined with.** The vertex order only: the direction order renders every
 //! vertex into each shadow buffer at once, and a refinement traces a few vertices a round.
@@ -70,11 +78,15 @@
 //! refinement: refine first, then gather the bounces over the refined mesh, whose vertices
 //! they need.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use rayon::prelude::*;
 
 use crate::faces::Parameterization;
+use crate::product::Selection;
+use crate::relight::Lighting;
+use crate::relight::light::environment::{Environment, SphereMapping};
 use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::visibility::{
     PrecomputeReport, ray_offset, texel_directions, vertex_range,
@@ -83,6 +95,7 @@ use crate::relight::precompute::{Order, PrecomputeOptions};
 use crate::relight::scene::mesh::dot;
 use crate::relight::scene::refine::{Bisection, Edge};
 use crate::relight::{RefineRecord, Scene, SceneBvh, SceneCache, TransportSet};
+use crate::sphere::SphereRotation;
 use crate::{Error, Result};
 
 /// The budget of vertices when none is given: this many times the scene's.
@@ -98,21 +111,25 @@ pub const MIN_EDGE_OFFSETS: f64 = 16.0;
 ///
 /// ```
 /// use haarshift::relight::precompute::refine::Refinement;
-/// let r = Refinement { tolerance: 0.2, max_vertices: None };
+/// let r = Refinement { tolerance: 0.2, max_vertices: None, probe: None };
 /// assert_eq!(r.budget(1000).unwrap(), 4000);
-/// let err = Refinement { tolerance: 0.2, max_vertices: Some(999) }.budget(1000).unwrap_err();
+/// let err = Refinement { tolerance: 0.2, max_vertices: Some(999), probe: None }.budget(1000).unwrap_err();
 /// assert!(err.to_string().contains("999 vertices: the scene has 1000 already"), "{err}");
-/// assert!(Refinement { tolerance: 0.0, max_vertices: None }.check().is_err());
-/// assert!(Refinement { tolerance: 2.5, max_vertices: None }.check().is_err());
+/// assert!(Refinement { tolerance: 0.0, max_vertices: None, probe: None }.check().is_err());
+/// assert!(Refinement { tolerance: 2.5, max_vertices: None, probe: None }.check().is_err());
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Refinement {
-    /// `TOL`: split edges whose endpoints' transports differ by more than `TOL` times the
-    /// most an endpoint could receive (see the [module docs](self)), in `(0, 2]`.
+    /// `TOL`: split edges whose endpoints' transports (or radiances under the
+    /// [`probe`](Self::probe)) differ by more than `TOL` times the most an endpoint could
+    /// receive (see the [module docs](self)), in `(0, 2]`.
     pub tolerance: f64,
     /// `N`: the most vertices the refined mesh may have ([`DEFAULT_GROWTH`] times the
     /// scene's when `None`).
     pub max_vertices: Option<usize>,
+    /// `--refine-light ENV`: judge edges by their radiance under this lighting instead of by
+    /// their transport.
+    pub probe: Option<Probe>,
 }
 
 impl Refinement {
@@ -160,7 +177,7 @@ impl Refinement {
     /// use haarshift::relight::VisibilityOptions;
     /// use haarshift::faces::{ParamKind, Parameterization};
     /// let mut o = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap()));
-    /// let r = Refinement { tolerance: 0.1, max_vertices: None };
+    /// let r = Refinement { tolerance: 0.1, max_vertices: None, probe: None };
     /// assert!(r.check_with(&o, None).is_ok());
     /// let err = r.check_with(&o, Some(Shard::new(0, 2).unwrap())).unwrap_err().to_string();
     /// assert!(err.contains("with --shard"), "{err}");
@@ -181,6 +198,14 @@ impl Refinement {
                 "refine",
                 "with --order direction: every shadow buffer serves all vertices at once, and \
                  a refinement traces a few a round; refine with --order vertex",
+            ));
+        }
+        if let Some(probe) = &self.probe
+            && probe.lighting.param() != options.visibility.param
+        {
+            return Err(Error::parameter(
+                "refine light",
+                "the probe lighting was made at another parameterisation than the transport's",
             ));
         }
         if options.visibility.samples != 1 {
@@ -245,12 +270,12 @@ impl RefineReport {
 /// let mut scene = Scene::from_mesh(Generator::Sphere { cells: 1 }.mesh().unwrap(), false).unwrap();
 /// scene.add_ground_plane_of(2).unwrap();
 /// let options = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap()));
-/// let refinement = Refinement { tolerance: 0.5, max_vertices: Some(200) };
+/// let refinement = Refinement { tolerance: 0.5, max_vertices: Some(200), probe: None };
 /// let (cache, _, report) = precompute_refined(scene, &options, &refinement).unwrap();
 /// assert!(report.vertices > 24 + 9 && report.vertices <= 200);
 /// assert_eq!(cache.mesh.vertex_count(), report.vertices);
 /// assert_eq!(cache.ground_vertices, report.ground_vertices);
-/// assert_eq!(cache.params.refine.unwrap().tolerance, 0.5);
+/// assert_eq!(cache.params.refine.as_ref().unwrap().tolerance, 0.5);
 /// ```
 pub fn precompute_refined(
     scene: Scene,
@@ -262,19 +287,14 @@ pub fn precompute_refined(
     (options.budget(None)).check("the refined scene", max_vertices as u128)?;
     let start = Instant::now();
     let mut bisection = Bisection::new(&scene);
-    let trace = |bisection: &Bisection, vertices: std::ops::Range<usize>| {
+    let trace = |bisection: &Bisection, vertices: Range<usize>| {
         let mesh = bisection.working_mesh()?;
         let bvh = SceneBvh::with_tracer(&mesh, options.ray_tracer);
         vertex_range(&mesh, &bvh, &options.visibility, vertices)
     };
-    let unoccluded = Unoccluded::new(options.visibility.param);
-    let scales = |bisection: &Bisection, vertices: std::ops::Range<usize>| {
-        (vertices.into_par_iter())
-            .map(|v| unoccluded.norm(bisection.normal(v)))
-            .collect::<Vec<f64>>()
-    };
+    let mut judge = Judge::new(options.visibility.param, refinement.probe.as_ref());
     let (mut transport, mut report) = trace(&bisection, 0..bisection.vertex_count())?;
-    let mut scale = scales(&bisection, 0..bisection.vertex_count());
+    judge.extend(&bisection, &transport, 0..bisection.vertex_count());
     let shortest = (MIN_EDGE_OFFSETS * ray_offset(&scene.mesh)).powi(2);
     let (mut rounds, mut first) = (1, 0u32);
     loop {
@@ -283,7 +303,7 @@ pub fn precompute_refined(
             .filter(|&(a, b)| a >= first || b >= first)
             .filter(|&e| bisection.squared_length(e) >= shortest)
             .collect();
-        let mut marked = differences(&transport, &scale, &judged, refinement.tolerance);
+        let mut marked = judge.above(&transport, &judged, refinement.tolerance);
         if marked.is_empty() {
             break;
         }
@@ -292,7 +312,7 @@ pub fn precompute_refined(
         if bisection.vertex_count() > made {
             let (set, r) = trace(&bisection, made..bisection.vertex_count())?;
             transport.append(&set)?;
-            scale.extend(scales(&bisection, made..bisection.vertex_count()));
+            judge.extend(&bisection, &transport, made..bisection.vertex_count());
             report = join(report, r)?;
             rounds += 1;
         }
@@ -302,7 +322,7 @@ pub fn precompute_refined(
         first = made as u32;
     }
     let all: Vec<Edge> = bisection.edges().collect();
-    let left = differences(&transport, &scale, &all, refinement.tolerance);
+    let left = judge.above(&transport, &all, refinement.tolerance);
     let short = (left.iter())
         .filter(|&&(e, _)| bisection.squared_length(e) < shortest)
         .count();
@@ -313,6 +333,7 @@ pub fn precompute_refined(
     params.refine = Some(RefineRecord {
         tolerance: refinement.tolerance,
         max_vertices,
+        probe: refinement.probe.as_ref().map(|p| p.name.clone()),
     });
     let mut cache = SceneCache::new(params, refined.mesh, refined.albedo, transport)?;
     cache.ground_vertices = refined.ground_vertices;
@@ -346,28 +367,138 @@ fn split_marked(
         .all(|&(e, _)| bisection.split(e, max_vertices))
 }
 
-/// Of `edges`, those whose endpoints' transports differ by more than `tolerance` times the
-/// larger of their unoccluded norms `scale` (see the [module docs](self)), with the ratio.
-fn differences(
-    transport: &TransportSet,
-    scale: &[f64],
-    edges: &[Edge],
-    tolerance: f64,
-) -> Vec<(Edge, f64)> {
-    let texels = transport.param().texels();
-    edges
-        .par_iter()
-        .map_init(
-            || vec![0.0f64; texels],
-            |dense, &(a, b)| {
-                let most = scale[a as usize].max(scale[b as usize]);
-                let d = difference(transport, a as usize, b as usize, dense) / most;
-                // 0 / 0: neither end receives anything, and NaN is never above.
-                (d > tolerance).then_some(((a, b), d))
-            },
-        )
-        .flatten()
-        .collect()
+/// A probe lighting for the criterion (`--refine-light ENV`, see the [module docs](self)): the
+/// environment at the transport's parameterisation, as Haar coefficients (for `<T_v, L>`) and
+/// as texels (for the unoccluded `<U_v, L>`), unrotated and untruncated.
+///
+/// ```
+/// use haarshift::relight::precompute::refine::Probe;
+/// use haarshift::relight::light::environment::Environment;
+/// use haarshift::faces::{ParamKind, Parameterization};
+/// use haarshift::sphere::LatLongMap;
+/// let sky = Environment::new(LatLongMap::<f64>::from_fn(16, 3, |d, o| o.fill(1.0 + d[1])).unwrap());
+/// let probe = Probe::new("sky", &sky, Parameterization::new(ParamKind::Cube, 4).unwrap()).unwrap();
+/// assert_eq!(probe.name(), "sky");
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe {
+    name: String,
+    lighting: Lighting,
+    texels: Vec<[f64; 3]>,
+}
+
+impl Probe {
+    /// `env` brought to `param` ([`SphereMapping`]), recorded in the cache as `name`.
+    pub fn new(
+        name: impl Into<String>,
+        env: &Environment,
+        param: Parameterization,
+    ) -> Result<Probe> {
+        let map = SphereMapping::new(env.map().height(), param)?
+            .apply(env, &SphereRotation::identity())?;
+        let lighting = Lighting::from_map(&map, Selection::All)?;
+        let rows = lighting.coefficients_f64();
+        let a = map.as_array();
+        let last = map.channels() - 1; // a grey map (1) broadcast, as the lighting's
+        let texels = (a.rows().into_iter())
+            .map(|t| [t[0], t[1.min(last)], t[2.min(last)]])
+            .collect::<Vec<_>>();
+        debug_assert_eq!(
+            (texels.len(), rows.nrows()),
+            (param.texels(), param.texels())
+        );
+        Ok(Probe {
+            name: name.into(),
+            lighting,
+            texels,
+        })
+    }
+
+    /// The name the cache records.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// `<T_v, L_c>` per channel: the sparse transport against the lighting's coefficients.
+    fn radiance(&self, transport: &TransportSet, v: usize) -> [f64; 3] {
+        let rows = self.lighting.coefficients_f64();
+        let (indices, values) = transport.coefficients(v);
+        let mut sum = [0.0; 3];
+        for (&i, &x) in indices.iter().zip(values) {
+            for (s, &l) in sum.iter_mut().zip(rows.row(i as usize)) {
+                *s += f64::from(x) * l;
+            }
+        }
+        sum
+    }
+}
+
+/// The criterion's per-vertex state, extended as rounds make vertices: the scale `|U_v|` (or
+/// `|<U_v, L>|` under a probe) and, under a probe, each vertex's `<T_v, L>`.
+struct Judge<'a> {
+    unoccluded: Unoccluded,
+    probe: Option<&'a Probe>,
+    scale: Vec<f64>,
+    radiance: Vec<[f64; 3]>,
+}
+
+impl<'a> Judge<'a> {
+    fn new(param: Parameterization, probe: Option<&'a Probe>) -> Self {
+        Judge {
+            unoccluded: Unoccluded::new(param),
+            probe,
+            scale: Vec::new(),
+            radiance: Vec::new(),
+        }
+    }
+
+    /// The state of `vertices`, the next of the bisection's, traced into `transport`.
+    fn extend(&mut self, bisection: &Bisection, transport: &TransportSet, vertices: Range<usize>) {
+        let (unoccluded, probe) = (&self.unoccluded, self.probe);
+        let scale: Vec<f64> = (vertices.clone().into_par_iter())
+            .map(|v| match probe {
+                None => unoccluded.norm(bisection.normal(v)),
+                Some(p) => norm(unoccluded.radiance(bisection.normal(v), &p.texels)),
+            })
+            .collect();
+        self.scale.extend(scale);
+        if let Some(p) = probe {
+            let radiance: Vec<[f64; 3]> = (vertices.into_par_iter())
+                .map(|v| p.radiance(transport, v))
+                .collect();
+            self.radiance.extend(radiance);
+        }
+    }
+
+    /// Of `edges`, those whose endpoints differ by more than `tolerance` times the larger of
+    /// their scales (see the [module docs](self)), with the ratio.
+    fn above(&self, transport: &TransportSet, edges: &[Edge], tolerance: f64) -> Vec<(Edge, f64)> {
+        let texels = transport.param().texels();
+        edges
+            .par_iter()
+            .map_init(
+                || vec![0.0f64; texels],
+                |dense, &(a, b)| {
+                    let (a, b) = (a as usize, b as usize);
+                    let most = self.scale[a].max(self.scale[b]);
+                    let d = match self.probe {
+                        None => difference(transport, a, b, dense),
+                        Some(_) => {
+                            let (x, y) = (self.radiance[a], self.radiance[b]);
+                            norm([0, 1, 2].map(|c| x[c] - y[c]))
+                        }
+                    } / most;
+                    // 0 / 0: neither end receives anything, and NaN is never above.
+                    (d > tolerance).then_some(((a as u32, b as u32), d))
+                },
+            )
+            .flatten()
+            .collect()
+    }
+}
+
+fn norm(x: [f64; 3]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
 }
 
 /// `|T_a - T_b|` in f64, through `dense`, a zeroed scratch of one vertex's texels, left zeroed.
@@ -401,6 +532,19 @@ impl Unoccluded {
             directions: texel_directions(param),
             solid_angles: param.solid_angles().iter().copied().collect(),
         }
+    }
+
+    /// `<U_n, L_c>` per channel, `sum_t max(0, n . w_t) dOmega_t L_c(w_t)`, for the
+    /// lighting's `texels`.
+    pub(crate) fn radiance(&self, n: [f64; 3], texels: &[[f64; 3]]) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for ((&w, &o), l) in self.directions.iter().zip(&self.solid_angles).zip(texels) {
+            let weight = dot(n, w).max(0.0) * o;
+            for (s, &x) in sum.iter_mut().zip(l) {
+                *s += weight * x;
+            }
+        }
+        sum
     }
 
     /// `sqrt(sum_t (max(0, n . w_t) dOmega_t)^2)`.

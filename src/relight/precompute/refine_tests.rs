@@ -1,9 +1,13 @@
 use super::*;
 use crate::faces::{ParamKind, Parameterization};
 use crate::product::Selection;
+use crate::relight::light::environment::Environment;
 use crate::relight::precompute::precompute;
 use crate::relight::scene::refine::Bisection;
+use crate::relight::shade::lambert::{ShadeOptions, shade};
 use crate::relight::{Generator, RayTracer, VisibilityOptions};
+use crate::sphere::LatLongMap;
+use ndarray::Array2;
 
 /// A cube sphere of two cells a face (touching the ground at one vertex) on a ground plane of
 /// 2 x 2 cells: 54 + 9 vertices.
@@ -26,7 +30,21 @@ fn refinement(tolerance: f64, max_vertices: usize) -> Refinement {
     Refinement {
         tolerance,
         max_vertices: Some(max_vertices),
+        probe: None,
     }
+}
+
+/// A dim sky of 0.05 with a sun of 50 within 0.15 rad of `(0.8, 0.6, 0)`, 37 degrees up in
+/// the +x sky: the ball's shadow falls on the ground from about `x = 0` to `x = -3`.
+fn sunny() -> Environment {
+    let sun = [0.8, 0.6, 0.0];
+    let len = dot(sun, sun).sqrt();
+    let map = LatLongMap::<f64>::from_fn(64, 3, |d, out| {
+        let c = dot([d[0], d[1], d[2]], sun) / len;
+        out.fill(if c > 0.15f64.cos() { 50.0 } else { 0.05 });
+    })
+    .unwrap();
+    Environment::new(map)
 }
 
 /// Every edge's criterion in `cache`, largest first.
@@ -162,6 +180,89 @@ fn refine_first_then_bounce_bounces_over_the_refined_mesh() {
     assert!(gathered.coefficient_count() > 0);
     assert_eq!(unrefined.bounced.as_ref(), Some(gathered));
     assert_eq!(bounced.params.bounces, 1);
+}
+
+#[test]
+fn the_probe_s_radiance_is_the_shaded_one_and_an_open_vertex_s_its_unoccluded_sum() {
+    let o = options(Order::Vertex);
+    let probe = Probe::new("sun", &sunny(), o.visibility.param).unwrap();
+    let (cache, _) = precompute(ball_on_ground(), &o).unwrap();
+    // Against the Lambertian shading of the same transport (albedo pi: radiance <T, L>).
+    let albedo = Array2::<f32>::from_elem((cache.mesh.vertex_count(), 3), std::f32::consts::PI);
+    let shaded = shade::<f64>(
+        &cache.transport,
+        albedo.view(),
+        &probe.lighting,
+        &ShadeOptions::default(),
+    )
+    .unwrap();
+    let mut judge = Judge::new(o.visibility.param, Some(&probe));
+    let bisection = Bisection::new(&ball_on_ground());
+    judge.extend(&bisection, &cache.transport, 0..cache.mesh.vertex_count());
+    for v in 0..cache.mesh.vertex_count() {
+        for c in 0..3 {
+            let (got, want) = (judge.radiance[v][c], shaded[[v, c]]);
+            assert!(
+                (got - want).abs() <= 1e-6 * want.abs().max(1e-3),
+                "{v}: {got} {want}"
+            );
+        }
+    }
+    // A ground corner far from the ball sees the whole sky: its radiance is its scale.
+    let (corner, r) = (
+        cache.mesh.vertex_count() - 1,
+        judge.radiance.last().unwrap(),
+    );
+    let rel = (norm(*r) - judge.scale[corner]).abs() / judge.scale[corner];
+    assert!(rel < 1e-5, "{rel}");
+    // A lighting at another parameterisation is refused.
+    let mut r = refinement(0.3, 100);
+    r.probe = Some(
+        Probe::new(
+            "sun",
+            &sunny(),
+            Parameterization::new(ParamKind::Cube, 4).unwrap(),
+        )
+        .unwrap(),
+    );
+    let e = r.check_with(&o, None).unwrap_err().to_string();
+    assert!(e.contains("another parameterisation"), "{e}");
+}
+
+#[test]
+fn under_a_sunny_probe_the_shadow_s_far_edges_are_split_that_the_transport_leaves() {
+    let o = options(Order::Vertex);
+    let mut r = refinement(0.3, 400);
+    let (by_transport, _, _) = precompute_refined(ball_on_ground(), &o, &r).unwrap();
+    r.probe = Some(Probe::new("sun", &sunny(), o.visibility.param).unwrap());
+    let (by_probe, _, report) = precompute_refined(ball_on_ground(), &o, &r).unwrap();
+    // The ground's 2 x 2 cells span [-4, 4]. The transport splits the ground's edges around
+    // the contact, alike on every side; the probe goes on along the shadow, which the sun at
+    // +x casts towards -x: new vertices beyond |x| = 2 near z = 0 on that side alone.
+    let beyond = |c: &SceneCache, side: f64| {
+        let p = c.mesh.positions();
+        (c.mesh.vertex_count() - c.ground_vertices..c.mesh.vertex_count())
+            .filter(|&v| (2.01..3.99).contains(&(side * p[[v, 0]])) && p[[v, 2]].abs() < 0.9)
+            .count()
+    };
+    assert_eq!(
+        [beyond(&by_transport, -1.0), beyond(&by_transport, 1.0)],
+        [0, 0]
+    );
+    assert!(beyond(&by_probe, -1.0) > 0, "{report:?}");
+    assert_eq!(beyond(&by_probe, 1.0), 0, "the lit side");
+    let record = by_probe.params.refine.as_ref().unwrap();
+    assert_eq!(record.probe.as_deref(), Some("sun"));
+    // Still a plain precompute of the refined mesh.
+    let mut again = Scene::from_mesh(by_probe.mesh.clone(), false).unwrap();
+    again.albedo = by_probe.albedo.clone();
+    again.ground_plane = true;
+    again.ground_cells = Some(2);
+    again.ground_vertices = by_probe.ground_vertices;
+    assert_eq!(
+        precompute(again, &o).unwrap().0.transport,
+        by_probe.transport
+    );
 }
 
 #[test]

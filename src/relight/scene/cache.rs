@@ -156,7 +156,7 @@ fn is_zero(n: &usize) -> bool {
 /// ([`precompute::refine`](crate::relight::precompute::refine)): its mesh is the scene's
 /// refined, and its ground plane's vertices ([`CacheHeader::ground_vertices`]) are the
 /// grid's and the midpoints made on it.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RefineRecord {
     /// `TOL`: the largest relative L2 difference left between an edge's endpoints'
@@ -164,6 +164,10 @@ pub struct RefineRecord {
     pub tolerance: f64,
     /// `N`: the most vertices the refined mesh could have.
     pub max_vertices: usize,
+    /// The probe lighting the edges were judged under (`--refine-light ENV`: its file
+    /// name), or `None` when they were judged by their transport.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<String>,
 }
 
 impl CacheParams {

@@ -6,7 +6,10 @@ use haarshift::Result;
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
-use haarshift::relight::precompute::refine::{MIN_EDGE_OFFSETS, Refinement, precompute_refined};
+use haarshift::relight::light::environment::Environment;
+use haarshift::relight::precompute::refine::{
+    MIN_EDGE_OFFSETS, Probe, Refinement, precompute_refined,
+};
 use haarshift::relight::precompute::{
     DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_bounce_shard,
     precompute_shard, shard_is_done,
@@ -61,8 +64,12 @@ vertices precomputed, and so on until every edge is within TOL or the next verte
 shorter than 16 ray offsets are left as they are. New
 vertices come after the objects' and after the ground's own, so the ground stays the last
 block; the cache equals a precomputation of the refined mesh. Vertex order only, one ray per
-texel, not with --shard; refine first, then bounce. results/relight/refine.md measures it:
+texel, not with --shard; refine first, then bounce. With --refine-light ENV the edges are
+judged by their radiance under that map instead (the same ratio, of <T, L> over <U, L>): the
+sun's shadow, one texel of the transport, is most of the radiance. results/relight/refine.md
+measures both:
   haarshift relight precompute bunny.ply --ground-plane --param cube --refine 0.2 --max-vertices 5000 -o bunny.hsr
+  haarshift relight precompute bunny.ply --ground-plane --param cube --refine 0.2 --refine-light sky.hdr -o bunny.hsr
 
 Sharded across machines (vertex order only): shard I of N computes the vertices
 [I x V / N, (I + 1) x V / N) against the whole scene, with the bits an unsharded run gives
@@ -153,6 +160,11 @@ pub struct Args {
     #[arg(long, value_name = "N", requires = "refine")]
     pub max_vertices: Option<usize>,
 
+    /// With --refine: judge edges by their radiance under this environment map (unrotated)
+    /// instead of by their transport
+    #[arg(long, value_name = "ENV", requires = "refine")]
+    pub refine_light: Option<PathBuf>,
+
     #[command(flatten)]
     pub shard: ShardFlags,
 
@@ -173,6 +185,7 @@ pub fn run(args: Args) -> Result<()> {
     let existing_allowed = args.force || shard.is_some();
     let mut inputs = vec![args.scene.input.as_path()];
     inputs.extend(args.bounce_from.as_deref());
+    inputs.extend(args.refine_light.as_deref());
     refuse_outputs(&inputs, &[&args.output], existing_allowed)?;
     let param = Parameterization::new(args.param, args.resolution)?;
     let mut visibility = VisibilityOptions::new(param);
@@ -192,9 +205,20 @@ pub fn run(args: Args) -> Result<()> {
         bounces: args.bounces,
     };
     options.check()?;
+    let probe = match &args.refine_light {
+        Some(path) => {
+            let env = Environment::load(path)?;
+            let name = path
+                .file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into());
+            Some(Probe::new(name, &env, param).map_err(|e| e.in_file(path))?)
+        }
+        None => None,
+    };
     let refinement = args.refine.map(|tolerance| Refinement {
         tolerance,
         max_vertices: args.max_vertices,
+        probe,
     });
     if let Some(r) = &refinement {
         r.check_with(&options, shard)?;
