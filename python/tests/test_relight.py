@@ -130,6 +130,25 @@ def test_a_shader_agrees_with_relight_render(cli, cached, tmp_path, options, fla
     assert np.array_equal(again, ours)
 
 
+def test_a_bounce_cache_is_the_command_line_s_and_shades_as_relight_render(cli, cached, tmp_path):
+    _, path, sky = cached
+    scene = tmp_path / "balls.json"
+    ours = tmp_path / "ours.hsr"
+    cache = haarshift.relight.precompute(scene, resolution=8, bounces=2, output=ours)
+    assert cache.bounces == 2
+    theirs = tmp_path / "theirs.hsr"
+    cli("relight", "precompute", scene, "--resolution", "8", "--bounces", "2", "-o", theirs)
+    assert ours.read_bytes() == theirs.read_bytes()
+    radiance, _ = haarshift.relight.Shader(haarshift.relight.Cache.read(ours)).shade(sky)
+    out = tmp_path / "v.npy"
+    cli("relight", "render", ours, "--env", sky, "--vertices", out,
+        "--width", "32", "--height", "24", "-o", tmp_path / "frame.png")
+    assert np.array_equal(radiance.astype(np.float32), np.load(out))
+    # The bounces add light: more than the direct cache's everywhere, somewhere strictly.
+    direct, _ = haarshift.relight.Shader(haarshift.relight.Cache.read(path)).shade(sky)
+    assert (radiance >= direct - 1e-6).all() and (radiance > direct + 1e-4).any()
+
+
 def test_the_cache_object(cached):
     cache, path, _ = cached
     read = haarshift.relight.Cache.read(path)
