@@ -9,7 +9,8 @@
 # cube 6 x 16^2 by default: RESOLUTION=N to change), B = 0 (direct only) to 3; precompute time
 # and peak memory for each B; frame time with bounces on and off (`relight render
 # --direct-only`); the speed target's ratio, `--bounces 1` against direct precomputation of
-# the bunny on its ground at cube 6 x 32^2; and, where the build has `--ground-cells`, the
+# the bunny on its ground at cube 6 x 32^2 and of the cubes scene at cube 6 x 64^2; how far
+# caches cast by Embree and by our packets differ; and, where the build has `--ground-cells`, the
 # gather's difference from the path tracer as the ground gets denser. Also writes the picture
 # triple results/relight/bounces_{direct,bounced,paths}.png (the bunny in the box, Rooitou
 # Park). Low resolutions and PATHS=256 keep the run to minutes on 2 cores.
@@ -30,6 +31,14 @@ rel() {
     python3 -c 'import numpy as np, sys
 a, t = np.load(sys.argv[1]).astype(float), np.load(sys.argv[2]).astype(float)
 print(f"{np.sqrt(np.mean((a - t) ** 2) / np.mean(t ** 2)):.4f}")' "$1" "$2"
+}
+# The same, less the path tracer's own noise: sqrt(max(0, mean((a - t)^2) - mean(se^2)) /
+# mean(t^2)) with SE its (V, 3) standard errors. The expected squared difference from a noisy
+# truth is the squared bias plus the noise's variance, so this estimates the bias alone.
+bias() {
+    python3 -c 'import numpy as np, sys
+a, t, s = (np.load(p).astype(float) for p in sys.argv[1:4])
+print(f"{np.sqrt(max(0.0, np.mean((a - t) ** 2) - np.mean(s ** 2)) / np.mean(t ** 2)):.4f}")' "$1" "$2" "$3"
 }
 for s in bunny box; do
     # shellcheck disable=SC2086
@@ -64,6 +73,11 @@ echo "$resolution x $((2 * resolution))). Errors are relative RMS over vertices 
 echo "\`sqrt(mean((x - truth)^2) / mean(truth^2))\`; \`gather B\` is \`relight reference --bounces B\`"
 echo "(the pixel-domain gather over the $resolution x $((2 * resolution)) texel rays), \`Haar B\` the render"
 echo "of a cache precomputed with \`--bounces B\` at cube 6 x ${resolution}^2, every coefficient kept."
+echo "Under a sun (Rooitou Park, the studio) $paths cosine-weighted paths leave the truth itself"
+echo "noisy, its standard error near the differences measured; the second table takes that noise out,"
+echo "\`sqrt(max(0, mean((x - truth)^2) - mean(se^2)) / mean(truth^2))\` with \`se\` the path"
+echo "tracer's standard error per vertex and channel (the squared difference from a noisy truth is"
+echo "the squared bias plus the noise's variance): what is left is the method's own error."
 echo
 echo "| scene | map | path tracer's RMS standard error / RMS radiance | gather 0 (direct only) | gather 1 | gather 2 | gather 3 | Haar 0 | Haar 1 | Haar 2 | Haar 3 |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
@@ -75,6 +89,22 @@ print(f"{np.sqrt(np.mean(s ** 2) / np.mean(t ** 2)):.4f}")' "$work/se-$s-$m.npy"
         row="| $s | $m | $se"
         for b in 0 1 2 3; do row+=" | $(rel "$work/gather-$s-$m-$b.npy" "$work/pt-$s-$m.npy")"; done
         for b in 0 1 2 3; do row+=" | $(rel "$work/haar-$s-$m-$b.npy" "$work/pt-$s-$m.npy")"; done
+        echo "$row |"
+    done
+done
+echo
+echo "Less the path tracer's noise:"
+echo
+echo "| scene | map | gather 0 (direct only) | gather 1 | gather 2 | gather 3 | Haar 0 | Haar 1 | Haar 2 | Haar 3 |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
+for s in bunny box; do
+    for m in "${maps[@]}"; do
+        row="| $s | $m"
+        for kind in gather haar; do
+            for b in 0 1 2 3; do
+                row+=" | $(bias "$work/$kind-$s-$m-$b.npy" "$work/pt-$s-$m.npy" "$work/se-$s-$m.npy")"
+            done
+        done
         echo "$row |"
     done
 done
@@ -110,11 +140,54 @@ echo
 echo "Wall time of \`--bounces 1\` over the direct run's: $(python3 -c "print(f'{$w1 / $w0:.2f}')")x"
 echo "(target at most 3x); peak memory $(peak_mib speed-1) MiB against $(peak_mib speed-0) MiB."
 echo
+echo "## Speed: one bounce on the 85,860-vertex cubes scene (cube 6 x 64^2)"
+echo
+echo "| step | wall (m:ss) | CPU s | peak resident MiB | what it reports |"
+echo "|---|---|---|---|---|"
+for b in 0 1; do
+    timed "cubes-$b" relight precompute testdata/scenes/cubes.json --param cube --resolution 64 \
+        --bounces $b --memory-limit 16GiB -o "$work/cubes-$b.hsr"
+    rm "$work/cubes-$b.hsr"
+    step_row "cubes-$b"
+done
+c0=$(seconds "$(field cubes-0 'Elapsed (wall clock)')")
+c1=$(seconds "$(field cubes-1 'Elapsed (wall clock)')")
+echo
+echo "Wall time of \`--bounces 1\` over the direct run's: $(python3 -c "print(f'{$c1 / $c0:.2f}')")x"
+echo "(target at most 3x); peak memory $(peak_mib cubes-1) MiB against $(peak_mib cubes-0) MiB."
+echo
+echo "## Embree against our packets (the bunny in the box, 2 bounces, cube 6 x ${resolution}^2)"
+echo
+echo "Each tracer answers a ray through an edge or a vertex its own way, and a bounce gathers the"
+echo "transport of whatever the ray hits, so the two tracers' caches differ slightly. Relative RMS"
+echo "(and the largest difference over the RMS) of the radiance over vertices, Rooitou Park:"
+echo
+echo "| what | relative RMS | largest / RMS |"
+echo "|---|---|---|"
+env=testdata/envmaps/rooitou_park_1k.hdr
+for t in embree packets; do
+    timed "tracer-$t" relight precompute testdata/scenes/bunny_in_box.json --param cube \
+        --resolution "$resolution" --bounces 2 --ray-tracer "$t" -o "$work/tracer-$t.hsr"
+    for only in "" --direct-only; do
+        # shellcheck disable=SC2086
+        "$hs" relight render "$work/tracer-$t.hsr" --env "$env" $only --width 64 --height 48 \
+            --vertices "$work/tracer-$t${only}.npy" -o "$work/r.png" --force >&2
+    done
+done
+difference() {
+    python3 -c 'import numpy as np, sys
+a, b = (np.load(p).astype(float) for p in sys.argv[1:3])
+rms = np.sqrt(np.mean(b ** 2))
+print(f"{np.sqrt(np.mean((a - b) ** 2)) / rms:.2e} | {np.abs(a - b).max() / rms:.2e}")' "$1" "$2"
+}
+echo "| direct light alone | $(difference "$work/tracer-packets--direct-only.npy" "$work/tracer-embree--direct-only.npy") |"
+echo "| with 2 bounces | $(difference "$work/tracer-packets.npy" "$work/tracer-embree.npy") |"
+echo
 echo "## The gather against the path tracer as the ground gets denser (bunny, Rooitou Park, 1 bounce)"
 echo
 if "$hs" relight reference --help | grep -q -- --ground-cells; then
-    echo "| ground cells a side | vertices | gather 1 against path tracer (depth 1) | path tracer's RMS standard error / RMS |"
-    echo "|---|---|---|---|"
+    echo "| ground cells a side | vertices | gather 1 against path tracer (depth 1) | less the path tracer's noise | path tracer's RMS standard error / RMS |"
+    echo "|---|---|---|---|---|"
     env=testdata/envmaps/rooitou_park_1k.hdr
     for g in 16 32 64 128; do
         a=(relight reference testdata/meshes/bunny.ply --ground-plane --ground-cells "$g" --env "$env" --resolution $resolution)
@@ -125,7 +198,7 @@ if "$hs" relight reference --help | grep -q -- --ground-cells; then
         se=$(python3 -c 'import numpy as np, sys
 s, t = np.load(sys.argv[1]).astype(float), np.load(sys.argv[2]).astype(float)
 print(f"{np.sqrt(np.mean(s ** 2) / np.mean(t ** 2)):.4f}")' "$work/gse-$g.npy" "$work/gpt-$g.npy")
-        echo "| $g | $v | $(rel "$work/g-$g.npy" "$work/gpt-$g.npy") | $se |"
+        echo "| $g | $v | $(rel "$work/g-$g.npy" "$work/gpt-$g.npy") | $(bias "$work/g-$g.npy" "$work/gpt-$g.npy" "$work/gse-$g.npy") | $se |"
     done
 else
     echo "Not measured: this build has no \`--ground-cells\`."

@@ -41,8 +41,14 @@
 //! edge is split at its one midpoint, no T-junctions; new vertices get the interpolated normal
 //! and albedo; the objects' vertices, then the ground plane's, originals first in each). A
 //! round marks every edge above `TOL` among those touching the vertices the last round made
-//! (the first round: all edges; an edge between two older vertices was judged already), and
-//! splits them largest difference first, so a budget spent mid-round went to the worst edges.
+//! and those the last round left marked (the first round: all edges; another edge between two
+//! older vertices was judged already), and splits them in order of their difference times
+//! their length, making at most a quarter of the vertices the budget has left (at least 64).
+//! *Times the length*: the picture's error an edge leaves spans an area that grows with it, so
+//! a long ground edge across a shadow goes before a short one on the bunny with the same
+//! difference. *A quarter a round*: the halves of a split edge are judged in the next round
+//! and compete for the rest of the budget with the edges left, so a shadow's edge is refined
+//! again before the whole budget is spent at the first level.
 //!
 //! **Why the result is an unrefined precompute of the refined mesh.** A vertex's transport
 //! depends on its position, its normal and the surface its rays may hit. Old vertices keep
@@ -78,6 +84,7 @@
 //! refinement: refine first, then gather the bounces over the refined mesh, whose vertices
 //! they need.
 
+use std::collections::BTreeSet;
 use std::ops::Range;
 use std::time::Instant;
 
@@ -297,18 +304,25 @@ pub fn precompute_refined(
     judge.extend(&bisection, &transport, 0..bisection.vertex_count());
     let shortest = (MIN_EDGE_OFFSETS * ray_offset(&scene.mesh)).powi(2);
     let (mut rounds, mut first) = (1, 0u32);
+    // Marked edges a round's quota left unsplit, judged again with the next round's.
+    let mut pending: BTreeSet<Edge> = BTreeSet::new();
     loop {
         // Edges between two older vertices were judged in an earlier round.
         let judged: Vec<Edge> = (bisection.edges())
-            .filter(|&(a, b)| a >= first || b >= first)
+            .filter(|&(a, b)| a >= first || b >= first || pending.contains(&(a, b)))
             .filter(|&e| bisection.squared_length(e) >= shortest)
             .collect();
-        let mut marked = judge.above(&transport, &judged, refinement.tolerance);
+        let marked = judge.above(&transport, &judged, refinement.tolerance);
         if marked.is_empty() {
             break;
         }
         let made = bisection.vertex_count();
-        let stopped = split_marked(&mut bisection, &mut marked, max_vertices);
+        let cap = made + round_quota(max_vertices - made);
+        split_marked(&mut bisection, &marked, cap.min(max_vertices));
+        pending = (marked.iter())
+            .map(|&(e, _)| e)
+            .filter(|&e| bisection.has_edge(e))
+            .collect();
         if bisection.vertex_count() > made {
             let (set, r) = trace(&bisection, made..bisection.vertex_count())?;
             transport.append(&set)?;
@@ -316,7 +330,7 @@ pub fn precompute_refined(
             report = join(report, r)?;
             rounds += 1;
         }
-        if stopped {
+        if bisection.vertex_count() >= max_vertices || bisection.vertex_count() == made {
             break;
         }
         first = made as u32;
@@ -354,17 +368,27 @@ pub fn precompute_refined(
     Ok((cache, report, refine_report))
 }
 
-/// Splits the `marked` edges, largest difference first; returns whether the budget stopped
-/// it.
-fn split_marked(
-    bisection: &mut Bisection,
-    marked: &mut [(Edge, f64)],
-    max_vertices: usize,
-) -> bool {
-    marked.sort_by(|(e, x), (f, y)| y.total_cmp(x).then(e.cmp(f)));
-    !marked
-        .iter()
-        .all(|&(e, _)| bisection.split(e, max_vertices))
+/// The most vertices one round may make of the `left` the budget still allows: a quarter
+/// (at least [`MIN_ROUND`]), so that the shorter edges a round makes compete for the rest of
+/// the budget with the longer ones it left.
+fn round_quota(left: usize) -> usize {
+    (left / 4).max(MIN_ROUND)
+}
+
+/// The fewest vertices a round may make (unless the budget has fewer left).
+const MIN_ROUND: usize = 64;
+
+/// Splits the `marked` edges in order of their difference times their length (the area of
+/// the picture an edge's error spans grows with it), until the next would pass `cap` vertices.
+fn split_marked(bisection: &mut Bisection, marked: &[(Edge, f64)], cap: usize) {
+    let rank = |&(e, d): &(Edge, f64)| d * bisection.squared_length(e).sqrt();
+    let mut ranked: Vec<(f64, Edge)> = marked.iter().map(|m| (rank(m), m.0)).collect();
+    ranked.sort_by(|(x, e), (y, f)| y.total_cmp(x).then(e.cmp(f)));
+    for (_, e) in ranked {
+        if !bisection.split(e, cap) {
+            return;
+        }
+    }
 }
 
 /// A probe lighting for the criterion (`--refine-light ENV`, see the [module docs](self)): the

@@ -230,27 +230,26 @@ fn the_probe_s_radiance_is_the_shaded_one_and_an_open_vertex_s_its_unoccluded_su
 }
 
 #[test]
-fn under_a_sunny_probe_the_shadow_s_far_edges_are_split_that_the_transport_leaves() {
+fn under_a_sunny_probe_the_refinement_follows_the_shadow_to_its_far_end() {
     let o = options(Order::Vertex);
     let mut r = refinement(0.3, 400);
     let (by_transport, _, _) = precompute_refined(ball_on_ground(), &o, &r).unwrap();
     r.probe = Some(Probe::new("sun", &sunny(), o.visibility.param).unwrap());
     let (by_probe, _, report) = precompute_refined(ball_on_ground(), &o, &r).unwrap();
     // The ground's 2 x 2 cells span [-4, 4]. The transport splits the ground's edges around
-    // the contact, alike on every side; the probe goes on along the shadow, which the sun at
-    // +x casts towards -x: new vertices beyond |x| = 2 near z = 0 on that side alone.
+    // the contact alike on every side; the probe follows the shadow, which the sun at +x
+    // casts towards -x: more new vertices beyond |x| = 2 near z = 0 on that side than on the
+    // lit one.
     let beyond = |c: &SceneCache, side: f64| {
         let p = c.mesh.positions();
         (c.mesh.vertex_count() - c.ground_vertices..c.mesh.vertex_count())
             .filter(|&v| (2.01..3.99).contains(&(side * p[[v, 0]])) && p[[v, 2]].abs() < 0.9)
             .count()
     };
-    assert_eq!(
-        [beyond(&by_transport, -1.0), beyond(&by_transport, 1.0)],
-        [0, 0]
-    );
-    assert!(beyond(&by_probe, -1.0) > 0, "{report:?}");
-    assert_eq!(beyond(&by_probe, 1.0), 0, "the lit side");
+    let sides = |c: &SceneCache| [beyond(c, -1.0), beyond(c, 1.0)];
+    let [shadow, lit] = sides(&by_probe);
+    assert_eq!(sides(&by_transport)[0], sides(&by_transport)[1]);
+    assert!(shadow > lit + 10, "{shadow} {lit}: {report:?}"); // measured 31 and 0
     let record = by_probe.params.refine.as_ref().unwrap();
     assert_eq!(record.probe.as_deref(), Some("sun"));
     // Still a plain precompute of the refined mesh.

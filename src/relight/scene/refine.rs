@@ -110,6 +110,11 @@ impl Bisection {
         self.edges.keys().copied()
     }
 
+    /// Whether `e` is an edge of the mesh as it now is (not split, nor never made).
+    pub(crate) fn has_edge(&self, e: Edge) -> bool {
+        self.edges.contains_key(&e)
+    }
+
     /// The squared length of `e`.
     pub(crate) fn squared_length(&self, (a, b): Edge) -> f64 {
         let d = sub(self.positions[a as usize], self.positions[b as usize]);
