@@ -58,8 +58,15 @@ for tol in "${tolerances[@]}"; do
         --refine-light "$env" -o "$work/probe-$tol.hsr"
 done
 runs+=("${refined[@]}")
+# The probe's limit: the lighting turned by YAW (default 120 degrees) moves the sun and its
+# shadow away from where probe-TOL refined; each mesh rendered so against a reference so.
+turn=${YAW:-120}
+timed truth-turned relight reference "$work/truth.ply" --ground-plane --ground-cells "$truth_cells" \
+    --resolution "$truth_resolution" "${view[@]}" --yaw "$turn" --vertices "$work/truth-turned.npy" \
+    -o "$work/truth-turned.exr"
 for r in "${runs[@]}"; do
     timed "render-$r" relight render "$work/$r.hsr" "${view[@]}" -o "$work/$r.exr"
+    "$hs" relight render "$work/$r.hsr" "${view[@]}" --yaw "$turn" -o "$work/$r-turned.exr" >&2
     rm "$work/$r.hsr"
 done
 # The vertex count a precomputation printed ("FILE: V vertices, ...": the last such line).
@@ -118,6 +125,15 @@ for r in "${refined[@]}"; do
     v=$(vertices "$r")
     g=$(grep -oE '\(([0-9]+) of them the ground' "$work/pre-$r.out" | grep -oE '[0-9]+')
     echo "$r: $((v - g - objects)) on the bunny, $((g - 33 * 33)) on the ground;"
+done
+echo
+echo "Under the lighting turned by $turn degrees about +Y (the sun elsewhere, its shadow where the"
+echo "probe did not refine), each mesh's per-pixel relative RMS against the reference so turned:"
+echo
+echo "| mesh | per-pixel relative RMS, lighting turned $turn degrees |"
+echo "|---|---|"
+for r in "${runs[@]}"; do
+    echo "| $r | $(pixel_error truth-turned "$r-turned" | sed 's/ |.*//') |"
 done
 echo
 if [ ${#met[@]} -gt 0 ]; then
