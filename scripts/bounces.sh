@@ -134,11 +134,16 @@ for b in 0 1; do
     step_row "speed-$b"
 done
 seconds() { python3 -c 'import sys; h, m, s = ([0, 0] + sys.argv[1].split(":"))[-3:]; print(3600 * float(h) + 60 * float(m) + float(s))' "$1"; }
-w0=$(seconds "$(field speed-0 'Elapsed (wall clock)')")
-w1=$(seconds "$(field speed-1 'Elapsed (wall clock)')")
-echo
-echo "Wall time of \`--bounces 1\` over the direct run's: $(python3 -c "print(f'{$w1 / $w0:.2f}')")x"
-echo "(target at most 3x); peak memory $(peak_mib speed-1) MiB against $(peak_mib speed-0) MiB."
+# The speed target's lines for steps NAME-0 (direct) and NAME-1 (one bounce).
+ratio() {
+    local w0 w1
+    w0=$(seconds "$(field "$1-0" 'Elapsed (wall clock)')")
+    w1=$(seconds "$(field "$1-1" 'Elapsed (wall clock)')")
+    echo
+    echo "Wall time of \`--bounces 1\` over the direct run's: $(python3 -c "print(f'{$w1 / $w0:.2f}')")x"
+    echo "(target at most 3x); peak memory $(peak_mib "$1-1") MiB against $(peak_mib "$1-0") MiB."
+}
+ratio speed
 echo
 echo "## Speed: one bounce on the 85,860-vertex cubes scene (cube 6 x 64^2, 414 coefficients a vertex)"
 echo
@@ -154,11 +159,7 @@ for b in 0 1; do
     rm "$work/cubes-$b.hsr"
     step_row "cubes-$b"
 done
-c0=$(seconds "$(field cubes-0 'Elapsed (wall clock)')")
-c1=$(seconds "$(field cubes-1 'Elapsed (wall clock)')")
-echo
-echo "Wall time of \`--bounces 1\` over the direct run's: $(python3 -c "print(f'{$c1 / $c0:.2f}')")x"
-echo "(target at most 3x); peak memory $(peak_mib cubes-1) MiB against $(peak_mib cubes-0) MiB."
+ratio cubes
 echo
 echo "## Embree against our packets (the bunny in the box, 2 bounces, cube 6 x ${resolution}^2)"
 echo
