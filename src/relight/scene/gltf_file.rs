@@ -71,7 +71,7 @@ fn parse(bytes: &[u8]) -> Result<gltf::Gltf> {
         gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
     // gltf-json 1.4.1's validation indexes a primitive's POSITION accessor before checking
     // that it exists (mesh.rs, `primitive_validate_hook`), and panics on one that does not:
-    // found by the gltf fuzz target, so checked first.
+    // found by the gltf fuzz target, so checked first. Then the images, as below.
     let json = document.into_json();
     let accessors = json.accessors.len();
     for (m, mesh) in json.meshes.iter().enumerate() {
@@ -87,6 +87,18 @@ fn parse(bytes: &[u8]) -> Result<gltf::Gltf> {
                 .into());
             }
         }
+    }
+    // gltf 1.4.1's `Image::source` unwraps a uri where there is no bufferView, and a mimeType
+    // where there is one (the spec's rule for both, which its validation does not check):
+    // also found by the fuzz target.
+    for (k, image) in json.images.iter().enumerate() {
+        let why = match (&image.uri, &image.buffer_view, &image.mime_type) {
+            (None, None, _) => "names neither a uri nor a bufferView",
+            (Some(_), Some(_), _) => "names both a uri and a bufferView",
+            (None, Some(_), None) => "is in a bufferView but has no mimeType",
+            _ => continue,
+        };
+        return Err(SceneError::Corrupt(format!("image {k} {why}")).into());
     }
     let document = gltf::Document::from_json(json).map_err(invalid)?;
     Ok(gltf::Gltf { document, blob })

@@ -295,6 +295,15 @@ fn hostile_documents_are_refused_in_one_line_naming_the_part() {
             ],
         ),
         (
+            // And gltf's `Image::source` on an image of neither uri nor bufferView.
+            triangle(&[], |d| d["images"] = json!([{"name": "nothing"}])),
+            &["image 0 names neither a uri nor a bufferView"],
+        ),
+        (
+            triangle(&[], |d| d["images"] = json!([{"bufferView": 0}])),
+            &["image 0 is in a bufferView but has no mimeType"],
+        ),
+        (
             triangle(&[], |d| d["buffers"][0]["uri"] = json!("missing.bin")),
             &["buffer 0", "missing.bin"],
         ),
