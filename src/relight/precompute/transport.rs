@@ -186,44 +186,30 @@ impl TransportSet {
                 ),
             ));
         }
-        let mut out = match &self.sh {
-            Some(t) => TransportSet::with_sh(self.param, self.keep, t.bands())?,
-            None => TransportSet::new(self.param, self.keep),
-        };
-        for v in vertices.clone() {
-            let (indices, values) = self.coefficients(v);
-            out.rows.push(indices, values);
-        }
-        if let (Some(mine), Some(theirs)) = (&mut out.sh, &self.sh) {
-            let n = theirs.bands() * theirs.bands();
-            let rows = &theirs.as_slice()[vertices.start * n..vertices.end * n];
-            rows.chunks_exact(n).for_each(|row| mine.push(row));
-        }
-        Ok(out)
+        self.picked(vertices)
     }
 
     /// The set with its vertex `order[k]` as its `k`-th (the refined scene's order, from the
     /// order the refinement made its vertices in).
     pub(crate) fn reordered(&self, order: &[u32]) -> Result<TransportSet> {
-        let mut set = TransportSet {
-            param: self.param,
-            keep: self.keep,
-            rows: SparseRows::new(),
-            sh: self
-                .sh
-                .as_ref()
-                .map(|t| ShTransfer::empty(t.bands()))
-                .transpose()?,
+        self.picked(order.iter().map(|&v| v as usize))
+    }
+
+    /// A set of these vertices' rows (and harmonic transfer), in the order given.
+    fn picked(&self, vertices: impl Iterator<Item = usize>) -> Result<TransportSet> {
+        let mut out = match &self.sh {
+            Some(t) => TransportSet::with_sh(self.param, self.keep, t.bands())?,
+            None => TransportSet::new(self.param, self.keep),
         };
-        for &v in order {
-            let (indices, values) = self.coefficients(v as usize);
-            set.rows.push(indices, values);
-            if let (Some(mine), Some(theirs)) = (&mut set.sh, &self.sh) {
-                let len = theirs.bands() * theirs.bands();
-                mine.push(&theirs.as_slice()[v as usize * len..][..len]);
+        for v in vertices {
+            let (indices, values) = self.coefficients(v);
+            out.rows.push(indices, values);
+            if let (Some(mine), Some(theirs)) = (&mut out.sh, &self.sh) {
+                let n = theirs.bands() * theirs.bands();
+                mine.push(&theirs.as_slice()[v * n..(v + 1) * n]);
             }
         }
-        Ok(set)
+        Ok(out)
     }
 
     /// The spherical-harmonic transfer, when the set was made with it.
