@@ -72,35 +72,29 @@ fn parse_obj(text: &str, dir: &Path, memory_limit: u64) -> Result<MeshAsset> {
     for (line_no, line) in text.lines().enumerate() {
         let bad = |what: &str| corrupt(format!("line {}: {what}", line_no + 1));
         let mut words = line.split_whitespace();
-        let numbers = |words: std::str::SplitWhitespace<'_>, n: usize| -> Result<Vec<f64>> {
+        // The next `least` to `most` numbers of the line (the rest is left).
+        let numbers = |words: std::str::SplitWhitespace<'_>, least: usize, most: usize| {
             let parsed: Vec<f64> = words
-                .take(n)
+                .take(most)
                 .map(|w| w.parse::<f64>())
                 .collect::<Result<_, _>>()
                 .map_err(|_| bad("a coordinate is not a number"))?;
-            if parsed.len() != n {
+            if parsed.len() < least {
                 return Err(bad("too few coordinates"));
             }
-            Ok(parsed)
+            Ok::<_, crate::Error>(parsed)
         };
         match words.next() {
-            Some("v") => positions.extend(numbers(words, 3)?),
-            Some("vn") => file_normals.extend(numbers(words, 3)?),
+            Some("v") => positions.extend(numbers(words, 3, 3)?),
+            Some("vn") => file_normals.extend(numbers(words, 3, 3)?),
             Some("vt") => {
                 // `vt u [v [w]]`: v defaults to 0, w (a 3D texture's) is ignored.
-                let uv: Vec<f64> = words
-                    .take(2)
-                    .map(|w| w.parse::<f64>())
-                    .collect::<Result<_, _>>()
-                    .map_err(|_| bad("a texture coordinate is not a number"))?;
-                match uv[..] {
-                    [] => return Err(bad("too few coordinates")),
-                    _ if uv.iter().any(|x| !x.is_finite()) => {
-                        return Err(bad("a texture coordinate is not finite"));
-                    }
-                    [u] => uvs.push([u, 0.0]),
-                    [u, v, ..] => uvs.push([u, v]),
+                let mut uv = numbers(words, 1, 2)?;
+                if uv.iter().any(|x| !x.is_finite()) {
+                    return Err(bad("a texture coordinate is not finite"));
                 }
+                uv.resize(2, 0.0);
+                uvs.push([uv[0], uv[1]]);
             }
             Some("mtllib") => {
                 for name in words {

@@ -13,18 +13,23 @@ fn read(files: &[(&str, &[u8])]) -> (Result<MeshAsset>, tempfile::TempDir) {
 /// Two triangles sharing the edge 2-3 (positions 1..4), a 2 x 1 texture (black, white).
 const SQUARE: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nvt 0.25 0.5\nvt 0.75 0.5\nvt 0.5 0.5\n";
 
-fn texture_png() -> Vec<u8> {
+/// A PNG of two pixels, black then white, `width x height` (2 x 1 or 1 x 2).
+fn two_pixel_png(width: u32, height: u32) -> Vec<u8> {
     use image::ImageEncoder;
     let mut png = Vec::new();
     image::codecs::png::PngEncoder::new(&mut png)
         .write_image(
             &[0, 0, 0, 255, 255, 255],
-            2,
-            1,
+            width,
+            height,
             image::ExtendedColorType::Rgb8,
         )
         .unwrap();
     png
+}
+
+fn texture_png() -> Vec<u8> {
+    two_pixel_png(2, 1)
 }
 
 #[test]
@@ -165,17 +170,8 @@ fn ply_colours_are_srgb_as_bytes_and_linear_as_floats() {
 
 #[test]
 fn a_texture_coordinate_s_v_is_read_and_points_up() {
-    use image::ImageEncoder;
     // A 1 x 2 texture: row 0 (the image's top) black, row 1 white.
-    let mut png = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut png)
-        .write_image(
-            &[0, 0, 0, 255, 255, 255],
-            1,
-            2,
-            image::ExtendedColorType::Rgb8,
-        )
-        .unwrap();
+    let png = two_pixel_png(1, 2);
     let mtl = b"newmtl tex\nKd 1 1 1\nmap_Kd t.png\n";
     // v = 0.75 is the top row's centre, v = 0.25 the bottom's; `vt u` alone has v = 0, the
     // bottom edge, half way between the bottom row and the top one it wraps to.
