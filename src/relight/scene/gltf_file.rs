@@ -64,8 +64,10 @@ fn asset_error(part: impl Into<String>, reason: impl std::fmt::Display) -> Error
     .into()
 }
 
-/// The document in `bytes` (`.glb` by its magic, else JSON), validated by the `gltf` crate.
-fn parse(bytes: &[u8]) -> Result<gltf::Gltf> {
+/// The document in `bytes` (`.glb` by its magic, else JSON), validated by the `gltf` crate
+/// after what its validation would panic on is refused; every glTF the crate reads (assets
+/// here, baked files in `render::baked`) comes through this.
+pub(crate) fn parse(bytes: &[u8]) -> Result<gltf::Gltf> {
     let invalid = |e: gltf::Error| SceneError::Corrupt(format!("not a valid glTF 2.0 file: {e}"));
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;

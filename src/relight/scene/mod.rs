@@ -64,7 +64,7 @@ pub mod cache_shard;
 mod file;
 pub(crate) mod framed;
 mod generators;
-mod gltf_file;
+pub(crate) mod gltf_file;
 mod ground;
 pub mod mesh;
 mod mtl;

@@ -9,6 +9,7 @@ use gltf::accessor::{DataType, Dimensions};
 use ndarray::Array2;
 
 use crate::relight::scene::asset_path::decode_data_uri;
+use crate::relight::scene::gltf_file::parse;
 use crate::{Error, Result};
 
 /// A baked glTF's first primitive, as stored: every attribute f32 `(V, 3)`, the triangles
@@ -68,7 +69,7 @@ impl BakedGltf {
     /// assert!(BakedGltf::from_bytes(b"glTF\x02\0\0\0\x0c\0\0\0").is_err());
     /// ```
     pub fn from_bytes(bytes: &[u8]) -> std::result::Result<Self, String> {
-        let file = gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a glTF file: {e}"))?;
+        let file = parse(bytes).map_err(|e| e.to_string())?;
         let buffer = match (file.buffers().next(), file.blob.as_deref()) {
             (Some(buffer), blob) => match buffer.source() {
                 gltf::buffer::Source::Bin => blob

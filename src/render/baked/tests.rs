@@ -137,4 +137,8 @@ fn a_truncated_or_foreign_file_is_refused_not_read() {
     document["accessors"][1]["count"] = serde_json::json!(mesh.vertex_count() + 1);
     let e = BakedGltf::from_bytes(&serde_json::to_vec(&document).unwrap()).unwrap_err();
     assert!(e.contains("beyond its view"), "{e}");
+    // A POSITION accessor that is not there (gltf-json's validation would panic on it).
+    document["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = serde_json::json!(99);
+    let e = BakedGltf::from_bytes(&serde_json::to_vec(&document).unwrap()).unwrap_err();
+    assert!(e.contains("POSITION accessor 99 is not among"), "{e}");
 }
