@@ -499,7 +499,11 @@ impl<'a> Judge<'a> {
     /// Of `edges`, those whose endpoints differ by more than `tolerance` times the larger of
     /// their scales (see the [module docs](self)), with the ratio.
     fn above(&self, transport: &TransportSet, edges: &[Edge], tolerance: f64) -> Vec<(Edge, f64)> {
-        let texels = transport.param().texels();
+        // The transport's difference needs a dense scratch of a vertex's texels; a probe's none.
+        let texels = match self.probe {
+            None => transport.param().texels(),
+            Some(_) => 0,
+        };
         edges
             .par_iter()
             .map_init(
