@@ -33,7 +33,11 @@
 //! `W_c[v][i] = sum over rays hitting a triangle with corner i of w_ray beta_i rho_hit,c / pi`
 //! (`beta_i` the corner's barycentric weight); then one sparse row combination per distinct
 //! hit vertex, `sum_i W_c[v][i] (T0_i + S_i,c)`, accumulated densely in f64 and truncated.
-//! The weights are kept between bounces, so `B` bounces cast each ray once.
+//! The weights are kept between bounces, so `B` bounces cast each ray once, and a whole
+//! precomputation casts it once for direct and bounced light together: the closest hit
+//! answers visibility too (a ray is blocked exactly when it hits something, front or back).
+//! The gather then takes most of the time: a scatter of the hit rows into a dense f64
+//! accumulator, limited by reading the rows (`results/relight/bounces.md` has its share).
 //!
 //! **Channels.** `rho_hit` is baked in, so the bounced sum is per channel: three sparse
 //! vectors a vertex ([`BouncedTransport::channels`] has three sets, R, G, B), or one when every
@@ -73,10 +77,12 @@ use crate::progress::Task;
 use crate::relight::Mesh;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::material::brdf::check_albedo;
+use crate::relight::precompute::cast::{BATCH, Caster, Visible, cast_vertices, driver_bytes};
 use crate::relight::precompute::raycast::{Hit, SceneBvh};
+use crate::relight::precompute::transport::Encoder;
 use crate::relight::precompute::transport::{Encoded, TransportSet};
 use crate::relight::precompute::visibility::{
-    BATCH, PrecomputeReport, RaySet, VisibilityOptions, f32x3, origin_and_normal, ray_offset,
+    PrecomputeReport, VisibilityOptions, texel_directions,
 };
 use crate::relight::scene::mesh::{cross, dot, sub};
 use crate::{Error, Result};
@@ -293,27 +299,92 @@ pub fn bounce_range(
         return Err(Error::parameter("bounces", why));
     }
     let start = Instant::now();
-    let (weights, rays) = hit_weights(mesh, bvh, options, albedo, grey, vertices.clone())?;
-    let mut sum = lower.cloned();
-    for bounce in from + 1..=bounces {
-        sum = Some(gather(
-            &weights,
-            direct,
-            sum.as_ref(),
-            bounce,
-            options.progress,
-        )?);
-    }
-    let sum = sum.expect("at least one bounce");
+    let folding = HitFolding::new(mesh, bvh, options, albedo, grey);
+    let (rows, rays) = cast_vertices(mesh, &folding, options, vertices, "bounce rays")?;
+    let weights = HitWeights::from_rows(folding.channels, rows);
+    let sum = sum_up(&weights, direct, lower, bounces, options.progress)?;
     let seconds = start.elapsed().as_secs_f64();
     let report = PrecomputeReport {
         rays,
         seconds,
-        working_bytes: weights.bytes() + rayon::current_num_threads() * count * 16,
+        working_bytes: weights.bytes() + folding.working_bytes(),
         tracer: Some(bvh.tracer()),
         bounce_seconds: seconds,
     };
     Ok((sum, report))
+}
+
+/// The direct transport of every vertex of `mesh` and the bounced sum of `bounces` bounces
+/// (1 to [`MAX_BOUNCES`]), from **one** cast of every ray: a closest-hit query answers
+/// visibility (a ray is blocked exactly when it hits something) as the any-hit query of
+/// [`vertex_major`](super::visibility::vertex_major) does, and its hit is folded into the
+/// weights per hit vertex; the direct transport has the bits [`vertex_major`] gives and the
+/// sum those of [`bounce_range`] over every vertex. The report's bounce seconds are the
+/// gather's.
+pub(crate) fn direct_and_bounced(
+    mesh: &Mesh,
+    bvh: &SceneBvh,
+    options: &VisibilityOptions,
+    albedo: ArrayView2<'_, f32>,
+    bounces: usize,
+) -> Result<(TransportSet, BouncedTransport, PrecomputeReport)> {
+    options.check()?;
+    check_bounces(bounces)?;
+    check_albedo(albedo)?;
+    let count = mesh.vertex_count();
+    if albedo.nrows() != count {
+        return Err(Error::parameter(
+            "bounces",
+            format!("the albedo must have the mesh's {count} vertices"),
+        ));
+    }
+    let start = Instant::now();
+    let encoder = Encoder::new(options.param, options.keep, options.sh_bands)?;
+    let folding = HitFolding::new(mesh, bvh, options, albedo, is_grey(albedo));
+    let channels = folding.channels;
+    let caster = Visible::new(folding, &encoder, options);
+    let label = "visibility and bounce rays";
+    let (rows, rays) = cast_vertices(mesh, &caster, options, 0..count, label)?;
+    let mut direct = encoder.empty_set()?;
+    let mut hits = Vec::with_capacity(rows.len());
+    for (vertex, row) in rows {
+        direct.extend(&vertex);
+        hits.push(row);
+    }
+    let weights = HitWeights::from_rows(channels, hits);
+    let gathering = Instant::now();
+    let sum = sum_up(&weights, &direct, None, bounces, options.progress)?;
+    let threads = rayon::current_num_threads();
+    let thread_bytes = driver_bytes(options.param) + caster.thread_bytes();
+    let report = PrecomputeReport {
+        rays,
+        seconds: start.elapsed().as_secs_f64(),
+        working_bytes: weights.bytes() + threads * thread_bytes + encoder.bytes(),
+        tracer: Some(bvh.tracer()),
+        bounce_seconds: gathering.elapsed().as_secs_f64(),
+    };
+    Ok((direct, sum, report))
+}
+
+/// `lower` (or nothing) continued to `bounces` bounces by gathering through `weights`.
+fn sum_up(
+    weights: &HitWeights,
+    direct: &TransportSet,
+    lower: Option<&BouncedTransport>,
+    bounces: usize,
+    progress: bool,
+) -> Result<BouncedTransport> {
+    let from = lower.map_or(0, BouncedTransport::bounces);
+    let mut sum = lower.cloned();
+    for bounce in from + 1..=bounces {
+        sum = Some(gather(weights, direct, sum.as_ref(), bounce, progress)?);
+    }
+    sum.ok_or_else(|| {
+        Error::parameter(
+            "bounces",
+            format!("{bounces} bounces asked for from a sum of {from}"),
+        )
+    })
 }
 
 /// The weights per hit vertex of a range of vertices, `W_c[v][i]` (see the
@@ -342,92 +413,150 @@ impl HitWeights {
     fn bytes(&self) -> usize {
         self.offsets.len() * 8 + self.hits.len() * 4 + self.weights.len() * 4
     }
-}
 
-/// Casts every ray of `vertices` and folds the front-face hits into [`HitWeights`], with the
-/// rays cast.
-fn hit_weights(
-    mesh: &Mesh,
-    bvh: &SceneBvh,
-    options: &VisibilityOptions,
-    albedo: ArrayView2<'_, f32>,
-    grey: bool,
-    vertices: Range<usize>,
-) -> Result<(HitWeights, u64)> {
-    let channels = if grey { 1 } else { 3 };
-    let rays = RaySet::new(options);
-    let eps = ray_offset(mesh);
-    let weights = options.param.solid_angles();
-    let per_ray = 1.0 / (options.samples * options.samples) as f64 / std::f64::consts::PI;
-    let bar = Task::begin(options.progress, "bounce rays", vertices.len());
-    let rows: Vec<(Vec<u32>, Vec<f32>, u64)> = vertices
-        .into_par_iter()
-        .map_init(
-            || Folder::new(mesh.vertex_count(), channels),
-            |folder, v| {
-                let (origin, n) = origin_and_normal(mesh, v, eps);
-                let mut cast = Cast {
-                    mesh,
-                    bvh,
-                    albedo,
-                    origin: f32x3(origin),
-                    folder,
-                    rays: 0,
-                };
-                let solid = weights.as_slice().expect("fresh array is contiguous");
-                rays.for_each(v, n, |d, t| {
-                    let w = dot(n, rays.directions[t]) * solid[t] * per_ray;
-                    cast.push(d, w);
-                });
-                cast.flush();
-                let rays = cast.rays;
-                let (hits, w) = folder.take();
-                bar.advance(1);
-                (hits, w, rays)
-            },
-        )
-        .collect();
-    let mut out = HitWeights {
-        channels,
-        offsets: vec![0],
-        hits: Vec::new(),
-        weights: Vec::new(),
-    };
-    let mut cast = 0;
-    for (hits, w, r) in rows {
-        out.hits.extend_from_slice(&hits);
-        out.weights.extend_from_slice(&w);
-        out.offsets.push(out.hits.len());
-        cast += r;
+    /// The weights of `channels` channels from one row (hit vertices, weights) a vertex.
+    fn from_rows(channels: usize, rows: Vec<(Vec<u32>, Vec<f32>)>) -> Self {
+        let mut out = HitWeights {
+            channels,
+            offsets: Vec::with_capacity(rows.len() + 1),
+            hits: Vec::new(),
+            weights: Vec::new(),
+        };
+        out.offsets.push(0);
+        for (hits, w) in rows {
+            out.hits.extend_from_slice(&hits);
+            out.weights.extend_from_slice(&w);
+            out.offsets.push(out.hits.len());
+        }
+        out
     }
-    Ok((out, cast))
 }
 
-/// One thread's weights per hit vertex, dense over the mesh's vertices with the list of those
-/// touched, reused from vertex to vertex.
-struct Folder {
+/// Folds the front-face closest hits of a vertex's rays into its weights per hit vertex (see
+/// the [module docs](self)); a ray is blocked when it hits anything, front or back.
+struct HitFolding<'a> {
+    mesh: &'a Mesh,
+    bvh: &'a SceneBvh,
+    albedo: ArrayView2<'a, f32>,
     channels: usize,
-    dense: Vec<f64>,
-    touched: Vec<u32>,
-    seen: Vec<bool>,
-    directions: Vec<[f32; 3]>,
-    ray_weights: Vec<f64>,
+    /// Texel centre directions and solid angles, by texel index.
+    directions: Vec<[f64; 3]>,
+    solid: Vec<f64>,
+    /// `1 / (S^2 pi)`.
+    per_ray: f64,
+}
+
+impl<'a> HitFolding<'a> {
+    fn new(
+        mesh: &'a Mesh,
+        bvh: &'a SceneBvh,
+        options: &VisibilityOptions,
+        albedo: ArrayView2<'a, f32>,
+        grey: bool,
+    ) -> Self {
+        let samples = options.samples * options.samples;
+        HitFolding {
+            mesh,
+            bvh,
+            albedo,
+            channels: if grey { 1 } else { 3 },
+            directions: texel_directions(options.param),
+            solid: options.param.solid_angles().into_iter().collect(),
+            per_ray: 1.0 / samples as f64 / std::f64::consts::PI,
+        }
+    }
+
+    /// The working memory its threads hold: the dense weights over the mesh's vertices.
+    fn working_bytes(&self) -> usize {
+        rayon::current_num_threads() * self.mesh.vertex_count() * (8 * self.channels + 1)
+    }
+}
+
+impl Caster for HitFolding<'_> {
+    type Thread = Folder;
+    type Row = (Vec<u32>, Vec<f32>);
+
+    fn thread(&self) -> Folder {
+        Folder::new(self.mesh.vertex_count(), self.channels)
+    }
+
+    fn cast(
+        &self,
+        folder: &mut Folder,
+        origin: [f32; 3],
+        n: [f64; 3],
+        directions: &[[f32; 3]],
+        texels: &[u32],
+        blocked: &mut [bool],
+    ) {
+        let hits = &mut folder.hits[..directions.len()];
+        (self.bvh).closest_hits_from(origin, directions, f32::INFINITY, hits);
+        let (p, triangles) = (self.mesh.positions(), self.mesh.triangles());
+        for (k, hit) in hits.iter().enumerate() {
+            blocked[k] = hit.is_some();
+            let Some(hit) = hit else { continue };
+            let corners = triangles[hit.triangle];
+            let at = |c: u32| {
+                let r = p.row(c as usize);
+                [r[0], r[1], r[2]]
+            };
+            let [a, b, c] = corners.map(at);
+            let winding = cross(sub(b, a), sub(c, a));
+            if dot(winding, directions[k].map(f64::from)) >= 0.0 {
+                continue; // the back of the triangle
+            }
+            let (u, v) = (f64::from(hit.u), f64::from(hit.v));
+            let beta = [1.0 - u - v, u, v];
+            let mut rho = [0.0; 3];
+            for (&corner, &bk) in corners.iter().zip(&beta) {
+                let albedo = self.albedo.row(corner as usize);
+                for (r, &x) in rho.iter_mut().zip(albedo) {
+                    *r += bk * f64::from(x);
+                }
+            }
+            let t = texels[k] as usize;
+            let w = dot(n, self.directions[t]) * self.solid[t] * self.per_ray;
+            for (&corner, &bk) in corners.iter().zip(&beta) {
+                folder.weights.add(corner, rho.map(|r| w * bk * r));
+            }
+        }
+    }
+
+    fn finish(&self, folder: &mut Folder, _: [f64; 3], _: &[u32]) -> Result<Self::Row> {
+        Ok(folder.weights.take())
+    }
+}
+
+/// One thread's closest hits of a batch and the weights of the vertex being cast.
+struct Folder {
     hits: Vec<Option<Hit>>,
+    weights: DenseWeights,
 }
 
 impl Folder {
     fn new(vertices: usize, channels: usize) -> Self {
         Folder {
-            channels,
-            dense: vec![0.0; vertices * channels],
-            touched: Vec::new(),
-            seen: vec![false; vertices],
-            directions: Vec::with_capacity(BATCH),
-            ray_weights: Vec::with_capacity(BATCH),
             hits: vec![None; BATCH],
+            weights: DenseWeights {
+                channels,
+                dense: vec![0.0; vertices * channels],
+                touched: Vec::new(),
+                seen: vec![false; vertices],
+            },
         }
     }
+}
 
+/// Weights per hit vertex, dense over the mesh's vertices with the list of those touched,
+/// reused from vertex to vertex.
+struct DenseWeights {
+    channels: usize,
+    dense: Vec<f64>,
+    touched: Vec<u32>,
+    seen: Vec<bool>,
+}
+
+impl DenseWeights {
     fn add(&mut self, vertex: u32, weights: [f64; 3]) {
         let i = vertex as usize;
         if !self.seen[i] {
@@ -452,65 +581,6 @@ impl Folder {
             self.seen[i] = false;
         }
         (std::mem::take(&mut self.touched), weights)
-    }
-}
-
-/// The rays of one vertex, cast [`BATCH`] at a time into its [`Folder`].
-struct Cast<'a> {
-    mesh: &'a Mesh,
-    bvh: &'a SceneBvh,
-    albedo: ArrayView2<'a, f32>,
-    origin: [f32; 3],
-    folder: &'a mut Folder,
-    rays: u64,
-}
-
-impl Cast<'_> {
-    fn push(&mut self, direction: [f32; 3], weight: f64) {
-        self.folder.directions.push(direction);
-        self.folder.ray_weights.push(weight);
-        if self.folder.directions.len() == BATCH {
-            self.flush();
-        }
-    }
-
-    fn flush(&mut self) {
-        let n = self.folder.directions.len();
-        let mut hits = std::mem::take(&mut self.folder.hits);
-        let directions = std::mem::take(&mut self.folder.directions);
-        (self.bvh).closest_hits_from(self.origin, &directions, f32::INFINITY, &mut hits[..n]);
-        let (p, triangles) = (self.mesh.positions(), self.mesh.triangles());
-        for k in 0..n {
-            let Some(hit) = hits[k] else { continue };
-            let corners = triangles[hit.triangle];
-            let at = |c: u32| {
-                let r = p.row(c as usize);
-                [r[0], r[1], r[2]]
-            };
-            let [a, b, c] = corners.map(at);
-            let winding = cross(sub(b, a), sub(c, a));
-            if dot(winding, directions[k].map(f64::from)) >= 0.0 {
-                continue; // the back of the triangle
-            }
-            let (u, v) = (f64::from(hit.u), f64::from(hit.v));
-            let beta = [1.0 - u - v, u, v];
-            let mut rho = [0.0; 3];
-            for (&corner, &bk) in corners.iter().zip(&beta) {
-                let albedo = self.albedo.row(corner as usize);
-                for (r, &x) in rho.iter_mut().zip(albedo) {
-                    *r += bk * f64::from(x);
-                }
-            }
-            let w = self.folder.ray_weights[k];
-            for (&corner, &bk) in corners.iter().zip(&beta) {
-                self.folder.add(corner, rho.map(|r| w * bk * r));
-            }
-        }
-        self.rays += n as u64;
-        self.folder.hits = hits;
-        self.folder.directions = directions;
-        self.folder.directions.clear();
-        self.folder.ray_weights.clear();
     }
 }
 
@@ -549,10 +619,7 @@ fn gather(
                         for set in sets {
                             for (j, &i) in hits.iter().enumerate() {
                                 let wi = f64::from(w[j * channels + c]);
-                                let (indices, values) = set.coefficients(i as usize);
-                                for (&t, &x) in indices.iter().zip(values) {
-                                    dense[t as usize] += wi * f64::from(x);
-                                }
+                                add_row(dense, wi, set.coefficients(i as usize));
                                 for (o, &x) in sh.iter_mut().zip(sh_row(set, i as usize, sh_len)) {
                                     *o += wi * f64::from(x);
                                 }
@@ -585,6 +652,16 @@ fn gather(
         }
     }
     BouncedTransport::new(bounce, sets)
+}
+
+/// `dense[t] += w x` over the sparse row `(t, x)`: the gather's inner loop, nearly all of its
+/// time. A slice of its own, so that its start and length stay in registers while it is
+/// written.
+#[inline]
+fn add_row(dense: &mut [f64], w: f64, (indices, values): (&[u32], &[f32])) {
+    for (&t, &x) in indices.iter().zip(values) {
+        dense[t as usize] += w * f64::from(x);
+    }
 }
 
 #[cfg(test)]

@@ -4,6 +4,8 @@ use ndarray::{Array2, array};
 
 use super::*;
 use crate::faces::{ParamKind, Parameterization};
+use crate::relight::precompute::cast::{RaySet, f32x3, origin_and_normal};
+use crate::relight::ray_offset;
 use crate::relight::scene::shapes::{cube_sphere, grid, merge};
 use crate::relight::{Generator, vertex_major};
 
@@ -107,6 +109,51 @@ fn sphere_over_ground() -> (Mesh, Array2<f32>) {
         0.3 + 0.2 * c as f32 + 0.01 * (i % 7) as f32
     });
     (mesh, albedo)
+}
+
+/// A sphere in a corner: a floor and two walls meeting it, so that many rays start in a
+/// neighbouring surface's plane or graze it (where tracers answer edge rays their own way).
+fn sphere_in_a_corner() -> (Mesh, Array2<f32>) {
+    let mesh = merge([
+        grid([-2.0, 0.0, 2.0], [4.0, 0.0, 0.0], [0.0, 0.0, -4.0], 4, 4).unwrap(),
+        grid([-2.0, 0.0, -2.0], [4.0, 0.0, 0.0], [0.0, 3.0, 0.0], 4, 3).unwrap(),
+        grid([-2.0, 0.0, 2.0], [0.0, 0.0, -4.0], [0.0, 3.0, 0.0], 4, 3).unwrap(),
+        cube_sphere([0.0, 1.0, 0.0], 0.8, 2).unwrap(),
+    ]);
+    let v = mesh.vertex_count();
+    let albedo = Array2::from_shape_fn((v, 3), |(i, c)| {
+        0.3 + 0.2 * c as f32 + 0.01 * (i % 5) as f32
+    });
+    (mesh, albedo)
+}
+
+#[test]
+fn one_cast_gives_the_bits_of_visibility_and_of_the_gather_with_every_tracer() {
+    let (mesh, albedo) = sphere_in_a_corner();
+    let mut options = VisibilityOptions::new(cube(8));
+    (options.samples, options.keep, options.sh_bands) = (2, Selection::Largest(60), Some(3));
+    let all = 0..mesh.vertex_count();
+    for bvh in crate::relight::precompute::raycast::tests::every_tracer(&mesh) {
+        let (direct, bounced, report) =
+            direct_and_bounced(&mesh, &bvh, &options, albedo.view(), 2).unwrap();
+        let (want, visibility) = vertex_major(&mesh, &bvh, &options).unwrap();
+        let (sum, _) = bounce_range(
+            &mesh,
+            &bvh,
+            &options,
+            albedo.view(),
+            &want,
+            None,
+            2,
+            all.clone(),
+        )
+        .unwrap();
+        let tracer = bvh.tracer();
+        assert!(direct == want, "{tracer:?}: the direct transport differs");
+        assert!(bounced == sum, "{tracer:?}: the bounced sum differs");
+        assert_eq!(report.rays, visibility.rays, "{tracer:?}: each ray once");
+        assert!(report.bounce_seconds > 0.0 && report.seconds >= report.bounce_seconds);
+    }
 }
 
 /// `x[i][c]` of a set that is the same for every channel.

@@ -14,6 +14,7 @@
 //! before the BVH or any transport is built.
 
 pub mod bounce;
+pub(crate) mod cast;
 pub mod embree;
 mod packet;
 pub mod raycast;
@@ -28,6 +29,7 @@ use crate::named::named_enum;
 use std::path::Path;
 
 use crate::product::Selection;
+use crate::relight::precompute::bounce::BouncedTransport;
 use crate::relight::precompute::shard::Shard;
 use crate::relight::precompute::visibility::{
     PrecomputeReport, VisibilityOptions, direction_major, vertex_range,
@@ -253,14 +255,21 @@ pub fn precompute(
     scene: Scene,
     options: &PrecomputeOptions,
 ) -> Result<(SceneCache, PrecomputeReport)> {
-    let (transport, mut report) = transport(&scene, options, None)?;
+    let (transport, bounced, report) = if options.bounces > 0 {
+        direct_and_bounced(&scene, options)?
+    } else {
+        let (transport, report) = transport(&scene, options, None)?;
+        (transport, None, report)
+    };
     let mut cache = SceneCache::new(
         options.record(scene.ground_cells, report.tracer),
         scene.mesh,
         scene.albedo,
         transport,
     )?;
-    report = add_bounces(&mut cache, options, report)?;
+    if let Some(bounced) = bounced {
+        cache.set_bounced(bounced)?;
+    }
     cache.environment = scene.environment;
     cache.camera = scene.camera;
     Ok((cache, report))
@@ -463,6 +472,26 @@ pub fn shard_is_done(
 }
 
 /// The transport of `scene`'s vertices, all of them or `shard`'s, with the report.
+/// The direct transport and the bounced sum of `options.bounces` bounces of every vertex of
+/// `scene`, each ray cast once ([`bounce::direct_and_bounced`]); the vertex order only.
+fn direct_and_bounced(
+    scene: &Scene,
+    options: &PrecomputeOptions,
+) -> Result<(TransportSet, Option<BouncedTransport>, PrecomputeReport)> {
+    options.check()?;
+    let mesh = &scene.mesh;
+    (options.budget(None)).check("the scene", mesh.vertex_count() as u128)?;
+    let bvh = SceneBvh::with_tracer(mesh, options.ray_tracer);
+    let (direct, bounced, report) = bounce::direct_and_bounced(
+        mesh,
+        &bvh,
+        &options.visibility,
+        scene.albedo.view(),
+        options.bounces,
+    )?;
+    Ok((direct, Some(bounced), report))
+}
+
 fn transport(
     scene: &Scene,
     options: &PrecomputeOptions,

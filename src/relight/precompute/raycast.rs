@@ -451,4 +451,4 @@ impl Occlusion for SceneBvh {
 
 #[cfg(test)]
 #[path = "raycast_tests.rs"]
-mod tests;
+pub(crate) mod tests;

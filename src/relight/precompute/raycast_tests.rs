@@ -28,7 +28,7 @@ fn packets(mesh: &Mesh) -> SceneBvh {
 
 /// The BVH of `mesh` with every tracer: Embree only where it loads (skipped in one line
 /// otherwise, a failure where `HAARSHIFT_REQUIRE` names it).
-fn every_tracer(mesh: &Mesh) -> Vec<SceneBvh> {
+pub(crate) fn every_tracer(mesh: &Mesh) -> Vec<SceneBvh> {
     let tracers = RayTracer::ALL.iter().filter(|t| {
         haarshift_testkit::needs(t.name(), t.unavailable().map_or(Ok(()), Err)).is_some()
     });

@@ -43,6 +43,9 @@ use crate::product::Selection;
 use crate::progress::Task;
 use crate::relight::Mesh;
 use crate::relight::harmonics::check_bands;
+use crate::relight::precompute::cast::{
+    Occluding, Visible, cast_vertices, driver_bytes, origin_and_normal,
+};
 use crate::relight::precompute::raycast::{Occlusion, RayTracer};
 use crate::relight::precompute::shadowmap::ShadowMap;
 use crate::relight::precompute::transport::{Encoded, Encoder, TransportSet};
@@ -159,33 +162,6 @@ pub(crate) fn texel_directions(param: Parameterization) -> Vec<[f64; 3]> {
         .collect()
 }
 
-/// SplitMix64: a well-mixed hash of a 64-bit key.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// Two uniform numbers in `[0, 1)` for one (seed, vertex, texel, sample).
-pub(crate) fn jitter(seed: u64, vertex: usize, texel: usize, sample: usize) -> (f64, f64) {
-    let h = mix(seed ^ mix((vertex as u64) << 32 ^ texel as u64) ^ mix(sample as u64 + 1));
-    let unit = |x: u64| (x >> 11) as f64 / (1u64 << 53) as f64;
-    (unit(h), unit(mix(h)))
-}
-
-/// The ray origin of vertex `v` and its normal.
-pub(crate) fn origin_and_normal(mesh: &Mesh, v: usize, eps: f64) -> ([f64; 3], [f64; 3]) {
-    let (p, n) = (mesh.positions(), mesh.normals());
-    let n = [n[[v, 0]], n[[v, 1]], n[[v, 2]]];
-    (std::array::from_fn(|k| p[[v, k]] + eps * n[k]), n)
-}
-
-#[inline]
-pub(crate) fn f32x3(a: [f64; 3]) -> [f32; 3] {
-    a.map(|x| x as f32)
-}
-
 /// Vertex-major precomputation by ray casting; see the [module docs](self).
 ///
 /// ```
@@ -246,198 +222,22 @@ pub fn vertex_range(
         ));
     }
     let start = Instant::now();
-    let param = options.param;
-    let rays = RaySet::new(options);
-    let directions = &rays.directions;
-    let eps = ray_offset(mesh);
-    let samples = options.samples;
-    let encoder = Encoder::new(param, options.keep, options.sh_bands)?;
+    let encoder = Encoder::new(options.param, options.keep, options.sh_bands)?;
+    let caster = Visible::new(Occluding(occlusion), &encoder, options);
+    let (rows, rays) = cast_vertices(mesh, &caster, options, vertices, "visibility (rays)")?;
     let mut set = encoder.empty_set()?;
-    let bar = Task::begin(options.progress, "visibility (rays)", vertices.len());
-    let encoded: Vec<Result<(Encoded, u64)>> = vertices
-        .into_par_iter()
-        .map_init(
-            || Scratch::new(param),
-            |scratch, v| {
-                let (origin, n) = origin_and_normal(mesh, v, eps);
-                let mut batch = Batch {
-                    occlusion,
-                    origin: f32x3(origin),
-                    scratch,
-                    rays: 0,
-                };
-                batch.scratch.escaped.fill(0);
-                rays.for_each(v, n, |d, t| batch.push(d, t));
-                batch.flush();
-                let rays = batch.rays;
-                let Scratch {
-                    values, escaped, ..
-                } = scratch;
-                let flat = values.as_slice_mut().expect("fresh array is contiguous");
-                for (t, (value, &w)) in flat.iter_mut().zip(directions).enumerate() {
-                    let cos = dot(n, w);
-                    *value = if cos <= 0.0 {
-                        0.0
-                    } else {
-                        (escaped[t] as f64 / (samples * samples) as f64 * cos) as f32
-                    };
-                }
-                let vertex = encoder.encode(values.view())?;
-                bar.advance(1);
-                Ok((vertex, rays))
-            },
-        )
-        .collect();
-    let mut rays = 0;
-    for vertex in encoded {
-        let (vertex, r) = vertex?;
-        set.extend(&vertex);
-        rays += r;
+    for (vertex, ()) in &rows {
+        set.extend(vertex);
     }
+    let thread_bytes = driver_bytes(options.param) + caster.thread_bytes();
     let report = PrecomputeReport {
         rays,
         seconds: start.elapsed().as_secs_f64(),
-        working_bytes: rayon::current_num_threads() * Scratch::bytes(param) + encoder.bytes(),
+        working_bytes: rayon::current_num_threads() * thread_bytes + encoder.bytes(),
         tracer: occlusion.tracer(),
         bounce_seconds: 0.0,
     };
     Ok((set, report))
-}
-
-/// The rays a vertex casts (the [module docs](self)): the texel centres above its horizon,
-/// or with `S > 1` their `S x S` jittered sub-rays above it, in [`block_order`]. Visibility
-/// and the bounces' gather ([`bounce`](super::bounce)) cast the same set.
-pub(crate) struct RaySet {
-    param: Parameterization,
-    /// Texel centre directions, by texel index.
-    pub(crate) directions: Vec<[f64; 3]>,
-    order: Vec<usize>,
-    samples: usize,
-    seed: u64,
-}
-
-impl RaySet {
-    pub(crate) fn new(options: &VisibilityOptions) -> Self {
-        RaySet {
-            param: options.param,
-            directions: texel_directions(options.param),
-            order: block_order(options.param),
-            samples: options.samples,
-            seed: options.seed,
-        }
-    }
-
-    /// Calls `ray(direction, texel)` for every ray vertex `v` (unit normal `n`) casts.
-    pub(crate) fn for_each(&self, v: usize, n: [f64; 3], mut ray: impl FnMut([f32; 3], usize)) {
-        let (s, samples) = (self.param.face_size(), self.samples);
-        for &t in &self.order {
-            if dot(n, self.directions[t]) <= 0.0 {
-                continue;
-            }
-            if samples == 1 {
-                ray(f32x3(self.directions[t]), t);
-                continue;
-            }
-            let (face, row, col) = (t / (s * s), (t / s) % s, t % s);
-            for k in 0..samples * samples {
-                let (ju, jv) = jitter(self.seed, v, t, k);
-                let r = row as f64 + ((k / samples) as f64 + ju) / samples as f64;
-                let c = col as f64 + ((k % samples) as f64 + jv) / samples as f64;
-                let d = self.param.point(face, r, c);
-                if dot(n, d) > 0.0 {
-                    ray(f32x3(d), t);
-                }
-            }
-        }
-    }
-}
-
-/// Texel indices face by face in [`BLOCK`] x [`BLOCK`] blocks (row-major inside a block and
-/// across blocks): consecutive rays of a vertex then point at neighbouring texels, so a packet
-/// of them is a narrow cone.
-fn block_order(param: Parameterization) -> Vec<usize> {
-    let s = param.face_size();
-    let mut order = Vec::with_capacity(param.texels());
-    for face in 0..param.faces() {
-        for r0 in (0..s).step_by(BLOCK) {
-            for c0 in (0..s).step_by(BLOCK) {
-                for r in r0..(r0 + BLOCK).min(s) {
-                    for c in c0..(c0 + BLOCK).min(s) {
-                        order.push((face * s + r) * s + c);
-                    }
-                }
-            }
-        }
-    }
-    order
-}
-
-/// The side of the texel blocks rays are cast in: a block's `BLOCK^2` centres fill one packet.
-const BLOCK: usize = 4;
-
-/// The rays cast per call of [`Occlusion::occluded_from`]: a bound on the buffer whatever the
-/// samples per texel.
-pub(crate) const BATCH: usize = 1024;
-
-/// One thread's working memory, reused from vertex to vertex.
-struct Scratch {
-    /// The vertex's transport, texel by texel.
-    values: Array3<f32>,
-    /// Escaped rays per texel.
-    escaped: Vec<u32>,
-    /// The rays waiting to be cast, their texels and answers.
-    directions: Vec<[f32; 3]>,
-    texels: Vec<u32>,
-    blocked: Vec<bool>,
-}
-
-impl Scratch {
-    fn new(param: Parameterization) -> Self {
-        let s = param.face_size();
-        Scratch {
-            values: Array3::zeros((param.faces(), s, s)),
-            escaped: vec![0; param.texels()],
-            directions: Vec::with_capacity(BATCH),
-            texels: Vec::with_capacity(BATCH),
-            blocked: vec![false; BATCH],
-        }
-    }
-
-    fn bytes(param: Parameterization) -> usize {
-        param.texels() * 8 + BATCH * (12 + 4 + 1)
-    }
-}
-
-/// The rays of one vertex, cast [`BATCH`] at a time.
-struct Batch<'a, O> {
-    occlusion: &'a O,
-    origin: [f32; 3],
-    scratch: &'a mut Scratch,
-    rays: u64,
-}
-
-impl<O: Occlusion> Batch<'_, O> {
-    fn push(&mut self, direction: [f32; 3], texel: usize) {
-        self.scratch.directions.push(direction);
-        self.scratch.texels.push(texel as u32);
-        if self.scratch.directions.len() == BATCH {
-            self.flush();
-        }
-    }
-
-    /// Casts the waiting rays and counts the escaped ones into their texels.
-    fn flush(&mut self) {
-        let s = &mut *self.scratch;
-        let n = s.directions.len();
-        let blocked = &mut s.blocked[..n];
-        (self.occlusion).occluded_from(self.origin, &s.directions, f32::INFINITY, blocked);
-        for (&t, &b) in s.texels.iter().zip(blocked.iter()) {
-            s.escaped[t as usize] += u32::from(!b);
-        }
-        self.rays += n as u64;
-        s.directions.clear();
-        s.texels.clear();
-    }
 }
 
 /// Direction-major precomputation with a shadow buffer of `map_size x map_size` texels per

@@ -2,6 +2,7 @@ use std::f64::consts::PI;
 
 use super::*;
 use crate::faces::ParamKind;
+use crate::relight::precompute::cast::f32x3;
 use crate::relight::{Generator, SceneBvh, add_ground_plane};
 use crate::test_support::corner_form_factor;
 

@@ -38,7 +38,8 @@ use rayon::prelude::*;
 
 use super::{ReferenceOptions, ReferenceReport, ReferenceVisibility, lit_texels};
 use crate::progress::Task;
-use crate::relight::precompute::visibility::{f32x3, origin_and_normal, ray_offset};
+use crate::relight::precompute::cast::{f32x3, origin_and_normal};
+use crate::relight::precompute::visibility::ray_offset;
 use crate::relight::scene::mesh::{cross, dot, sub};
 use crate::relight::{Brdf, Mesh, SceneBvh};
 use crate::sphere::LatLongMap;

@@ -37,8 +37,9 @@ use super::{
 };
 use crate::progress::Task;
 use crate::relight::SceneBvh;
+use crate::relight::precompute::cast::{f32x3, origin_and_normal};
 use crate::relight::precompute::raycast::Occlusion;
-use crate::relight::precompute::visibility::{f32x3, origin_and_normal, ray_offset};
+use crate::relight::precompute::visibility::ray_offset;
 use crate::relight::scene::mesh::dot;
 use crate::relight::{Brdf, Mesh};
 use crate::sphere::LatLongMap;
