@@ -168,7 +168,7 @@ echo "Park. The difference is not the bounces': direct light alone differs as mu
 echo "box's corner columns and floor edges, where a vertex's origin, offset along its wall's normal,"
 echo "lies in the plane of the wall it meets: every ray meets that wall at t = 0 to within f32"
 echo "rounding; Embree counts those hits (the vertex is black), our packets here do not (it sees out)."
-echo "Neither is the light there; see the module docs of \\`relight::precompute::raycast\\`."
+echo "Neither is the light there; see the module docs of \`relight::precompute::raycast\`."
 echo
 echo "| what | relative RMS | largest / RMS |"
 echo "|---|---|---|"
