@@ -36,8 +36,10 @@
 //! The weights are kept between bounces, so `B` bounces cast each ray once, and a whole
 //! precomputation casts it once for direct and bounced light together: the closest hit
 //! answers visibility too (a ray is blocked exactly when it hits something, front or back).
-//! The gather then takes most of the time: a scatter of the hit rows into a dense f64
-//! accumulator, limited by reading the rows (`results/relight/bounces.md` has its share).
+//! The gather then takes most of the time, a scalar scatter of the hit rows into a dense f64
+//! accumulator (`results/relight/bounces.md` reports its seconds beside the casting's).
+//! Gathering eight vertices at once in vector lanes, or the accumulator in tiles, gave the
+//! same bits no faster on the bunny: neighbouring vertices share too few hit rows.
 //!
 //! **Channels.** `rho_hit` is baked in, so the bounced sum is per channel: three sparse
 //! vectors a vertex ([`BouncedTransport::channels`] has three sets, R, G, B), or one when every
