@@ -38,8 +38,6 @@
 //! answers visibility too (a ray is blocked exactly when it hits something, front or back).
 //! The gather then takes most of the time, a scalar scatter of the hit rows into a dense f64
 //! accumulator (`results/relight/bounces.md` reports its seconds beside the casting's).
-//! Gathering eight vertices at once in vector lanes, or the accumulator in tiles, gave the
-//! same bits no faster on the bunny: neighbouring vertices share too few hit rows.
 //!
 //! **Channels.** `rho_hit` is baked in, so the bounced sum is per channel: three sparse
 //! vectors a vertex ([`BouncedTransport::channels`] has three sets, R, G, B), or one when every
@@ -79,7 +77,7 @@ use crate::progress::Task;
 use crate::relight::Mesh;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::material::brdf::check_albedo;
-use crate::relight::precompute::cast::{BATCH, Caster, Visible, cast_vertices, driver_bytes};
+use crate::relight::precompute::cast::{BATCH, Caster, Visible, cast_vertices, working_bytes};
 use crate::relight::precompute::raycast::{Hit, SceneBvh};
 use crate::relight::precompute::transport::Encoder;
 use crate::relight::precompute::transport::{Encoded, TransportSet};
@@ -309,7 +307,7 @@ pub fn bounce_range(
     let report = PrecomputeReport {
         rays,
         seconds,
-        working_bytes: weights.bytes() + folding.working_bytes(),
+        working_bytes: weights.bytes() + working_bytes(&folding, options.param),
         tracer: Some(bvh.tracer()),
         bounce_seconds: seconds,
     };
@@ -356,12 +354,10 @@ pub(crate) fn direct_and_bounced(
     let weights = HitWeights::from_rows(channels, hits);
     let gathering = Instant::now();
     let sum = sum_up(&weights, &direct, None, bounces, options.progress)?;
-    let threads = rayon::current_num_threads();
-    let thread_bytes = driver_bytes(options.param) + caster.thread_bytes();
     let report = PrecomputeReport {
         rays,
         seconds: start.elapsed().as_secs_f64(),
-        working_bytes: weights.bytes() + threads * thread_bytes + encoder.bytes(),
+        working_bytes: weights.bytes() + working_bytes(&caster, options.param) + encoder.bytes(),
         tracer: Some(bvh.tracer()),
         bounce_seconds: gathering.elapsed().as_secs_f64(),
     };
@@ -467,11 +463,6 @@ impl<'a> HitFolding<'a> {
             per_ray: 1.0 / samples as f64 / std::f64::consts::PI,
         }
     }
-
-    /// The working memory its threads hold: the dense weights over the mesh's vertices.
-    fn working_bytes(&self) -> usize {
-        rayon::current_num_threads() * self.mesh.vertex_count() * (8 * self.channels + 1)
-    }
 }
 
 impl Caster for HitFolding<'_> {
@@ -480,6 +471,12 @@ impl Caster for HitFolding<'_> {
 
     fn thread(&self) -> Folder {
         Folder::new(self.mesh.vertex_count(), self.channels)
+    }
+
+    /// The batch's hits and the dense weights over the mesh's vertices.
+    fn thread_bytes(&self) -> usize {
+        let hits = BATCH * std::mem::size_of::<Option<Hit>>();
+        hits + self.mesh.vertex_count() * (8 * self.channels + 1)
     }
 
     fn cast(
@@ -656,9 +653,7 @@ fn gather(
     BouncedTransport::new(bounce, sets)
 }
 
-/// `dense[t] += w x` over the sparse row `(t, x)`: the gather's inner loop, nearly all of its
-/// time. A slice of its own, so that its start and length stay in registers while it is
-/// written.
+/// `dense[t] += w x` over the sparse row `(t, x)`: the gather's inner loop, most of its time.
 #[inline]
 fn add_row(dense: &mut [f64], w: f64, (indices, values): (&[u32], &[f32])) {
     for (&t, &x) in indices.iter().zip(values) {

@@ -149,6 +149,10 @@ fn one_cast_gives_the_bits_of_visibility_and_of_the_gather_with_every_tracer() {
         )
         .unwrap();
         let tracer = bvh.tracer();
+        assert!(
+            sum.coefficient_count() > 0,
+            "{tracer:?}: the corner bounces light"
+        );
         assert!(direct == want, "{tracer:?}: the direct transport differs");
         assert!(bounced == sum, "{tracer:?}: the bounced sum differs");
         assert_eq!(report.rays, visibility.rays, "{tracer:?}: each ray once");

@@ -140,6 +140,9 @@ pub(crate) trait Caster: Sync {
     /// A fresh thread state.
     fn thread(&self) -> Self::Thread;
 
+    /// Bytes one thread state holds.
+    fn thread_bytes(&self) -> usize;
+
     /// Sets `blocked[k]` for the rays `directions[k]` (through texels `texels[k]`) from
     /// `origin` of the vertex with normal `n`, folding what else it keeps into `thread`.
     fn cast(
@@ -165,6 +168,10 @@ impl<O: Occlusion> Caster for Occluding<'_, O> {
     type Row = ();
 
     fn thread(&self) {}
+
+    fn thread_bytes(&self) -> usize {
+        0
+    }
 
     fn cast(
         &self,
@@ -205,11 +212,6 @@ impl<'a, C: Caster> Visible<'a, C> {
             samples: options.samples,
         }
     }
-
-    /// Bytes one thread holds for the encoding: its texel values.
-    pub(crate) fn thread_bytes(&self) -> usize {
-        self.param.texels() * 4
-    }
 }
 
 impl<C: Caster> Caster for Visible<'_, C> {
@@ -219,6 +221,11 @@ impl<C: Caster> Caster for Visible<'_, C> {
     fn thread(&self) -> Self::Thread {
         let (f, s) = (self.param.faces(), self.param.face_size());
         (self.inner.thread(), Array3::zeros((f, s, s)))
+    }
+
+    /// The inner caster's and the texel values encoded.
+    fn thread_bytes(&self) -> usize {
+        self.inner.thread_bytes() + self.param.texels() * 4
     }
 
     fn cast(
@@ -254,9 +261,10 @@ impl<C: Caster> Caster for Visible<'_, C> {
     }
 }
 
-/// Bytes one thread of [`cast_vertices`] holds itself, besides its caster's state.
-pub(crate) fn driver_bytes(param: Parameterization) -> usize {
-    param.texels() * 4 + BATCH * (12 + 4 + 1)
+/// Bytes the threads of [`cast_vertices`] hold: each its [`Batch`] and `caster`'s state.
+pub(crate) fn working_bytes<C: Caster>(caster: &C, param: Parameterization) -> usize {
+    let batch = param.texels() * 4 + BATCH * (12 + 4 + 1);
+    rayon::current_num_threads() * (batch + caster.thread_bytes())
 }
 
 /// Casts every ray of the vertices `vertices` of `mesh` through `caster`, in parallel: its

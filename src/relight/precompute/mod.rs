@@ -255,12 +255,7 @@ pub fn precompute(
     scene: Scene,
     options: &PrecomputeOptions,
 ) -> Result<(SceneCache, PrecomputeReport)> {
-    let (transport, bounced, report) = if options.bounces > 0 {
-        direct_and_bounced(&scene, options)?
-    } else {
-        let (transport, report) = transport(&scene, options, None)?;
-        (transport, None, report)
-    };
+    let (transport, bounced, report) = transport(&scene, options, None)?;
     let mut cache = SceneCache::new(
         options.record(scene.ground_cells, report.tracer),
         scene.mesh,
@@ -332,7 +327,7 @@ pub fn precompute_shard(
              --bounces, merge, then add one bounce at a time with --bounce-from MERGED.hsr",
         ));
     }
-    let (transport, report) = transport(&scene, options, Some(shard))?;
+    let (transport, _, report) = transport(&scene, options, Some(shard))?;
     let mut part = CacheShard::new(
         shard,
         options.record(scene.ground_cells, report.tracer),
@@ -471,43 +466,40 @@ pub fn shard_is_done(
     .in_file(path))
 }
 
-/// The transport of `scene`'s vertices, all of them or `shard`'s, with the report.
-/// The direct transport and the bounced sum of `options.bounces` bounces of every vertex of
-/// `scene`, each ray cast once ([`bounce::direct_and_bounced`]); the vertex order only.
-fn direct_and_bounced(
-    scene: &Scene,
-    options: &PrecomputeOptions,
-) -> Result<(TransportSet, Option<BouncedTransport>, PrecomputeReport)> {
-    options.check()?;
-    let mesh = &scene.mesh;
-    (options.budget(None)).check("the scene", mesh.vertex_count() as u128)?;
-    let bvh = SceneBvh::with_tracer(mesh, options.ray_tracer);
-    let (direct, bounced, report) = bounce::direct_and_bounced(
-        mesh,
-        &bvh,
-        &options.visibility,
-        scene.albedo.view(),
-        options.bounces,
-    )?;
-    Ok((direct, Some(bounced), report))
-}
-
+/// The transport of `scene`'s vertices, all of them or `shard`'s, with the report; and of
+/// all of them in the vertex order with `options.bounces`, the bounced sum too, each ray cast
+/// once for both ([`bounce::direct_and_bounced`]).
 fn transport(
     scene: &Scene,
     options: &PrecomputeOptions,
     shard: Option<Shard>,
-) -> Result<(TransportSet, PrecomputeReport)> {
+) -> Result<(TransportSet, Option<BouncedTransport>, PrecomputeReport)> {
     options.check()?;
     let mesh = &scene.mesh;
     (options.budget(shard)).check("the scene", mesh.vertex_count() as u128)?;
+    let without_bounces = |(set, report)| (set, None, report);
     match (options.order, shard) {
+        (Order::Vertex, None) if options.bounces > 0 => {
+            let bvh = SceneBvh::with_tracer(mesh, options.ray_tracer);
+            let (set, bounced, report) = bounce::direct_and_bounced(
+                mesh,
+                &bvh,
+                &options.visibility,
+                scene.albedo.view(),
+                options.bounces,
+            )?;
+            Ok((set, Some(bounced), report))
+        }
         (Order::Vertex, shard) => vertex_range(
             mesh,
             &SceneBvh::with_tracer(mesh, options.ray_tracer),
             &options.visibility,
             shard.unwrap_or(Shard::whole()).range(mesh.vertex_count()),
-        ),
-        (Order::Direction, None) => direction_major(mesh, &options.visibility, options.map_size),
+        )
+        .map(without_bounces),
+        (Order::Direction, None) => {
+            direction_major(mesh, &options.visibility, options.map_size).map(without_bounces)
+        }
         (Order::Direction, Some(_)) => Err(Error::parameter(
             "order",
             "direction: every shadow buffer serves all vertices at once, so it cannot be \

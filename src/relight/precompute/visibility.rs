@@ -44,7 +44,7 @@ use crate::progress::Task;
 use crate::relight::Mesh;
 use crate::relight::harmonics::check_bands;
 use crate::relight::precompute::cast::{
-    Occluding, Visible, cast_vertices, driver_bytes, origin_and_normal,
+    Occluding, Visible, cast_vertices, origin_and_normal, working_bytes,
 };
 use crate::relight::precompute::raycast::{Occlusion, RayTracer};
 use crate::relight::precompute::shadowmap::ShadowMap;
@@ -229,11 +229,10 @@ pub fn vertex_range(
     for (vertex, ()) in &rows {
         set.extend(vertex);
     }
-    let thread_bytes = driver_bytes(options.param) + caster.thread_bytes();
     let report = PrecomputeReport {
         rays,
         seconds: start.elapsed().as_secs_f64(),
-        working_bytes: rayon::current_num_threads() * thread_bytes + encoder.bytes(),
+        working_bytes: working_bytes(&caster, options.param) + encoder.bytes(),
         tracer: occlusion.tracer(),
         bounce_seconds: 0.0,
     };
