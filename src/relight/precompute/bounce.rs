@@ -36,8 +36,9 @@
 //! The weights are kept between bounces, so `B` bounces cast each ray once, and a whole
 //! precomputation casts it once for direct and bounced light together: the closest hit
 //! answers visibility too (a ray is blocked exactly when it hits something, front or back).
-//! The gather then takes most of the time, a scalar scatter of the hit rows into a dense f64
-//! accumulator (`results/relight/bounces.md` reports its seconds beside the casting's).
+//! The row combination is `precompute::combine`'s: dense tiles of the stored rows when
+//! they are dense (the bunny's), a scatter of each sparse row otherwise, with the same bits
+//! (`results/relight/bounces.md` reports the gather's seconds beside the casting's).
 //!
 //! **Channels.** `rho_hit` is baked in, so the bounced sum is per channel: three sparse
 //! vectors a vertex ([`BouncedTransport::channels`] has three sets, R, G, B), or one when every
@@ -67,8 +68,7 @@
 use std::ops::Range;
 use std::time::Instant;
 
-use ndarray::{Array3, ArrayView2};
-use rayon::prelude::*;
+use ndarray::{ArrayView2, ArrayView3};
 
 use crate::faces::integrate::layout;
 use crate::product::Selection;
@@ -78,6 +78,7 @@ use crate::relight::Mesh;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::material::brdf::check_albedo;
 use crate::relight::precompute::cast::{BATCH, Caster, Visible, cast_vertices, working_bytes};
+use crate::relight::precompute::combine::{RowCombiner, Weights};
 use crate::relight::precompute::raycast::{Hit, SceneBvh};
 use crate::relight::precompute::transport::Encoder;
 use crate::relight::precompute::transport::{Encoded, TransportSet};
@@ -302,12 +303,12 @@ pub fn bounce_range(
     let folding = HitFolding::new(mesh, bvh, options, albedo, grey);
     let (rows, rays) = cast_vertices(mesh, &folding, options, vertices, "bounce rays")?;
     let weights = HitWeights::from_rows(folding.channels, rows);
-    let sum = sum_up(&weights, direct, lower, bounces, options.progress)?;
+    let (sum, gathering) = sum_up(&weights, direct, lower, bounces, options.progress)?;
     let seconds = start.elapsed().as_secs_f64();
     let report = PrecomputeReport {
         rays,
         seconds,
-        working_bytes: weights.bytes() + working_bytes(&folding, options.param),
+        working_bytes: weights.bytes() + working_bytes(&folding, options.param).max(gathering),
         tracer: Some(bvh.tracer()),
         bounce_seconds: seconds,
     };
@@ -353,36 +354,40 @@ pub(crate) fn direct_and_bounced(
     }
     let weights = HitWeights::from_rows(channels, hits);
     let gathering = Instant::now();
-    let sum = sum_up(&weights, &direct, None, bounces, options.progress)?;
+    let (sum, gather_bytes) = sum_up(&weights, &direct, None, bounces, options.progress)?;
+    let cast_bytes = working_bytes(&caster, options.param) + encoder.bytes();
     let report = PrecomputeReport {
         rays,
         seconds: start.elapsed().as_secs_f64(),
-        working_bytes: weights.bytes() + working_bytes(&caster, options.param) + encoder.bytes(),
+        working_bytes: weights.bytes() + cast_bytes.max(gather_bytes),
         tracer: Some(bvh.tracer()),
         bounce_seconds: gathering.elapsed().as_secs_f64(),
     };
     Ok((direct, sum, report))
 }
 
-/// `lower` (or nothing) continued to `bounces` bounces by gathering through `weights`.
+/// `lower` (or nothing) continued to `bounces` bounces by gathering through `weights`, and
+/// the most bytes a gather held besides its inputs and output.
 fn sum_up(
     weights: &HitWeights,
     direct: &TransportSet,
     lower: Option<&BouncedTransport>,
     bounces: usize,
     progress: bool,
-) -> Result<BouncedTransport> {
+) -> Result<(BouncedTransport, usize)> {
     let from = lower.map_or(0, BouncedTransport::bounces);
-    let mut sum = lower.cloned();
+    let (mut sum, mut most) = (lower.cloned(), 0);
     for bounce in from + 1..=bounces {
-        sum = Some(gather(weights, direct, sum.as_ref(), bounce, progress)?);
+        let (next, bytes) = gather(weights, direct, sum.as_ref(), bounce, progress)?;
+        (sum, most) = (Some(next), most.max(bytes));
     }
-    sum.ok_or_else(|| {
+    let sum = sum.ok_or_else(|| {
         Error::parameter(
             "bounces",
             format!("{bounces} bounces asked for from a sum of {from}"),
         )
-    })
+    })?;
+    Ok((sum, most))
 }
 
 /// The weights per hit vertex of a range of vertices, `W_c[v][i]` (see the
@@ -584,14 +589,15 @@ impl DenseWeights {
 }
 
 /// One more bounce: `keep(G(T0~ + lower~))` per channel for the rows of `weights`, from the
-/// direct transport and the lower sum of every vertex.
+/// direct transport and the lower sum of every vertex, and the bytes the row combination
+/// held ([`RowCombiner::bytes`]).
 fn gather(
     weights: &HitWeights,
     direct: &TransportSet,
     lower: Option<&BouncedTransport>,
     bounce: usize,
     progress: bool,
-) -> Result<BouncedTransport> {
+) -> Result<(BouncedTransport, usize)> {
     let param = direct.param();
     let (faces, s) = (param.faces(), param.face_size());
     let keep: Selection = direct.keep();
@@ -600,65 +606,66 @@ fn gather(
     let channels = weights.channels;
     let label = format!("bounce {bounce} (gather)");
     let bar = Task::begin(progress, &label, weights.len() * channels);
-    fn sh_row(set: &TransportSet, i: usize, len: usize) -> &[f32] {
-        set.sh()
-            .map_or(&[][..], |t| &t.as_slice()[i * len..(i + 1) * len])
-    }
-    let rows: Vec<Result<Vec<Encoded>>> = (0..weights.len())
-        .into_par_iter()
-        .map_init(
-            || (vec![0.0f64; param.texels()], vec![0.0f64; sh_len]),
-            |(dense, sh), k| {
-                let (hits, w) = weights.row(k);
-                (0..channels)
-                    .map(|c| {
-                        dense.fill(0.0);
-                        sh.fill(0.0);
-                        let sets = std::iter::once(direct).chain(lower.map(|l| l.channel(c)));
-                        for set in sets {
-                            for (j, &i) in hits.iter().enumerate() {
-                                let wi = f64::from(w[j * channels + c]);
-                                add_row(dense, wi, set.coefficients(i as usize));
-                                for (o, &x) in sh.iter_mut().zip(sh_row(set, i as usize, sh_len)) {
-                                    *o += wi * f64::from(x);
-                                }
-                            }
-                        }
-                        let coefficients = Array3::from_shape_fn((faces, s, s), |(f, r, col)| {
-                            dense[(f * s + r) * s + col] as f32
-                        });
-                        let (indices, coefficients) =
-                            kept_of_coefficients(coefficients.view(), layout(param), keep)?;
-                        bar.advance(1);
-                        Ok(Encoded {
-                            indices,
-                            coefficients,
-                            sh: sh.iter().map(|&x| x as f32).collect(),
-                        })
-                    })
-                    .collect()
-            },
-        )
+    // The sets added, direct first: the channel `c` of output row `k * channels + c` adds
+    // set 0 and, from bounce 2, set `1 + c` of the lower sum (its one set when grey).
+    let sets: Vec<&TransportSet> = std::iter::once(direct)
+        .chain(lower.into_iter().flat_map(BouncedTransport::channels))
         .collect();
+    let lower_sets = sets.len() - 1;
+    let combiner = RowCombiner::plan(
+        param.texels(),
+        sets.iter().map(|set| set.rows()).collect(),
+        None,
+    );
+    let terms = |r: usize| {
+        let (k, c) = (r / channels, r % channels);
+        let (hits, values) = weights.row(k);
+        let w = Weights {
+            values,
+            stride: channels,
+            offset: c,
+        };
+        let mut terms = vec![(0, hits, w)];
+        if lower_sets > 0 {
+            terms.push((1 + c.min(lower_sets - 1), hits, w));
+        }
+        terms
+    };
+    let finish = |r: usize, texels: &[f32]| -> Result<Encoded> {
+        let coefficients = ArrayView3::from_shape((faces, s, s), texels)
+            .map_err(|e| Error::parameter("bounced transport", e.to_string()))?;
+        let (indices, coefficients) = kept_of_coefficients(coefficients, layout(param), keep)?;
+        let mut sh = vec![0.0f64; sh_len];
+        for (set, hits, w) in terms(r) {
+            let set = sets[set];
+            for (j, &i) in hits.iter().enumerate() {
+                let i = i as usize;
+                let row = set
+                    .sh()
+                    .map_or(&[][..], |t| &t.as_slice()[i * sh_len..(i + 1) * sh_len]);
+                for (o, &x) in sh.iter_mut().zip(row) {
+                    *o += w.at(j) * f64::from(x);
+                }
+            }
+        }
+        bar.advance(1);
+        Ok(Encoded {
+            indices,
+            coefficients,
+            sh: sh.iter().map(|&x| x as f32).collect(),
+        })
+    };
+    let n = weights.len() * channels;
+    let rows = combiner.combine(n, terms, finish);
     let empty = || match bands {
         Some(b) => TransportSet::with_sh(param, keep, b),
         None => Ok(TransportSet::new(param, keep)),
     };
-    let mut sets = (0..channels).map(|_| empty()).collect::<Result<Vec<_>>>()?;
-    for row in rows {
-        for (set, vertex) in sets.iter_mut().zip(row?) {
-            set.extend(&vertex);
-        }
+    let mut out = (0..channels).map(|_| empty()).collect::<Result<Vec<_>>>()?;
+    for (r, row) in rows.into_iter().enumerate() {
+        out[r % channels].extend(&row?);
     }
-    BouncedTransport::new(bounce, sets)
-}
-
-/// `dense[t] += w x` over the sparse row `(t, x)`: the gather's inner loop, most of its time.
-#[inline]
-fn add_row(dense: &mut [f64], w: f64, (indices, values): (&[u32], &[f32])) {
-    for (&t, &x) in indices.iter().zip(values) {
-        dense[t as usize] += w * f64::from(x);
-    }
+    Ok((BouncedTransport::new(bounce, out)?, combiner.bytes(n)))
 }
 
 #[cfg(test)]

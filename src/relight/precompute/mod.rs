@@ -15,6 +15,7 @@
 
 pub mod bounce;
 pub(crate) mod cast;
+pub(crate) mod combine;
 pub mod embree;
 mod packet;
 pub mod raycast;
