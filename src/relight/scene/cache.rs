@@ -611,23 +611,26 @@ pub(super) fn write_parts(
     albedo: &Array2<f32>,
     sets: Sets<'_>,
 ) -> Result<u64> {
-    let sizes = [
-        mesh.positions().len() * 16,
-        mesh.triangles().len() * 12,
-        albedo.len() * 4,
-        sets.all().map(TransportSet::stored_bytes).sum(),
-    ];
-    FORMAT.write(path, force, header, sizes.iter().sum(), |body| {
-        body.array(mesh.positions().iter().chain(mesh.normals()));
-        body.array(mesh.triangles().iter().flatten());
-        body.array(albedo);
+    let (positions, normals) = (mesh.positions(), mesh.normals());
+    let (positions, normals) = (positions.as_standard_layout(), normals.as_standard_layout());
+    let albedo = albedo.as_standard_layout();
+    let flat = "a standard layout is contiguous";
+    let (positions, normals) = (
+        positions.as_slice().expect(flat),
+        normals.as_slice().expect(flat),
+    );
+    let albedo = albedo.as_slice().expect(flat);
+    FORMAT.write(path, force, header, |body| {
+        body.array([positions, normals]);
+        body.array([bytemuck::cast_slice::<_, u32>(mesh.triangles())]);
+        body.array([albedo]);
         for set in sets.all() {
             let (offsets, indices, values) = set.parts();
-            body.array(offsets);
-            body.array(indices);
-            body.array(values);
+            body.array([offsets]);
+            body.array([indices]);
+            body.array([values]);
             if let Some(sh) = set.sh() {
-                body.array(sh.as_slice());
+                body.array([sh.as_slice()]);
             }
         }
     })

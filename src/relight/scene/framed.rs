@@ -6,6 +6,7 @@
 //! typed [`SceneError`], so that one parser serves both files and each names itself in its
 //! messages.
 
+use std::io::Write;
 use std::path::Path;
 
 use bytemuck::Pod;
@@ -60,15 +61,67 @@ macro_rules! little_endian {
 }
 little_endian!(u64, u32, f64, f32);
 
-/// A file's body as it is written: the header, then arrays at aligned offsets.
-pub(crate) struct Body(Vec<u8>);
+/// A file's body as it is written: the header, then arrays at aligned offsets, streamed to
+/// `out` (nothing, when only its checksum is wanted) in pieces of at most [`PIECE`] bytes,
+/// with their CRC-32 and length kept.
+pub(crate) struct Body<'w> {
+    out: &'w mut dyn Write,
+    crc: crc32fast::Hasher,
+    len: usize,
+    error: Option<std::io::Error>,
+}
 
-impl Body {
-    /// Appends one array, every value of `values`, at the next aligned offset.
-    pub fn array<'a, T: LittleEndian + 'a>(&mut self, values: impl IntoIterator<Item = &'a T>) {
-        let gap = (ALIGN - self.0.len() % ALIGN) % ALIGN;
-        self.0.resize(self.0.len() + gap, 0);
-        values.into_iter().for_each(|x| x.put(&mut self.0));
+/// The most bytes of one write of a [`Body`].
+const PIECE: usize = 4 << 20;
+
+impl Body<'_> {
+    /// Appends one array at the next aligned offset: the values of `parts`, one after another.
+    pub fn array<'a, T: LittleEndian + 'a>(&mut self, parts: impl IntoIterator<Item = &'a [T]>) {
+        let gap = (ALIGN - self.len % ALIGN) % ALIGN;
+        self.bytes(&[0; ALIGN][..gap]);
+        for values in parts {
+            if cfg!(target_endian = "little") {
+                self.bytes(bytemuck::cast_slice(values));
+            } else {
+                for piece in values.chunks(PIECE / 8) {
+                    let mut le = Vec::with_capacity(std::mem::size_of_val(piece));
+                    piece.iter().for_each(|&x| x.put(&mut le));
+                    self.bytes(&le);
+                }
+            }
+        }
+    }
+
+    fn bytes(&mut self, bytes: &[u8]) {
+        self.crc.update(bytes);
+        self.len += bytes.len();
+        for piece in bytes.chunks(PIECE) {
+            if self.error.is_none() {
+                self.error = self.out.write_all(piece).err();
+            }
+        }
+    }
+
+    /// The header's length and bytes, then the arrays `arrays` appends, written to `out`:
+    /// the body's CRC-32 and length.
+    fn stream(
+        out: &mut dyn Write,
+        json: &[u8],
+        arrays: &impl Fn(&mut Body),
+    ) -> std::io::Result<(u32, usize)> {
+        let mut body = Body {
+            out,
+            crc: crc32fast::Hasher::new(),
+            len: 0,
+            error: None,
+        };
+        body.bytes(&(json.len() as u64).to_le_bytes());
+        body.bytes(json);
+        arrays(&mut body);
+        match body.error {
+            Some(e) => Err(e),
+            None => Ok((body.crc.finalize(), body.len)),
+        }
     }
 }
 
@@ -79,30 +132,32 @@ impl Format {
     }
 
     /// Writes `path` atomically (an existing file only with `force`): the magic, the version,
-    /// the checksum, then the header and the arrays `arrays` appends (about `capacity` bytes).
-    /// Returns the file's size in bytes.
+    /// the checksum, then the header and the arrays `arrays` appends. The body is made twice,
+    /// for its checksum and then into the file, so that no copy of it is held; `arrays` must
+    /// append the same both times (a second checksum that differs is an error). Returns the
+    /// file's size in bytes.
     pub fn write(
         &self,
         path: &Path,
         force: bool,
         header: &impl Serialize,
-        capacity: usize,
-        arrays: impl FnOnce(&mut Body),
+        arrays: impl Fn(&mut Body),
     ) -> Result<u64> {
         let json = serde_json::to_vec(header).expect("the header serialises");
-        let mut body = Body(Vec::with_capacity(8 + json.len() + capacity + 8 * ALIGN));
-        (json.len() as u64).put(&mut body.0);
-        body.0.extend_from_slice(&json);
-        arrays(&mut body);
-        let body = body.0;
-        let checksum = crc32fast::hash(&body);
+        let (checksum, len) =
+            Body::stream(&mut std::io::sink(), &json, &arrays).expect("a sink takes every write");
         crate::io::write_file_atomically(path, force, |w| {
             w.write_all(self.magic)?;
             w.write_all(&self.version.to_le_bytes())?;
             w.write_all(&checksum.to_le_bytes())?;
-            w.write_all(&body)
+            if Body::stream(w, &json, &arrays)? != (checksum, len) {
+                return Err(std::io::Error::other(
+                    "the body changed between its two passes",
+                ));
+            }
+            Ok(())
         })?;
-        Ok((16 + body.len()) as u64)
+        Ok((PREFIX + len) as u64)
     }
 
     /// [`Format::open`] on a mapped file, whose arrays the reader then reads in place.
@@ -217,5 +272,59 @@ impl<'a> Reader<'a> {
         } else {
             Err(self.format.corrupt(format!("bytes after the {last}")))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    use super::*;
+
+    const TEST: Format = Format {
+        magic: b"HSFRAMED",
+        version: 3,
+        name: "test file",
+        corrupt: SceneError::CacheCorrupt,
+        other_version: |found, expected| SceneError::CacheVersion { found, expected },
+    };
+
+    #[test]
+    fn arrays_of_several_parts_read_back_at_aligned_offsets() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.bin");
+        let size = TEST
+            .write(&path, false, &"h", |body| {
+                body.array([&[1.5f32][..], &[2.5, 3.5]]);
+                body.array([&[7u64][..]]);
+            })
+            .unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        // The body: the header's length (8 bytes) and `"h"` (3), a gap of 5 to the f32s at 16
+        // (12 bytes), a gap of 4 to the u64 at 32; then 16 bytes of prefix before it.
+        assert_eq!((size, bytes.len()), (56, 56));
+        let (header, mut r) = TEST.open::<String>(&bytes).unwrap();
+        assert_eq!(header, "h");
+        assert_eq!(r.values::<f32>(3).unwrap(), [1.5, 2.5, 3.5]);
+        assert_eq!(r.values::<u64>(1).unwrap(), [7]);
+    }
+
+    #[test]
+    fn a_body_that_differs_between_its_two_passes_is_refused_and_nothing_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("b.bin");
+        let pass = Cell::new(0u32);
+        let err = TEST
+            .write(&path, false, &"h", |body| {
+                pass.set(pass.get() + 1);
+                body.array([&[pass.get()][..]]);
+            })
+            .unwrap_err();
+        assert!(
+            err.to_string().contains("changed between its two passes"),
+            "{err}"
+        );
+        assert_eq!(pass.get(), 2);
+        assert!(!path.exists());
     }
 }

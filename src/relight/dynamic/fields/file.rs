@@ -217,10 +217,10 @@ impl OcclusionField {
             samples: self.maps.len(),
             coefficients: indices.len(),
         };
-        FORMAT.write(path, force, &header, self.maps.bytes(), |body| {
-            body.array(offsets);
-            body.array(indices);
-            body.array(values);
+        FORMAT.write(path, force, &header, |body| {
+            body.array([offsets]);
+            body.array([indices]);
+            body.array([values]);
         })
     }
 
