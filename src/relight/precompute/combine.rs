@@ -2,8 +2,9 @@
 //! sparse rows `out_v[t] = sum over sets s, then hit rows j of w_j,s x row_s(i_j)[t]`, added in
 //! `f64` in exactly that order for every texel `t` and rounded once to `f32`.
 //!
-//! Two kernels compute it, and give the same bits (a missing entry adds `w x 0 = +0`, which
-//! changes no sum that starts at `+0` and has non-negative weights):
+//! Two kernels compute it, and give the same bits: where one adds an entry the other lacks,
+//! the entry is zero, and `w x 0 = +-0` (a finite `w`) changes no sum that starts at `+0`
+//! (such a sum is never `-0`, so adding a zero of either sign leaves it as it is):
 //! - [`Kernel::Scatter`] adds each sparse row into a dense `f64` accumulator over every
 //!   texel. It reads each entry once, and for each hit row afresh: at the bunny's 2,928
 //!   vertices a vertex combines about 300 rows of 2,200 entries (5 MB), read from beyond the
@@ -14,9 +15,10 @@
 //!   few hundred KB) are read from the L2 cache by every output row of a chunk, in vector
 //!   adds without indices. It pays when the stored rows are dense at the tile's scale.
 //!
-//! [`RowCombiner::plan`] chooses: tiles when the dense segments take at most twice the bytes
-//! of the sparse rows (segments at least a quarter full), the scatter otherwise (the cubes
-//! scene's rows keep 414 of 24,576 coefficients, under 2%).
+//! [`RowCombiner::plan`] chooses: tiles when the dense segments and their slot table take at
+//! most twice the bytes of the sparse rows (segments about a quarter full or more; the
+//! bunny's are 68% full and take 37 MB against 51), the scatter otherwise (the cubes scene's
+//! rows keep 414 of 24,576 coefficients, under 2%).
 
 use rayon::prelude::*;
 
@@ -31,7 +33,9 @@ const CHUNK_BYTES: usize = 4 << 20;
 /// Which way a [`RowCombiner`] adds rows; see the [module docs](self).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Kernel {
+    /// Each sparse row into a dense accumulator over every texel.
     Scatter,
+    /// Dense segments, tile by tile.
     Tiles,
 }
 
@@ -50,12 +54,16 @@ pub(crate) type Terms<'t> = Vec<(usize, &'t [u32], Weights<'t>)>;
 /// The weights of a term's rows: `values[j * stride + offset]` for row `j`.
 #[derive(Clone, Copy)]
 pub(crate) struct Weights<'t> {
+    /// The weights of every channel, row after row.
     pub values: &'t [f32],
+    /// Weights a row (the channels).
     pub stride: usize,
+    /// The channel.
     pub offset: usize,
 }
 
 impl Weights<'_> {
+    /// Row `j`'s weight.
     pub(crate) fn at(&self, j: usize) -> f64 {
         f64::from(self.values[j * self.stride + self.offset])
     }
@@ -151,6 +159,7 @@ impl<'a> RowCombiner<'a> {
         chunks.into_iter().flatten().collect()
     }
 
+    /// [`Kernel::Scatter`] for the output rows of `terms`, into `out` (their texels, row by row).
     fn add_scatter(&self, terms: &[Terms<'_>], out: &mut [f32]) {
         let mut dense = vec![0.0f64; self.texels];
         for (row, o) in terms.iter().zip(out.chunks_exact_mut(self.texels)) {
@@ -188,18 +197,22 @@ fn add_tiles(tiles: &[DenseTiles], terms: &[Terms<'_>], out: &mut [f32]) {
     add_tiles_portable(tiles, terms, out)
 }
 
+/// [`add_tiles_portable`] compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 fn add_tiles_avx512(tiles: &[DenseTiles], terms: &[Terms<'_>], out: &mut [f32]) {
     add_tiles_portable(tiles, terms, out)
 }
 
+/// [`add_tiles_portable`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn add_tiles_avx2(tiles: &[DenseTiles], terms: &[Terms<'_>], out: &mut [f32]) {
     add_tiles_portable(tiles, terms, out)
 }
 
+/// [`Kernel::Tiles`] for the output rows of `terms`, into `out` (their texels, row by row):
+/// one source for every target, so that each compiles the same adds in the same order.
 #[inline(always)]
 fn add_tiles_portable(tiles: &[DenseTiles], terms: &[Terms<'_>], out: &mut [f32]) {
     let Some(first) = tiles.first() else { return };
