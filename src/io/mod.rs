@@ -82,6 +82,7 @@ mod openexr;
 mod raster;
 mod tiff_codec;
 
+pub(crate) use atomic::PendingFile;
 pub use atomic::{ensure_distinct_paths, write_file_atomically};
 pub use coefficients::{
     CoefficientFile, CoefficientMetadata, StoredCoefficients, TransformRequest,

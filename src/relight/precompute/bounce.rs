@@ -78,7 +78,7 @@ use crate::relight::Mesh;
 use crate::relight::harmonics::ShTransfer;
 use crate::relight::material::brdf::check_albedo;
 use crate::relight::precompute::cast::{BATCH, Caster, Visible, cast_vertices, working_bytes};
-use crate::relight::precompute::combine::{RowCombiner, Weights};
+use crate::relight::precompute::combine::{RowCombiner, Terms, Weights};
 use crate::relight::precompute::raycast::{Hit, SceneBvh};
 use crate::relight::precompute::transport::Encoder;
 use crate::relight::precompute::transport::{Encoded, TransportSet};
@@ -606,12 +606,12 @@ fn gather(
     let channels = weights.channels;
     let label = format!("bounce {bounce} (gather)");
     let bar = Task::begin(progress, &label, weights.len() * channels);
-    // The sets added, direct first: the channel `c` of output row `k * channels + c` adds
-    // set 0 and, from bounce 2, set `1 + c` of the lower sum (its one set when grey).
-    let sets: Vec<&TransportSet> = std::iter::once(direct)
-        .chain(lower.into_iter().flat_map(BouncedTransport::channels))
-        .collect();
-    let lower_sets = sets.len() - 1;
+    // The sets added, direct first: channel `c` of output row `k * channels + c` adds set 0
+    // and, from bounce 2, set `1 + c`, the lower sum's channel `c`.
+    let lower_channels = lower
+        .into_iter()
+        .flat_map(|l| (0..channels).map(|c| l.channel(c)));
+    let sets: Vec<&TransportSet> = std::iter::once(direct).chain(lower_channels).collect();
     let combiner = RowCombiner::plan(
         param.texels(),
         sets.iter().map(|set| set.rows()).collect(),
@@ -626,17 +626,17 @@ fn gather(
             offset: c,
         };
         let mut terms = vec![(0, hits, w)];
-        if lower_sets > 0 {
-            terms.push((1 + c.min(lower_sets - 1), hits, w));
+        if lower.is_some() {
+            terms.push((1 + c, hits, w));
         }
         terms
     };
-    let finish = |r: usize, texels: &[f32]| -> Result<Encoded> {
+    let finish = |_: usize, terms: &Terms<'_>, texels: &[f32]| -> Result<Encoded> {
         let coefficients = ArrayView3::from_shape((faces, s, s), texels)
             .map_err(|e| Error::parameter("bounced transport", e.to_string()))?;
         let (indices, coefficients) = kept_of_coefficients(coefficients, layout(param), keep)?;
         let mut sh = vec![0.0f64; sh_len];
-        for (set, hits, w) in terms(r) {
+        for &(set, hits, w) in terms {
             let set = sets[set];
             for (j, &i) in hits.iter().enumerate() {
                 let i = i as usize;

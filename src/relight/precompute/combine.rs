@@ -6,19 +6,20 @@
 //! the entry is zero, and `w x 0 = +-0` (a finite `w`) changes no sum that starts at `+0`
 //! (such a sum is never `-0`, so adding a zero of either sign leaves it as it is):
 //! - [`Kernel::Scatter`] adds each sparse row into a dense `f64` accumulator over every
-//!   texel. It reads each entry once, and for each hit row afresh: at the bunny's 2,928
-//!   vertices a vertex combines about 300 rows of 2,200 entries (5 MB), read from beyond the
-//!   L2 cache for every vertex, so it runs at the speed of that read.
+//!   texel. It reads each hit row afresh for every output row: the bunny's rows hold about
+//!   2,170 entries each (`results/relight/bounces.md`: 6,364,004 coefficients for 2,928
+//!   vertices), so an output row's hundreds of hit rows come from beyond the L2 cache, and
+//!   the scatter runs at the speed of that read.
 //! - [`Kernel::Tiles`] first regroups every row by tiles of [`TILE`] texels, each non-empty
 //!   segment stored densely and one tile's segments of every row together; it then makes
-//!   every output row's tile before moving to the next tile, so that the tile's segments (a
-//!   few hundred KB) are read from the L2 cache by every output row of a chunk, in vector
-//!   adds without indices. It pays when the stored rows are dense at the tile's scale.
+//!   every output row's tile before moving to the next tile, so that the tile's segments
+//!   (1/96 of the tiles at cube 6 x 32^2) are read from the L2 cache by every output row of
+//!   a chunk, in vector adds without indices. It pays when the stored rows are dense at the tile's scale.
 //!
 //! [`RowCombiner::plan`] chooses: tiles when the dense segments and their slot table take at
-//! most twice the bytes of the sparse rows (segments about a quarter full or more; the
-//! bunny's are 68% full and take 37 MB against 51), the scatter otherwise (the cubes scene's
-//! rows keep 414 of 24,576 coefficients, under 2%).
+//! most twice the bytes of the sparse rows (segments about a quarter full or more), the
+//! scatter otherwise (the cubes scene's rows keep 414 of 24,576 coefficients, under 2%). The
+//! tiles are counted in the working memory a precomputation reports.
 
 use rayon::prelude::*;
 
@@ -131,14 +132,14 @@ impl<'a> RowCombiner<'a> {
         (CHUNK_BYTES / (self.texels * 4)).clamp(1, n.div_ceil(8).max(1))
     }
 
-    /// Output rows `0..n` from `terms(r)`, in parallel over chunks of rows: `finish(r, out_r)`
-    /// receives each output row's texels in order of `r` within a chunk, and its results are
-    /// returned in order of `r`.
+    /// Output rows `0..n` from `terms(r)`, in parallel over chunks of rows:
+    /// `finish(r, terms_r, out_r)` receives each output row's terms and texels in order of `r`
+    /// within a chunk, and its results are returned in order of `r`.
     pub(crate) fn combine<'t, R: Send>(
         &self,
         n: usize,
         terms: impl Fn(usize) -> Terms<'t> + Sync,
-        finish: impl Fn(usize, &[f32]) -> R + Sync,
+        finish: impl Fn(usize, &Terms<'t>, &[f32]) -> R + Sync,
     ) -> Vec<R> {
         let (texels, chunk) = (self.texels, self.chunk(n));
         let chunks: Vec<Vec<R>> = (0..n.div_ceil(chunk))
@@ -151,8 +152,8 @@ impl<'a> RowCombiner<'a> {
                     Some(tiles) => add_tiles(tiles, &terms, &mut out),
                     None => self.add_scatter(&terms, &mut out),
                 }
-                rows.zip(out.chunks_exact(texels))
-                    .map(|(r, o)| finish(r, o))
+                rows.zip(terms.iter().zip(out.chunks_exact(texels)))
+                    .map(|(r, (t, o))| finish(r, t, o))
                     .collect()
             })
             .collect();

@@ -40,7 +40,7 @@ fn combined(
             })
             .collect()
     };
-    combiner.combine(rows.len(), terms, |r, out| (r, out.to_vec()))
+    combiner.combine(rows.len(), terms, |r, _, out| (r, out.to_vec()))
 }
 
 /// `count` rows over `texels` texels, each a random subset with values in -1..1 (some zero).

@@ -6,13 +6,14 @@
 //! typed [`SceneError`], so that one parser serves both files and each names itself in its
 //! messages.
 
-use std::io::Write;
+use std::io::{Seek, SeekFrom, Write};
 use std::path::Path;
 
 use bytemuck::Pod;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
+use crate::io::PendingFile;
 use crate::io::mapped::{Buffer, MappedFile};
 use crate::relight::SceneError;
 use crate::{Error, Result};
@@ -62,8 +63,7 @@ macro_rules! little_endian {
 little_endian!(u64, u32, f64, f32);
 
 /// A file's body as it is written: the header, then arrays at aligned offsets, streamed to
-/// `out` (nothing, when only its checksum is wanted) in pieces of at most [`PIECE`] bytes,
-/// with their CRC-32 and length kept.
+/// `out` in pieces of at most [`PIECE`] bytes, with their CRC-32 and length kept.
 pub(crate) struct Body<'w> {
     out: &'w mut dyn Write,
     crc: crc32fast::Hasher,
@@ -107,7 +107,7 @@ impl Body<'_> {
     fn stream(
         out: &mut dyn Write,
         json: &[u8],
-        arrays: &impl Fn(&mut Body),
+        arrays: impl FnOnce(&mut Body),
     ) -> std::io::Result<(u32, usize)> {
         let mut body = Body {
             out,
@@ -132,31 +132,33 @@ impl Format {
     }
 
     /// Writes `path` atomically (an existing file only with `force`): the magic, the version,
-    /// the checksum, then the header and the arrays `arrays` appends. The body is made twice,
-    /// for its checksum and then into the file, so that no copy of it is held; `arrays` must
-    /// append the same both times (a second checksum that differs is an error). Returns the
-    /// file's size in bytes.
+    /// the checksum, then the header and the arrays `arrays` appends. The body is streamed
+    /// to the file as it is made, so that no copy of it is held, and its checksum written
+    /// into its place once it is known. Returns the file's size in bytes.
     pub fn write(
         &self,
         path: &Path,
         force: bool,
         header: &impl Serialize,
-        arrays: impl Fn(&mut Body),
+        arrays: impl FnOnce(&mut Body),
     ) -> Result<u64> {
         let json = serde_json::to_vec(header).expect("the header serialises");
-        let (checksum, len) =
-            Body::stream(&mut std::io::sink(), &json, &arrays).expect("a sink takes every write");
-        crate::io::write_file_atomically(path, force, |w| {
+        let mut file = PendingFile::create(path, force)?;
+        let w = file.writer();
+        let write = || -> std::io::Result<usize> {
             w.write_all(self.magic)?;
             w.write_all(&self.version.to_le_bytes())?;
+            w.write_all(&[0; 4])?;
+            let (checksum, len) = Body::stream(w, &json, arrays)?;
+            w.seek(SeekFrom::Start(PREFIX as u64 - 4))?;
             w.write_all(&checksum.to_le_bytes())?;
-            if Body::stream(w, &json, &arrays)? != (checksum, len) {
-                return Err(std::io::Error::other(
-                    "the body changed between its two passes",
-                ));
-            }
-            Ok(())
+            Ok(len)
+        };
+        let len = write().map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
         })?;
+        file.commit()?;
         Ok((PREFIX + len) as u64)
     }
 
@@ -277,8 +279,6 @@ impl<'a> Reader<'a> {
 
 #[cfg(test)]
 mod tests {
-    use std::cell::Cell;
-
     use super::*;
 
     const TEST: Format = Format {
@@ -307,24 +307,5 @@ mod tests {
         assert_eq!(header, "h");
         assert_eq!(r.values::<f32>(3).unwrap(), [1.5, 2.5, 3.5]);
         assert_eq!(r.values::<u64>(1).unwrap(), [7]);
-    }
-
-    #[test]
-    fn a_body_that_differs_between_its_two_passes_is_refused_and_nothing_is_written() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("b.bin");
-        let pass = Cell::new(0u32);
-        let err = TEST
-            .write(&path, false, &"h", |body| {
-                pass.set(pass.get() + 1);
-                body.array([&[pass.get()][..]]);
-            })
-            .unwrap_err();
-        assert!(
-            err.to_string().contains("changed between its two passes"),
-            "{err}"
-        );
-        assert_eq!(pass.get(), 2);
-        assert!(!path.exists());
     }
 }
