@@ -1,4 +1,8 @@
-//! The one error type of the library.
+//! The one error type of the core crate.
+//!
+//! The relighting crate (`haarshift-relight`) has an error type of its own that wraps this one
+//! (`From<haarshift::Error>`, displayed unchanged) beside what only a scene can get wrong, so
+//! that `?` carries a core error up unchanged; the experiments crate uses the relighting's.
 
 use std::path::PathBuf;
 
@@ -66,43 +70,12 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
-    /// A scene (mesh, scene file or scene cache) is not usable; `path` names its file when
-    /// there is one.
-    #[error("{}{source}", file_prefix(path.as_deref()))]
-    Scene {
-        /// The file the problem was found in, if any.
-        path: Option<PathBuf>,
-        /// What is wrong.
-        #[source]
-        source: crate::relight::SceneError,
-    },
-    /// A measured-BRDF (MERL) file is not usable.
-    #[error("{}: {source}", path.display())]
-    Merl {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong with it.
-        #[source]
-        source: crate::relight::material::merl::MerlError,
-    },
     /// The output file exists and the caller did not ask to replace it.
     #[error("{}: already exists", path.display())]
     OutputExists {
         /// The existing file.
         path: PathBuf,
     },
-}
-
-/// `"path: "` when there is a path, else nothing.
-fn file_prefix(path: Option<&std::path::Path>) -> String {
-    path.map(|p| format!("{}: ", p.display()))
-        .unwrap_or_default()
-}
-
-impl From<crate::relight::SceneError> for Error {
-    fn from(source: crate::relight::SceneError) -> Self {
-        Error::Scene { path: None, source }
-    }
 }
 
 /// `Result` with [`Error`].
@@ -120,15 +93,7 @@ impl Error {
     /// ```
     pub fn in_file(self, path: &std::path::Path) -> Self {
         match self {
-            Error::Scene { path: None, source } => Error::Scene {
-                path: Some(path.to_path_buf()),
-                source,
-            },
-            Error::Io { .. }
-            | Error::Format { .. }
-            | Error::OutputExists { .. }
-            | Error::Merl { .. }
-            | Error::Scene { .. } => self,
+            Error::Io { .. } | Error::Format { .. } | Error::OutputExists { .. } => self,
             other => Error::Format {
                 path: path.to_path_buf(),
                 reason: other.to_string(),
@@ -150,7 +115,12 @@ impl Error {
     }
 
     /// Shorthand for [`Error::InvalidShape`].
-    pub(crate) fn shape(shape: &[usize], reason: impl Into<String>) -> Self {
+    ///
+    /// ```
+    /// let e = haarshift::Error::shape(&[0, 3], "empty");
+    /// assert_eq!(e.to_string(), "invalid shape [0, 3]: empty");
+    /// ```
+    pub fn shape(shape: &[usize], reason: impl Into<String>) -> Self {
         Error::InvalidShape {
             shape: shape.to_vec(),
             reason: reason.into(),

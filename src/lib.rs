@@ -36,7 +36,6 @@ mod test_support;
 
 mod boundary;
 mod error;
-pub mod experiments;
 pub mod faces;
 pub mod io;
 pub mod kernels;
@@ -47,8 +46,6 @@ pub mod patterns;
 mod planar_image;
 pub mod product;
 pub mod progress;
-pub mod relight;
-pub mod render;
 pub mod rotate;
 mod sample;
 pub mod shift;

@@ -173,7 +173,8 @@ pub fn disk_mask(h: usize, w: usize, radius: f64) -> Array2<bool> {
 }
 
 /// Serialises infinities as JSON `null` (JSON has no infinity) and reads `null` back as +inf.
-pub(crate) mod infinite_as_null {
+#[doc(hidden)] // For haarshift-experiments (the crates' rule: README's "Crates").
+pub mod infinite_as_null {
     use serde::{Deserialize, Deserializer, Serializer};
 
     pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {

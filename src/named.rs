@@ -1,6 +1,10 @@
 //! One definition of "an enum the user picks by name": `ALL`, `name()`, `FromStr`, `Display`.
 
-/// Declares a fieldless enum whose variants have user-facing lower-case names.
+/// Declares a fieldless enum whose variants have user-facing lower-case names. Not part of the
+/// public API: exported for the relighting crate's named enums (the expanding crate needs
+/// serde with its derive feature).
+#[doc(hidden)]
+#[macro_export]
 macro_rules! named_enum {
     (
         $(#[$meta:meta])*
@@ -42,4 +46,5 @@ macro_rules! named_enum {
     };
 }
 
+#[allow(unused_imports)]
 pub(crate) use named_enum;

@@ -1,6 +1,7 @@
 //! Synthetic test patterns that stress resampling: a zone plate (every frequency up to
 //! Nyquist) and a Siemens star (edges at every orientation, frequency rising toward the
-//! centre). Values are in 0..=255 like an 8-bit image.
+//! centre). Values are in 0..=255 like an 8-bit image. And [`whole_shifts`], a fixed
+//! pseudo-random chain of whole shifts.
 
 use ndarray::Array2;
 
@@ -61,6 +62,24 @@ pub fn siemens_star(h: usize, w: usize, spokes: usize) -> Result<Array2<f64>> {
         }
         255.0 * white as f64 / (SUB * SUB) as f64
     }))
+}
+
+/// Deterministic pseudo-random whole shifts `(dx, dy)` in `[-span, span)` times `unit`
+/// (xorshift64, fixed seed), so that every run checks the same chain.
+///
+/// ```
+/// let s = haarshift::patterns::whole_shifts(3, 10, 4);
+/// assert!(s.iter().all(|&(dx, dy)| dx % 4 == 0 && dy.abs() <= 40));
+/// ```
+pub fn whole_shifts(count: usize, span: i64, unit: i64) -> Vec<(i64, i64)> {
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % (2 * span as u64)) as i64 - span
+    };
+    (0..count).map(|_| (next() * unit, next() * unit)).collect()
 }
 
 #[cfg(test)]

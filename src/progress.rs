@@ -71,12 +71,20 @@ pub fn set_reporter(reporter: Box<dyn Progress>) -> Result<(), Box<dyn Progress>
 }
 
 /// The task of one computation: nothing when progress was not asked for or no reporter is
-/// installed.
-pub(crate) struct Task(Option<Box<dyn ProgressTask>>);
+/// installed. What a long computation of this crate or one built on it (the relighting)
+/// reports through.
+///
+/// ```
+/// use haarshift::progress::Task;
+/// // Not asked for: nothing is reported, whatever reporter is installed.
+/// let task = Task::begin(false, "a computation", 10);
+/// task.advance(10);
+/// ```
+pub struct Task(Option<Box<dyn ProgressTask>>);
 
 impl Task {
     /// Begins `what` of `len` units if `report` and a reporter is installed.
-    pub(crate) fn begin(report: bool, what: &str, len: usize) -> Task {
+    pub fn begin(report: bool, what: &str, len: usize) -> Task {
         Task(
             REPORTER
                 .get()
@@ -86,74 +94,9 @@ impl Task {
     }
 
     /// `units` more units are done.
-    pub(crate) fn advance(&self, units: usize) {
+    pub fn advance(&self, units: usize) {
         if let Some(task) = &self.0 {
             task.advance(units as u64);
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::sync::Mutex;
-
-    /// Every task begun in this test binary: (name, length, units advanced), kept after
-    /// the task ends.
-    static SEEN: Mutex<Vec<(String, u64, u64)>> = Mutex::new(Vec::new());
-
-    struct Record;
-    struct RecordTask(usize);
-
-    impl Progress for Record {
-        fn begin(&self, what: &str, len: u64) -> Box<dyn ProgressTask> {
-            let mut seen = SEEN.lock().unwrap();
-            seen.push((what.to_string(), len, 0));
-            Box::new(RecordTask(seen.len() - 1))
-        }
-    }
-
-    impl ProgressTask for RecordTask {
-        fn advance(&self, units: u64) {
-            SEEN.lock().unwrap()[self.0].2 += units;
-        }
-    }
-
-    /// The tasks named `what` that were begun since `from`.
-    fn tasks_since(from: usize, what: &str) -> Vec<(u64, u64)> {
-        SEEN.lock().unwrap()[from..]
-            .iter()
-            .filter(|t| t.0 == what)
-            .map(|t| (t.1, t.2))
-            .collect()
-    }
-
-    #[test]
-    fn visibility_reports_one_unit_per_vertex_only_when_asked() {
-        use crate::faces::{ParamKind, Parameterization};
-        use crate::relight::{Mesh, SceneBvh, VisibilityOptions, vertex_major};
-        use ndarray::array;
-
-        // Installed once for the whole binary; other tests report into it harmlessly.
-        let _ = set_reporter(Box::new(Record));
-        let mesh = Mesh::new(
-            array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
-            vec![[0, 1, 2]],
-            None,
-        )
-        .unwrap();
-        let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
-        let name = "visibility (rays)";
-        for report in [false, true] {
-            let from = SEEN.lock().unwrap().len();
-            let options = VisibilityOptions {
-                progress: report,
-                ..VisibilityOptions::new(param)
-            };
-            vertex_major(&mesh, &SceneBvh::new(&mesh), &options).unwrap();
-            let n = mesh.vertex_count() as u64;
-            let expected = if report { vec![(n, n)] } else { vec![] };
-            assert_eq!(tasks_since(from, name), expected, "report = {report}");
         }
     }
 }

@@ -47,13 +47,15 @@ pub trait Sample:
 }
 
 /// Four samples in one SIMD register where the platform has one, sealed inside the crate.
-pub(crate) mod lanes {
+#[doc(hidden)]
+pub mod lanes {
     use std::ops::{Add, AddAssign, Mul};
 
-    /// Four lanes of a sample type: glam's `Vec4` (one SSE register) for f32, `DVec4` for f64.
-    /// What the shading's sparse dot products gather an RGB row (and a zero) as, so that one
-    /// coefficient is one load and one multiply-add of four lanes; arrays of four would do the
-    /// same arithmetic, but the compiler drops the unused fourth lane and splits the load.
+    /// Four lanes of a sample type: [`Quad4f32`] (one SSE register on x86-64) for f32,
+    /// [`Quad4f64`] for f64. What the shading's sparse dot products gather an RGB row (and a
+    /// zero) as, so that one coefficient is one load and one multiply-add of four lanes; arrays
+    /// of four would do the same arithmetic, but the compiler drops the unused fourth lane and
+    /// splits the load.
     pub trait Lanes: Copy {
         /// The four lanes.
         type Quad: Copy
@@ -71,27 +73,194 @@ pub(crate) mod lanes {
         fn first_three(quad: Self::Quad) -> [Self; 3];
     }
 
-    impl Lanes for f32 {
-        type Quad = glam::Vec4;
+    /// Four f32 lanes, lane-wise IEEE arithmetic: an SSE register on x86-64 (every x86-64
+    /// has SSE2), a 16-byte aligned array elsewhere.
+    #[derive(Clone, Copy, Debug)]
+    #[repr(transparent)]
+    pub struct Quad4f32(Inner32);
+
+    #[cfg(target_arch = "x86_64")]
+    type Inner32 = std::arch::x86_64::__m128;
+    #[cfg(not(target_arch = "x86_64"))]
+    type Inner32 = Aligned4f32;
+
+    /// Four f32 on a 16-byte boundary, where no SSE register holds them.
+    #[cfg(not(target_arch = "x86_64"))]
+    #[derive(Clone, Copy, Debug)]
+    #[repr(C, align(16))]
+    pub struct Aligned4f32([f32; 4]);
+
+    #[cfg(target_arch = "x86_64")]
+    mod sse {
+        use std::arch::x86_64::{_mm_add_ps, _mm_mul_ps, _mm_set1_ps, _mm_setr_ps, _mm_storeu_ps};
+
+        use super::Quad4f32;
+
+        // SAFETY (every function): SSE is part of the x86-64 baseline, so these intrinsics are
+        // always available; they read and write only their arguments and `out`.
         #[inline(always)]
-        fn rgb([r, g, b]: [f32; 3]) -> glam::Vec4 {
-            glam::Vec4::new(r, g, b, 0.0)
+        pub(super) fn new(x: [f32; 4]) -> Quad4f32 {
+            Quad4f32(unsafe { _mm_setr_ps(x[0], x[1], x[2], x[3]) })
         }
         #[inline(always)]
-        fn first_three(quad: glam::Vec4) -> [f32; 3] {
-            quad.truncate().to_array()
+        pub(super) fn add(a: Quad4f32, b: Quad4f32) -> Quad4f32 {
+            Quad4f32(unsafe { _mm_add_ps(a.0, b.0) })
+        }
+        #[inline(always)]
+        pub(super) fn scale(a: Quad4f32, s: f32) -> Quad4f32 {
+            Quad4f32(unsafe { _mm_mul_ps(a.0, _mm_set1_ps(s)) })
+        }
+        #[inline(always)]
+        pub(super) fn array(a: Quad4f32) -> [f32; 4] {
+            let mut out = [0.0f32; 4];
+            unsafe { _mm_storeu_ps(out.as_mut_ptr(), a.0) };
+            out
+        }
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    mod sse {
+        use super::{Aligned4f32, Quad4f32};
+
+        #[inline(always)]
+        pub(super) fn new(x: [f32; 4]) -> Quad4f32 {
+            Quad4f32(Aligned4f32(x))
+        }
+        #[inline(always)]
+        pub(super) fn add(a: Quad4f32, b: Quad4f32) -> Quad4f32 {
+            new(std::array::from_fn(|k| a.0.0[k] + b.0.0[k]))
+        }
+        #[inline(always)]
+        pub(super) fn scale(a: Quad4f32, s: f32) -> Quad4f32 {
+            new(a.0.0.map(|x| x * s))
+        }
+        #[inline(always)]
+        pub(super) fn array(a: Quad4f32) -> [f32; 4] {
+            a.0.0
+        }
+    }
+
+    impl Default for Quad4f32 {
+        #[inline(always)]
+        fn default() -> Self {
+            sse::new([0.0; 4])
+        }
+    }
+
+    impl Add for Quad4f32 {
+        type Output = Self;
+        #[inline(always)]
+        fn add(self, other: Self) -> Self {
+            sse::add(self, other)
+        }
+    }
+
+    impl AddAssign for Quad4f32 {
+        #[inline(always)]
+        fn add_assign(&mut self, other: Self) {
+            *self = sse::add(*self, other);
+        }
+    }
+
+    impl Mul<f32> for Quad4f32 {
+        type Output = Self;
+        #[inline(always)]
+        fn mul(self, s: f32) -> Self {
+            sse::scale(self, s)
+        }
+    }
+
+    // SAFETY: four f32 in a register or an array; no pointer, nothing shared.
+    unsafe impl Send for Quad4f32 {}
+    unsafe impl Sync for Quad4f32 {}
+
+    /// Four f64 lanes, lane-wise IEEE arithmetic (as four scalars: a 256-bit register is not
+    /// in the x86-64 baseline).
+    #[derive(Clone, Copy, Debug, Default)]
+    #[repr(C, align(32))]
+    pub struct Quad4f64([f64; 4]);
+
+    impl Add for Quad4f64 {
+        type Output = Self;
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            let [a, b, c, d] = self.0;
+            Quad4f64([a + o.0[0], b + o.0[1], c + o.0[2], d + o.0[3]])
+        }
+    }
+
+    impl AddAssign for Quad4f64 {
+        #[inline(always)]
+        fn add_assign(&mut self, other: Self) {
+            *self = *self + other;
+        }
+    }
+
+    impl Mul<f64> for Quad4f64 {
+        type Output = Self;
+        #[inline(always)]
+        fn mul(self, s: f64) -> Self {
+            let [a, b, c, d] = self.0;
+            Quad4f64([a * s, b * s, c * s, d * s])
+        }
+    }
+
+    impl Lanes for f32 {
+        type Quad = Quad4f32;
+        #[inline(always)]
+        fn rgb([r, g, b]: [f32; 3]) -> Quad4f32 {
+            sse::new([r, g, b, 0.0])
+        }
+        #[inline(always)]
+        fn first_three(quad: Quad4f32) -> [f32; 3] {
+            let [r, g, b, _] = sse::array(quad);
+            [r, g, b]
         }
     }
 
     impl Lanes for f64 {
-        type Quad = glam::DVec4;
+        type Quad = Quad4f64;
         #[inline(always)]
-        fn rgb([r, g, b]: [f64; 3]) -> glam::DVec4 {
-            glam::DVec4::new(r, g, b, 0.0)
+        fn rgb([r, g, b]: [f64; 3]) -> Quad4f64 {
+            Quad4f64([r, g, b, 0.0])
         }
         #[inline(always)]
-        fn first_three(quad: glam::DVec4) -> [f64; 3] {
-            quad.truncate().to_array()
+        fn first_three(quad: Quad4f64) -> [f64; 3] {
+            let [r, g, b, _] = quad.0;
+            [r, g, b]
+        }
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::Lanes;
+
+        /// Lane-wise IEEE arithmetic, bit for bit as scalars give it.
+        #[test]
+        fn lanes_add_and_scale_as_scalars_do() {
+            let (a, b, s) = (
+                [0.1f32, -3.5, 7.25e-8],
+                [1e30f32, 2.0, -7.25e-8],
+                1.0f32 / 3.0,
+            );
+            let mut q = f32::rgb(a) * s;
+            q += f32::rgb(b);
+            let expect: [f32; 3] = std::array::from_fn(|k| a[k] * s + b[k]);
+            assert_eq!(
+                f32::first_three(q).map(f32::to_bits),
+                expect.map(f32::to_bits)
+            );
+            let (a, b, s) = (
+                [0.1f64, -3.5, 7.25e-8],
+                [1e300f64, 2.0, -7.25e-8],
+                1.0f64 / 3.0,
+            );
+            let q = f64::rgb(a) * s + f64::rgb(b);
+            let expect: [f64; 3] = std::array::from_fn(|k| a[k] * s + b[k]);
+            assert_eq!(
+                f64::first_three(q).map(f64::to_bits),
+                expect.map(f64::to_bits)
+            );
         }
     }
 }

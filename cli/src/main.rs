@@ -98,7 +98,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         // The library's message serves every caller; the flag that replaces a file is ours.
-        Err(error @ haarshift::Error::OutputExists { .. }) => {
+        Err(error @ haarshift_relight::Error::Core(haarshift::Error::OutputExists { .. })) => {
             eprintln!("haarshift: {error} (use --force to replace it)");
             ExitCode::FAILURE
         }

@@ -9,20 +9,21 @@ use pyo3::exceptions::{
 /// The exception a Python caller expects: `ValueError` for a bad argument or array,
 /// `OSError` (or its `FileNotFoundError`, `PermissionError`, `FileExistsError` subclasses) for a
 /// file, `MemoryError` for work beyond the memory budget.
-pub fn to_py(error: haarshift::Error) -> PyErr {
-    use haarshift::Error;
+pub fn to_py(error: haarshift_relight::Error) -> PyErr {
+    use haarshift::Error as Core;
+    use haarshift_relight::Error;
     let message = error.to_string();
     match &error {
-        Error::Io { source, .. } => match source.kind() {
+        Error::Core(Core::Io { source, .. }) => match source.kind() {
             std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
             std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
             _ => PyOSError::new_err(message),
         },
-        Error::OutputExists { .. } => PyFileExistsError::new_err(message),
-        Error::Format { .. } | Error::Merl { .. } | Error::Scene { path: Some(_), .. } => {
-            PyOSError::new_err(message)
-        }
-        Error::MemoryBudget { .. } => PyMemoryError::new_err(message),
+        Error::Core(Core::OutputExists { .. }) => PyFileExistsError::new_err(message),
+        Error::Core(Core::Format { .. })
+        | Error::Merl { .. }
+        | Error::Scene { path: Some(_), .. } => PyOSError::new_err(message),
+        Error::Core(Core::MemoryBudget { .. }) => PyMemoryError::new_err(message),
         _ => PyValueError::new_err(message),
     }
 }
@@ -33,9 +34,9 @@ pub trait OrRaise<T> {
     fn or_raise(self) -> pyo3::PyResult<T>;
 }
 
-impl<T> OrRaise<T> for haarshift::Result<T> {
+impl<T, E: Into<haarshift_relight::Error>> OrRaise<T> for Result<T, E> {
     fn or_raise(self) -> pyo3::PyResult<T> {
-        self.map_err(to_py)
+        self.map_err(|e| to_py(e.into()))
     }
 }
 

@@ -3,16 +3,17 @@
 
 use std::str::FromStr;
 
+use haarshift::BoundaryMode;
 use haarshift::kernels::{KernelOptions, Outside, ShiftMethod};
 use haarshift::transform::Levels;
-use haarshift::{BoundaryMode, Error};
+
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 
 use crate::errors::{OrRaise, bad_argument};
 
 /// A name the library knows (`"bspline3"`, `"reflect"`, ...), or its `ValueError`.
-pub fn parse<T: FromStr<Err = Error>>(value: &str) -> PyResult<T> {
+pub fn parse<T: FromStr<Err: Into<haarshift_relight::Error>>>(value: &str) -> PyResult<T> {
     value.parse().or_raise()
 }
 

@@ -7,20 +7,20 @@ use std::path::PathBuf;
 
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
-use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions, DynamicScene};
-use haarshift::relight::light::environment::Environment;
-use haarshift::relight::precompute::shard::Shard;
-use haarshift::relight::precompute::{Order, PrecomputeOptions, precompute_shard, shard_is_done};
-use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader};
-use haarshift::relight::shade::glossy::GlossyOptions;
-use haarshift::relight::shade::{
+use haarshift::sphere::{LatLongMap, SphereRotation};
+use haarshift_relight::dynamic::{DynamicBudgets, DynamicOptions, DynamicScene};
+use haarshift_relight::light::environment::Environment;
+use haarshift_relight::precompute::shard::Shard;
+use haarshift_relight::precompute::{Order, PrecomputeOptions, precompute_shard, shard_is_done};
+use haarshift_relight::render::view::ViewSpec;
+use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader};
+use haarshift_relight::shade::glossy::GlossyOptions;
+use haarshift_relight::shade::{
     FrameSpec, LightSpec, Method, ShadeOptions, Shader as LibraryShader, ShaderSpec, ShadingInput,
 };
-use haarshift::relight::{
+use haarshift_relight::{
     Brdf, EnvironmentSpec, RayTracer, Scene, SceneCache, VisibilityOptions, merge_shards,
 };
-use haarshift::render::view::ViewSpec;
-use haarshift::sphere::{LatLongMap, SphereRotation};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 
@@ -109,7 +109,7 @@ fn scene<'py>(
         roll,
     };
     let keep_light = keep_light.map_or(Selection::All, Selection::Largest);
-    let shading = py.detach(|| -> haarshift::Result<_> {
+    let shading = py.detach(|| -> haarshift_relight::Result<_> {
         let built = DynamicScene::load(&scene, &options)?;
         let (env, angles) = lighting(&light, given, built.environment.as_ref())?;
         DynamicShader::new(&built, method, keep_light).shade(&FrameSpec {
@@ -127,13 +127,13 @@ fn lighting(
     light: &LightSpec,
     given: Option<Environment>,
     file: Option<&EnvironmentSpec>,
-) -> haarshift::Result<(Environment, [f64; 3])> {
+) -> haarshift_relight::Result<(Environment, [f64; 3])> {
     match given {
         Some(env) => Ok((env, light.angles(file))),
-        None if file.is_none() => Err(haarshift::Error::InvalidParameter {
-            name: "env",
-            reason: "give env= (the scene names no environment)".into(),
-        }),
+        None if file.is_none() => Err(haarshift_relight::Error::parameter(
+            "env",
+            "give env= (the scene names no environment)",
+        )),
         None => light.load(file),
     }
 }
@@ -141,9 +141,9 @@ fn lighting(
 /// Radiance as numpy, in the precision it was computed in.
 fn radiance_array(
     py: Python<'_>,
-    radiance: haarshift::relight::shade::Radiance,
+    radiance: haarshift_relight::shade::Radiance,
 ) -> Bound<'_, PyAny> {
-    use haarshift::relight::shade::Radiance;
+    use haarshift_relight::shade::Radiance;
     match radiance {
         Radiance::F32(r) => r.into_pyarray(py).into_any(),
         Radiance::F64(r) => r.into_pyarray(py).into_any(),
@@ -347,7 +347,7 @@ fn precompute(
             "the ground plane's cells need ground_plane=True",
         ));
     }
-    let load = || -> haarshift::Result<Scene> {
+    let load = || -> haarshift_relight::Result<Scene> {
         let mut loaded = Scene::load(&scene)?;
         match (ground_plane, ground_cells) {
             (false, _) => {}
@@ -364,7 +364,7 @@ fn precompute(
                 "a shard is written to a file: give output=",
             ));
         };
-        py.detach(|| -> haarshift::Result<()> {
+        py.detach(|| -> haarshift_relight::Result<()> {
             let loaded = load()?;
             if !force && shard_is_done(&path, &loaded, &options, shard)? {
                 return Ok(());
@@ -378,8 +378,8 @@ fn precompute(
         return Ok(path.into_pyobject(py)?.str()?.into_any().unbind());
     }
     let cache = py
-        .detach(|| -> haarshift::Result<_> {
-            let (cache, _) = haarshift::relight::precompute::precompute(load()?, &options)?;
+        .detach(|| -> haarshift_relight::Result<_> {
+            let (cache, _) = haarshift_relight::precompute::precompute(load()?, &options)?;
             if let Some(path) = &output {
                 cache.write(path, force)?;
             }
@@ -421,13 +421,13 @@ fn merge(
     force: bool,
 ) -> PyResult<Cache> {
     let cache = py
-        .detach(|| -> haarshift::Result<_> {
+        .detach(|| -> haarshift_relight::Result<_> {
             if let Some(path) = &output {
                 for shard in &shards {
                     haarshift::io::ensure_distinct_paths(shard, path)?;
                 }
                 if !force && path.exists() {
-                    return Err(haarshift::Error::OutputExists { path: path.clone() });
+                    return Err(haarshift::Error::OutputExists { path: path.clone() }.into());
                 }
             }
             let cache = merge_shards(&shards)?;
@@ -455,9 +455,9 @@ fn merge(
 pub struct Shader {
     /// Locked only to be shared with Python's threads: each call has it to itself.
     shader: std::sync::Mutex<Box<dyn LibraryShader>>,
-    mesh: haarshift::relight::Mesh,
+    mesh: haarshift_relight::Mesh,
     environment: Option<EnvironmentSpec>,
-    camera: Option<haarshift::relight::CameraSpec>,
+    camera: Option<haarshift_relight::CameraSpec>,
 }
 
 /// A shading's radiance (a numpy array) and its timing report.
@@ -466,7 +466,7 @@ type ShadeResult<'py> = (Bound<'py, PyAny>, HashMap<String, Py<PyAny>>);
 #[pymethods]
 impl Shader {
     #[new]
-    #[pyo3(signature = (cache, *, basis = "haar", brdf = "lambert", albedo = None, keep_light = None, keep_visibility = None, depth = None, brdf_rotation = "haar", level = None, keep_brdf = None, brdf_levels = None, rotation_cache = None, elevations = haarshift::relight::material::brdf::DEFAULT_ELEVATIONS, fill_cache = false, light_rotation = "source"))]
+    #[pyo3(signature = (cache, *, basis = "haar", brdf = "lambert", albedo = None, keep_light = None, keep_visibility = None, depth = None, brdf_rotation = "haar", level = None, keep_brdf = None, brdf_levels = None, rotation_cache = None, elevations = haarshift_relight::material::brdf::DEFAULT_ELEVATIONS, fill_cache = false, light_rotation = "source"))]
     #[allow(clippy::too_many_arguments)] // the keyword arguments of one Python class
     fn new(
         py: Python<'_>,
@@ -576,7 +576,7 @@ impl Shader {
             .map_err(|_| bad_argument("shader", "a previous call panicked"))?;
         let (mesh, file, camera) = (&self.mesh, self.environment.as_ref(), self.camera.as_ref());
         let shading = py
-            .detach(|| -> haarshift::Result<_> {
+            .detach(|| -> haarshift_relight::Result<_> {
                 let (env, angles) = lighting(&light, given, file)?;
                 let eye = match eye {
                     Some(e) => e,

@@ -287,7 +287,8 @@ pub(super) fn plain_trees<T: Sample, const C: usize>(
 }
 
 /// The layout whose Mallat index breaks selection ties: lat-long faces side by side.
-pub(crate) fn layout(param: Parameterization) -> FaceLayout {
+#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+pub fn layout(param: Parameterization) -> FaceLayout {
     match param.kind() {
         ParamKind::LatLong => FaceLayout::SideBySide,
         ParamKind::Cube => FaceLayout::Stacked,

@@ -10,8 +10,23 @@ use super::io_error;
 use crate::{Error, Result};
 
 /// An output being written: a temporary file beside its destination, renamed into place by
-/// [`commit`](Self::commit) and deleted if dropped before that.
-pub(crate) struct PendingFile {
+/// [`commit`](Self::commit) and deleted if dropped before that. For outputs streamed in parts
+/// ([`write_file_atomically`](super::write_file_atomically) takes them whole).
+///
+/// ```
+/// use std::io::Write;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("out.txt");
+/// let mut file = haarshift::io::PendingFile::create(&path, false).unwrap();
+/// file.writer().write_all(b"one part, ").unwrap();
+/// file.writer().write_all(b"then another").unwrap();
+/// assert!(!path.exists()); // nothing at the destination until commit
+/// file.commit().unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), b"one part, then another");
+/// // An existing output is kept unless asked to replace it.
+/// assert!(haarshift::io::PendingFile::create(&path, false).is_err());
+/// ```
+pub struct PendingFile {
     path: PathBuf,
     force: bool,
     writer: BufWriter<NamedTempFile>,
@@ -19,7 +34,7 @@ pub(crate) struct PendingFile {
 
 impl PendingFile {
     /// Starts writing `path`; fails at once when it exists and `force` is off.
-    pub(crate) fn create(path: &Path, force: bool) -> Result<Self> {
+    pub fn create(path: &Path, force: bool) -> Result<Self> {
         if !force && path.symlink_metadata().is_ok() {
             return Err(Error::OutputExists {
                 path: path.to_path_buf(),
@@ -56,12 +71,12 @@ impl PendingFile {
     }
 
     /// Where to write the content.
-    pub(crate) fn writer(&mut self) -> &mut BufWriter<NamedTempFile> {
+    pub fn writer(&mut self) -> &mut BufWriter<NamedTempFile> {
         &mut self.writer
     }
 
     /// Flushes the content to disk and renames it to the destination.
-    pub(crate) fn commit(self) -> Result<()> {
+    pub fn commit(self) -> Result<()> {
         let path = self.path;
         let temp = self
             .writer

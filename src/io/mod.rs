@@ -76,13 +76,12 @@ use crate::{Error, PlanarImage, Result, Sample, SampleDepth, ensure_finite};
 
 mod atomic;
 mod coefficients;
-pub(crate) mod mapped;
 mod npy;
 mod openexr;
 mod raster;
 mod tiff_codec;
 
-pub(crate) use atomic::PendingFile;
+pub use atomic::PendingFile;
 pub use atomic::{ensure_distinct_paths, write_file_atomically};
 pub use coefficients::{
     CoefficientFile, CoefficientMetadata, StoredCoefficients, TransformRequest,

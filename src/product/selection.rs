@@ -153,16 +153,20 @@ impl Selection {
 
 /// A detail coefficient competing for a place: its squared magnitude and tie-break index.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Candidate {
-    pub(crate) magnitude2: f64,
-    pub(crate) index: u64,
+#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+pub struct Candidate {
+    /// The coefficient's squared magnitude.
+    pub magnitude2: f64,
+    /// Its tie-break index.
+    pub index: u64,
     /// Where the caller records the choice.
-    pub(crate) slot: usize,
+    pub slot: usize,
 }
 
 /// Keeps the `k` best candidates (largest magnitude, then smallest index) in `pool`,
 /// reordering it; returns how many were kept (the first ones).
-pub(crate) fn keep_largest(pool: &mut [Candidate], k: usize) -> usize {
+#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+pub fn keep_largest(pool: &mut [Candidate], k: usize) -> usize {
     if k == 0 {
         return 0;
     }

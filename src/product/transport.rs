@@ -97,7 +97,8 @@ impl<T: Sample, const C: usize> Transport<T, C> {
     }
 
     /// Wraps a tree known to carry the weight (a product that includes a transport).
-    pub(crate) fn from_weighted_tree(tree: HaarTree<T, C>) -> Self {
+    #[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+    pub fn from_weighted_tree(tree: HaarTree<T, C>) -> Self {
         Transport { tree }
     }
 }

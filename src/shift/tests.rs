@@ -9,7 +9,7 @@ use proptest::prelude::*;
 use super::dense::{self, shift_pyramid_in_strips};
 use super::*;
 use crate::Error;
-use crate::experiments::stability::chain::whole_shifts;
+use crate::patterns::whole_shifts;
 use crate::transform::{Band, Band1d, Coefficients, Normalization, TransformSpec, haar1d, pyramid};
 
 const TOL: f64 = 1e-12;

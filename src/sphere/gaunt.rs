@@ -241,7 +241,7 @@ impl Gaunt {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::sphere_grid;
+    use haarshift_testkit::quadrature::sphere_grid;
     use std::f64::consts::PI;
 
     #[test]

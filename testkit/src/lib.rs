@@ -1,4 +1,5 @@
-//! How a test that needs an optional system component (Chromium, Embree, Slurm, node) behaves
+//! What the workspace's tests share: [`quadrature`], oracles that tests in several crates
+//! integrate against; [`fuzz`], the fuzz harnesses' scratch files and corpus replay; and how a test that needs an optional system component (Chromium, Embree, Slurm, node) behaves
 //! where that component is missing.
 //!
 //! On a machine with only Rust, a C toolchain and Python the workspace's tests pass: a test
@@ -13,6 +14,9 @@
 //! // A component that is present hands its value on.
 //! assert_eq!(haarshift_testkit::needs("chromium", Ok::<_, String>(7)), Some(7));
 //! ```
+
+pub mod fuzz;
+pub mod quadrature;
 
 use std::fmt::Display;
 use std::io::Write;
@@ -89,4 +93,35 @@ mod tests {
             None
         );
     }
+}
+
+/// Asserts that `result` is an `Err` whose error matches `pattern` and whose message contains
+/// every `needle`: the body of each crate's `assert_err!`, which names its error type's
+/// variants. A bare `is_err()` passes for any failure, including the wrong check firing first;
+/// this names the one the test expects.
+///
+/// ```
+/// let r: Result<(), std::io::Error> = Err(std::io::Error::other("disk full"));
+/// haarshift_testkit::assert_err_matches!(r, e if e.kind() == std::io::ErrorKind::Other, "full");
+/// ```
+#[macro_export]
+macro_rules! assert_err_matches {
+    ($result:expr, $pattern:pat $(if $guard:expr)? $(, $needle:expr)* $(,)?) => {
+        match $result {
+            Ok(_) => panic!("expected Err({}), got Ok", stringify!($pattern)),
+            Err(e) => {
+                assert!(
+                    matches!(&e, $pattern $(if $guard)?),
+                    "expected {}, got {e:?}",
+                    stringify!($pattern)
+                );
+                let message = e.to_string();
+                $(
+                    let needle: &str = $needle;
+                    assert!(!needle.trim().is_empty(), "an empty needle checks nothing");
+                    assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+                )*
+            }
+        }
+    };
 }

@@ -24,8 +24,8 @@ use std::time::{Duration, Instant};
 
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
-use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
-use haarshift::relight::shade::LightSpec;
+use haarshift_relight::dynamic::{DynamicOptions, DynamicScene};
+use haarshift_relight::shade::LightSpec;
 use haarshift_viewer::browser::Browser;
 use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
 use serde_json::Value;

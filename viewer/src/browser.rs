@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 use serde_json::{Value, json};
 use tungstenite::{Message, WebSocket};
 
-use haarshift::{Error, Result};
+use haarshift_relight::{Error, Result};
 
 /// The flags every launch passes: headless, no sandbox (CI runs as root), SwiftShader's
 /// WebGL, nothing fetched from the network.

@@ -9,7 +9,7 @@
 
 use std::net::{IpAddr, Ipv6Addr, SocketAddr};
 
-use haarshift::{Error, Result};
+use haarshift_relight::{Error, Result};
 
 /// A host name (lower case; an IPv6 address in brackets, in its canonical form) and a port.
 #[derive(Clone, Debug, PartialEq, Eq)]

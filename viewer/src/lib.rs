@@ -5,7 +5,7 @@
 //! its address. The page it serves (one HTML file and one script, embedded in the binary: no
 //! network at run time) draws the scene's mesh with WebGL2 and the per-vertex radiance the
 //! server computes for every view through the library's
-//! [`Shader`](haarshift::relight::shade::Shader): the same code, options and numbers as
+//! [`Shader`](haarshift_relight::shade::Shader): the same code, options and numbers as
 //! `relight render`, whose command line for the current view the page copies.
 //!
 //! | module | what it holds |

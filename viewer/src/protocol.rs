@@ -20,7 +20,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use haarshift::{Error, Result};
+use haarshift_relight::{Error, Result};
 
 /// The largest angle, in degrees, a state may carry: a hundred turns either way. Beyond it a
 /// request is refused rather than reduced, since no drag produces it.
@@ -69,7 +69,7 @@ pub struct GlbRequest {
 impl GlbRequest {
     /// Refuses an exposure `relight bake` would refuse.
     pub fn check(&self) -> Result<()> {
-        haarshift::render::baked::BakeInfo {
+        haarshift_relight::render::baked::BakeInfo {
             exposure: self.exposure,
             ..Default::default()
         }

@@ -8,15 +8,15 @@ use serde_json::json;
 
 use haarshift::faces::Parameterization;
 use haarshift::product::Selection;
-use haarshift::relight::dynamic::motion::{FrameState, MotionPath};
-use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
-use haarshift::relight::light::environment::Environment;
-use haarshift::relight::shade::LightSpec;
-use haarshift::relight::{Brdf, Mesh, SceneCache};
-use haarshift::render::camera::Camera;
-use haarshift::render::view::ViewSpec;
 use haarshift::sphere::SphereRotation;
-use haarshift::{Error, Result};
+use haarshift_relight::dynamic::motion::{FrameState, MotionPath};
+use haarshift_relight::dynamic::{DynamicOptions, DynamicScene};
+use haarshift_relight::light::environment::Environment;
+use haarshift_relight::render::camera::Camera;
+use haarshift_relight::render::view::ViewSpec;
+use haarshift_relight::shade::LightSpec;
+use haarshift_relight::{Brdf, Mesh, SceneCache};
+use haarshift_relight::{Error, Result};
 
 use crate::protocol::{PacketKind, SampleFormat, packet, sample_bytes};
 
@@ -48,7 +48,7 @@ impl Source {
 /// A scene with its lighting, loaded once and shared by every page's session.
 ///
 /// ```no_run
-/// use haarshift::relight::shade::LightSpec;
+/// use haarshift_relight::shade::LightSpec;
 /// use haarshift_viewer::ViewedScene;
 /// let light = LightSpec { env: Some("park.hdr".into()), ..LightSpec::default() };
 /// let scene = ViewedScene::load("bunny.hsr".as_ref(), &light).unwrap();
@@ -91,8 +91,8 @@ impl ViewedScene {
     /// file `motion` checked against it, and the lighting `light` names (else the file's).
     ///
     /// ```no_run
-    /// use haarshift::relight::dynamic::{DynamicOptions, DynamicScene};
-    /// use haarshift::relight::shade::LightSpec;
+    /// use haarshift_relight::dynamic::{DynamicOptions, DynamicScene};
+    /// use haarshift_relight::shade::LightSpec;
     /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// use haarshift_viewer::ViewedScene;
     /// let path = std::path::Path::new("bunny_and_ball.json");
@@ -126,8 +126,8 @@ impl ViewedScene {
         path: &Path,
         motion: Option<Vec<FrameState>>,
         light: &LightSpec,
-        environment: Option<haarshift::relight::EnvironmentSpec>,
-        camera: Option<haarshift::relight::CameraSpec>,
+        environment: Option<haarshift_relight::EnvironmentSpec>,
+        camera: Option<haarshift_relight::CameraSpec>,
     ) -> Result<ViewedScene> {
         let (env_path, angles) = light.resolve(environment.as_ref())?;
         let environment = Environment::load(&env_path)?;
@@ -149,7 +149,7 @@ impl ViewedScene {
     /// scene file's: it takes none.
     ///
     /// ```no_run
-    /// use haarshift::relight::shade::LightSpec;
+    /// use haarshift_relight::shade::LightSpec;
     /// use haarshift_viewer::ViewedScene;
     /// let light = LightSpec { env: Some("park.hdr".into()), ..LightSpec::default() };
     /// let scene = ViewedScene::load("bunny.hsr".as_ref(), &light).unwrap()
@@ -340,7 +340,7 @@ pub(crate) fn positions_bytes(mesh: &Mesh) -> Vec<u8> {
 /// transport), for the command the page copies.
 ///
 /// ```
-/// use haarshift::relight::dynamic::DynamicOptions;
+/// use haarshift_relight::dynamic::DynamicOptions;
 /// use haarshift::faces::param::{ParamKind, Parameterization};
 /// use haarshift::product::Selection;
 /// let mut options = DynamicOptions::new(Parameterization::new(ParamKind::Cube, 16).unwrap());

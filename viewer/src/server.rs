@@ -24,7 +24,7 @@ use std::time::Duration;
 use tungstenite::protocol::{Role, WebSocket};
 use tungstenite::{Message, handshake::derive_accept_key};
 
-use haarshift::{Error, Result};
+use haarshift_relight::{Error, Result};
 
 use crate::host::AllowedHosts;
 use crate::protocol::Notice;
@@ -78,7 +78,7 @@ impl Default for ViewerOptions {
 /// A viewer bound to its address, ready to [`serve`](Self::serve).
 ///
 /// ```no_run
-/// use haarshift::relight::shade::LightSpec;
+/// use haarshift_relight::shade::LightSpec;
 /// use haarshift_viewer::{Viewer, ViewerOptions, ViewedScene};
 /// let light = LightSpec { env: Some("park.hdr".into()), ..LightSpec::default() };
 /// let scene = ViewedScene::load("bunny.hsr".as_ref(), &light).unwrap();

@@ -16,19 +16,19 @@ use serde_json::json;
 use tungstenite::{Message, WebSocket};
 
 use haarshift::product::Selection;
-use haarshift::relight::dynamic::{Change, DynamicScene, Placement};
-use haarshift::relight::light::environment::LightRotation;
-use haarshift::relight::material::orient::BrdfRotation;
-use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
-use haarshift::relight::shade::glossy::GlossyOptions;
-use haarshift::relight::shade::{
+use haarshift::sphere::SphereRotation;
+use haarshift_relight::dynamic::{Change, DynamicScene, Placement};
+use haarshift_relight::light::environment::LightRotation;
+use haarshift_relight::material::orient::BrdfRotation;
+use haarshift_relight::render::baked::{BakeInfo, GltfContainer, baked_gltf};
+use haarshift_relight::render::output::write_render;
+use haarshift_relight::render::view::{Backdrop, ViewSpec};
+use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
+use haarshift_relight::shade::glossy::GlossyOptions;
+use haarshift_relight::shade::{
     FrameSpec, Method, ShadeOptions, Shader, ShaderSpec, Shading, ShadingInput,
 };
-use haarshift::render::baked::{BakeInfo, GltfContainer, baked_gltf};
-use haarshift::render::output::write_render;
-use haarshift::render::view::{Backdrop, ViewSpec};
-use haarshift::sphere::SphereRotation;
-use haarshift::{Error, Result};
+use haarshift_relight::{Error, Result};
 
 use crate::progress::{Counter, watch};
 use crate::protocol::{
@@ -201,7 +201,9 @@ impl Session {
                 tempfile::tempdir().map_err(|e| Error::parameter("picture", e.to_string()))?;
             let path = dir.path().join("view.exr");
             write_render(&image, &path, 0.0, false)?;
-            let bytes = std::fs::read(&path).map_err(|source| Error::Io { path, source })?;
+            let bytes = std::fs::read(&path).map_err(|source| {
+                haarshift_relight::Error::from(haarshift::Error::Io { path, source })
+            })?;
             let header =
                 json!({ "width": request.width, "height": request.height, "format": "exr" });
             packet(PacketKind::Picture, &header, &bytes)
@@ -691,7 +693,7 @@ fn check_dynamic(state: &ViewState) -> Result<()> {
 /// translations.
 fn placements(
     scene: &DynamicScene,
-    motion: Option<&[haarshift::relight::dynamic::motion::FrameState]>,
+    motion: Option<&[haarshift_relight::dynamic::motion::FrameState]>,
     state: &ViewState,
 ) -> Result<(Vec<Placement>, f64)> {
     let n = scene.object_count();

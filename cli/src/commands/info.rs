@@ -3,8 +3,9 @@
 use std::fmt::Write;
 use std::path::PathBuf;
 
+use haarshift::Channels;
 use haarshift::io::{CoefficientFile, FileFormat, ReadOptions, StoredCoefficients, read_image};
-use haarshift::{Channels, Result};
+use haarshift_relight::Result;
 use ndarray::ArrayView3;
 
 use super::print;

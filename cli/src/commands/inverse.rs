@@ -2,8 +2,9 @@
 
 use std::path::PathBuf;
 
+use haarshift::SampleDepth;
 use haarshift::io::{CoefficientFile, ReadOptions, StoredCoefficients};
-use haarshift::{Result, SampleDepth};
+use haarshift_relight::Result;
 
 use super::{ImageOutput, TransformFlags, choice, names};
 

@@ -1,8 +1,8 @@
 //! The `--method` flags shared by `rotate` and `shift`: which 1D shift kernel, and its
 //! parameters.
 
-use haarshift::Result;
 use haarshift::kernels::{KernelOptions, ShiftMethod};
+use haarshift_relight::Result;
 
 use super::{choice, names};
 

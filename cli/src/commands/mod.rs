@@ -4,9 +4,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use clap::builder::{PossibleValuesParser, TypedValueParser};
+use haarshift::BoundaryMode;
 use haarshift::io::TransformRequest;
 use haarshift::transform::{Layout, Levels, Normalization};
-use haarshift::{BoundaryMode, Error, Result};
+use haarshift_relight::Result;
 
 pub mod experiment;
 pub mod info;
@@ -22,7 +23,7 @@ pub mod transform;
 /// that `--help` lists the choices and the library stays the one place that defines them.
 fn choice<T>(names: impl Iterator<Item = &'static str>) -> impl TypedValueParser<Value = T>
 where
-    T: std::str::FromStr<Err = Error> + Clone + Send + Sync + 'static,
+    T: std::str::FromStr<Err = haarshift::Error> + Clone + Send + Sync + 'static,
 {
     PossibleValuesParser::new(names.collect::<Vec<_>>()).try_map(|s| s.parse::<T>())
 }
@@ -177,10 +178,12 @@ pub fn number(x: f64) -> String {
 /// error.
 pub fn print(text: &str) -> Result<()> {
     match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::Io {
-            path: PathBuf::from("<stdout>"),
-            source: e,
-        }),
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(haarshift_relight::Error::from(haarshift::Error::Io {
+                path: PathBuf::from("<stdout>"),
+                source: e,
+            }))
+        }
         _ => Ok(()),
     }
 }
@@ -195,9 +198,11 @@ pub fn refuse_outputs(inputs: &[&Path], outputs: &[&Path], force: bool) -> Resul
         }
     }
     match outputs.iter().find(|p| !force && p.exists()) {
-        Some(path) => Err(Error::OutputExists {
-            path: path.to_path_buf(),
-        }),
+        Some(path) => Err(haarshift_relight::Error::from(
+            haarshift::Error::OutputExists {
+                path: path.to_path_buf(),
+            },
+        )),
         None => Ok(()),
     }
 }

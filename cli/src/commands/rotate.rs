@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use haarshift::io::read_image;
 use haarshift::kernels::{Outside, ShiftMethod};
 use haarshift::rotate::{Canvas, RotateOptions, rotate_image};
-use haarshift::{BoundaryMode, Result, Sample, SampleDepth};
+use haarshift::{BoundaryMode, Sample, SampleDepth};
+use haarshift_relight::Result;
 
 use super::method::MethodFlags;
 use super::{Compute, ComputeFlag, ImageOutput, choice, names, number};

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use haarshift::io::read_image;
 use haarshift::kernels::ShiftMethod;
 use haarshift::shift::PlaneShift;
-use haarshift::{BoundaryMode, Result, Sample};
+use haarshift::{BoundaryMode, Sample};
+use haarshift_relight::Result;
 
 use super::method::MethodFlags;
 use super::{Compute, ComputeFlag, ImageOutput, choice, names, number};

@@ -9,7 +9,8 @@ use haarshift::faces::product::{ProductOptions, map_product};
 use haarshift::io::{CoefficientFile, FileFormat, WriteOptions, read_image};
 use haarshift::product::Selection;
 use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
-use haarshift::{Error, PlanarImage, Result, Sample, SampleDepth};
+use haarshift::{PlanarImage, Sample, SampleDepth};
+use haarshift_relight::Result;
 use indicatif::ProgressBar;
 
 use super::{Compute, ComputeFlag, ImageOutput, choice, names, print, refuse_outputs};
@@ -180,10 +181,10 @@ fn rotate_image<T: Sample>(
     };
     if args.coefficients {
         let file = rotated.coefficients.to_coefficient_file(image.depth())?;
-        file.write(&args.output, write)
+        Ok(file.write(&args.output, write)?)
     } else {
         let out = rotated.map.to_image(image.depth())?;
-        haarshift::io::write_image(&out, &args.output, write)
+        Ok(haarshift::io::write_image(&out, &args.output, write)?)
     }
 }
 
@@ -229,7 +230,11 @@ pub struct MapFlags {
 impl MapFlags {
     /// The selection of each map (one for all when one is given).
     fn selections(&self) -> Result<Vec<Selection>> {
-        Selection::from_counts(&self.keep, self.threshold, self.per_face)
+        Ok(Selection::from_counts(
+            &self.keep,
+            self.threshold,
+            self.per_face,
+        )?)
     }
 
     /// The float type given, or f64 when any map holds f64 samples and f32 otherwise.
@@ -382,7 +387,7 @@ fn integrate_as<T: Sample>(args: &IntegrateArgs) -> Result<()> {
                 compute: T::NAME,
             })
             .collect();
-        haarshift::experiments::output::write_json(json, &records, args.force)?;
+        haarshift_experiments::output::write_json(json, &records, args.force)?;
     }
     print(&text)
 }
@@ -444,14 +449,14 @@ fn product(args: ProductArgs) -> Result<()> {
         &[FileFormat::Exr, FileFormat::Hdr, FileFormat::Npy]
     };
     if !format.is_some_and(|f| allowed.contains(&f)) {
-        return Err(Error::Format {
+        return Err(haarshift_relight::Error::from(haarshift::Error::Format {
             path: args.output.clone(),
             reason: if args.coefficients {
                 "coefficients are written as .npy".into()
             } else {
                 "a product map is written as .exr, .hdr or .npy".into()
             },
-        });
+        }));
     }
     match args.maps.compute()? {
         Compute::F32 => product_as::<f32>(&args, &output, SampleDepth::F32),

@@ -2,8 +2,9 @@
 
 use std::path::PathBuf;
 
+use haarshift::Sample;
 use haarshift::io::{CoefficientFile, WriteOptions, read_image};
-use haarshift::{Result, Sample};
+use haarshift_relight::Result;
 
 use super::{Compute, TransformFlags, print, refuse_outputs};
 

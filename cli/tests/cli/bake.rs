@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use haarshift::relight::SceneCache;
-use haarshift::render::baked::BakedGltf;
+use haarshift_relight::SceneCache;
+use haarshift_relight::render::baked::BakedGltf;
 use ndarray::Array2;
 use serde_json::Value;
 

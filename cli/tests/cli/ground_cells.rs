@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use haarshift::relight::SceneCache;
+use haarshift_relight::SceneCache;
 use ndarray::Array2;
 
 use crate::common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, usage_error};

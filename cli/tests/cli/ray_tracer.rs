@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use haarshift::relight::{EMBREE_LIBRARY_VAR, RayTracer, SceneCache};
+use haarshift_relight::{EMBREE_LIBRARY_VAR, RayTracer, SceneCache};
 
 use crate::common::{p, succeeds_with_stdout, testdata, text};
 
@@ -133,7 +133,7 @@ pub fn version_and_header(bytes: &[u8]) -> (u32, serde_json::Value) {
 /// it made anew): the layout of the arrays is the same, the header only lacks the tracer and
 /// version 6's ground and refinement fields (read as absent: no ground plane, not refined).
 fn as_current_version(mut bytes: Vec<u8>) -> Vec<u8> {
-    bytes[8..12].copy_from_slice(&haarshift::relight::scene::cache::CACHE_VERSION.to_le_bytes());
+    bytes[8..12].copy_from_slice(&haarshift_relight::scene::cache::CACHE_VERSION.to_le_bytes());
     let crc = crc32fast::hash(&bytes[16..]);
     bytes[12..16].copy_from_slice(&crc.to_le_bytes());
     bytes
@@ -174,7 +174,7 @@ fn embree_loaded_at_run_time_casts_the_cache_the_linked_build_cast() {
     let (version, mut header) = version_and_header(&now);
     assert_eq!(
         (old_version, version),
-        (4, haarshift::relight::scene::cache::CACHE_VERSION)
+        (4, haarshift_relight::scene::cache::CACHE_VERSION)
     );
     let tracer = header["params"]
         .as_object_mut()

@@ -2,7 +2,7 @@
 //! refused in one line before any work, and a refined cache that renders, its ground the
 //! trailing block it records.
 
-use haarshift::relight::SceneCache;
+use haarshift_relight::SceneCache;
 
 use crate::common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, usage_error};
 

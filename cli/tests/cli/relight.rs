@@ -323,7 +323,7 @@ fn render_writes_the_image_and_vertices_and_times_each_stage() {
         &["--env", p(&env), "--keep-light", "20"],
     ));
     let linear = haarshift::io::read_image::<f32>(&exr).unwrap();
-    let srgb = haarshift::render::to_srgb8(&linear, 0.0).unwrap();
+    let srgb = haarshift_relight::render::to_srgb8(&linear, 0.0).unwrap();
     assert_eq!(srgb.planes(), image.planes());
 }
 
@@ -683,7 +683,7 @@ fn reference_refuses_bad_inputs_before_any_work() {
 
 #[test]
 fn reference_takes_glossy_and_measured_brdfs() {
-    use haarshift::relight::material::merl::MerlBrdf;
+    use haarshift_relight::material::merl::MerlBrdf;
     let dir = tempfile::tempdir().unwrap();
     let scene = sphere_on_plane(dir.path());
     let env = env32();
@@ -1044,10 +1044,10 @@ fn render_selects_the_reference_and_ambient_occlusion_by_name() {
 #[test]
 fn render_with_the_prefiltered_light_rotation_is_the_librarys_prefiltered_path() {
     use haarshift::product::Selection;
-    use haarshift::relight::SceneCache;
-    use haarshift::relight::light::environment::{Environment, LightRotation};
-    use haarshift::relight::shade::{FrameSpec, ShaderSpec, ShadingInput};
     use haarshift::sphere::SphereRotation;
+    use haarshift_relight::SceneCache;
+    use haarshift_relight::light::environment::{Environment, LightRotation};
+    use haarshift_relight::shade::{FrameSpec, ShaderSpec, ShadingInput};
     // A map 128 high and a working map 8 high: the prefiltered copy (16 high) is not the
     // source, so the two rotations differ.
     let dir = tempfile::tempdir().unwrap();

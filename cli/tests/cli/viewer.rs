@@ -867,7 +867,7 @@ fn the_results_page_shows_an_experiment_s_records_pictures_and_plot() {
 
 #[test]
 fn a_measured_brdf_given_with_merl_is_offered_by_name_and_shaded_as_relight_render_does() {
-    use haarshift::relight::material::merl::MerlBrdf;
+    use haarshift_relight::material::merl::MerlBrdf;
     let dir = tempfile::tempdir().unwrap();
     let cache = bunny_cache(dir.path());
     let env = testdata("envmaps/rooitou_park_256x128.npy");

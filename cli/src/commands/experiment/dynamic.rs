@@ -3,14 +3,14 @@
 
 use std::path::PathBuf;
 
-use haarshift::experiments::dynamic::{DynamicProtocol, DynamicRecord, Scenario, run};
-use haarshift::experiments::journal::Journal;
-use haarshift::experiments::pareto::frontier;
-use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
-use haarshift::experiments::table::{Table, significant};
-use haarshift::relight::Transform;
-use haarshift::relight::light::environment::Environment;
-use haarshift::{Error, Result};
+use haarshift_experiments::dynamic::{DynamicProtocol, DynamicRecord, Scenario, run};
+use haarshift_experiments::journal::Journal;
+use haarshift_experiments::pareto::frontier;
+use haarshift_experiments::plot::{LabeledPoint, log_log_scatter};
+use haarshift_experiments::table::{Table, significant};
+use haarshift_relight::Result;
+use haarshift_relight::Transform;
+use haarshift_relight::light::environment::Environment;
 
 use super::{OutputFlags, finish_journal, wrote};
 use crate::commands::print;
@@ -81,9 +81,11 @@ const DEFAULT_SCENARIOS: [&str; 2] = [
 
 /// `FILE:NAME:X,Y,Z`, parsed.
 fn parse_scenario(s: &str) -> Result<(PathBuf, String, [f64; 3])> {
-    let bad = || Error::InvalidParameter {
-        name: "scenario",
-        reason: format!("{s:?}: expected FILE:NAME:X,Y,Z"),
+    let bad = || {
+        haarshift_relight::Error::from(haarshift::Error::InvalidParameter {
+            name: "scenario",
+            reason: format!("{s:?}: expected FILE:NAME:X,Y,Z"),
+        })
     };
     let mut parts = s.rsplitn(3, ':');
     let (Some(to), Some(name), Some(file)) = (parts.next(), parts.next(), parts.next()) else {
@@ -149,13 +151,15 @@ pub fn run_command(args: Args) -> Result<()> {
             (Some(p), _) => (p.clone(), [0.0; 3]),
             (None, Some(e)) => (scenario.dir.join(&e.path), [e.yaw, e.pitch, e.roll]),
             (None, None) => {
-                return Err(Error::InvalidParameter {
-                    name: "env",
-                    reason: format!(
-                        "{}: the scene names no environment; give --env",
-                        file.display()
-                    ),
-                });
+                return Err(haarshift_relight::Error::from(
+                    haarshift::Error::InvalidParameter {
+                        name: "env",
+                        reason: format!(
+                            "{}: the scene names no environment; give --env",
+                            file.display()
+                        ),
+                    },
+                ));
             }
         };
         let env = Environment::load(&env_path)?;

@@ -5,14 +5,14 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use clap::Subcommand;
-use haarshift::experiments::journal::Journal;
-use haarshift::experiments::kernel_cycle::KernelCycle;
-use haarshift::experiments::output::{ReportDir, ReportWriter, write_json};
-use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
-use haarshift::experiments::rotation_cycle::{CycleRecord, MemoryMeter};
-use haarshift::experiments::table::{Table, significant};
 use haarshift::kernels::{KernelOptions, ShiftMethod};
-use haarshift::{Error, Result};
+use haarshift_experiments::journal::Journal;
+use haarshift_experiments::kernel_cycle::KernelCycle;
+use haarshift_experiments::output::{ReportDir, ReportWriter, write_json};
+use haarshift_experiments::plot::{LabeledPoint, log_log_scatter};
+use haarshift_experiments::rotation_cycle::{CycleRecord, MemoryMeter};
+use haarshift_experiments::table::{Table, significant};
+use haarshift_relight::Result;
 use serde::Serialize;
 
 use crate::commands::refuse_outputs;
@@ -145,12 +145,14 @@ impl Reports {
             return Journal::resume(&path, options);
         }
         Journal::create(&path, options, self.dir.force()).map_err(|e| match e {
-            Error::OutputExists { path } => Error::Format {
-                path,
-                reason: "holds the measurements of a stopped run: --resume goes on with it, \
+            haarshift_relight::Error::Core(haarshift::Error::OutputExists { path }) => {
+                haarshift_relight::Error::from(haarshift::Error::Format {
+                    path,
+                    reason: "holds the measurements of a stopped run: --resume goes on with it, \
                          --force starts again"
-                    .into(),
-            },
+                        .into(),
+                })
+            }
             e => e,
         })
     }
@@ -300,10 +302,12 @@ pub fn parse_methods(
         }
     }
     if methods.is_empty() {
-        return Err(Error::InvalidParameter {
-            name: "methods",
-            reason: "the list is empty".into(),
-        });
+        return Err(haarshift_relight::Error::from(
+            haarshift::Error::InvalidParameter {
+                name: "methods",
+                reason: "the list is empty".into(),
+            },
+        ));
     }
     Ok(methods)
 }

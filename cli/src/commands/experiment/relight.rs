@@ -3,10 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use haarshift::Result;
-use haarshift::experiments::journal::Journal;
-use haarshift::experiments::relight::report::{coefficient_plot, report, time_plot};
-use haarshift::experiments::relight::{Light, RelightProtocol, Subject, run};
+use haarshift_experiments::journal::Journal;
+use haarshift_experiments::relight::report::{coefficient_plot, report, time_plot};
+use haarshift_experiments::relight::{Light, RelightProtocol, Subject, run};
+use haarshift_relight::Result;
 
 use super::{OutputFlags, finish_journal, wrote};
 use crate::commands::print;

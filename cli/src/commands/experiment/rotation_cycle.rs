@@ -3,13 +3,13 @@
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-use haarshift::Result;
-use haarshift::experiments::kernel_cycle::{
+use haarshift_experiments::kernel_cycle::{
     KernelCycle, NamedPlane, default_images, run_rotation_cycle,
 };
-use haarshift::experiments::plot::{LabeledPoint, labelled_tiles};
-use haarshift::experiments::rotation_cycle::{CycleRecord, CycleRun, PROTOCOL};
-use haarshift::experiments::table::significant;
+use haarshift_experiments::plot::{LabeledPoint, labelled_tiles};
+use haarshift_experiments::rotation_cycle::{CycleRecord, CycleRun, PROTOCOL};
+use haarshift_experiments::table::significant;
+use haarshift_relight::Result;
 use ndarray::{Array2, ArrayView2, s};
 
 use super::{MethodFlags, OutputFlags, PeakMeter, Reports, cycle_table, wrote};
@@ -83,9 +83,12 @@ pub fn run(args: Args) -> Result<()> {
 /// The named images, or the default set.
 pub fn load_images(paths: &[PathBuf]) -> Result<Vec<NamedPlane>> {
     if paths.is_empty() {
-        return default_images();
+        return Ok(default_images()?);
     }
-    paths.iter().map(|p| NamedPlane::read(p)).collect()
+    Ok(paths
+        .iter()
+        .map(|p| NamedPlane::read(p))
+        .collect::<haarshift::Result<_>>()?)
 }
 
 /// Runs every method on every image with a progress bar; `each` sees every run.

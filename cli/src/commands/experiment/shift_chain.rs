@@ -3,10 +3,10 @@
 use std::fmt::Write;
 use std::path::PathBuf;
 
-use haarshift::Result;
-use haarshift::experiments::plot::LabeledPoint;
-use haarshift::experiments::shift_chain::{ChainRecord, run_chain};
-use haarshift::experiments::table::{Table, significant};
+use haarshift_experiments::plot::LabeledPoint;
+use haarshift_experiments::shift_chain::{ChainRecord, run_chain};
+use haarshift_experiments::table::{Table, significant};
+use haarshift_relight::Result;
 
 use super::rotation_cycle::load_images;
 use super::{MethodFlags, OutputFlags, Reports};

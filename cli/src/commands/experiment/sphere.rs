@@ -2,12 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use haarshift::experiments::plot::{Series, category_points};
-use haarshift::experiments::table::{Table, significant};
 use haarshift::io::read_image;
 use haarshift::sphere::experiment::{self, Record, STANDARD_ROTATIONS, default_maps};
 use haarshift::sphere::{LatLongMap, Method};
-use haarshift::{Error, Result};
+use haarshift_experiments::plot::{Series, category_points};
+use haarshift_experiments::table::{Table, significant};
+use haarshift_relight::Result;
 
 use super::{OutputFlags, wrote};
 use crate::commands::{choice, names, print};
@@ -97,15 +97,12 @@ impl LevelChoice {
     fn resolve(self, finest: usize, map: &str) -> Result<Option<usize>> {
         match self {
             LevelChoice::BelowFinest(0) => Ok(None),
-            LevelChoice::BelowFinest(k) => {
-                finest
-                    .checked_sub(k)
-                    .map(Some)
-                    .ok_or_else(|| Error::InvalidParameter {
-                        name: "levels",
-                        reason: format!("full-{k}: {map} has detail levels 0..={finest} only"),
-                    })
-            }
+            LevelChoice::BelowFinest(k) => finest.checked_sub(k).map(Some).ok_or_else(|| {
+                haarshift_relight::Error::from(haarshift::Error::InvalidParameter {
+                    name: "levels",
+                    reason: format!("full-{k}: {map} has detail levels 0..={finest} only"),
+                })
+            }),
             LevelChoice::Level(l) => Ok(Some(l)),
         }
     }

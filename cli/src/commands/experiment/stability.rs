@@ -4,13 +4,13 @@
 use std::fmt::Write;
 use std::path::PathBuf;
 
-use haarshift::Result;
-use haarshift::experiments::kernel_cycle::{NamedPlane, default_photograph};
-use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
-use haarshift::experiments::stability::{
+use haarshift_experiments::kernel_cycle::{NamedPlane, default_photograph};
+use haarshift_experiments::plot::{LabeledPoint, log_log_scatter};
+use haarshift_experiments::stability::{
     FAMILIES, StabilityConfig, StabilityRecord, StabilityReport, eight_bit, run_stability,
 };
-use haarshift::experiments::table::{Table, significant};
+use haarshift_experiments::table::{Table, significant};
+use haarshift_relight::Result;
 
 use super::{OutputFlags, PeakMeter, Reports};
 use crate::commands::print;

@@ -4,11 +4,11 @@
 use std::fmt::Write;
 use std::path::PathBuf;
 
-use haarshift::experiments::plot::{LabeledPoint, log_log_scatter};
-use haarshift::experiments::rotation_cycle::{CycleRecord, PROTOCOL};
-use haarshift::experiments::table::{Table, significant};
-use haarshift::experiments::tradeoff::{TradeoffGrid, TradeoffPoint, summarize};
-use haarshift::{Error, Result};
+use haarshift_experiments::plot::{LabeledPoint, log_log_scatter};
+use haarshift_experiments::rotation_cycle::{CycleRecord, PROTOCOL};
+use haarshift_experiments::table::{Table, significant};
+use haarshift_experiments::tradeoff::{TradeoffGrid, TradeoffPoint, summarize};
+use haarshift_relight::Result;
 use serde::Serialize;
 
 use super::rotation_cycle::{load_images, run_methods};
@@ -112,18 +112,20 @@ pub fn run(args: Args) -> Result<()> {
     // The precisions and supersampling given here are replaced by the grid's sweep.
     let configs = grid.expand(&parse_methods(args.methods.as_deref(), 0, 1, 0)?);
     if configs.is_empty() {
-        return Err(Error::InvalidParameter {
-            name: "methods",
-            reason: "no configuration to run (retained Haar with --max-retained-precision 0)"
-                .into(),
-        });
+        return Err(haarshift_relight::Error::from(
+            haarshift::Error::InvalidParameter {
+                name: "methods",
+                reason: "no configuration to run (retained Haar with --max-retained-precision 0)"
+                    .into(),
+            },
+        ));
     }
     let mut images = load_images(&args.images)?;
     if let CropSize::Side(side) = args.size {
         images = images
             .iter()
             .map(|image| image.centre_crop(side))
-            .collect::<Result<_>>()?;
+            .collect::<haarshift::Result<_>>()?;
     }
     let runs = run_methods(&images, &configs, args.steps as usize, |_| {})?;
     let points = summarize(&runs);

@@ -3,12 +3,12 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::relight::SceneCache;
-use haarshift::relight::shade::{FrameSpec, Method, ShadingInput};
-use haarshift::render::animation::{numbered_path, write_gif};
-use haarshift::render::view::Frames;
-use haarshift::render::{to_srgb8, write_render};
-use haarshift::{Error, Result};
+use haarshift_relight::Result;
+use haarshift_relight::SceneCache;
+use haarshift_relight::render::animation::{numbered_path, write_gif};
+use haarshift_relight::render::view::Frames;
+use haarshift_relight::render::{to_srgb8, write_render};
+use haarshift_relight::shade::{FrameSpec, Method, ShadingInput};
 
 use super::flags::{
     CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, rotation,
@@ -81,10 +81,12 @@ const MAX_FRAMES: usize = 3600;
 
 pub fn run(args: Args) -> Result<()> {
     if !(1..=MAX_FRAMES).contains(&args.frames) {
-        return Err(Error::InvalidParameter {
-            name: "frames",
-            reason: format!("{}: must be 1 to {MAX_FRAMES}", args.frames),
-        });
+        return Err(haarshift_relight::Error::from(
+            haarshift::Error::InvalidParameter {
+                name: "frames",
+                reason: format!("{}: must be 1 to {MAX_FRAMES}", args.frames),
+            },
+        ));
     }
     let gif = args
         .output
@@ -99,7 +101,7 @@ pub fn run(args: Args) -> Result<()> {
             .collect::<Result<_>>()?
     };
     if let Some(first) = frame_paths.first() {
-        haarshift::render::render_format(first)?;
+        haarshift_relight::render::render_format(first)?;
     }
     let outputs = if gif {
         vec![args.output.clone()]

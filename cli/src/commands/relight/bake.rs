@@ -3,12 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
-use haarshift::relight::SceneCache;
-use haarshift::relight::light::environment::LightRotation;
-use haarshift::relight::shade::{FrameSpec, Method, ShadingInput};
-use haarshift::render::baked::{BakeInfo, GltfContainer, write_baked_gltf};
-use haarshift::render::view::ViewSpec;
-use haarshift::{Error, Result};
+use haarshift_relight::Result;
+use haarshift_relight::SceneCache;
+use haarshift_relight::light::environment::LightRotation;
+use haarshift_relight::render::baked::{BakeInfo, GltfContainer, write_baked_gltf};
+use haarshift_relight::render::view::ViewSpec;
+use haarshift_relight::shade::{FrameSpec, Method, ShadingInput};
 
 use super::flags::{GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, rotation, triple};
 use crate::commands::{choice, names, print, refuse_outputs};
@@ -153,13 +153,13 @@ fn refuse_missing_folder(path: &Path) -> Result<()> {
     if folder.is_dir() {
         return Ok(());
     }
-    Err(Error::Io {
+    Err(haarshift_relight::Error::from(haarshift::Error::Io {
         path: path.to_path_buf(),
         source: std::io::Error::new(
             std::io::ErrorKind::NotFound,
             "the output directory does not exist or is not a directory",
         ),
-    })
+    }))
 }
 
 /// The file name of `path`, as the asset's extras state it.

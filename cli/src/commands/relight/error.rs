@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use haarshift::io::read_image;
 use haarshift::metrics::RelativeError;
-use haarshift::{Error, Result};
+use haarshift_relight::Result;
 use ndarray::Array2;
 
 use crate::commands::print;
@@ -40,7 +40,7 @@ pub fn run(args: Args) -> Result<()> {
     for path in &args.renders {
         let render = samples(path)?;
         if render.dim() != reference.dim() {
-            return Err(Error::Format {
+            return Err(haarshift_relight::Error::from(haarshift::Error::Format {
                 path: path.clone(),
                 reason: format!(
                     "{:?} samples, the reference {} has {:?}",
@@ -48,7 +48,7 @@ pub fn run(args: Args) -> Result<()> {
                     args.reference.display(),
                     reference.dim()
                 ),
-            });
+            }));
         }
         let e = RelativeError::between(render.view(), reference.view())
             .map_err(|e| e.in_file(&args.reference))?;

@@ -5,20 +5,20 @@ use std::path::{Path, PathBuf};
 
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
-use haarshift::relight::dynamic::fields::file::FieldStore;
-use haarshift::relight::dynamic::{DynamicBudgets, DynamicOptions};
-use haarshift::relight::light::environment::{Environment, LightRotation};
-use haarshift::relight::material::brdf::DEFAULT_ELEVATIONS;
-use haarshift::relight::material::orient::BrdfRotation;
-use haarshift::relight::precompute::shard::{Shard, ShardSpec};
-use haarshift::relight::scene::validate::MemoryBudget;
-use haarshift::relight::shade::glossy::GlossyOptions;
-use haarshift::relight::shade::{LightSpec, Method, Precision, ShadeOptions, ShaderSpec};
-use haarshift::relight::{Brdf, EnvironmentSpec, Scene, SceneCache};
-use haarshift::render::view::{Backdrop, ViewSpec};
-use haarshift::{Error, Result};
+use haarshift_relight::Result;
+use haarshift_relight::dynamic::fields::file::FieldStore;
+use haarshift_relight::dynamic::{DynamicBudgets, DynamicOptions};
+use haarshift_relight::light::environment::{Environment, LightRotation};
+use haarshift_relight::material::brdf::DEFAULT_ELEVATIONS;
+use haarshift_relight::material::orient::BrdfRotation;
+use haarshift_relight::precompute::shard::{Shard, ShardSpec};
+use haarshift_relight::render::view::{Backdrop, ViewSpec};
+use haarshift_relight::scene::validate::MemoryBudget;
+use haarshift_relight::shade::glossy::GlossyOptions;
+use haarshift_relight::shade::{LightSpec, Method, Precision, ShadeOptions, ShaderSpec};
+use haarshift_relight::{Brdf, EnvironmentSpec, Scene, SceneCache};
 
-pub use haarshift::relight::shade::frame::rotation;
+pub use haarshift_relight::shade::frame::rotation;
 
 use crate::commands::{choice, names};
 
@@ -85,7 +85,7 @@ impl SceneFlags {
 /// `--ground-cells`, checked by the library.
 fn ground_cells(s: &str) -> std::result::Result<usize, String> {
     let cells: usize = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
-    haarshift::relight::scene::check_ground_cells(cells).map_err(|e| e.to_string())?;
+    haarshift_relight::scene::check_ground_cells(cells).map_err(|e| e.to_string())?;
     Ok(cells)
 }
 
@@ -140,7 +140,8 @@ impl ShardFlags {
 
 /// `--shard`, parsed by the library.
 fn shard_spec(s: &str) -> std::result::Result<ShardSpec, String> {
-    s.parse().map_err(|e: haarshift::Error| e.to_string())
+    s.parse()
+        .map_err(|e: haarshift_relight::Error| e.to_string())
 }
 
 /// When a looked-up occlusion map is truncated.
@@ -316,10 +317,12 @@ impl MaterialFlags {
     pub fn apply(&self, albedo: &mut ndarray::Array2<f32>) -> Result<()> {
         if let Some(a) = self.albedo {
             if a.iter().any(|x| !(0.0..=1.0).contains(x)) {
-                return Err(Error::InvalidParameter {
-                    name: "albedo",
-                    reason: format!("{a:?}: every channel must be from 0 to 1"),
-                });
+                return Err(haarshift_relight::Error::from(
+                    haarshift::Error::InvalidParameter {
+                        name: "albedo",
+                        reason: format!("{a:?}: every channel must be from 0 to 1"),
+                    },
+                ));
             }
             for mut row in albedo.rows_mut() {
                 row.assign(&ndarray::arr1(&a.map(|x| x as f32)));
@@ -335,14 +338,14 @@ impl MaterialFlags {
     /// --direct-only` drops the sum first).
     pub fn apply_to_cache(&self, cache: &mut SceneCache, path: &Path) -> Result<()> {
         if let (Some(_), Some(b)) = (self.albedo, &cache.bounced) {
-            return Err(Error::Format {
+            return Err(haarshift_relight::Error::from(haarshift::Error::Format {
                 path: path.to_path_buf(),
                 reason: format!(
                     "it holds {} bounces of light made with its own albedo, so --albedo cannot \
                      change it (--direct-only shows the direct light alone)",
                     b.bounces()
                 ),
-            });
+            }));
         }
         self.apply(&mut cache.albedo)
     }
@@ -465,12 +468,14 @@ impl CameraFlags {
             .ok()
             .filter(|c| c.iter().all(|&x| x >= 0.0))
             .map(|c| Backdrop::Colour(c.map(|x| x as f32)))
-            .ok_or_else(|| Error::InvalidParameter {
-                name: "background",
-                reason: format!(
-                    "{:?}: expected `env` or a linear colour r,g,b (non-negative)",
-                    self.background
-                ),
+            .ok_or_else(|| {
+                haarshift_relight::Error::from(haarshift::Error::InvalidParameter {
+                    name: "background",
+                    reason: format!(
+                        "{:?}: expected `env` or a linear colour r,g,b (non-negative)",
+                        self.background
+                    ),
+                })
             })
     }
 }

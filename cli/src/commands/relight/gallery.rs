@@ -2,8 +2,8 @@
 
 use std::path::PathBuf;
 
-use haarshift::Result;
-use haarshift::relight::gallery::{GalleryOptions, gallery};
+use haarshift_experiments::gallery::{GalleryOptions, gallery};
+use haarshift_relight::Result;
 
 use crate::commands::print;
 

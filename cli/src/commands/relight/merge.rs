@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::Result;
-use haarshift::relight::merge_shards;
+use haarshift_relight::Result;
+use haarshift_relight::merge_shards;
 
 use super::flags::bytes;
 use crate::commands::{print, refuse_outputs};

@@ -4,7 +4,7 @@
 //! are in [`flags`].
 
 use clap::Subcommand;
-use haarshift::Result;
+use haarshift_relight::Result;
 
 pub mod animate;
 pub mod bake;

@@ -2,19 +2,19 @@
 
 use std::path::PathBuf;
 
-use haarshift::Result;
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::memory::peak_resident_bytes;
 use haarshift::product::Selection;
-use haarshift::relight::light::environment::Environment;
-use haarshift::relight::precompute::refine::{
+use haarshift_relight::Result;
+use haarshift_relight::light::environment::Environment;
+use haarshift_relight::precompute::refine::{
     MIN_EDGE_OFFSETS, Probe, Refinement, precompute_refined,
 };
-use haarshift::relight::precompute::{
+use haarshift_relight::precompute::{
     DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_bounce_shard,
     precompute_shard, shard_is_done,
 };
-use haarshift::relight::{RayTracer, Scene, SceneCache, VisibilityOptions};
+use haarshift_relight::{RayTracer, Scene, SceneCache, VisibilityOptions};
 
 use super::flags::{SceneFlags, ShardFlags, bytes};
 use crate::commands::{choice, names, print, refuse_outputs};
@@ -298,7 +298,7 @@ fn refined(
     scene: Scene,
     options: &PrecomputeOptions,
     refinement: &Refinement,
-) -> Result<(SceneCache, haarshift::relight::PrecomputeReport)> {
+) -> Result<(SceneCache, haarshift_relight::PrecomputeReport)> {
     let (cache, report, r) = precompute_refined(scene, options, refinement)?;
     let tolerance = refinement.tolerance;
     let mut end = if r.stopped_by_budget() {

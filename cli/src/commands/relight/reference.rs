@@ -3,19 +3,18 @@
 
 use std::path::PathBuf;
 
+use haarshift::SampleDepth;
 use haarshift::io::write_npy;
-use haarshift::relight::light::environment::Environment;
-use haarshift::relight::shade::reference::interreflection::{
-    self, check_bounces, check_lambertian,
-};
-use haarshift::relight::shade::reference::path_trace::{PathTraceOptions, path_trace};
-use haarshift::relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
-use haarshift::relight::{Brdf, Scene, SceneBvh};
-use haarshift::render::Camera;
-use haarshift::render::view::ViewSpec;
-use haarshift::render::{render_format, write_render};
 use haarshift::sphere::SphereRotation;
-use haarshift::{Result, SampleDepth};
+use haarshift_relight::Result;
+use haarshift_relight::light::environment::Environment;
+use haarshift_relight::render::Camera;
+use haarshift_relight::render::view::ViewSpec;
+use haarshift_relight::render::{render_format, write_render};
+use haarshift_relight::shade::reference::interreflection::{self, check_bounces, check_lambertian};
+use haarshift_relight::shade::reference::path_trace::{PathTraceOptions, path_trace};
+use haarshift_relight::shade::{FrameSpec, Method, ShaderSpec, ShadingInput};
+use haarshift_relight::{Brdf, Scene, SceneBvh};
 use ndarray::ArrayView2;
 
 use super::flags::{CameraFlags, LightFlags, MaterialFlags, SceneFlags, rotation};

@@ -4,10 +4,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use haarshift::relight::SceneCache;
-use haarshift::relight::shade::{FrameSpec, Method, ShadingInput};
-use haarshift::render::{render_format, write_render};
-use haarshift::{Result, SampleDepth};
+use haarshift::SampleDepth;
+use haarshift_relight::Result;
+use haarshift_relight::SceneCache;
+use haarshift_relight::render::{render_format, write_render};
+use haarshift_relight::shade::{FrameSpec, Method, ShadingInput};
 
 use super::flags::{
     CameraFlags, GlossyFlags, LightFlags, MaterialFlags, ShadingFlags, ms, rotation,

@@ -4,19 +4,20 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use haarshift::SampleDepth;
 use haarshift::product::Selection;
-use haarshift::relight::dynamic::fields::file::FieldStore;
-use haarshift::relight::dynamic::motion::{MotionPath, play};
-use haarshift::relight::dynamic::{Change, DynamicScene};
-use haarshift::relight::light::environment::LightRotation;
-use haarshift::relight::precompute::shard::Shard;
-use haarshift::relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
-use haarshift::relight::shade::{FrameSpec, Shader, ShaderSpec};
-use haarshift::relight::{Brdf, CameraSpec};
-use haarshift::render::animation::{numbered_path, write_gif};
-use haarshift::render::view::Frames;
-use haarshift::render::{Camera, render_format, to_srgb8, write_render};
-use haarshift::{Error, Result, SampleDepth};
+use haarshift_relight::Result;
+use haarshift_relight::dynamic::fields::file::FieldStore;
+use haarshift_relight::dynamic::motion::{MotionPath, play};
+use haarshift_relight::dynamic::{Change, DynamicScene};
+use haarshift_relight::light::environment::LightRotation;
+use haarshift_relight::precompute::shard::Shard;
+use haarshift_relight::render::animation::{numbered_path, write_gif};
+use haarshift_relight::render::view::Frames;
+use haarshift_relight::render::{Camera, render_format, to_srgb8, write_render};
+use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
+use haarshift_relight::shade::{FrameSpec, Shader, ShaderSpec};
+use haarshift_relight::{Brdf, CameraSpec};
 use ndarray::{Array2, Array3};
 
 use super::flags::{
@@ -151,14 +152,12 @@ pub struct Args {
 
 /// `--shard`: this machine's share of the shapes' fields, built (or found) in --fields-dir.
 fn build_fields(args: &Args, shard: Shard) -> Result<()> {
-    let dir = args
-        .dynamic
-        .fields_dir
-        .as_ref()
-        .ok_or_else(|| Error::InvalidParameter {
+    let dir = args.dynamic.fields_dir.as_ref().ok_or_else(|| {
+        haarshift_relight::Error::from(haarshift::Error::InvalidParameter {
             name: "shard",
             reason: "--shard builds fields into a directory: add --fields-dir DIR".into(),
-        })?;
+        })
+    })?;
     let options = args.dynamic.options()?;
     let mut store = FieldStore::new(dir, args.force);
     store.prepare()?;
@@ -182,33 +181,36 @@ fn build_fields(args: &Args, shard: Shard) -> Result<()> {
 
 pub fn run(args: Args) -> Result<()> {
     if args.bounces > 0 {
-        return Err(Error::InvalidParameter {
-            name: "bounces",
-            reason: "a dynamic scene's objects move, so their interreflections are not \
+        return Err(haarshift_relight::Error::from(
+            haarshift::Error::InvalidParameter {
+                name: "bounces",
+                reason: "a dynamic scene's objects move, so their interreflections are not \
                      precomputed: --bounces is for static scenes (relight precompute --bounces)"
-                .into(),
-        });
+                    .into(),
+            },
+        ));
     }
     if let Some(shard) = args.shard.resolve()? {
         return build_fields(&args, shard);
     }
-    let output = args
-        .output
-        .as_deref()
-        .ok_or_else(|| Error::InvalidParameter {
+    let output = args.output.as_deref().ok_or_else(|| {
+        haarshift_relight::Error::from(haarshift::Error::InvalidParameter {
             name: "output",
             reason: "-o IMAGE is needed to render (only --shard renders nothing)".into(),
-        })?;
+        })
+    })?;
     let gif = output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
     let path = args.animate.as_deref().map(MotionPath::load).transpose()?;
     let frame_count = path.as_ref().map_or(1, MotionPath::frame_count);
     if path.is_none() && gif {
-        return Err(Error::InvalidParameter {
-            name: "output",
-            reason: "a .gif needs --animate PATH.json; one frame is .png or .exr".into(),
-        });
+        return Err(haarshift_relight::Error::from(
+            haarshift::Error::InvalidParameter {
+                name: "output",
+                reason: "a .gif needs --animate PATH.json; one frame is .png or .exr".into(),
+            },
+        ));
     }
     let frame_paths: Vec<PathBuf> = match (&path, gif) {
         (Some(_), false) => (0..frame_count)
@@ -238,12 +240,15 @@ pub fn run(args: Args) -> Result<()> {
     );
     refuse_outputs(&inputs, &outputs, args.force)?;
     if args.light.light_rotation != LightRotation::Source && args.animate.is_some() {
-        return Err(Error::InvalidParameter {
-            name: "light-rotation",
-            reason: "--light-rotation prefiltered applies to one frame; an animation's lighting \
+        return Err(haarshift_relight::Error::from(
+            haarshift::Error::InvalidParameter {
+                name: "light-rotation",
+                reason:
+                    "--light-rotation prefiltered applies to one frame; an animation's lighting \
                      is rotated at the source's resolution"
-                .into(),
-        });
+                        .into(),
+            },
+        ));
     }
     let view = args.camera.view()?;
     let options = args.dynamic.options()?;

@@ -3,8 +3,8 @@
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
-use haarshift::relight::dynamic::DynamicScene;
-use haarshift::{Error, Result};
+use haarshift_relight::Result;
+use haarshift_relight::dynamic::DynamicScene;
 use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
 
 use super::flags::{DynamicFlags, LightFlags};
@@ -114,13 +114,15 @@ pub fn run(args: Args) -> Result<()> {
             ("fields-dir", args.dynamic.fields_dir.is_some()),
         ] {
             if given {
-                return Err(Error::InvalidParameter {
-                    name: flag,
-                    reason: format!(
-                        "--{flag} applies to a scene file (SCENE.json); {} is a scene cache",
-                        args.scene.display()
-                    ),
-                });
+                return Err(haarshift_relight::Error::from(
+                    haarshift::Error::InvalidParameter {
+                        name: flag,
+                        reason: format!(
+                            "--{flag} applies to a scene file (SCENE.json); {} is a scene cache",
+                            args.scene.display()
+                        ),
+                    },
+                ));
             }
         }
         ViewedScene::load(&args.scene, &args.light.spec())?

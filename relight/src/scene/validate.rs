@@ -1,0 +1,280 @@
+//! The checks a scene passes once, between parsing and everything else: what the BVH, the
+//! ground plane and the camera need of their input, stated as ranges.
+//!
+//! * **Coordinates** (vertex positions after every transform, camera positions and points
+//!   looked at) are finite and within [`MAX_COORDINATE`] of the origin. The BVH ([`obvhs`]
+//!   0.4) converts positions to f32 and assumes finite boxes whose Morton codes and surface
+//!   areas it can compute: a coordinate beyond `f32::MAX` becomes infinite there and its
+//!   wide-BVH conversion indexes out of bounds. `1e15` leaves the squares and cross products
+//!   of differences (`~1e30`) far inside f32 and f64.
+//! * **A ground plane** needs a horizontal extent (the mesh's width or depth) that is positive
+//!   and large enough against its distance from the origin for the plane's corners to differ
+//!   in f32 ([`check_ground_extent`]), so that its normal exists.
+//! * **Counts** that size allocations (generator cells, path frames) are summed and multiplied
+//!   with checked arithmetic ([`grid_vertices`]), so that no count wraps around a limit.
+//! * **Memory**: a scene file's generators make meshes of any size from a few bytes, so
+//!   their vertex count is known before anything is built, and a [`MemoryBudget`] (by
+//!   default the image readers' [`DEFAULT_MEMORY_LIMIT`], 4 GiB) refuses it when the mesh,
+//!   its BVH and what the caller will store per vertex (a precomputation's transport) would
+//!   not fit. Mesh files are not estimated: their reader's memory is bounded by the file.
+//!
+//! Failures are [`SceneError`]s naming the field; the caller adds the file.
+
+use ndarray::{ArrayView1, ArrayView2};
+
+use super::mesh::Bounds;
+use crate::Result;
+use crate::SceneError;
+
+pub use haarshift::io::DEFAULT_MEMORY_LIMIT;
+
+/// The largest distance from the origin of any coordinate in a scene; see the
+/// [module docs](self).
+///
+/// ```
+/// use haarshift_relight::scene::validate::{MAX_COORDINATE, check_point};
+/// assert!(check_point("camera", [0.0, MAX_COORDINATE, 0.0]).is_ok());
+/// let far = check_point("camera", [0.0, 1e308, 0.0]);
+/// assert!(matches!(far, Err(haarshift::Error::Scene { .. })));
+/// ```
+pub const MAX_COORDINATE: f64 = 1e15;
+
+/// The smallest horizontal extent of a mesh under a ground plane, relative to its largest
+/// coordinate: above f32's relative precision (`1.2e-7`), so the plane's corners are distinct
+/// points once the BVH converts them.
+pub const MIN_GROUND_EXTENT_RATIO: f64 = 1e-6;
+
+/// Whether `v` is finite and within [`MAX_COORDINATE`] of zero (a NaN is not).
+///
+/// ```
+/// use haarshift_relight::scene::validate::in_range;
+/// assert!(in_range(-1e15) && !in_range(2e15) && !in_range(f64::NAN));
+/// ```
+pub fn in_range(v: f64) -> bool {
+    v.abs() <= MAX_COORDINATE
+}
+
+/// Checks that `point` is finite and within [`MAX_COORDINATE`] of the origin in every
+/// coordinate; `what` names it in the error.
+pub fn check_point(what: &str, point: [f64; 3]) -> Result<()> {
+    match point.iter().find(|v| !in_range(**v)) {
+        Some(v) => Err(SceneError::OutOfRange {
+            what: what.to_owned(),
+            value: *v,
+        }
+        .into()),
+        None => Ok(()),
+    }
+}
+
+/// Checks every row of a `(V, 3)` array of vertex positions with [`check_point`]; the error
+/// names the first vertex out of range.
+pub fn check_positions(positions: ArrayView2<'_, f64>) -> Result<()> {
+    let outside = |r: &ArrayView1<'_, f64>| r.iter().any(|&v| !in_range(v));
+    match positions.outer_iter().position(|r| outside(&r)) {
+        Some(k) => {
+            let r = positions.row(k);
+            check_point(&format!("vertex {k}"), [r[0], r[1], r[2]])
+        }
+        None => Ok(()),
+    }
+}
+
+/// Checks that a ground plane can go under a mesh of bounding box `bounds`: a positive
+/// horizontal extent (width or depth) of at least [`MIN_GROUND_EXTENT_RATIO`] times its
+/// largest coordinate.
+///
+/// ```
+/// use haarshift_relight::Bounds;
+/// use haarshift_relight::scene::validate::check_ground_extent;
+/// let unit = Bounds { min: [0.0; 3], max: [1.0; 3] };
+/// assert!(check_ground_extent(&unit).is_ok());
+/// let line = Bounds { min: [1.0, 0.0, 1.0], max: [1.0, 5.0, 1.0] }; // vertical
+/// assert!(matches!(check_ground_extent(&line), Err(haarshift::Error::Scene { .. })));
+/// ```
+pub fn check_ground_extent(bounds: &Bounds) -> Result<()> {
+    let extent = (bounds.max[0] - bounds.min[0]).max(bounds.max[2] - bounds.min[2]);
+    let largest = bounds
+        .min
+        .iter()
+        .chain(&bounds.max)
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    if extent.is_finite() && extent > 0.0 && extent >= MIN_GROUND_EXTENT_RATIO * largest {
+        return Ok(());
+    }
+    Err(SceneError::NoGroundExtent { extent, largest }.into())
+}
+
+/// The vertices of a `cells x cells` grid, `(cells + 1)^2`, or `None` when that does not fit
+/// in a `usize` (checked: `cells + 1` itself may wrap).
+///
+/// ```
+/// use haarshift_relight::scene::validate::grid_vertices;
+/// assert_eq!(grid_vertices(2), Some(9));
+/// assert_eq!(grid_vertices(usize::MAX), None);
+/// assert_eq!(grid_vertices(1 << 32), None);
+/// ```
+pub fn grid_vertices(cells: usize) -> Option<usize> {
+    let side = cells.checked_add(1)?;
+    side.checked_mul(side)
+}
+
+/// The bytes one vertex of a scene holds while it is loaded, its BVH built and its cache
+/// written, about two triangles a vertex: the mesh (positions and normals in f64, albedo in
+/// f32, indices: 84 bytes), the BVH's f32 triangles and its build, and the file's copy of
+/// the mesh. Measured: `haarshift relight precompute s.json --resolution 2 -o s.hsr` with
+/// `s.json` = `{"objects":[{"generator":{"sphere":{"cells":300}}}]}` (543,606 vertices)
+/// reports a peak of 342.9 MiB, 646 bytes a vertex, about 136 of them its 8-texel transport
+/// and file copy of it; the remaining 510 leave 640 a quarter to spare.
+pub const MESH_BYTES_PER_VERTEX: u64 = 640;
+
+/// How much memory a scene and the work on it may take, checked from its vertex count
+/// before anything is built: [`MESH_BYTES_PER_VERTEX`] times the vertices, plus `per_vertex`
+/// (what the caller stores for each vertex, e.g. a precomputation's transport) times the
+/// vertices of the largest of `shards` equal shares, against `limit`; more is an
+/// [`Error::MemoryBudget`](crate::Error::MemoryBudget).
+///
+/// ```
+/// use haarshift_relight::scene::validate::{DEFAULT_MEMORY_LIMIT, MemoryBudget};
+/// let budget = MemoryBudget::default();
+/// assert_eq!((budget.limit, budget.per_vertex, budget.shards), (DEFAULT_MEMORY_LIMIT, 0, 1));
+/// assert!(budget.check("the scene", 1_000_000).is_ok());
+/// let err = budget.check("the scene", 100_000_000).unwrap_err();
+/// assert!(matches!(err, haarshift::Error::MemoryBudget { .. }));
+/// assert!(err.to_string().starts_with("the scene (100000000 vertices) needs"));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryBudget {
+    /// The most bytes the scene and its work may hold at once.
+    pub limit: u64,
+    /// Bytes each stored vertex needs beyond [`MESH_BYTES_PER_VERTEX`].
+    pub per_vertex: u64,
+    /// The work is split into this many shares of the vertices (shards), each storing
+    /// `per_vertex` for its own; 0 counts as 1.
+    pub shards: u64,
+}
+
+impl Default for MemoryBudget {
+    fn default() -> Self {
+        MemoryBudget {
+            limit: DEFAULT_MEMORY_LIMIT,
+            per_vertex: 0,
+            shards: 1,
+        }
+    }
+}
+
+impl MemoryBudget {
+    /// The bytes `vertices` vertices need under this budget (in `u128`: no count wraps).
+    pub fn needed(&self, vertices: u128) -> u128 {
+        let stored = vertices.div_ceil(u128::from(self.shards.max(1)));
+        vertices
+            .saturating_mul(u128::from(MESH_BYTES_PER_VERTEX))
+            .saturating_add(stored.saturating_mul(u128::from(self.per_vertex)))
+    }
+
+    /// Refuses `vertices` vertices whose [`needed`](Self::needed) bytes exceed the limit;
+    /// `what` names them in the error.
+    pub fn check(&self, what: &str, vertices: u128) -> Result<()> {
+        let needed = self.needed(vertices);
+        if needed <= u128::from(self.limit) {
+            return Ok(());
+        }
+        Err(crate::Error::from(haarshift::Error::MemoryBudget {
+            what: format!("{what} ({vertices} vertices)"),
+            needed,
+            budget: u128::from(self.limit),
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_beyond_the_range_or_not_finite_are_refused_by_name() {
+        check_point("vertex 0", [-MAX_COORDINATE, 0.0, MAX_COORDINATE]).unwrap();
+        for bad in [1.0001e15, -3.41e38, f64::INFINITY, f64::NAN] {
+            assert_err!(
+                check_point("vertex 3", [0.0, bad, 0.0]),
+                Scene { .. },
+                "vertex 3",
+                "1e15"
+            );
+        }
+    }
+
+    #[test]
+    fn a_ground_plane_needs_a_horizontal_extent_f32_can_tell_apart() {
+        let b = |min: [f64; 3], max: [f64; 3]| Bounds { min, max };
+        check_ground_extent(&b([0.0; 3], [1e-9, 0.0, 0.0])).unwrap();
+        check_ground_extent(&b([1e5, 0.0, 0.0], [1e5 + 1.0, 0.0, 0.0])).unwrap();
+        for bad in [
+            b([1.0; 3], [1.0; 3]),
+            b([1.0, 0.0, 1.0], [1.0, 9.0, 1.0]),
+            b([1e9, 0.0, 0.0], [1e9 + 1.0, 0.0, 0.0]),
+            b([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        ] {
+            assert_err!(
+                check_ground_extent(&bad),
+                Scene { .. },
+                "ground plane",
+                "width or depth"
+            );
+        }
+    }
+
+    #[test]
+    fn grid_counts_are_checked_not_wrapped() {
+        assert_eq!(grid_vertices(0), Some(1));
+        assert_eq!(grid_vertices(1000), Some(1_002_001));
+        let largest = (1usize << 32) - 2; // (2^32 - 1)^2 fits in 64 bits, 2^64 does not
+        assert_eq!(grid_vertices(largest), Some((largest + 1) * (largest + 1)));
+        assert_eq!(grid_vertices(largest + 1), None);
+        assert_eq!(grid_vertices(usize::MAX), None);
+    }
+
+    #[test]
+    fn a_budget_refuses_from_the_count_and_names_it() {
+        let budget = MemoryBudget {
+            limit: 1 << 20,
+            per_vertex: 1024 - MESH_BYTES_PER_VERTEX,
+            shards: 1,
+        };
+        // 1024 bytes a vertex: exactly 1024 vertices fit in 1 MiB, one more does not.
+        assert_eq!(budget.needed(1024), 1 << 20);
+        budget.check("the scene", 1024).unwrap();
+        assert_err!(
+            budget.check("the scene's generators", 1025),
+            MemoryBudget {
+                needed: 1_049_600,
+                budget: 1_048_576,
+                ..
+            },
+            "the scene's generators (1025 vertices) needs 1049600 bytes"
+        );
+        // In 4 shards each stores 256 of 1024 vertices (and the largest 257 of 1025), the
+        // mesh stays whole.
+        let sharded = MemoryBudget {
+            shards: 4,
+            ..budget
+        };
+        assert_eq!(sharded.needed(1024), 1024 * 640 + 256 * 384);
+        assert_eq!(sharded.needed(1025), 1025 * 640 + 257 * 384);
+        assert_eq!(
+            MemoryBudget {
+                shards: 0,
+                ..budget
+            }
+            .needed(10),
+            10 * 1024
+        );
+        // A count past u64 stays a count, not a wrapped small one.
+        assert_err!(
+            MemoryBudget::default().check("x", u128::from(u64::MAX) * 4),
+            MemoryBudget { .. },
+            "memory budget"
+        );
+    }
+}
