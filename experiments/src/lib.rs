@@ -9,7 +9,7 @@
 //! * [`tradeoff`]: every kernel and parameter through the rotation cycle; Pareto frontiers.
 //! * [`relight`]: every relighting method against the ray-cast truth over the sources' axes;
 //!   picture grids.
-//! * [`dynamic`]: occlusion fields and just-in-time radiance transfer against the ray-cast truth.
+//! * [`moving_objects`]: occlusion fields and just-in-time radiance transfer against the ray-cast truth.
 //! * [`output`]: CSV, JSON and PNG files side by side, written atomically.
 //! * [`journal`]: measurements written as they are made, so that a killed run resumes.
 //! * [`plot`]: the PNG plots the experiment commands write next to their CSV and JSON.
@@ -24,10 +24,10 @@ mod test_support;
 
 pub use haarshift_relight::{Error, Result};
 
-pub mod dynamic;
 pub mod gallery;
 pub mod journal;
 pub mod kernel_cycle;
+pub mod moving_objects;
 pub mod output;
 pub mod pareto;
 pub mod plot;

@@ -13,7 +13,7 @@ use haarshift_relight::light::environment::Environment;
 use haarshift_relight::precompute::shard::Shard;
 use haarshift_relight::precompute::{Order, PrecomputeOptions, precompute_shard, shard_is_done};
 use haarshift_relight::render::view::ViewSpec;
-use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader};
+use haarshift_relight::shade::dynamic_scene::{DynamicMethod, DynamicShader};
 use haarshift_relight::shade::glossy::GlossyOptions;
 use haarshift_relight::shade::{
     FrameSpec, LightSpec, Method, ShadeOptions, Shader as LibraryShader, ShaderSpec, ShadingInput,

@@ -3,7 +3,7 @@
 
 use haarshift::faces::ParamKind;
 use haarshift::faces::integrate::{IntegralMethod, IntegrateOptions, integrate as integrate_maps};
-use haarshift::faces::product::{ProductOptions, map_product};
+use haarshift::faces::map_product::{ProductOptions, map_product};
 use haarshift::product::Selection;
 use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
 use haarshift::{Sample, round_to_code};

@@ -9,7 +9,7 @@
 //! |---|---|
 //! | [`error`] | [`SceneError`]: what can be wrong with a mesh, a scene file or a cache |
 //! | [`scene`] | the ground plane, procedural generators, the JSON scene file ([`Scene`]); [`scene::mesh`] ([`Mesh`]: OBJ and PLY in, vertex normals); [`scene::cache`] ([`SceneCache`]: the versioned, checksummed `.hsr` file) |
-//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order: [`precompute::raycast`] ([`Occlusion`], answered by [`SceneBvh`]), [`precompute::shadowmap`] ([`ShadowMap`], the PRT patent's depth buffer), [`precompute::visibility`] ([`vertex_major`], [`direction_major`]), [`precompute::transport`] ([`TransportSet`]), [`precompute::sparse`] (many sparse Haar functions in flat arrays) |
+//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order: [`precompute::raycast`] ([`Occlusion`], answered by [`SceneBvh`]), [`precompute::shadowmap`] ([`ShadowMap`], the PRT patent's depth buffer), [`precompute::visibility`] ([`vertex_major`], [`direction_major`]), [`precompute::transport_set`] ([`TransportSet`]), [`precompute::sparse`] (many sparse Haar functions in flat arrays) |
 //! | [`light`] | [`light::environment`]: the lighting loaded, downsampled by solid-angle-weighted means, rotated; [`light::lighting`] ([`Lighting`]): its kept Haar coefficients, RGB, in Mallat order |
 //! | [`material`] | [`material::brdf`] ([`Brdf`]: Lambert, Phong, Blinn-Phong, local copies), [`material::merl`] (measured BRDFs), [`material::orient`] (a BRDF into a vertex's frame: Haar, spatial, reference or direct) |
 //! | [`shade`](mod@shade) | per-vertex outgoing radiance behind one [`Shader`](shade::Shader), built from a [`ShaderSpec`](shade::ShaderSpec): Lambertian Haar ([`PreparedTransport`]), glossy Haar with the rotation cache ([`shade::glossy`]), spherical harmonics ([`shade_sh`], [`PhongSh`]), the ground truth by direct quadrature ([`reference()`]), ambient occlusion, dynamic scenes |
@@ -30,23 +30,22 @@ mod test_support;
 
 pub mod dynamic;
 pub mod error;
-pub mod harmonics;
 pub mod light;
 pub mod mapped;
 pub mod material;
 pub mod precompute;
 pub mod render;
 pub mod scene;
+pub mod sh_transfer;
 pub mod shade;
 
 pub use error::{Error, Result, SceneError};
-pub use harmonics::ShTransfer;
 pub use light::lighting::Lighting;
 pub use material::brdf::Brdf;
 pub use precompute::embree::EMBREE_LIBRARY_VAR;
 pub use precompute::raycast::{Hit, Occlusion, RayTracer, SceneBvh};
 pub use precompute::shadowmap::ShadowMap;
-pub use precompute::transport::TransportSet;
+pub use precompute::transport_set::TransportSet;
 pub use precompute::visibility::{
     PrecomputeReport, VisibilityOptions, direction_major, ray_offset, vertex_major, vertex_range,
 };
@@ -59,9 +58,10 @@ pub use scene::{
     CameraSpec, EnvironmentSpec, Generator, Material, Scene, SceneFile, SceneObject, Transform,
     add_ground_plane,
 };
-pub use shade::harmonics::{PhongSh, non_zonal_material, shade_sh, shade_sh_glossy};
+pub use sh_transfer::ShTransfer;
 pub use shade::reference::{ReferenceOptions, ReferenceReport, ReferenceVisibility, reference};
-pub use shade::{PreparedTransport, ShadeOptions, shade};
+pub use shade::sh::{PhongSh, non_zonal_material, shade_sh, shade_sh_glossy};
+pub use shade::{PreparedTransport, ShadeOptions, shade_lambertian};
 
 /// The [`SceneError`] of a refusal that names the file `path`; panics on anything else.
 #[cfg(test)]

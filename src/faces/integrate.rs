@@ -194,7 +194,7 @@ fn check_maps<T: Sample>(maps: &[LatLongMap<T>]) -> Result<usize> {
 }
 
 /// Checks that `map` can join maps of height `height` (the first map's) in [`integrate`] or
-/// [`map_product`](super::product::map_product): its height is `height`, a power of two. A caller
+/// [`map_product`](super::map_product::map_product): its height is `height`, a power of two. A caller
 /// that reads maps one by one can name the file at fault.
 ///
 /// ```

@@ -11,7 +11,7 @@
 pub mod convert;
 pub mod cube;
 pub mod integrate;
+pub mod map_product;
 pub mod param;
-pub mod product;
 
 pub use param::{ParamKind, Parameterization, SphereMap};

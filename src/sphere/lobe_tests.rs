@@ -5,9 +5,9 @@
 
 use std::f64::consts::PI;
 
-use super::experiment::weighted_rms;
 use super::latlong::angles;
 use super::level_tests::block_means;
+use super::map_error::weighted_rms;
 use super::*;
 
 /// `(e + 2) / (2 pi) max(0, axis . d)^e`, the energy-normalised Phong lobe.

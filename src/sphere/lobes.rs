@@ -15,7 +15,7 @@
 
 use std::time::Instant;
 
-use super::experiment::{relative_energy_error, weighted_rms};
+use super::map_error::{relative_energy_error, weighted_rms};
 use super::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
 use crate::Result;
 
@@ -43,7 +43,7 @@ pub const AXES: [(&str, [f64; 3]); 2] = [
 ];
 
 /// The rotations measured, as `(yaw, pitch, roll)` in degrees: pitches of 30, 45, 60 and 90
-/// degrees and the compound rotation of [`STANDARD_ROTATIONS`](super::experiment::STANDARD_ROTATIONS).
+/// degrees and the compound rotation of [`STANDARD_ROTATIONS`](super::map_error::STANDARD_ROTATIONS).
 pub const ROTATIONS: [(f64, f64, f64); 5] = [
     (0.0, 30.0, 0.0),
     (0.0, 45.0, 0.0),

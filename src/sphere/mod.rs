@@ -44,11 +44,11 @@
 
 pub mod chain_rule;
 pub mod coefficients;
-pub mod experiment;
 pub mod gaunt;
 pub mod harmonics;
 pub mod latlong;
 pub mod lobes;
+pub mod map_error;
 pub mod reference;
 pub mod resample;
 pub mod rotation;
@@ -57,26 +57,6 @@ pub mod yaw;
 pub use coefficients::SphereCoefficients;
 pub use latlong::LatLongMap;
 pub use rotation::SphereRotation;
-
-/// The face-map modules before they moved to [`crate::faces`], kept for one release
-/// (CHANGELOG.md lists them).
-macro_rules! moved {
-    ($($old:ident, $note:literal;)*) => {$(
-        #[doc(hidden)]
-        #[deprecated(note = $note)]
-        pub mod $old {
-            pub use crate::faces::$old::*;
-        }
-    )*};
-}
-
-moved! {
-    convert, "moved to `haarshift::faces::convert`";
-    cube, "moved to `haarshift::faces::cube`";
-    integrate, "moved to `haarshift::faces::integrate`";
-    param, "moved to `haarshift::faces::param`";
-    product, "moved to `haarshift::faces::product`";
-}
 
 use crate::named::named_enum;
 use crate::{Error, Result, Sample};
@@ -162,7 +142,7 @@ pub struct Rotated<T> {
 /// let r = SphereRotation::from_degrees(30.0, 20.0, 10.0).unwrap();
 /// let truth = rotate_map(&f, &r, &SphereOptions { method: Method::Reference, ..Default::default() }).unwrap();
 /// let haar = rotate_map(&f, &r, &SphereOptions::default()).unwrap();
-/// let rms = haarshift::sphere::experiment::weighted_rms(&haar.map, &truth.map).unwrap();
+/// let rms = haarshift::sphere::map_error::weighted_rms(&haar.map, &truth.map).unwrap();
 /// assert!(rms < 0.01);
 /// ```
 pub fn rotate_map<T: Sample>(

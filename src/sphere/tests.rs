@@ -9,8 +9,8 @@ use ndarray::Array3;
 use super::chain_rule::{
     CoefficientIndex, DifferenceFields, rotate_selected, set_mean_from_energy,
 };
-use super::experiment::{relative_energy_error, weighted_rms};
 use super::latlong::{angles, direction, pixel_centre};
+use super::map_error::{relative_energy_error, weighted_rms};
 use super::*;
 use crate::transform::Band;
 

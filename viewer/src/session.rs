@@ -23,7 +23,7 @@ use haarshift_relight::material::orient::BrdfRotation;
 use haarshift_relight::render::baked::{BakeInfo, GltfContainer, baked_gltf};
 use haarshift_relight::render::output::write_render;
 use haarshift_relight::render::view::{Backdrop, ViewSpec};
-use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
+use haarshift_relight::shade::dynamic_scene::{DynamicMethod, DynamicShader, glossy_material};
 use haarshift_relight::shade::glossy::GlossyOptions;
 use haarshift_relight::shade::{
     FrameSpec, Method, ShadeOptions, Shader, ShaderSpec, Shading, ShadingInput,

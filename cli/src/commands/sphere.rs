@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use clap::Subcommand;
 use haarshift::faces::ParamKind;
 use haarshift::faces::integrate::{IntegralMethod, IntegrateOptions, check_size};
-use haarshift::faces::product::{ProductOptions, map_product};
+use haarshift::faces::map_product::{ProductOptions, map_product};
 use haarshift::io::{CoefficientFile, FileFormat, WriteOptions, read_image};
 use haarshift::product::Selection;
 use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};

@@ -8,7 +8,7 @@ use crate::common::{
 };
 
 use haarshift::io::{CoefficientFile, WriteOptions, read_image, write_image};
-use haarshift::sphere::experiment::{self, STANDARD_ROTATIONS};
+use haarshift::sphere::map_error::{self, STANDARD_ROTATIONS};
 use haarshift::sphere::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
 use haarshift::{Channels, PlanarImage, SampleDepth};
 use ndarray::Array3;
@@ -266,7 +266,7 @@ fn experiment_writes_csv_json_and_plot_with_the_library_numbers() {
     };
     let got = parse(&records);
     assert_eq!(got, parse(&out_dir.join("sphere.json")));
-    let want = experiment::run(
+    let want = map_error::run(
         MAP_NAME,
         &test_map(),
         &STANDARD_ROTATIONS,

@@ -6,7 +6,7 @@
 //! **What is computed.** A Lambertian vertex `v` of albedo `a` reflects
 //! `B_v = a / pi x integral of T_v x L x prod_(k != own) O_k`, Sun 2006 eq. 3.1-3.3 with the
 //! BRDF constant: `T_v` the vertex's own transport (its object's self-visibility, the ground
-//! plane's occlusion where the scene has one, cosine and solid angle; [`TransportSet`](crate::precompute::transport::TransportSet)
+//! plane's occlusion where the scene has one, cosine and solid angle; [`TransportSet`](crate::precompute::transport_set::TransportSet)
 //! semantics), `L` the lighting, `O_k` object `k`'s occlusion looked up at the vertex
 //! ([`OcclusionField::lookup`], with the options' [`Truncation`]); a vertex beyond an object's
 //! outermost shell takes `O_k = 1`. Each factor is truncated as the options say (the lighting
@@ -377,14 +377,6 @@ pub use options::{DynamicBudgets, DynamicOptions};
 pub use placement::Placement;
 use placement::{columns, place_mesh, turned};
 use shading::{Receiver, Scratch, light_sparse, light_tree, radiance};
-
-/// The old name of [`JustInTimeTransfer`], kept for one release.
-#[deprecated(note = "renamed `haarshift_relight::dynamic::JustInTimeTransfer`")]
-pub type Jrt<T> = JustInTimeTransfer<T>;
-
-/// The old name of [`TransferReport`], kept for one release.
-#[deprecated(note = "renamed `haarshift_relight::dynamic::TransferReport`")]
-pub type JrtReport = TransferReport;
 
 #[cfg(test)]
 mod tests;

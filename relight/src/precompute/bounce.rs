@@ -71,15 +71,15 @@ use std::time::Instant;
 use ndarray::{ArrayView2, ArrayView3};
 
 use crate::Mesh;
-use crate::harmonics::ShTransfer;
 use crate::material::brdf::check_albedo;
 use crate::precompute::cast::{BATCH, Caster, Visible, cast_vertices, working_bytes};
 use crate::precompute::combine::{RowCombiner, Terms, Weights};
 use crate::precompute::raycast::{Hit, SceneBvh};
-use crate::precompute::transport::Encoder;
-use crate::precompute::transport::{Encoded, TransportSet};
+use crate::precompute::transport_set::Encoder;
+use crate::precompute::transport_set::{Encoded, TransportSet};
 use crate::precompute::visibility::{PrecomputeReport, VisibilityOptions, texel_directions};
 use crate::scene::mesh::{cross, dot, sub};
+use crate::sh_transfer::ShTransfer;
 use crate::{Error, Result};
 use haarshift::faces::integrate::layout;
 use haarshift::product::Selection;

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use crate::Mesh;
 use crate::Result;
 use crate::precompute::raycast::Occlusion;
-use crate::precompute::transport::{Encoded, Encoder};
+use crate::precompute::transport_set::{Encoded, Encoder};
 use crate::precompute::visibility::{VisibilityOptions, ray_offset, texel_directions};
 use crate::scene::mesh::dot;
 use haarshift::faces::Parameterization;

@@ -23,7 +23,7 @@ pub mod refine;
 pub mod shadowmap;
 pub mod shard;
 pub mod sparse;
-pub mod transport;
+pub mod transport_set;
 pub mod visibility;
 
 use haarshift::named_enum;

@@ -37,7 +37,7 @@
 //! differ by as little as they receive.
 //!
 //! **The splits** are conforming longest-edge bisections
-//! ([`scene::refine`](crate::scene) in the crate's source: every triangle on a split
+//! ([`scene::bisect`](crate::scene) in the crate's source: every triangle on a split
 //! edge is split at its one midpoint, no T-junctions; new vertices get the interpolated normal
 //! and albedo; the objects' vertices, then the ground plane's, originals first in each). A
 //! round marks every edge above `TOL` among those touching the vertices the last round made
@@ -97,8 +97,8 @@ use crate::light::environment::{Environment, SphereMapping};
 use crate::precompute::shard::Shard;
 use crate::precompute::visibility::{PrecomputeReport, ray_offset, texel_directions, vertex_range};
 use crate::precompute::{Order, PrecomputeOptions};
+use crate::scene::bisect::{Bisection, Edge};
 use crate::scene::mesh::dot;
-use crate::scene::refine::{Bisection, Edge};
 use crate::{Error, Result};
 use crate::{RefineRecord, Scene, SceneBvh, SceneCache, TransportSet};
 use haarshift::faces::Parameterization;

@@ -1,8 +1,8 @@
 use super::*;
 use crate::light::environment::Environment;
 use crate::precompute::precompute;
-use crate::scene::refine::Bisection;
-use crate::shade::lambert::{ShadeOptions, shade};
+use crate::scene::bisect::Bisection;
+use crate::shade::lambert::{ShadeOptions, shade_lambertian};
 use crate::{Generator, RayTracer, VisibilityOptions};
 use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
@@ -189,7 +189,7 @@ fn the_probe_s_radiance_is_the_shaded_one_and_an_open_vertex_s_its_unoccluded_su
     let (cache, _) = precompute(ball_on_ground(), &o).unwrap();
     // Against the Lambertian shading of the same transport (albedo pi: radiance <T, L>).
     let albedo = Array2::<f32>::from_elem((cache.mesh.vertex_count(), 3), std::f32::consts::PI);
-    let shaded = shade::<f64>(
+    let shaded = shade_lambertian::<f64>(
         &cache.transport,
         albedo.view(),
         &probe.lighting,

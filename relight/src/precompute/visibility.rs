@@ -25,7 +25,7 @@
 //!   Texel centres only (`samples = 1`).
 //!
 //! With [`VisibilityOptions::sh_bands`], both also project every vertex's values onto spherical
-//! harmonics ([`harmonics`](crate::harmonics): `t_i = sum_t V cos Y_i(w_t) dOmega_t`, the
+//! harmonics ([`harmonics`](crate::sh_transfer): `t_i = sum_t V cos Y_i(w_t) dOmega_t`, the
 //! basis tabulated once per texel and shared by all threads); the returned set carries the
 //! transfer ([`TransportSet::sh`]).
 //!
@@ -39,14 +39,14 @@ use ndarray::Array3;
 use rayon::prelude::*;
 
 use crate::Mesh;
-use crate::harmonics::check_bands;
 use crate::precompute::cast::{
     Occluding, Visible, cast_vertices, origin_and_normal, working_bytes,
 };
 use crate::precompute::raycast::{Occlusion, RayTracer};
 use crate::precompute::shadowmap::ShadowMap;
-use crate::precompute::transport::{Encoded, Encoder, TransportSet};
+use crate::precompute::transport_set::{Encoded, Encoder, TransportSet};
 use crate::scene::mesh::dot;
+use crate::sh_transfer::check_bands;
 use crate::{Error, Result};
 use haarshift::faces::Parameterization;
 use haarshift::product::Selection;
@@ -72,8 +72,8 @@ pub struct VisibilityOptions {
     pub seed: u64,
     /// Also project every vertex's transport onto this many bands of spherical harmonics
     /// (`--sh-bands B`: degrees `0..B`, `B^2` coefficients, 1 to
-    /// [`MAX_SH_BANDS`](crate::harmonics::MAX_SH_BANDS)); the set then carries an
-    /// [`ShTransfer`](crate::harmonics::ShTransfer).
+    /// [`MAX_SH_BANDS`](crate::sh_transfer::MAX_SH_BANDS)); the set then carries an
+    /// [`ShTransfer`](crate::sh_transfer::ShTransfer).
     pub sh_bands: Option<usize>,
     /// Report progress to the installed [reporter](haarshift::progress) (nothing is drawn without one).
     pub progress: bool,

@@ -86,10 +86,6 @@ pub struct LitMesh<'a> {
     pub radiance: ArrayView2<'a, f32>,
 }
 
-/// The old name of [`LitMesh`], kept for one release.
-#[deprecated(note = "renamed `haarshift_relight::render::raster::LitMesh`")]
-pub type Mesh<'a> = LitMesh<'a>;
-
 impl LitMesh<'_> {
     /// Checks shapes, indices and values.
     fn check(&self) -> Result<()> {

@@ -50,13 +50,13 @@ use std::path::Path;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
-use crate::harmonics::ShTransfer;
 use crate::mapped::Buffer;
 use crate::mapped::MappedFile;
 use crate::precompute::bounce::{BouncedTransport, is_grey};
-use crate::precompute::transport::TransportSet;
+use crate::precompute::transport_set::TransportSet;
 use crate::scene::framed::{Format, Reader};
 use crate::scene::{CameraSpec, EnvironmentSpec};
+use crate::sh_transfer::ShTransfer;
 use crate::{Error, Result};
 use crate::{Mesh, SceneError};
 use haarshift::faces::{ParamKind, Parameterization};

@@ -59,6 +59,7 @@
 
 mod asset;
 pub(crate) mod asset_path;
+pub(crate) mod bisect;
 pub mod cache;
 pub mod cache_shard;
 mod file;
@@ -69,7 +70,6 @@ mod ground;
 pub mod mesh;
 mod mtl;
 mod obj;
-pub(crate) mod refine;
 pub(crate) mod shapes;
 pub mod texture;
 pub mod validate;

@@ -14,23 +14,23 @@
 //! |---|---|---|
 //! | [`lambert`] | [`LambertShader`](lambert::LambertShader): one sparse dot per vertex | [`PreparedTransport`] |
 //! | [`glossy`] | [`GlossyHaarShader`](glossy::GlossyHaarShader): the triple product with the rotated BRDF | [`GlossyShader`](glossy::GlossyShader), the rotation cache |
-//! | [`harmonics`] | [`ShShader`](harmonics::ShShader): Microsoft 2003's spherical-harmonic baseline | [`shade_sh`](harmonics::shade_sh), [`PhongSh`](harmonics::PhongSh) |
+//! | [`sh`] | [`ShShader`](sh::ShShader): Microsoft 2003's spherical-harmonic baseline | [`shade_sh`](sh::shade_sh), [`PhongSh`](sh::PhongSh) |
 //! | [`mod@reference`] | [`ReferenceShader`](reference::ReferenceShader): the ground truth | [`reference()`](reference::reference) |
 //! | [`ambient`] | [`AmbientShader`](ambient::AmbientShader): `albedo / pi x <T, 1>` | [`PreparedTransport`] under a white sky |
-//! | [`dynamic`] | [`DynamicShader`](dynamic::DynamicShader): moving objects (Sun 2006) | [`DynamicScene`](crate::dynamic::DynamicScene) |
+//! | [`dynamic_scene`] | [`DynamicShader`](dynamic_scene::DynamicShader): moving objects (Sun 2006) | [`DynamicScene`](crate::dynamic::DynamicScene) |
 //! | [`frame`] | [`FrameSpec`], [`LightSpec`]: the lighting of a frame, resolved | |
 
 pub mod ambient;
-pub mod dynamic;
+pub mod dynamic_scene;
 pub mod frame;
 pub mod glossy;
-pub mod harmonics;
 pub mod lambert;
 pub mod reference;
+pub mod sh;
 mod spec;
 
 pub use frame::{FrameSpec, LightSpec};
-pub use lambert::{PreparedTransport, ShadeOptions, shade};
+pub use lambert::{PreparedTransport, ShadeOptions, shade_lambertian};
 pub(crate) use lambert::{select_kept, within_depth};
 pub use spec::{Method, Precision, ShaderSpec, ShadingInput};
 

@@ -313,7 +313,7 @@ fn dispatch(line: &str) -> Option<String> {
     // A method or a material named in a match arm, a comparison or a pattern (naming one to
     // build a spec or a protocol is not dispatch).
     let methods = Method::ALL.iter().map(|m| format!("Method::{m:?}")).chain(
-        dynamic::DynamicMethod::ALL
+        dynamic_scene::DynamicMethod::ALL
             .iter()
             .map(|m| format!("DynamicMethod::{m:?}")),
     );

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use haarshift_experiments::dynamic::{DynamicProtocol, DynamicRecord, Scenario, run};
 use haarshift_experiments::journal::Journal;
+use haarshift_experiments::moving_objects::{DynamicProtocol, DynamicRecord, Scenario, run};
 use haarshift_experiments::pareto::frontier;
 use haarshift_experiments::plot::{LabeledPoint, log_log_scatter};
 use haarshift_experiments::table::{Table, significant};

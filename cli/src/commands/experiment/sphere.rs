@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use haarshift::io::read_image;
-use haarshift::sphere::experiment::{self, Record, STANDARD_ROTATIONS, default_maps};
+use haarshift::sphere::map_error::{self, Record, STANDARD_ROTATIONS, default_maps};
 use haarshift::sphere::{LatLongMap, Method};
 use haarshift_experiments::plot::{Series, category_points};
 use haarshift_experiments::table::{Table, significant};
@@ -152,7 +152,7 @@ pub fn run(args: Args) -> Result<()> {
         for rotation in STANDARD_ROTATIONS {
             let label = rotation_label(rotation);
             bar.set_message(format!("{name}: {label}"));
-            let rows = experiment::run(name, map, &[rotation], &methods, args.samples)?;
+            let rows = map_error::run(name, map, &[rotation], &methods, args.samples)?;
             categories.push(if maps.len() > 1 {
                 format!("{name}: {label}")
             } else {

@@ -15,7 +15,7 @@ use haarshift_relight::precompute::shard::Shard;
 use haarshift_relight::render::animation::{numbered_path, write_gif};
 use haarshift_relight::render::view::Frames;
 use haarshift_relight::render::{Camera, render_format, to_srgb8, write_render};
-use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader, glossy_material};
+use haarshift_relight::shade::dynamic_scene::{DynamicMethod, DynamicShader, glossy_material};
 use haarshift_relight::shade::{FrameSpec, Shader, ShaderSpec};
 use haarshift_relight::{Brdf, CameraSpec};
 use ndarray::{Array2, Array3};

@@ -58,7 +58,7 @@ use crate::Mesh;
 use crate::precompute::cast::f32x3;
 use crate::precompute::raycast::{Occlusion, SceneBvh};
 use crate::precompute::sparse::SparseRows;
-use crate::precompute::transport::encode;
+use crate::precompute::transport_set::encode;
 use crate::precompute::visibility::{ray_offset, texel_directions};
 use crate::{Error, Result};
 use haarshift::faces::cube::{face_direction, face_point};

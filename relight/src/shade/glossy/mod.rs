@@ -65,7 +65,7 @@ use crate::Mesh;
 use crate::light::lighting::Lighting;
 use crate::material::brdf::Brdf;
 use crate::material::orient::{BrdfRotation, Frame, Orientation, to_pole, unit};
-use crate::precompute::transport::TransportSet;
+use crate::precompute::transport_set::TransportSet;
 use crate::{Error, Result};
 use haarshift::Sample;
 use haarshift::faces::Parameterization;

@@ -48,7 +48,7 @@ use super::{
 use crate::light::lighting::Lighting;
 use crate::material::brdf::check_albedo;
 use crate::precompute::sparse::SparseRows;
-use crate::precompute::transport::TransportSet;
+use crate::precompute::transport_set::TransportSet;
 use crate::{Error, Result};
 use haarshift::Sample;
 use haarshift::faces::Parameterization;
@@ -384,7 +384,7 @@ fn add_run<T: Sample>(total: &mut [f64; 3], acc: [T::Quad; LANES]) {
 ///
 /// ```
 /// use haarshift::product::Selection;
-/// use haarshift_relight::{Lighting, ShadeOptions, TransportSet, shade};
+/// use haarshift_relight::{Lighting, ShadeOptions, TransportSet, shade_lambertian};
 /// use haarshift::faces::param::{ParamKind, Parameterization, SphereMap};
 /// use ndarray::{Array2, Array3};
 /// let param = Parameterization::new(ParamKind::Cube, 4).unwrap();
@@ -393,15 +393,15 @@ fn add_run<T: Sample>(total: &mut [f64; 3], acc: [T::Quad; LANES]) {
 /// let one = SphereMap::<f64>::from_fn(param, 1, |_, out| out[0] = 1.0).unwrap();
 /// let light = Lighting::from_map(&one, Selection::All).unwrap();
 /// let albedo = Array2::from_elem((1, 3), 0.5f32);
-/// let b = shade::<f32>(&set, albedo.view(), &light, &ShadeOptions::default()).unwrap();
+/// let b = shade_lambertian::<f32>(&set, albedo.view(), &light, &ShadeOptions::default()).unwrap();
 /// assert!((b[[0, 2]] - 2.0).abs() < 1e-5); // 0.5 / pi x 4 pi
 /// // A lighting in another parameterisation is refused.
 /// let other = Parameterization::new(ParamKind::Cube, 8).unwrap();
 /// let wrong = Lighting::from_map(&SphereMap::from_fn(other, 1, |_, o| o[0] = 1.0).unwrap(),
 ///                                Selection::All).unwrap();
-/// assert!(shade::<f32>(&set, albedo.view(), &wrong, &ShadeOptions::default()).is_err());
+/// assert!(shade_lambertian::<f32>(&set, albedo.view(), &wrong, &ShadeOptions::default()).is_err());
 /// ```
-pub fn shade<T: Sample>(
+pub fn shade_lambertian<T: Sample>(
     set: &TransportSet,
     albedo: ArrayView2<'_, f32>,
     lighting: &Lighting,

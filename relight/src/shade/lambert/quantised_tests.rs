@@ -3,7 +3,7 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
 use super::*;
-use crate::precompute::transport::Encoded;
+use crate::precompute::transport_set::Encoded;
 use crate::{ShadeOptions, TransportSet};
 use haarshift::faces::param::{ParamKind, SphereMap};
 use haarshift::product::Selection;

@@ -111,7 +111,7 @@ fn an_unoccluded_sphere_returns_its_albedo() {
     for n in [16, 32] {
         let param = latlong(n);
         let set = precompute(&mesh, param);
-        let b = shade::<f64>(
+        let b = shade_lambertian::<f64>(
             &set,
             grey(mesh.vertex_count(), a).view(),
             &constant_lighting(param, 1.0),
@@ -155,7 +155,7 @@ fn a_point_under_a_floating_box_sees_one_minus_the_form_factor() {
     for n in [16, 32, 64, 128] {
         let param = latlong(n);
         let set = precompute(&mesh, param);
-        let b = shade::<f64>(
+        let b = shade_lambertian::<f64>(
             &set,
             grey(mesh.vertex_count(), a as f32).view(),
             &constant_lighting(param, 1.0),
@@ -236,8 +236,8 @@ fn full_coefficients_equal_the_pixel_quadrature() {
         let set = precompute(&mesh, param);
         let light = Lighting::from_map(&map, Selection::All).unwrap();
         let options = ShadeOptions::default();
-        let in_f64 = shade::<f64>(&set, albedo.view(), &light, &options).unwrap();
-        let in_f32 = shade::<f32>(&set, albedo.view(), &light, &options).unwrap();
+        let in_f64 = shade_lambertian::<f64>(&set, albedo.view(), &light, &options).unwrap();
+        let in_f32 = shade_lambertian::<f32>(&set, albedo.view(), &light, &options).unwrap();
         let e64 = relative_rms_error(in_f64.view(), want.view()).unwrap();
         let e32 = relative_rms_error(in_f32.mapv(f64::from).view(), want.view()).unwrap();
         eprintln!(
@@ -324,14 +324,14 @@ fn the_error_shrinks_as_more_coefficients_are_kept_and_vanishes_at_all() {
     let full_light = Lighting::new(&env, param, &identity, Selection::All).unwrap();
     let by_light = truncation_errors(&ks, |keep| {
         let light = Lighting::new(&env, param, &identity, keep).unwrap();
-        shade::<f64>(&set, albedo.view(), &light, &ShadeOptions::default()).unwrap()
+        shade_lambertian::<f64>(&set, albedo.view(), &light, &ShadeOptions::default()).unwrap()
     });
     let by_visibility = truncation_errors(&ks, |keep| {
         let options = ShadeOptions {
             keep_visibility: Some(keep),
             ..ShadeOptions::default()
         };
-        shade::<f64>(&set, albedo.view(), &full_light, &options).unwrap()
+        shade_lambertian::<f64>(&set, albedo.view(), &full_light, &options).unwrap()
     });
     for (what, errors) in [("light", &by_light), ("visibility", &by_visibility)] {
         eprintln!("keep {what} {ks:?}: {}", sci(errors));
@@ -364,7 +364,7 @@ fn depth_limits_match_the_product_integral_and_the_face_means() {
             depth,
             ..ShadeOptions::default()
         };
-        shade::<f64>(&set, albedo.view(), &light, &options).unwrap()
+        shade_lambertian::<f64>(&set, albedo.view(), &light, &options).unwrap()
     };
     assert_eq!(render(Some(levels)), render(None));
     // Depth 0: albedo / pi x sum over faces of S^2 x mean(T_v) x mean(L), from the pixels.
@@ -464,7 +464,8 @@ fn lambert_is_the_triple_product_with_a_constant_brdf() {
     let param = latlong(8);
     let set = precompute(&mesh, param);
     let light = Lighting::new(&park(), param, &SphereRotation::identity(), Selection::All).unwrap();
-    let got = shade::<f64>(&set, albedo.view(), &light, &ShadeOptions::default()).unwrap();
+    let got =
+        shade_lambertian::<f64>(&set, albedo.view(), &light, &ShadeOptions::default()).unwrap();
     let trees: Vec<HaarTree<f32, 1>> = (0..3).map(|c| channel_tree(&light, c)).collect();
     let s = param.face_size();
     let (mut worst, mut scale) = (0.0f64, 0.0f64);
@@ -496,14 +497,14 @@ fn mismatches_are_one_line_errors() {
         assert!(!m.contains('\n'), "{m}");
         m
     };
-    let e = shade::<f32>(&set, grey(2, 0.5).view(), &light, &options).unwrap_err();
+    let e = shade_lambertian::<f32>(&set, grey(2, 0.5).view(), &light, &options).unwrap_err();
     assert!(matches!(
         e,
         Error::Core(haarshift::Error::InvalidShape { .. })
     ));
     assert!(message(e).contains("must be (1, 3)"));
     let cube = constant_lighting(Parameterization::new(ParamKind::Cube, 4).unwrap(), 1.0);
-    let e = shade::<f32>(&set, one.view(), &cube, &options).unwrap_err();
+    let e = shade_lambertian::<f32>(&set, one.view(), &cube, &options).unwrap_err();
     assert!(matches!(
         e,
         Error::Core(haarshift::Error::InvalidParameter {
@@ -543,14 +544,14 @@ fn mismatches_are_one_line_errors() {
         ),
     ];
     for (name, o) in bad {
-        let e = shade::<f32>(&set, one.view(), &light, &o).unwrap_err();
+        let e = shade_lambertian::<f32>(&set, one.view(), &light, &o).unwrap_err();
         assert!(
             matches!(&e, Error::Core(haarshift::Error::InvalidParameter { name: n, .. }) if *n == name),
             "{e}"
         );
         message(e);
     }
-    let e = shade::<f32>(&set, grey(1, -0.5).view(), &light, &options).unwrap_err();
+    let e = shade_lambertian::<f32>(&set, grey(1, -0.5).view(), &light, &options).unwrap_err();
     assert!(message(e).contains("-0.5 at vertex 0"));
     let two = SphereMap::<f64>::from_fn(param, 2, |_, o| o.fill(1.0)).unwrap();
     let e = Lighting::from_map(&two, Selection::All).unwrap_err();

@@ -20,7 +20,7 @@ named_enum! {
     /// How a dynamic scene's radiance is computed: the names `relight scene --method` takes.
     ///
     /// ```
-    /// use haarshift_relight::shade::dynamic::DynamicMethod;
+    /// use haarshift_relight::shade::dynamic_scene::DynamicMethod;
     /// assert_eq!("reference".parse::<DynamicMethod>().unwrap(), DynamicMethod::Reference);
     /// ```
     pub enum DynamicMethod ("method") {
@@ -40,7 +40,7 @@ named_enum! {
 /// use haarshift_relight::SceneFile;
 /// use haarshift_relight::dynamic::{DynamicOptions, DynamicScene};
 /// use haarshift_relight::light::environment::Environment;
-/// use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader};
+/// use haarshift_relight::shade::dynamic_scene::{DynamicMethod, DynamicShader};
 /// use haarshift_relight::shade::{FrameSpec, Shader};
 /// use haarshift::faces::param::{ParamKind, Parameterization};
 /// use haarshift::sphere::{LatLongMap, SphereRotation};
@@ -82,7 +82,7 @@ impl<'a> DynamicShader<'a> {
     /// use haarshift_relight::SceneFile;
     /// use haarshift_relight::dynamic::{DynamicOptions, DynamicScene};
     /// use haarshift_relight::light::environment::{Environment, LightRotation};
-    /// use haarshift_relight::shade::dynamic::{DynamicMethod, DynamicShader};
+    /// use haarshift_relight::shade::dynamic_scene::{DynamicMethod, DynamicShader};
     /// use haarshift_relight::shade::{FrameSpec, Shader};
     /// use haarshift::faces::param::{ParamKind, Parameterization};
     /// use haarshift::sphere::{LatLongMap, SphereRotation};
@@ -211,7 +211,7 @@ impl DynamicMethod {
 /// ```
 /// use haarshift_relight::{Brdf, SceneFile};
 /// use haarshift_relight::dynamic::{DynamicOptions, DynamicScene};
-/// use haarshift_relight::shade::dynamic::glossy_material;
+/// use haarshift_relight::shade::dynamic_scene::glossy_material;
 /// use haarshift::faces::param::{ParamKind, Parameterization};
 /// let file: SceneFile = serde_json::from_str(r#"{"objects": [
 ///     {"generator": {"sphere": {"cells": 2}}}]}"#).unwrap();

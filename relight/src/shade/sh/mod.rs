@@ -47,8 +47,8 @@ use super::{
     FrameMapping, FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput,
     Timing, seconds,
 };
-use crate::harmonics::{ShTransfer, check_bands};
 use crate::material::orient::mirror_directions;
+use crate::sh_transfer::{ShTransfer, check_bands};
 use crate::{Brdf, Mesh};
 use crate::{Error, Result};
 use haarshift::sphere::gaunt::Gaunt;
@@ -60,8 +60,8 @@ use haarshift::sphere::harmonics::{SphericalHarmonics, phong_factors};
 /// [`SphericalHarmonics::project`] of the rotated environment. Both must be finite.
 ///
 /// ```
-/// use haarshift_relight::harmonics::ShTransfer;
-/// use haarshift_relight::shade::harmonics::shade_sh;
+/// use haarshift_relight::sh_transfer::ShTransfer;
+/// use haarshift_relight::shade::sh::shade_sh;
 /// use ndarray::{Array2, array};
 /// let pi = std::f64::consts::PI;
 /// // One upward vertex that sees its whole hemisphere: t_00 = int cos Y_00 = pi / (2 sqrt pi).
@@ -157,7 +157,7 @@ fn lambert(
 /// use --basis haar`.
 ///
 /// ```
-/// use haarshift_relight::shade::harmonics::non_zonal_material;
+/// use haarshift_relight::shade::sh::non_zonal_material;
 /// let e = non_zonal_material("merl:gold.binary");
 /// assert_eq!(
 ///     e.to_string(),
@@ -179,8 +179,8 @@ pub fn non_zonal_material(material: &str) -> Error {
 /// [module docs](self).
 ///
 /// ```
-/// use haarshift_relight::harmonics::ShTransfer;
-/// use haarshift_relight::shade::harmonics::PhongSh;
+/// use haarshift_relight::sh_transfer::ShTransfer;
+/// use haarshift_relight::shade::sh::PhongSh;
 /// use ndarray::{Array2, array};
 /// let pi = std::f64::consts::PI;
 /// let phong = PhongSh::new(2, 0.0).unwrap(); // exponent 0: the constant 1 / pi

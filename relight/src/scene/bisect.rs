@@ -279,5 +279,5 @@ impl Bisection {
 }
 
 #[cfg(test)]
-#[path = "refine_tests.rs"]
+#[path = "bisect_tests.rs"]
 mod tests;

@@ -27,7 +27,7 @@ use crate::{Error, Result, Sample};
 /// rotation.
 ///
 /// ```
-/// use haarshift::sphere::experiment::STANDARD_ROTATIONS;
+/// use haarshift::sphere::map_error::STANDARD_ROTATIONS;
 /// assert_eq!(STANDARD_ROTATIONS[1], (0.0, 30.0, 0.0));
 /// assert_eq!(STANDARD_ROTATIONS.len(), 6);
 /// ```
@@ -51,7 +51,7 @@ pub const DEFAULT_MAPS: [(&str, &[u8]); 1] = [(
 /// The [`DEFAULT_MAPS`], decoded, as `(name, map)`.
 ///
 /// ```
-/// let maps = haarshift::sphere::experiment::default_maps::<f32>().unwrap();
+/// let maps = haarshift::sphere::map_error::default_maps::<f32>().unwrap();
 /// assert_eq!(maps[0].0, "rooitou_park_256x128");
 /// assert_eq!((maps[0].1.height(), maps[0].1.width()), (128, 256));
 /// ```
@@ -167,7 +167,7 @@ impl Comparison {
     ///
     /// ```
     /// use haarshift::sphere::*;
-    /// use haarshift::sphere::experiment::Comparison;
+    /// use haarshift::sphere::map_error::Comparison;
     /// let f = LatLongMap::<f64>::from_fn(16, 1, |d, o| o[0] = 2.0 + d[0]).unwrap();
     /// let r = SphereRotation::from_degrees(0.0, 30.0, 0.0).unwrap();
     /// let truth = rotate_map(&f, &r, &SphereOptions { method: Method::Reference, ..Default::default() }).unwrap();

@@ -17,9 +17,9 @@
 
 use ndarray::{Array3, Array4, ArrayView3};
 
-use crate::harmonics::{ShProjector, ShTransfer};
 use crate::mapped::Buffer;
 use crate::precompute::sparse::SparseRows;
+use crate::sh_transfer::{ShProjector, ShTransfer};
 use crate::{Error, Result};
 use haarshift::faces::Parameterization;
 use haarshift::faces::integrate::layout;
@@ -61,7 +61,7 @@ impl TransportSet {
     }
 
     /// An empty set that also projects every vertex onto `bands` bands of spherical harmonics
-    /// ([`ShTransfer`]; 1 to [`MAX_SH_BANDS`](crate::harmonics::MAX_SH_BANDS)).
+    /// ([`ShTransfer`]; 1 to [`MAX_SH_BANDS`](crate::sh_transfer::MAX_SH_BANDS)).
     ///
     /// ```
     /// use haarshift::product::Selection;

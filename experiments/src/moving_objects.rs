@@ -203,7 +203,7 @@ pub struct DynamicRecord {
 /// setups are taken from it, and a run whose setups are all journaled builds nothing.
 ///
 /// ```no_run
-/// use haarshift_experiments::dynamic::{DynamicProtocol, Scenario, run};
+/// use haarshift_experiments::moving_objects::{DynamicProtocol, Scenario, run};
 /// use haarshift_experiments::journal::Journal;
 /// use haarshift_relight::Transform;
 /// use haarshift_relight::light::environment::Environment;

@@ -35,7 +35,7 @@ use crate::{Result, Sample};
 /// What [`map_product`] does.
 ///
 /// ```
-/// use haarshift::faces::product::ProductOptions;
+/// use haarshift::faces::map_product::ProductOptions;
 /// let o = ProductOptions::default();
 /// assert!(o.resolution.is_none() && o.selections.is_empty());
 /// ```
@@ -70,7 +70,7 @@ pub struct SphereProduct<T> {
 ///
 /// ```
 /// use haarshift::sphere::LatLongMap;
-/// use haarshift::faces::product::{ProductOptions, map_product};
+/// use haarshift::faces::map_product::{ProductOptions, map_product};
 /// let f = LatLongMap::<f64>::from_fn(8, 1, |d, out| out[0] = 1.0 + d[1]).unwrap();
 /// let g = LatLongMap::<f64>::from_fn(8, 3, |d, out| out.fill(2.0 + d[0])).unwrap();
 /// let fg = map_product(&[f.clone(), g.clone()], &ProductOptions::default()).unwrap();
@@ -106,15 +106,6 @@ pub fn map_product<T: Sample>(
         3 => channels!(3),
         _ => channels!(4),
     })
-}
-
-/// The old name of [`map_product`], kept for one release.
-#[deprecated(note = "renamed `haarshift::faces::product::map_product`")]
-pub fn multiply<T: Sample>(
-    maps: &[LatLongMap<T>],
-    options: &ProductOptions,
-) -> Result<SphereProduct<T>> {
-    map_product(maps, options)
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //! [`TransportSet`](crate::TransportSet) carries it beside the Haar coefficients.
 //!
 //! Shading with it (Lambertian [`shade_sh`] and the glossy baseline [`PhongSh`]) is a stage of
-//! its own: [`shade::harmonics`](super::shade::harmonics).
+//! its own: [`shade::sh`](super::shade::sh).
 
 use ndarray::{Array2, ArrayView2};
 use rayon::prelude::*;
@@ -29,7 +29,7 @@ pub const MAX_SH_BANDS: usize = 16;
 /// Every vertex's spherical-harmonic transfer vector, `(V, B^2)`; see the [module docs](self).
 ///
 /// ```
-/// use haarshift_relight::harmonics::ShTransfer;
+/// use haarshift_relight::sh_transfer::ShTransfer;
 /// use ndarray::Array2;
 /// let t = ShTransfer::new(2, Array2::zeros((5, 4))).unwrap();
 /// assert_eq!((t.bands(), t.vertex_count(), t.stored_bytes()), (2, 5, 80));
@@ -175,9 +175,6 @@ impl ShProjector {
         self.basis.len() * 8
     }
 }
-
-/// Moved to [`shade::harmonics`](super::shade::harmonics); these paths stay for one release.
-pub use super::shade::harmonics::{PhongSh, non_zonal_material, shade_sh, shade_sh_glossy};
 
 #[cfg(test)]
 mod tests;
