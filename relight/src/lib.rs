@@ -1,23 +1,69 @@
-//! All-frequency relighting, in the order the data flows: a scene is read and checked
-//! ([`scene`]), its per-vertex transport precomputed ([`precompute`]), the lighting encoded
-//! ([`light`]), a material brought into each vertex's frame ([`material`]), the outgoing
-//! radiance computed behind one [`Shader`](shade::Shader) ([`shade`](mod@shade)), and
-//! scenes whose objects move relit by just-in-time radiance transfer ([`dynamic`]). Images of
-//! the result are [`crate::render`]'s.
+//! # haarshift-relight
+//!
+//! All-frequency relighting on [`haarshift`]'s Haar transforms: a mesh's light transport
+//! precomputed once per vertex as sparse Haar coefficients, then shaded under any environment
+//! map, turned as it likes, with shadows, glossy BRDFs rotated in the Haar domain, bounced
+//! light and moving objects.
+//!
+//! ## Start here
+//!
+//! **Precompute a mesh's transport**: visibility x cosine at every texel of a lat-long map
+//! around each vertex, Haar-transformed and kept sparse ([`precompute`]):
+//!
+//! ```
+//! use haarshift::faces::{ParamKind, Parameterization};
+//! use haarshift_relight::precompute::{PrecomputeOptions, precompute};
+//! use haarshift_relight::{Generator, Scene, VisibilityOptions};
+//! let sphere = Generator::Sphere { cells: 2 }.mesh()?; // or Mesh::load("bunny.ply")
+//! let scene = Scene::from_mesh(sphere, true)?; // on a ground plane
+//! let param = Parameterization::new(ParamKind::LatLong, 8)?; // 8 x 16 directions
+//! let (cache, report) = precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(param)))?;
+//! assert_eq!(cache.transport.vertex_count(), cache.mesh.vertex_count());
+//! # Ok::<(), haarshift_relight::Error>(())
+//! ```
+//!
+//! **Shade it under a new lighting**: a [`Shader`](shade::Shader) built once from the cache,
+//! then one sparse dot product a vertex for each frame ([`shade`](mod@shade)):
+//!
+//! ```
+//! # use haarshift::faces::{ParamKind, Parameterization};
+//! # use haarshift_relight::precompute::{PrecomputeOptions, precompute};
+//! # use haarshift_relight::{Generator, Scene, VisibilityOptions};
+//! # let scene = Scene::from_mesh(Generator::Sphere { cells: 2 }.mesh()?, true)?;
+//! # let param = Parameterization::new(ParamKind::LatLong, 8)?;
+//! # let (cache, _) = precompute(scene, &PrecomputeOptions::new(VisibilityOptions::new(param)))?;
+//! use haarshift::sphere::{LatLongMap, SphereRotation};
+//! use haarshift_relight::light::environment::Environment;
+//! use haarshift_relight::shade::{FrameSpec, ShaderSpec, ShadingInput};
+//! // A sky bright above the horizon (or Environment::load("sky.hdr")), turned 90 degrees.
+//! let sky = Environment::new(LatLongMap::from_fn(16, 3, |d, rgb| rgb.fill(d[1].max(0.0)))?);
+//! let mut shader = ShaderSpec::default().build(&ShadingInput::cache(&cache))?;
+//! let rotation = SphereRotation::from_degrees(90.0, 0.0, 0.0)?;
+//! let shading = shader.shade(&FrameSpec { environment: &sky, rotation, eye: None })?;
+//! let radiance = shading.radiance.to_f32(); // (vertices, RGB), linear
+//! assert_eq!(radiance.dim(), (cache.mesh.vertex_count(), 3));
+//! # Ok::<(), haarshift_relight::Error>(())
+//! ```
+//!
+//! Images of the result are [`render`]'s (`relight/examples/relight_mesh.rs` renders three
+//! views); the command line's `haarshift relight` does all of this from files.
+//!
+//! ## Modules, in the order the data flows
 //!
 //! | module | idea |
 //! |---|---|
-//! | [`error`] | [`SceneError`]: what can be wrong with a mesh, a scene file or a cache |
-//! | [`scene`] | the ground plane, procedural generators, the JSON scene file ([`Scene`]); [`scene::mesh`] ([`Mesh`]: OBJ and PLY in, vertex normals); [`scene::cache`] ([`SceneCache`]: the versioned, checksummed `.hsr` file) |
-//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order: [`precompute::raycast`] ([`Occlusion`], answered by [`SceneBvh`]), [`precompute::shadowmap`] ([`ShadowMap`], the PRT patent's depth buffer), [`precompute::visibility`] ([`vertex_major`], [`direction_major`]), [`precompute::transport_set`] ([`TransportSet`]), [`precompute::sparse`] (many sparse Haar functions in flat arrays) |
-//! | [`light`] | [`light::environment`]: the lighting loaded, downsampled by solid-angle-weighted means, rotated; [`light::lighting`] ([`Lighting`]): its kept Haar coefficients, RGB, in Mallat order |
-//! | [`material`] | [`material::brdf`] ([`Brdf`]: Lambert, Phong, Blinn-Phong, local copies), [`material::merl`] (measured BRDFs), [`material::orient`] (a BRDF into a vertex's frame: Haar, spatial, reference or direct) |
-//! | [`shade`](mod@shade) | per-vertex outgoing radiance behind one [`Shader`](shade::Shader), built from a [`ShaderSpec`](shade::ShaderSpec): Lambertian Haar ([`PreparedTransport`]), glossy Haar with the rotation cache ([`shade::glossy`]), spherical harmonics ([`shade_sh`], [`PhongSh`]), the ground truth by direct quadrature ([`reference()`]), ambient occlusion, dynamic scenes |
-//! | [`harmonics`] | [`ShTransfer`]: the PRT patent's spherical-harmonic transfer |
-//! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other (Sun 2006); [`dynamic::fields`] (occlusion fields, the `.hsf` file), [`dynamic::motion`] (animations played with re-formed transfer) |
-//! | [`gallery`] | the committed diffuse renders: Haar, SH and the reference under several maps |
+//! | [`scene`] | meshes (OBJ+MTL, PLY, glTF 2.0) and the JSON scene file ([`Scene`]), the ground plane, generators; [`scene::cache`] ([`SceneCache`]: the versioned, checksummed `.hsr` file) |
+//! | [`precompute`] | the whole precomputation of a scene into its cache, in either loop order: [`precompute::raycast`] ([`Occlusion`], [`SceneBvh`]), [`precompute::shadowmap`] ([`ShadowMap`]), [`precompute::visibility`] ([`vertex_major`], [`direction_major`]), [`precompute::transport_set`] ([`TransportSet`]), bounces, refinement, shards |
+//! | [`sh_transfer`] | [`ShTransfer`]: the PRT patent's spherical-harmonic transfer |
+//! | [`light`] | [`light::environment`]: the lighting loaded, downsampled, rotated; [`light::lighting`] ([`Lighting`]): its kept Haar coefficients |
+//! | [`material`] | [`material::brdf`] ([`Brdf`]), [`material::merl`] (measured BRDFs), [`material::orient`] (a BRDF into a vertex's frame) |
+//! | [`shade`](mod@shade) | per-vertex outgoing radiance behind one [`Shader`](shade::Shader), built from a [`ShaderSpec`](shade::ShaderSpec): Lambertian Haar, glossy Haar, spherical harmonics ([`shade::sh`]), the reference ([`reference()`]), ambient occlusion, dynamic scenes |
+//! | [`dynamic`] | [`DynamicScene`](dynamic::DynamicScene): moving objects shadowing each other (Sun 2006); occlusion fields, animations |
+//! | [`render`] | the rasteriser, cameras, animations, baked glTF out |
+//! | [`mapped`] | a cache's arrays read in place from the file |
+//! | [`error`] | [`Error`] (wraps [`haarshift::Error`] as [`Error::Core`]) and [`SceneError`] |
 //!
-//! Conventions are the sphere module's: world Y up, right-handed, directions as in
+//! Conventions are the core's: world Y up, right-handed, directions as in
 //! [`sphere::latlong`](haarshift::sphere::latlong), rotations `g(p) = f(R p)` with
 //! `R = Rz(roll) Ry(yaw) Rx(pitch)`.
 //! The transport is the one factor of a product integral that carries the texel solid angle
