@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Occlusion rays per second: haarshift's vertex-major precomputation against Intel Embree.
 
-The rays are haarshift's own: `examples/rays.rs --export` records every ray the
+The rays are haarshift's own: `tools/measure/src/bin/rays.rs --export` records every ray the
 precomputation casts (cube 32 x 32 texel centres above each vertex's horizon, one ray each,
 origins 1e-4 of the diagonal off the surface along the normal: the CLI's `relight precompute
 SCENE --param cube --resolution 32 --visibility-samples 1`) as f32 .npy arrays with its
@@ -179,7 +179,7 @@ def main():
         embree_child(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
         return
     subprocess.run(
-        ["cargo", "build", "--release", "--example", "rays"],
+        ["cargo", "build", "--release", "-p", "haarshift-measure", "--bin", "rays"],
         cwd=ROOT,
         check=True,
     )
@@ -237,7 +237,7 @@ def main():
     text = f"""# Occlusion rays: haarshift against Embree
 
 Written by `python3 benches/compare_rays.py` (see its docstring for what is measured): the
-same f32 rays, exported by `examples/rays.rs` from haarshift's precomputation, cast by
+same f32 rays, exported by `tools/measure/src/bin/rays.rs` from haarshift's precomputation, cast by
 haarshift and by Embree {getattr(embreex, "__version__", "4.4.0")} through `embreex`
 (`rtcOccluded1` per ray, the "Embree 4.4" columns). Rates in millions of rays per second;
 haarshift's are its whole precomputation, rays and Haar encoding of the transport, with each

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tables of the product-integral benchmarks (benches/product.rs), with ratios from one run.
+"""Tables of the product-integral benchmarks (relight/benches/product.rs), with ratios from one run.
 
 Reads criterion's medians (target/criterion/<group>/<method>/<case>/new/estimates.json) and
 writes results/product/targets.md and results/product/scaling.md. With --run-cargo it first
@@ -89,7 +89,7 @@ def main():
         env = dict(os.environ, RAYON_NUM_THREADS="1", PRODUCT_BENCH_SIZES=args.sizes, PRODUCT_BENCH_LATLONG=args.latlong)
         # Short groups: the bench sets its own sample counts and measurement times.
         filt = "scaling" if args.skip_targets else "targets|scaling"
-        subprocess.run(["cargo", "bench", "--bench", "product", "--", filt], cwd=ROOT, env=env, check=True)
+        subprocess.run(["cargo", "bench", "-p", "haarshift-relight", "--bench", "product", "--", filt], cwd=ROOT, env=env, check=True)
     load_after = open("/proc/loadavg").read().split()[:3]
     OUT.mkdir(parents=True, exist_ok=True)
     note = (f"Criterion medians, f32, one core (RAYON_NUM_THREADS=1), on a 2-core machine shared with other jobs: "

@@ -14,6 +14,10 @@ use haarshift::rotate::{Canvas, RotateOptions, rotate_image};
 
 fn rotate(input: &Path, degrees: f64, out_dir: &Path) -> haarshift::Result<()> {
     let image = read_image::<f32>(input)?;
+    std::fs::create_dir_all(out_dir).map_err(|source| haarshift::Error::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
     let options = RotateOptions {
         canvas: Canvas::Expand,
         ..Default::default()

@@ -173,7 +173,7 @@ pub fn disk_mask(h: usize, w: usize, radius: f64) -> Array2<bool> {
 }
 
 /// Serialises infinities as JSON `null` (JSON has no infinity) and reads `null` back as +inf.
-#[doc(hidden)] // For haarshift-experiments (the crates' rule: README's "Crates").
+#[doc(hidden)] // For haarshift-experiments : public only for the sibling crates (crate docs).
 pub mod infinite_as_null {
     use serde::{Deserialize, Deserializer, Serializer};
 

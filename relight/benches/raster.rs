@@ -10,7 +10,7 @@
 //! colour. The radiance is a smooth function of position (the
 //! rasteriser's cost does not depend on it).
 //!
-//! Run: `cargo bench --bench raster -- --warm-up-time 1 --measurement-time 5`; the figures
+//! Run: `cargo bench -p haarshift-relight --bench raster -- --warm-up-time 1 --measurement-time 5`; the figures
 //! against the previous rasteriser are in `results/render/raster_speed.md`.
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -7,7 +7,7 @@
 //!   ([`Occlusion::occluded_from`]; the baseline answers them one by one);
 //! * `rays/precompute`: the precomputation of those vertices (rays and Haar encoding).
 //!
-//! `cargo bench --bench rays`; the ratio is baseline time over packet time. The comparison with
+//! `cargo bench -p haarshift-relight --bench rays`; the ratio is baseline time over packet time. The comparison with
 //! Embree on the same rays is `benches/compare_rays.py`.
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -20,7 +20,7 @@
 //! same 85,860 vertices at `B = 4, 6, 8` bands, RGB lighting: Lambertian [`shade_sh`] (`B^2`
 //! per vertex and channel) beside the glossy Phong 50 triple product [`PhongSh::shade`] (`B^4`),
 //! every vertex glossy; and the one-off [`PhongSh::new`] (the Gaunt table).
-//! Run: `cargo bench --bench relight -- --warm-up-time 1 --measurement-time 5`.
+//! Run: `cargo bench -p haarshift-relight --bench relight -- --warm-up-time 1 --measurement-time 5`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use rayon::prelude::*;

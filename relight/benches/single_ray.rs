@@ -1,7 +1,7 @@
 //! The single-ray path `SceneBvh` traced before its packet traversal: `obvhs`'s compressed
 //! 8-wide BVH (CWBVH, Ylitie et al. 2017) built by `build_cwbvh_from_tris` (medium preset) and
 //! its any-hit query `ray_traverse_miss`, one ray at a time. The named baseline of the ray
-//! benches (`benches/rays.rs`, `examples/rays.rs`); shared by both through `#[path]`.
+//! benches (`relight/benches/rays.rs`, `tools/measure/src/bin/rays.rs`); shared by both through `#[path]`.
 
 use glam::Vec3A;
 use haarshift_relight::{Mesh, Occlusion};

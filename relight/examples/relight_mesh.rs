@@ -33,6 +33,10 @@ fn relight(mesh: &Path, map: &Path, out_dir: &Path) -> Result<()> {
     );
     let mut shader = ShaderSpec::default().build(&ShadingInput::cache(&cache))?;
     let environment = Environment::load(map)?;
+    std::fs::create_dir_all(out_dir).map_err(|source| haarshift::Error::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
     let bounds = cache.mesh.bounds();
     let camera = Camera::framing(bounds.min, bounds.max, DEFAULT_FOV)?;
     for yaw in [0.0, 120.0, 240.0] {

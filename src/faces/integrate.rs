@@ -287,7 +287,7 @@ pub(super) fn plain_trees<T: Sample, const C: usize>(
 }
 
 /// The layout whose Mallat index breaks selection ties: lat-long faces side by side.
-#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+#[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
 pub fn layout(param: Parameterization) -> FaceLayout {
     match param.kind() {
         ParamKind::LatLong => FaceLayout::SideBySide,

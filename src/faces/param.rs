@@ -154,7 +154,7 @@ impl Parameterization {
     /// The direction of the point at row `row`, column `col` of face `face`, both in texel
     /// units of the face's parameter plane (`(theta, phi)` for lat-long, the face plane for the
     /// cube): texel `(r, c)` spans `[r, r + 1] x [c, c + 1]`.
-    #[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+    #[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
     pub fn point(&self, face: usize, row: f64, col: f64) -> [f64; 3] {
         let s = self.size;
         match self.kind {

@@ -58,7 +58,7 @@ pub fn kept_coefficients<T: Sample>(
 /// (the face-Mallat layout): every face's non-zero scaling coefficient and the non-zero
 /// details `selection` picks, as flat indices and values. The bounces' gather truncates its
 /// sums of transformed transport with it, by the rule the direct transport was truncated by.
-#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+#[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
 pub fn kept_of_coefficients<T: Sample>(
     coefficients: ArrayView3<'_, T>,
     layout: FaceLayout,

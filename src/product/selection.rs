@@ -153,7 +153,7 @@ impl Selection {
 
 /// A detail coefficient competing for a place: its squared magnitude and tie-break index.
 #[derive(Clone, Copy, Debug)]
-#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+#[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
 pub struct Candidate {
     /// The coefficient's squared magnitude.
     pub magnitude2: f64,
@@ -165,7 +165,7 @@ pub struct Candidate {
 
 /// Keeps the `k` best candidates (largest magnitude, then smallest index) in `pool`,
 /// reordering it; returns how many were kept (the first ones).
-#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+#[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
 pub fn keep_largest(pool: &mut [Candidate], k: usize) -> usize {
     if k == 0 {
         return 0;

@@ -97,7 +97,7 @@ impl<T: Sample, const C: usize> Transport<T, C> {
     }
 
     /// Wraps a tree known to carry the weight (a product that includes a transport).
-    #[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+    #[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
     pub fn from_weighted_tree(tree: HaarTree<T, C>) -> Self {
         Transport { tree }
     }

@@ -699,7 +699,7 @@ fn presence(kept: &[bool], s: usize) -> Vec<Vec<bool>> {
 /// The detail at Mallat position `(r, c)` of a face: `(band, level, row, col)` with band
 /// 0 = H `(row, 2^l + col)`, 1 = V `(2^l + row, col)`, 2 = D; `None` for the scaling
 /// coefficient `(0, 0)`.
-#[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+#[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
 pub fn mallat_detail(r: usize, c: usize) -> Option<(usize, usize, usize, usize)> {
     let m = r.max(c);
     if m == 0 {

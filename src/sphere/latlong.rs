@@ -436,7 +436,7 @@ impl<T: Sample> LatLongMap<T> {
     /// with its columns rolled by `roll` (`< W`): the values of `self.roll_columns(roll)`
     /// without the copy.
     #[inline]
-    #[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+    #[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
     pub fn bilinear_grid<const N: usize>(&self, y: f64, x: f64, roll: usize) -> [T; N] {
         let (taps, weights) = self.bilinear_taps(y, x, roll);
         let flat = self.data.as_slice().expect("standard layout");
@@ -494,7 +494,7 @@ impl<T: Sample> LatLongMap<T> {
     /// Continuous pixel coordinates `(row, column)` of `(theta, phi)`: pixel centres sit at
     /// whole numbers.
     #[inline]
-    #[doc(hidden)] // For haarshift-relight (the crates' rule: README's "Crates").
+    #[doc(hidden)] // For haarshift-relight : public only for the sibling crates (crate docs).
     pub fn grid_position(&self, theta: f64, phi: f64) -> (f64, f64) {
         let h = self.height() as f64;
         let step = std::f64::consts::PI / h;

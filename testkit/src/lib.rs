@@ -1,5 +1,6 @@
 //! What the workspace's tests share: [`quadrature`], oracles that tests in several crates
-//! integrate against; [`fuzz`], the fuzz harnesses' scratch files and corpus replay; and how a test that needs an optional system component (Chromium, Embree, Slurm, node) behaves
+//! integrate against; [`browser`], headless Chromium over the DevTools protocol (the viewer's
+//! page tests and frame-rate script); [`fuzz`], the fuzz harnesses' scratch files and corpus replay; and how a test that needs an optional system component (Chromium, Embree, Slurm, node) behaves
 //! where that component is missing.
 //!
 //! On a machine with only Rust, a C toolchain and Python the workspace's tests pass: a test
@@ -15,6 +16,7 @@
 //! assert_eq!(haarshift_testkit::needs("chromium", Ok::<_, String>(7)), Some(7));
 //! ```
 
+pub mod browser;
 pub mod fuzz;
 pub mod quadrature;
 

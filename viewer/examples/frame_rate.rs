@@ -26,7 +26,7 @@ use haarshift::faces::{ParamKind, Parameterization};
 use haarshift::product::Selection;
 use haarshift_relight::dynamic::{DynamicOptions, DynamicScene};
 use haarshift_relight::shade::LightSpec;
-use haarshift_viewer::browser::Browser;
+use haarshift_testkit::browser::Browser;
 use haarshift_viewer::{ViewedScene, Viewer, ViewerOptions};
 use serde_json::Value;
 

@@ -14,7 +14,6 @@
 //! | [`protocol`] | the messages: the page's [`ViewState`](protocol::ViewState), the server's packets |
 //! | [`scene`] | the scene cache and environment, loaded once |
 //! | [`progress`] | the reference's progress, counted for the page that asked |
-//! | [`browser`] | headless Chromium over the DevTools protocol: the page's tests and frame-rate script |
 //!
 //! The viewer answers only its own names, against DNS rebinding (a page of another site
 //! pointing its name at the loopback to read the viewer as its own): every request's `Host`
@@ -30,7 +29,6 @@
 //! method, material or budgets change), answers only the newest state queued on its socket,
 //! and computes the reference of the error view on a thread of its own.
 
-pub mod browser;
 mod host;
 pub mod progress;
 pub mod protocol;

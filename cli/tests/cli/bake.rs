@@ -251,7 +251,7 @@ fn three_js_alone_shows_the_baked_colours_in_headless_chromium() {
     else {
         return;
     };
-    if haarshift_testkit::needs("chromium", haarshift_viewer::browser::chromium()).is_none() {
+    if haarshift_testkit::needs("chromium", haarshift_testkit::browser::chromium()).is_none() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

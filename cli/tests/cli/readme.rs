@@ -4,7 +4,9 @@
 //! line of its other `sh` blocks runs in order from the root of a copy and succeeds (the few
 //! that take minutes as written at the smaller sizes of [`SMALLER`]), and every `cmp A B` line
 //! among them finds the two files it names equal, byte for byte; `relight view`, a server, on a
-//! free port until it serves its page.
+//! free port until it serves its page; and every `cargo run ... --example NAME -- ARGS` line
+//! runs that example's program, as `cargo test` built it, with `/tmp/` outputs in a temporary
+//! directory.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -287,4 +289,52 @@ fn serves_its_page(args: &[String], dir: &Path) {
         "`relight view {}`: {page}",
         args.join(" ")
     );
+}
+
+/// The example programs the README's `sh` blocks run: `(name, arguments)`.
+fn example_runs(readme: &str) -> Vec<(String, Vec<String>)> {
+    readme
+        .lines()
+        .filter_map(|line| {
+            let line = line.trim().strip_prefix("cargo run --release -p ")?;
+            let (_, rest) = line.split_once(" --example ")?;
+            let (name, args) = rest.split_once(" -- ").unwrap_or((rest, ""));
+            Some((name.to_owned(), args.split_whitespace().map(str::to_owned).collect()))
+        })
+        .collect()
+}
+
+#[test]
+fn every_readme_example_program_runs_as_written() {
+    let readme = std::fs::read_to_string(repository().join("README.md")).unwrap();
+    let runs = example_runs(&readme);
+    assert!(runs.len() >= 2, "the README runs {} example programs", runs.len());
+    // `cargo test` builds every example's program beside the binaries.
+    let examples = Path::new(env!("CARGO_BIN_EXE_haarshift"))
+        .parent()
+        .unwrap()
+        .join("examples");
+    let work = tempfile::tempdir().unwrap();
+    for (name, args) in runs {
+        let args: Vec<String> = args
+            .iter()
+            .map(|a| match a.strip_prefix("/tmp/") {
+                Some(rest) => work.path().join(rest).display().to_string(),
+                None => a.clone(),
+            })
+            .collect();
+        let program = examples.join(&name);
+        assert!(program.exists(), "{}: not built", program.display());
+        let out = Command::new(&program)
+            .args(&args)
+            .current_dir(repository())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "example {name} {}: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
 }

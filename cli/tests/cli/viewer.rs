@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-use haarshift_viewer::browser::{Browser, chromium};
+use haarshift_testkit::browser::{Browser, chromium};
 use ndarray::Array2;
 use serde_json::Value;
 

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use haarshift_viewer::browser::{Browser, chromium};
+use haarshift_testkit::browser::{Browser, chromium};
 use ndarray::Array3;
 use serde_json::Value;
 

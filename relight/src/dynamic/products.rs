@@ -5,7 +5,7 @@
 //! integral): on quadtrees (issue 7's [`product`] and the triple or `n`-function traversal with
 //! `T` as the transport) and through texels ([`TexelProduct`]: inverse-transform each factor,
 //! multiply, transform back). Which is cheaper depends on the face size, not on the scene.
-//! The `product` bench's `vertex` groups (`RAYON_NUM_THREADS=1 cargo bench --bench product --
+//! The `product` bench's `vertex` groups (`RAYON_NUM_THREADS=1 cargo bench -p haarshift-relight --bench product --
 //! vertex`, one run committed as `results/product/vertex.txt`) time the fixed product of a
 //! transport (70 kept), two occlusion maps (200 each) and the lighting (200, RGB), and a
 //! frame's `<T, O_a O_b>`, per vertex on one core:

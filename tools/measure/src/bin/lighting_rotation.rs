@@ -2,7 +2,7 @@
 //! asks for it, and measures how far each fast method lands from the source-resolution path.
 //!
 //! ```text
-//! cargo run --release --example lighting_rotation -- [ROTATIONS] [KEEP] [OUTPUT.md]
+//! cargo run --release -p haarshift-measure --bin lighting_rotation -- [ROTATIONS] [KEEP] [OUTPUT.md]
 //!   ROTATIONS  random rotations per map and parameterisation (default 20)
 //!   KEEP       lighting detail coefficients kept, or all (default 200)
 //!   OUTPUT.md  where the table goes (default results/viewer/lighting_rotation.md)
@@ -216,7 +216,7 @@ fn main() -> Fallible<()> {
     };
     let mut text = format!(
         "# Rotating and encoding the lighting at any angle\n\n\
-         Reproduce: `cargo run --release --example lighting_rotation -- {count} {} {}`\n\n\
+         Reproduce: `cargo run --release -p haarshift-measure --bin lighting_rotation -- {count} {} {}`\n\n\
          Per frame: `Lighting::encode` end to end (rotation, resampling to the working \
          parameterisation, Haar transform, selection of {keep_text}), median of {count} \
          random rotations (yaw, pitch, roll uniform in degrees; none a whole-column yaw), \

@@ -3,7 +3,7 @@
 //! the CLI's `relight precompute SCENE --param cube --resolution 32 --visibility-samples 1`.
 //!
 //! ```text
-//! cargo run --release --example rays -- SCENE [--tracer T] [--vertices A..B] [--export DIR] [--repeat R]
+//! cargo run --release -p haarshift-measure --bin rays -- SCENE [--tracer T] [--vertices A..B] [--export DIR] [--repeat R]
 //!   SCENE       a mesh (PLY, OBJ) or a scene file (JSON), as the CLI reads it
 //!   --tracer    the ray tracer, `packets` or `embree` (RayTracer; the best available by default)
 //!   --vertices  precompute these vertices only (all by default)

@@ -3,7 +3,7 @@
 //! of the whole process.
 //!
 //! ```text
-//! cargo run --release --example relight_precompute -- SCENE PARAM RESOLUTION KEEP ORDER [SH]
+//! cargo run --release -p haarshift-measure --bin relight_precompute -- SCENE PARAM RESOLUTION KEEP ORDER [SH]
 //!   SCENE       bunny (the bunny on its ground plane) | cubes (Vollick and Lessig, 85,860 vertices)
 //!               | cylinder-and-bump | plane-with-sphere
 //!   PARAM       latlong | cube
@@ -13,7 +13,7 @@
 //!   SH          optional: also project onto this many bands of spherical harmonics
 //! ```
 //!
-//! For example `cargo run --release --example relight_precompute -- cubes cube 64 414 vertex`; the
+//! For example `cargo run --release -p haarshift-measure --bin relight_precompute -- cubes cube 64 414 vertex`; the
 //! committed figures come from the CLI (`scripts/relight_speed.sh`).
 
 use std::path::Path;

@@ -17,7 +17,18 @@ use std::time::{Duration, Instant};
 use serde_json::{Value, json};
 use tungstenite::{Message, WebSocket};
 
-use haarshift_relight::{Error, Result};
+/// What went wrong driving the browser: it was not found, did not start, or a call failed.
+#[derive(Debug, thiserror::Error)]
+#[error("invalid {what}: {reason}")]
+pub struct BrowserError {
+    /// `chromium` (finding it) or `browser` (driving it).
+    pub what: &'static str,
+    /// Why.
+    pub reason: String,
+}
+
+/// `Result` with [`BrowserError`].
+pub type Result<T> = std::result::Result<T, BrowserError>;
 
 /// The flags every launch passes: headless, no sandbox (CI runs as root), SwiftShader's
 /// WebGL, nothing fetched from the network.
@@ -35,10 +46,19 @@ pub const FLAGS: [&str; 8] = [
 /// How long the browser may take to start and answer a call.
 const WAIT: Duration = Duration::from_secs(60);
 
+impl BrowserError {
+    fn new(what: &'static str, reason: impl Into<String>) -> Self {
+        BrowserError {
+            what,
+            reason: reason.into(),
+        }
+    }
+}
+
 /// A headless Chromium with one page attached.
 ///
 /// ```no_run
-/// use haarshift_viewer::browser::Browser;
+/// use haarshift_testkit::browser::Browser;
 /// use std::time::Duration;
 /// let mut browser = Browser::launch(640, 480).unwrap();
 /// browser.navigate("http://127.0.0.1:8765/").unwrap();
@@ -62,7 +82,7 @@ pub struct Browser {
 ///
 /// ```
 /// // Either a path or a one-line reason saying how to install one.
-/// match haarshift_viewer::browser::chromium() {
+/// match haarshift_testkit::browser::chromium() {
 ///     Ok(path) => assert!(path.ends_with("chromium") || std::env::var_os("CHROMIUM").is_some()),
 ///     Err(e) => assert!(e.to_string().contains("(apt-get install chromium"), "{e}"),
 /// }
@@ -78,7 +98,7 @@ fn find_chromium(named: Option<OsString>, path: Option<OsString>) -> Result<Path
         return if executable(&named) {
             Ok(named)
         } else {
-            Err(Error::parameter(
+            Err(BrowserError::new(
                 "browser",
                 format!(
                     "$CHROMIUM names {}, which is no executable file (apt-get install chromium, \
@@ -93,7 +113,7 @@ fn find_chromium(named: Option<OsString>, path: Option<OsString>) -> Result<Path
         .map(|dir| dir.join("chromium"))
         .find(|p| executable(p))
         .ok_or_else(|| {
-            Error::parameter(
+            BrowserError::new(
                 "browser",
                 "no chromium on the PATH (apt-get install chromium, or name one in $CHROMIUM)",
             )
@@ -115,7 +135,8 @@ fn executable(path: &Path) -> bool {
 }
 
 fn failure(what: impl std::fmt::Display) -> Error {
-    Error::parameter("browser", what.to_string())
+    BrowserError::new(
+                "browser", what.to_string())
 }
 
 impl Browser {
