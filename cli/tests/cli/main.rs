@@ -8,6 +8,7 @@ mod common;
 
 mod bake;
 mod bounces;
+mod cache_hashes;
 mod compute_precision;
 mod deploy;
 mod experiment;
