@@ -134,9 +134,9 @@ fn executable(path: &Path) -> bool {
     }
 }
 
-fn failure(what: impl std::fmt::Display) -> Error {
-    BrowserError::new(
-                "browser", what.to_string())
+/// A failure to drive the browser.
+fn failure(what: impl std::fmt::Display) -> BrowserError {
+    BrowserError::new("browser", what.to_string())
 }
 
 impl Browser {

@@ -299,7 +299,10 @@ fn example_runs(readme: &str) -> Vec<(String, Vec<String>)> {
             let line = line.trim().strip_prefix("cargo run --release -p ")?;
             let (_, rest) = line.split_once(" --example ")?;
             let (name, args) = rest.split_once(" -- ").unwrap_or((rest, ""));
-            Some((name.to_owned(), args.split_whitespace().map(str::to_owned).collect()))
+            Some((
+                name.to_owned(),
+                args.split_whitespace().map(str::to_owned).collect(),
+            ))
         })
         .collect()
 }
@@ -308,7 +311,11 @@ fn example_runs(readme: &str) -> Vec<(String, Vec<String>)> {
 fn every_readme_example_program_runs_as_written() {
     let readme = std::fs::read_to_string(repository().join("README.md")).unwrap();
     let runs = example_runs(&readme);
-    assert!(runs.len() >= 2, "the README runs {} example programs", runs.len());
+    assert!(
+        runs.len() >= 2,
+        "the README runs {} example programs",
+        runs.len()
+    );
     // `cargo test` builds every example's program beside the binaries.
     let examples = Path::new(env!("CARGO_BIN_EXE_haarshift"))
         .parent()
