@@ -13,8 +13,8 @@ revs=("$@")
 [ ${#revs[@]} -gt 0 ] || revs=(3ec9b9f3 HEAD)
 work=$(mktemp -d)
 trap 'for r in "${revs[@]}"; do git worktree remove --force "$work/$r" 2>/dev/null || true; done; rm -rf "$work"' EXIT
-echo "| revision | crates in the core's tree | clean release build of the core (s) | listed dependencies in the tree |"
-echo "|---|---|---|---|"
+echo "| revision | crates in the core's tree | clean release build of the core: wall (s) | CPU, user + system (s) | listed dependencies in the tree |"
+echo "|---|---|---|---|---|"
 for rev in "${revs[@]}"; do
     git worktree add -q --detach "$work/$rev" "$rev"
     (
@@ -23,10 +23,10 @@ for rev in "${revs[@]}"; do
         crates=$(cargo tree -p haarshift -e normal --prefix none | sed 's/ (\*)//; s/ (proc-macro)//' | sort -u)
         count=$(echo "$crates" | wc -l)
         listed=$(echo "$crates" | awk '{print $1}' | grep -xE 'gltf|gltf-json|obvhs|glam|libloading|plotters|csv|ply-rs-bw|data-encoding' | tr '\n' ' ')
-        start=$(date +%s.%N)
-        CARGO_TARGET_DIR="$work/target-$rev" cargo build -q --release -p haarshift
-        end=$(date +%s.%N)
-        printf '| %s (`%s`) | %s | %.1f | %s |\n' "$rev" "$(git rev-parse --short HEAD)" "$count" \
-            "$(echo "$end - $start" | bc)" "${listed:-none}"
+        # Wall, user and system seconds of the whole build (cargo and every rustc it runs).
+        read -r wall user sys < <(CARGO_TARGET_DIR="$work/target-$rev" /usr/bin/time -f '%e %U %S' \
+            cargo build -q --release -p haarshift 2>&1 >/dev/null | tail -n 1)
+        printf '| %s (`%s`) | %s | %.1f | %.1f | %s |\n' "$rev" "$(git rev-parse --short HEAD)" \
+            "$count" "$wall" "$(echo "$user + $sys" | bc)" "${listed:-none}"
     )
 done

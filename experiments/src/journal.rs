@@ -116,7 +116,7 @@ impl Journal {
     /// let mut journal = Journal::resume(&run, "o").unwrap();
     /// for unit in ["a", "b", "c"] {
     ///     assert!(journal.assigned(unit));
-    ///     journal.unit(unit, || -> haarshift::Result<usize> { unreachable!("journaled") }).unwrap();
+    ///     journal.unit(unit, || -> haarshift_experiments::Result<usize> { unreachable!("journaled") }).unwrap();
     /// }
     /// assert_eq!(journal.resumed(), 3);
     /// journal.finish().unwrap();

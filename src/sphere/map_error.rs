@@ -74,7 +74,7 @@ pub fn default_maps<T: Sample>() -> Result<Vec<(String, LatLongMap<T>)>> {
 /// The solid-angle weighted RMS difference of two maps of the same shape.
 ///
 /// ```
-/// use haarshift::sphere::{LatLongMap, experiment::weighted_rms};
+/// use haarshift::sphere::{LatLongMap, map_error::weighted_rms};
 /// let a = LatLongMap::<f64>::from_fn(8, 1, |_, o| o[0] = 1.0).unwrap();
 /// let b = LatLongMap::<f64>::from_fn(8, 1, |_, o| o[0] = 3.0).unwrap();
 /// assert!((weighted_rms(&a, &b).unwrap() - 2.0).abs() < 1e-12);
@@ -105,7 +105,7 @@ pub fn weighted_rms<T: Sample>(a: &LatLongMap<T>, b: &LatLongMap<T>) -> Result<f
 /// The plain RMS difference of two coefficient pyramids of the same shape.
 ///
 /// ```
-/// use haarshift::sphere::{LatLongMap, SphereCoefficients, experiment::coefficient_rms};
+/// use haarshift::sphere::{LatLongMap, SphereCoefficients, map_error::coefficient_rms};
 /// let a = LatLongMap::<f64>::from_fn(4, 1, |d, o| o[0] = d[0]).unwrap();
 /// let c = SphereCoefficients::from_map(&a).unwrap();
 /// assert_eq!(coefficient_rms(&c, &c).unwrap(), 0.0);
@@ -133,7 +133,7 @@ pub fn coefficient_rms<T: Sample>(
 /// `(E(a) - E(b)) / E(b)`, `E` the solid-angle integral summed over channels.
 ///
 /// ```
-/// use haarshift::sphere::{LatLongMap, experiment::relative_energy_error};
+/// use haarshift::sphere::{LatLongMap, map_error::relative_energy_error};
 /// let a = LatLongMap::<f64>::from_fn(8, 1, |_, o| o[0] = 1.1).unwrap();
 /// let b = LatLongMap::<f64>::from_fn(8, 1, |_, o| o[0] = 1.0).unwrap();
 /// assert!((relative_energy_error(&a, &b) - 0.1).abs() < 1e-12);
@@ -229,7 +229,7 @@ pub struct Record {
 /// reported (its own errors are zero, its energy error is its quadrature's).
 ///
 /// ```
-/// use haarshift::sphere::{LatLongMap, Method, experiment::run};
+/// use haarshift::sphere::{LatLongMap, Method, map_error::run};
 /// let f = LatLongMap::<f64>::from_fn(16, 1, |d, o| o[0] = 1.0 + d[0]).unwrap();
 /// let rows = run("smooth", &f, &[(0.0, 30.0, 0.0)], &[(Method::Haar, None), (Method::Bilinear, Some(2))], 4).unwrap();
 /// assert_eq!(rows.len(), 3);

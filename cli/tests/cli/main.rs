@@ -11,6 +11,7 @@ mod bounces;
 mod cache_hashes;
 mod compute_precision;
 mod deploy;
+mod examples;
 mod experiment;
 mod experiment_relight;
 mod flags;

@@ -132,7 +132,7 @@ impl Frame {
 /// the eye sits on the vertex, so every row is a direction).
 ///
 /// ```
-/// use haarshift_relight::{Mesh, orient::mirror_directions};
+/// use haarshift_relight::{Mesh, material::orient::mirror_directions};
 /// use ndarray::array;
 /// let m = Mesh::new(array![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
 ///                   vec![[0, 1, 2]], None).unwrap();

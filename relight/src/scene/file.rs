@@ -266,7 +266,7 @@ impl CameraSpec {
     /// ```
     /// use haarshift_relight::CameraSpec;
     /// let far = CameraSpec { position: [0.0, 2.0, 5.0], look_at: [0.0, 1e308, 0.0], fov: 40.0 };
-    /// assert!(matches!(far.check(), Err(haarshift::Error::Scene { .. })));
+    /// assert!(matches!(far.check(), Err(haarshift_relight::Error::Scene { .. })));
     /// ```
     pub fn check(&self) -> Result<()> {
         validate::check_point("the camera's position", self.position)?;

@@ -35,7 +35,7 @@ pub use haarshift::io::DEFAULT_MEMORY_LIMIT;
 /// use haarshift_relight::scene::validate::{MAX_COORDINATE, check_point};
 /// assert!(check_point("camera", [0.0, MAX_COORDINATE, 0.0]).is_ok());
 /// let far = check_point("camera", [0.0, 1e308, 0.0]);
-/// assert!(matches!(far, Err(haarshift::Error::Scene { .. })));
+/// assert!(matches!(far, Err(haarshift_relight::Error::Scene { .. })));
 /// ```
 pub const MAX_COORDINATE: f64 = 1e15;
 
@@ -90,7 +90,7 @@ pub fn check_positions(positions: ArrayView2<'_, f64>) -> Result<()> {
 /// let unit = Bounds { min: [0.0; 3], max: [1.0; 3] };
 /// assert!(check_ground_extent(&unit).is_ok());
 /// let line = Bounds { min: [1.0, 0.0, 1.0], max: [1.0, 5.0, 1.0] }; // vertical
-/// assert!(matches!(check_ground_extent(&line), Err(haarshift::Error::Scene { .. })));
+/// assert!(matches!(check_ground_extent(&line), Err(haarshift_relight::Error::Scene { .. })));
 /// ```
 pub fn check_ground_extent(bounds: &Bounds) -> Result<()> {
     let extent = (bounds.max[0] - bounds.min[0]).max(bounds.max[2] - bounds.min[2]);
@@ -140,7 +140,7 @@ pub const MESH_BYTES_PER_VERTEX: u64 = 640;
 /// assert_eq!((budget.limit, budget.per_vertex, budget.shards), (DEFAULT_MEMORY_LIMIT, 0, 1));
 /// assert!(budget.check("the scene", 1_000_000).is_ok());
 /// let err = budget.check("the scene", 100_000_000).unwrap_err();
-/// assert!(matches!(err, haarshift::Error::MemoryBudget { .. }));
+/// assert!(matches!(err, haarshift_relight::Error::Core(haarshift::Error::MemoryBudget { .. })));
 /// assert!(err.to_string().starts_with("the scene (100000000 vertices) needs"));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

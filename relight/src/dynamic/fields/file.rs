@@ -188,7 +188,7 @@ impl OcclusionField {
     /// frame is not `mesh`'s is refused.
     ///
     /// ```
-    /// use haarshift_relight::{Generator, fields::{FieldOptions, OcclusionField}};
+    /// use haarshift_relight::{Generator, dynamic::fields::{FieldOptions, OcclusionField}};
     /// use haarshift::faces::{ParamKind, Parameterization};
     /// let ball = Generator::Sphere { cells: 2 }.mesh().unwrap();
     /// let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
@@ -228,7 +228,7 @@ impl OcclusionField {
     /// [module docs](self).
     ///
     /// ```
-    /// # use haarshift_relight::{Generator, fields::{FieldOptions, OcclusionField}};
+    /// # use haarshift_relight::{Generator, dynamic::fields::{FieldOptions, OcclusionField}};
     /// # use haarshift::faces::{ParamKind, Parameterization};
     /// # let ball = Generator::Sphere { cells: 2 }.mesh().unwrap();
     /// # let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
@@ -256,7 +256,7 @@ impl OcclusionField {
     /// ([`SceneError::FieldMismatch`] names what differs).
     ///
     /// ```
-    /// # use haarshift_relight::{Generator, fields::{FieldOptions, OcclusionField}};
+    /// # use haarshift_relight::{Generator, dynamic::fields::{FieldOptions, OcclusionField}};
     /// # use haarshift::faces::{ParamKind, Parameterization};
     /// # let ball = Generator::Sphere { cells: 2 }.mesh().unwrap();
     /// # let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 4).unwrap());
@@ -388,7 +388,7 @@ pub enum FieldOrigin {
 /// error unless the store may replace it, when it is built again and replaced.
 ///
 /// ```
-/// use haarshift_relight::{Generator, fields::{FieldOptions, file::{FieldOrigin, FieldStore}}};
+/// use haarshift_relight::{Generator, dynamic::fields::{FieldOptions, file::{FieldOrigin, FieldStore}}};
 /// use haarshift::faces::{ParamKind, Parameterization};
 /// let generator = Generator::Sphere { cells: 2 };
 /// let ball = generator.mesh().unwrap();
@@ -454,7 +454,7 @@ impl FieldStore {
     /// recorded.
     ///
     /// ```
-    /// use haarshift_relight::{Generator, fields::file::FieldStore};
+    /// use haarshift_relight::{Generator, dynamic::fields::file::FieldStore};
     /// let store = FieldStore::new("fields", false);
     /// let (path, _) = store.path(Some("../meshes/bunny.ply".as_ref()), None);
     /// assert_eq!(path, std::path::Path::new("fields/bunny.hsf"));

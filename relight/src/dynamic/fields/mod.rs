@@ -265,7 +265,7 @@ impl Blend {
 /// An object's planar and spherical occlusion fields; see the [module docs](self).
 ///
 /// ```
-/// use haarshift_relight::{Generator, fields::{FieldOptions, OcclusionField}};
+/// use haarshift_relight::{Generator, dynamic::fields::{FieldOptions, OcclusionField}};
 /// use haarshift::faces::{ParamKind, Parameterization};
 /// let ball = Generator::Sphere { cells: 4 }.mesh().unwrap();
 /// let mut options = FieldOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
