@@ -77,7 +77,7 @@ fn relights_the_bunny_under_a_turning_sky() {
         format!("{data}/envmaps/rooitou_park_32x16.hdr"),
     );
     relight(mesh.as_ref(), map.as_ref(), dir.path()).unwrap();
-    let views: Vec<_> = ["yaw0.png", "yaw120.png", "yaw240.png"]
+    let views = ["yaw0.png", "yaw120.png", "yaw240.png"]
         .map(|n| haarshift::io::read_image::<f32>(dir.path().join(n)).unwrap());
     assert!(views.iter().all(|v| (v.height(), v.width()) == (240, 320)));
     // The sun moves: the views differ.
