@@ -1,4 +1,14 @@
 //! Assertions and oracles shared by the relighting's unit tests.
+//!
+//! Where tests live (one rule for the workspace): never inline. The unit tests of `x.rs` are in
+//! the sibling file `x_tests.rs`, declared at the end of `x.rs` as
+//! `#[cfg(test)] #[path = "x_tests.rs"] mod tests;`; those of a folder module `x/mod.rs` (or of
+//! the crate root) are in `x/tests.rs` (`#[cfg(test)] mod tests;`), a folder `x/tests/` when
+//! they are many. A second set of tests of one module is a second such file, named for its
+//! topic (`x_topic_tests.rs`, or `x/topic_tests.rs` in a folder module). A helper that more
+//! than one test file needs is written once, in this file (the CLI's integration tests:
+//! `cli/tests/cli/common/`), or is the library's own function; no two test helpers of a crate
+//! share a name (`python3 scripts/test_helper_names.py` checks it).
 
 /// Asserts that `result` is an `Err` holding the [`crate::Error`] variant `variant { fields }`
 /// (`Scene` and `Merl` are the relighting's own; any other names a core
@@ -55,4 +65,27 @@ pub(crate) fn differing_bits(a: &crate::Mesh, b: &crate::Mesh) -> (usize, usize)
         count(a.positions(), b.positions()),
         count(a.normals(), b.normals()),
     )
+}
+
+/// The lat-long parameterisation of height `n` (`n x 2n` texels).
+pub(crate) fn latlong(n: usize) -> haarshift::faces::Parameterization {
+    haarshift::faces::Parameterization::new(haarshift::faces::ParamKind::LatLong, n).unwrap()
+}
+
+/// The Stanford bunny of `testdata/` on the ground plane.
+pub(crate) fn bunny_on_ground() -> crate::Mesh {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../testdata/meshes/bunny.ply");
+    let mut mesh = crate::Mesh::load(path.as_ref()).unwrap();
+    crate::add_ground_plane(&mut mesh).unwrap();
+    mesh
+}
+
+/// An off-centre, squashed sphere, so that nothing about it is symmetric and its frame has no
+/// round numbers.
+pub(crate) fn squashed_sphere() -> crate::Mesh {
+    crate::Generator::Sphere { cells: 3 }
+        .mesh()
+        .unwrap()
+        .mapped(|p| [1.5 * p[0] + 0.3, p[1], 0.6 * p[2]], |n| n)
+        .unwrap()
 }

@@ -33,7 +33,7 @@ fn roundtrip(image: &PlanarImage<f64>, path: &Path) -> PlanarImage<f64> {
     read_image::<f64>(path).unwrap()
 }
 
-fn max_abs_diff(a: &PlanarImage<f64>, b: &PlanarImage<f64>) -> f64 {
+fn image_max_abs_diff(a: &PlanarImage<f64>, b: &PlanarImage<f64>) -> f64 {
     assert_eq!(a.planes().dim(), b.planes().dim());
     a.planes()
         .iter()
@@ -154,7 +154,7 @@ fn jpeg_is_eight_bit_close_and_refuses_alpha() {
     let eight = smooth(1.0, SampleDepth::U8);
     let back = roundtrip(&eight, &dir.path().join("a.jpg"));
     assert_eq!(back.depth(), SampleDepth::U8);
-    let err = max_abs_diff(&back, &eight);
+    let err = image_max_abs_diff(&back, &eight);
     // Measured 1 code value (1 for 16-bit input, 0 for gray); bound 3 (the decoder may take
     // another SIMD path, and round differently, on another machine).
     assert!(err <= 3.0, "max error {err}");
@@ -163,7 +163,7 @@ fn jpeg_is_eight_bit_close_and_refuses_alpha() {
     let sixteen = smooth(257.0, SampleDepth::U16);
     let back16 = roundtrip(&sixteen, &dir.path().join("b.jpeg"));
     assert_eq!(back16.depth(), SampleDepth::U8);
-    assert!(max_abs_diff(&back16, &eight) <= 3.0);
+    assert!(image_max_abs_diff(&back16, &eight) <= 3.0);
 
     let gray = PlanarImage::new(
         eight.planes().slice(ndarray::s![..1, .., ..]).to_owned(),
@@ -173,7 +173,7 @@ fn jpeg_is_eight_bit_close_and_refuses_alpha() {
     .unwrap();
     let back_gray = roundtrip(&gray, &dir.path().join("g.jpg"));
     assert_eq!(back_gray.channels(), Channels::Gray);
-    assert!(max_abs_diff(&back_gray, &gray) <= 3.0);
+    assert!(image_max_abs_diff(&back_gray, &gray) <= 3.0);
 
     let rgba = pattern(Channels::Rgba, SampleDepth::U8, 4, 4);
     let err = write_image(&rgba, dir.path().join("c.jpg"), WriteOptions::default()).unwrap_err();
@@ -541,7 +541,7 @@ fn coefficient_files_restore_images_exactly_for_every_layout_norm_and_padding() 
                     let restored = back.inverse().unwrap();
                     assert_eq!(restored.depth(), SampleDepth::U16);
                     // Measured at most 7.3e-11 (values up to 65535); bound 4x.
-                    assert!(max_abs_diff(&restored, &image) < 3e-10);
+                    assert!(image_max_abs_diff(&restored, &image) < 3e-10);
                     let png = path.with_extension("png");
                     write_image(&restored, &png, WriteOptions::default()).unwrap();
                     assert_eq!(read_image::<f64>(&png).unwrap(), image);

@@ -477,7 +477,7 @@ fn method_names_round_trip_and_build_named_kernels() {
 /// one at a time, bit for bit, for every kernel and in both sample types.
 #[test]
 fn grouped_rows_equal_single_rows() {
-    fn check<T: Sample>(rng: &mut StdRng) {
+    fn grouped_rows_equal_single_rows<T: Sample>(rng: &mut StdRng) {
         for method in ShiftMethod::ALL {
             let kernel = method.kernel::<T>();
             for rule in RULES {
@@ -512,8 +512,8 @@ fn grouped_rows_equal_single_rows() {
         }
     }
     let mut rng = StdRng::seed_from_u64(8);
-    check::<f32>(&mut rng);
-    check::<f64>(&mut rng);
+    grouped_rows_equal_single_rows::<f32>(&mut rng);
+    grouped_rows_equal_single_rows::<f64>(&mut rng);
 }
 
 /// With wrap, FFT shifts compose: sixteen shifts by 7.3 / 16 equal one by 7.3 for a row without

@@ -9,7 +9,7 @@ use super::{RetainedImage, shift_image};
 use crate::transform::{Layout, TransformSpec};
 
 /// Irregular values of magnitude up to 74 (not dyadic, so f32 rounds), held exactly in f32.
-fn image(h: usize, w: usize) -> Array2<f32> {
+fn f32_image(h: usize, w: usize) -> Array2<f32> {
     Array2::from_shape_fn((h, w), |(i, j)| {
         ((i as u64 * 7919 + j as u64 * 104_729) % 1009) as f32 / 7.0 - 70.0
     })
@@ -66,7 +66,7 @@ fn f32_bound(levels: usize, m: f64) -> f64 {
 /// with the wrong weight is off by more than 0.5).
 #[test]
 fn compact_fractional_shifts_in_f32_are_bilinear_within_the_rounding_budget() {
-    let x = image(32, 64);
+    let x = f32_image(32, 64);
     let x64 = x.mapv(f64::from);
     let m = x64.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let mut worst: f64 = 0.0;
@@ -104,7 +104,7 @@ fn compact_fractional_shifts_in_f32_are_bilinear_within_the_rounding_budget() {
 /// the same budget (2.4e-2 for four steps of 8 levels).
 #[test]
 fn retained_f32_chains_project_to_bilinear_and_keep_whole_blocks() {
-    let x = image(16, 32);
+    let x = f32_image(16, 32);
     let x64 = x.mapv(f64::from);
     let m = x64.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let c = TransformSpec::default().forward(x.view()).unwrap();

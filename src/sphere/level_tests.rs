@@ -3,9 +3,10 @@
 //! level. The reduction (block means) and the column roll are written here from their
 //! definitions, not with the module's `downsample`, `truncated` or `roll_columns`.
 
+use crate::test_support::sphere_options;
 use ndarray::Array3;
 
-use super::{LatLongMap, Method, SphereOptions, SphereRotation, rotate_map};
+use super::{LatLongMap, Method, SphereRotation, rotate_map};
 
 /// A smooth function on the sphere (degree-2 polynomial of the direction) in two channels.
 fn smooth(h: usize) -> LatLongMap<f64> {
@@ -45,14 +46,6 @@ fn rms(a: &Array3<f64>, b: &Array3<f64>) -> f64 {
     (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
 }
 
-fn with(method: Method, level: Option<usize>) -> SphereOptions {
-    SphereOptions {
-        method,
-        level,
-        ..Default::default()
-    }
-}
-
 /// The Haar path at levels 3 and 2 of a 32-row map (finest 4) against the reference
 /// rotation (8 x 8 samples per pixel) at full resolution, reduced to block means of the same
 /// level. Measured RMS: 2.30e-3 and 1.09e-2 (level 3, 2); the bounds are 1.5x those. A path
@@ -63,14 +56,14 @@ fn coarse_haar_levels_match_the_reduced_reference() {
     let h = 32;
     let f = smooth(h);
     let r = SphereRotation::from_degrees(20.0, 35.0, 10.0).unwrap();
-    let truth = rotate_map(&f, &r, &with(Method::Reference, None))
+    let truth = rotate_map(&f, &r, &sphere_options(Method::Reference, None))
         .unwrap()
         .map
         .into_array();
     for (level, measured) in [(3usize, 2.30e-3), (2, 1.09e-2)] {
         let block = h >> (level + 1);
         let want = block_means(&truth, block);
-        let got = rotate_map(&f, &r, &with(Method::Haar, Some(level)))
+        let got = rotate_map(&f, &r, &sphere_options(Method::Haar, Some(level)))
             .unwrap()
             .map
             .into_array();
@@ -94,11 +87,11 @@ fn level_zero_on_a_two_row_map() {
     let a = f.as_array().to_owned();
     let r = SphereRotation::from_degrees(20.0, 35.0, 10.0).unwrap();
     for &method in Method::ALL {
-        let full = rotate_map(&f, &r, &with(method, None)).unwrap();
-        let zero = rotate_map(&f, &r, &with(method, Some(0))).unwrap();
+        let full = rotate_map(&f, &r, &sphere_options(method, None)).unwrap();
+        let zero = rotate_map(&f, &r, &sphere_options(method, Some(0))).unwrap();
         assert_eq!(zero, full, "{method}");
         let constant = LatLongMap::<f64>::from_fn(2, 1, |_, out| out[0] = 3.5).unwrap();
-        let c = rotate_map(&constant, &r, &with(method, Some(0))).unwrap();
+        let c = rotate_map(&constant, &r, &sphere_options(method, Some(0))).unwrap();
         assert!(
             c.map.as_array().iter().all(|&v| (v - 3.5).abs() < 1e-12),
             "{method}: {:?}",
@@ -106,15 +99,15 @@ fn level_zero_on_a_two_row_map() {
         );
         for k in 1..4usize {
             let yaw = SphereRotation::from_degrees(90.0 * k as f64, 0.0, 0.0).unwrap();
-            let g = rotate_map(&f, &yaw, &with(method, Some(0))).unwrap();
+            let g = rotate_map(&f, &yaw, &sphere_options(method, Some(0))).unwrap();
             assert_eq!(g.map.as_array(), roll(&a, k), "{method} k={k}");
         }
     }
-    let truth = rotate_map(&f, &r, &with(Method::Reference, None))
+    let truth = rotate_map(&f, &r, &sphere_options(Method::Reference, None))
         .unwrap()
         .map
         .into_array();
-    let haar = rotate_map(&f, &r, &with(Method::Haar, Some(0)))
+    let haar = rotate_map(&f, &r, &sphere_options(Method::Haar, Some(0)))
         .unwrap()
         .map
         .into_array();
@@ -134,7 +127,7 @@ fn whole_column_yaws_with_a_level_are_the_reduced_rolled_map() {
         for level in 0..3usize {
             let want = block_means(&roll(&a, k), h >> (level + 1));
             for &method in Method::ALL {
-                let got = rotate_map(&f, &r, &with(method, Some(level)))
+                let got = rotate_map(&f, &r, &sphere_options(method, Some(level)))
                     .unwrap()
                     .map
                     .into_array();

@@ -9,6 +9,7 @@ use super::latlong::angles;
 use super::level_tests::block_means;
 use super::map_error::weighted_rms;
 use super::*;
+use crate::test_support::sphere_options;
 
 /// `(e + 2) / (2 pi) max(0, axis . d)^e`, the energy-normalised Phong lobe.
 fn lobe(exponent: f64, axis: [f64; 3], h: usize) -> LatLongMap<f64> {
@@ -36,14 +37,6 @@ fn rotations() -> Vec<SphereRotation> {
     .iter()
     .map(|&(y, p, r)| SphereRotation::from_degrees(y, p, r).unwrap())
     .collect()
-}
-
-fn with(method: Method, level: Option<usize>) -> SphereOptions {
-    SphereOptions {
-        method,
-        level,
-        ..Default::default()
-    }
 }
 
 /// The texel `(row, column)` of an `h`-row map that contains direction `d`.
@@ -88,7 +81,9 @@ fn a_lobe_turned_to_r_peaks_at_r_and_keeps_its_integral() {
     for &method in Method::ALL {
         let mut worst = 0.0f64;
         for r in rotations() {
-            let g = rotate_map(&f, &r, &with(method, None)).unwrap().map;
+            let g = rotate_map(&f, &r, &sphere_options(method, None))
+                .unwrap()
+                .map;
             let want = texel_of(h, r.inverse().apply(UP));
             let got = g.brightest();
             assert!(
@@ -129,7 +124,7 @@ fn haar_errors_fall_as_the_resolution_doubles() {
             let errors: Vec<f64> = [32, 64, 128, 256]
                 .iter()
                 .map(|&h| {
-                    let g = rotate_map(&lobe(e, UP, h), &r, &with(method, None)).unwrap();
+                    let g = rotate_map(&lobe(e, UP, h), &r, &sphere_options(method, None)).unwrap();
                     relative_error(&g.map, e, UP, &r)
                 })
                 .collect();
@@ -182,7 +177,9 @@ fn errors_per_level() {
     ] {
         let (errors, own): (Vec<f64>, Vec<f64>) = (0..7)
             .map(|level| {
-                let g = rotate_map(&f, &r, &with(method, Some(level))).unwrap().map;
+                let g = rotate_map(&f, &r, &sphere_options(method, Some(level)))
+                    .unwrap()
+                    .map;
                 let reduced = block_means(&truth.as_array().to_owned(), h >> (level + 1));
                 let reduced = LatLongMap::new(reduced).unwrap();
                 (
@@ -218,12 +215,13 @@ fn whole_column_yaw_of_haar_cubic_is_the_exact_coefficient_shift() {
     for k in [1usize, 6, 16, 63] {
         let r = SphereRotation::from_degrees(k as f64 * 360.0 / 64.0, 0.0, 0.0).unwrap();
         let shift = yaw::yaw_coefficients(&c, k).unwrap();
-        let got = rotate_coefficients(&c, &r, &with(Method::HaarCubic, None)).unwrap();
+        let got = rotate_coefficients(&c, &r, &sphere_options(Method::HaarCubic, None)).unwrap();
         assert_eq!(got, shift, "k={k}");
-        let from_pixels = rotate_map(&f, &r, &with(Method::HaarCubic, None)).unwrap();
+        let from_pixels = rotate_map(&f, &r, &sphere_options(Method::HaarCubic, None)).unwrap();
         assert_eq!(from_pixels.coefficients, shift, "k={k}");
         assert_eq!(from_pixels.map, f.roll_columns(k), "k={k}");
-        let coarse = rotate_coefficients(&c, &r, &with(Method::HaarCubic, Some(2))).unwrap();
+        let coarse =
+            rotate_coefficients(&c, &r, &sphere_options(Method::HaarCubic, Some(2))).unwrap();
         assert_eq!(coarse, shift.truncated(2).unwrap(), "k={k}");
     }
 }

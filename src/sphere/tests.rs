@@ -12,6 +12,7 @@ use super::chain_rule::{
 use super::latlong::{angles, direction, pixel_centre};
 use super::map_error::{relative_energy_error, weighted_rms};
 use super::*;
+use crate::test_support::sphere_options;
 use crate::transform::Band;
 
 /// A smooth test function: spherical harmonics up to degree 2 (plus a constant), with its
@@ -39,13 +40,6 @@ fn compound() -> SphereRotation {
     SphereRotation::from_degrees(20.0, 35.0, 10.0).unwrap()
 }
 
-fn options(method: Method) -> SphereOptions {
-    SphereOptions {
-        method,
-        ..Default::default()
-    }
-}
-
 fn max_abs_diff(a: &Array3<f64>, b: &Array3<f64>) -> f64 {
     (a - b).iter().fold(0.0, |m, v| m.max(v.abs()))
 }
@@ -65,7 +59,12 @@ fn identity_is_exact_for_every_method() {
     let f = harmonic_map(16, 2);
     let c = SphereCoefficients::from_map(&f).unwrap();
     for &method in Method::ALL {
-        let g = rotate_map(&f, &SphereRotation::identity(), &options(method)).unwrap();
+        let g = rotate_map(
+            &f,
+            &SphereRotation::identity(),
+            &sphere_options(method, None),
+        )
+        .unwrap();
         assert_eq!(g.map, f, "{method}");
         assert_eq!(g.coefficients, c, "{method}");
     }
@@ -81,7 +80,7 @@ fn whole_column_yaws_are_exact_shifts() {
         let want = f.roll_columns(k);
         let want_c = SphereCoefficients::from_map(&want).unwrap();
         for &method in Method::ALL {
-            let g = rotate_map(&f, &r, &options(method)).unwrap();
+            let g = rotate_map(&f, &r, &sphere_options(method, None)).unwrap();
             assert_eq!(g.map, want, "{method} k={k}");
             let err = max_abs_diff(
                 &g.coefficients.as_array().to_owned(),
@@ -107,7 +106,7 @@ fn whole_column_yaws_are_exact_shifts() {
     // Just off a whole column: not the exact path, but close to the neighbouring shift.
     let r = SphereRotation::from_degrees(360.0 / 32.0 + 1e-4, 0.0, 0.0).unwrap();
     assert_eq!(r.whole_column_yaw(w), None);
-    let g = rotate_map(&f, &r, &options(Method::Haar)).unwrap();
+    let g = rotate_map(&f, &r, &sphere_options(Method::Haar, None)).unwrap();
     let err = max_abs_diff(&g.map.into_array(), &f.roll_columns(1).into_array());
     // Measured 2.2e-6 (the step's slope times 1e-4 of a column); bound 4.5x.
     assert!(err < 1e-5, "{err}");
@@ -284,8 +283,8 @@ fn rotating_there_and_back_returns_the_map() {
     let f = harmonic_map(128, 1);
     let r = compound();
     for &method in Method::ALL {
-        let there = rotate_map(&f, &r, &options(method)).unwrap();
-        let back = rotate_map(&there.map, &r.inverse(), &options(method)).unwrap();
+        let there = rotate_map(&f, &r, &sphere_options(method, None)).unwrap();
+        let back = rotate_map(&there.map, &r.inverse(), &sphere_options(method, None)).unwrap();
         let rms = weighted_rms(&back.map, &f).unwrap();
         let bound = match method {
             Method::Reference => 4e-4,
@@ -309,7 +308,7 @@ fn smooth_maps_rotate_accurately_and_keep_their_energy() {
     // Energy: 4.1e-5, 8.3e-5, -2.8e-6, 3e-15 and -2.9e-6 (haar-cubic keeps the pole-corrected
     // sampled integral, not the plain sum); bounds 2.5x, 2.4x, 2.1x, 1e-14 and 2x.
     for &method in Method::ALL {
-        let g = rotate_map(&f, &r, &options(method)).unwrap();
+        let g = rotate_map(&f, &r, &sphere_options(method, None)).unwrap();
         let rms = weighted_rms(&g.map, &exact).unwrap();
         let (rms_bound, energy_bound) = match method {
             Method::Reference => (6e-4, 1e-4),
@@ -356,7 +355,7 @@ fn coefficients_in_equal_pixels_in() {
 #[test]
 fn coefficient_files_hold_the_generic_pyramid_of_each_channel() {
     let f = harmonic_map(16, 3);
-    let rotated = rotate_map(&f, &compound(), &options(Method::Haar)).unwrap();
+    let rotated = rotate_map(&f, &compound(), &sphere_options(Method::Haar, None)).unwrap();
     let file = rotated
         .coefficients
         .to_coefficient_file(crate::SampleDepth::F64)
@@ -438,8 +437,8 @@ fn f32_agrees_with_f64() {
     let f = harmonic_map(32, 1);
     let f32map = LatLongMap::new(f.as_array().mapv(|v| v as f32)).unwrap();
     let r = compound();
-    let a = rotate_map(&f, &r, &options(Method::Haar)).unwrap();
-    let b = rotate_map(&f32map, &r, &options(Method::Haar)).unwrap();
+    let a = rotate_map(&f, &r, &sphere_options(Method::Haar, None)).unwrap();
+    let b = rotate_map(&f32map, &r, &sphere_options(Method::Haar, None)).unwrap();
     let err = max_abs_diff(&a.map.into_array(), &b.map.into_array().mapv(|v| v as f64));
     // Measured 5.7e-7 (f32 rounding of values about 1); bound 3.5x.
     assert!(err < 2e-6, "{err}");
@@ -533,14 +532,14 @@ fn the_sun_lands_where_the_reference_puts_it() {
     ] {
         // g(p) = f(R p): the sun appears along R^-1 sun.
         let predicted = pixel_of(128, rotation.inverse().apply(sun));
-        let truth = rotate_map(&f, &rotation, &options(Method::Reference)).unwrap();
+        let truth = rotate_map(&f, &rotation, &sphere_options(Method::Reference, None)).unwrap();
         let at = truth.map.brightest();
         assert!(
             pixel_distance(at, predicted, 256) <= 1,
             "{at:?} vs {predicted:?}"
         );
         for method in [Method::Bilinear, Method::Bicubic, Method::Haar] {
-            let g = rotate_map(&f, &rotation, &options(method)).unwrap();
+            let g = rotate_map(&f, &rotation, &sphere_options(method, None)).unwrap();
             let here = g.map.brightest();
             assert!(
                 pixel_distance(here, at, 256) <= 1,
@@ -565,7 +564,7 @@ fn real_map_energy_within_tolerance() {
         (Method::Bilinear, 6e-3),
         (Method::Bicubic, 3e-3),
     ] {
-        let g = rotate_map(&f, &r, &options(method)).unwrap();
+        let g = rotate_map(&f, &r, &sphere_options(method, None)).unwrap();
         let e = relative_energy_error(&g.map, &f);
         assert!(e.abs() < bound, "{method}: {e}");
     }

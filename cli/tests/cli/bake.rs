@@ -11,10 +11,11 @@ use haarshift_relight::render::baked::BakedGltf;
 use ndarray::Array2;
 use serde_json::Value;
 
+use crate::common::strs;
 use crate::common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, usage_error};
 
 /// A sphere on the ground plane precomputed at lat-long 8 x 16 in `dir`.
-fn small_cache(dir: &Path) -> PathBuf {
+fn coloured_sphere_cache(dir: &Path) -> PathBuf {
     let scene = dir.join("sphere.json");
     std::fs::write(
         &scene,
@@ -65,7 +66,7 @@ fn bake(cache: &Path, args: &[&str]) -> String {
 #[test]
 fn each_yaw_s_file_holds_the_mesh_and_relight_render_s_radiance_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
-    let cache = small_cache(dir.path());
+    let cache = coloured_sphere_cache(dir.path());
     let out = dir.path().join("out.glb");
     let stdout = bake(
         &cache,
@@ -109,7 +110,7 @@ fn each_yaw_s_file_holds_the_mesh_and_relight_render_s_radiance_bit_for_bit() {
 #[test]
 fn bad_requests_are_refused_in_one_line_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
-    let cache = small_cache(dir.path());
+    let cache = coloured_sphere_cache(dir.path());
     let env = env();
     let out = dir.path().join("b.glb");
     // `relight bake CACHE --env ENV EXTRA -o OUT`.
@@ -119,46 +120,43 @@ fn bad_requests_are_refused_in_one_line_before_any_work() {
         args.extend(["-o", p(out)]);
         args.iter().map(|s| s.to_string()).collect()
     };
-    fn run(args: &[String]) -> Vec<&str> {
-        args.iter().map(String::as_str).collect()
-    }
     for empty in ["", ",", "10,,20", "nan"] {
         let args = with(&["--yaw", empty], &out);
         usage_error(
-            &run(&args),
+            &strs(&args),
             &["--yaw", "expected one or more finite angles"],
         );
     }
     usage_error(
-        &run(&with(&["--yaw", "5,5"], &out)),
+        &strs(&with(&["--yaw", "5,5"], &out)),
         &["yaw 5 is listed twice"],
     );
     // An existing output, the second of a list: refused before the first is written.
     let second = dir.path().join("b_yaw20.glb");
     std::fs::write(&second, b"keep").unwrap();
     fails_cleanly(
-        &run(&with(&["--yaw", "10,20"], &out)),
+        &strs(&with(&["--yaw", "10,20"], &out)),
         &["b_yaw20.glb", "already exists"],
     );
     assert!(!dir.path().join("b_yaw10.glb").exists());
     assert_eq!(std::fs::read(&second).unwrap(), b"keep");
-    succeeds(&run(&with(&["--yaw", "10,20", "--force"], &out)));
+    succeeds(&strs(&with(&["--yaw", "10,20", "--force"], &out)));
     assert!(BakedGltf::read(&second).is_ok());
     // A folder that is not there, or is a file.
     let missing = dir.path().join("no/such/folder/x.glb");
-    fails_cleanly(&run(&with(&[], &missing)), &["x.glb", "output directory"]);
+    fails_cleanly(&strs(&with(&[], &missing)), &["x.glb", "output directory"]);
     let under_file = second.join("x.glb");
     fails_cleanly(
-        &run(&with(&[], &under_file)),
+        &strs(&with(&[], &under_file)),
         &["x.glb", "output directory"],
     );
     // Another container, an absurd exposure, an output that is the cache.
     let obj = dir.path().join("b.obj");
-    fails_cleanly(&run(&with(&[], &obj)), &["b.obj", ".glb or .gltf"]);
+    fails_cleanly(&strs(&with(&[], &obj)), &["b.obj", ".glb or .gltf"]);
     let args = with(&["--exposure", "100", "--force"], &out);
-    fails_cleanly(&run(&args), &["exposure", "100"]);
+    fails_cleanly(&strs(&args), &["exposure", "100"]);
     let args = with(&["--force"], &cache);
-    fails_cleanly(&run(&args), &["sphere.hsr"]);
+    fails_cleanly(&strs(&args), &["sphere.hsr"]);
     assert!(SceneCache::read(&cache).is_ok());
 }
 
@@ -207,7 +205,7 @@ fn the_khronos_validator_finds_nothing_to_say_about_any_file_baked() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let cache = small_cache(dir.path());
+    let cache = coloured_sphere_cache(dir.path());
     let glb = dir.path().join("v.glb");
     let gltf = dir.path().join("v.gltf");
     bake(
@@ -255,7 +253,7 @@ fn three_js_alone_shows_the_baked_colours_in_headless_chromium() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let cache = small_cache(dir.path());
+    let cache = coloured_sphere_cache(dir.path());
     let glb = dir.path().join("s.glb");
     bake(&cache, &["--exposure", "1", "-o", p(&glb)]);
     let png = dir.path().join("s.png");
@@ -314,7 +312,7 @@ fn three_js_alone_shows_the_baked_colours_in_headless_chromium() {
 fn the_viewer_s_save_glb_is_the_last_frame_baked_as_relight_bake_bakes_it() {
     use crate::viewer::{Client, ViewProcess};
     let dir = tempfile::tempdir().unwrap();
-    let cache = small_cache(dir.path());
+    let cache = coloured_sphere_cache(dir.path());
     let view = ViewProcess::start(&[p(&cache), "--env", p(&env())]);
     let mut page = Client::opened(&view.url);
     page.send(r#"{"type": "glb", "exposure": 0}"#);

@@ -5,19 +5,10 @@
 
 use std::path::Path;
 
+use crate::common::read_vertices;
+use crate::common::relative_rms;
 use crate::common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata};
 use crate::viewer::{Client, ViewProcess};
-
-fn read(path: &Path) -> ndarray::Array2<f32> {
-    ndarray_npy::read_npy(path).unwrap()
-}
-
-/// `(rms of got - want) / rms of want`.
-fn relative_rms(got: &ndarray::Array2<f32>, want: &ndarray::Array2<f32>) -> f64 {
-    let square = |x: f32| f64::from(x).powi(2);
-    let diff: f64 = got.iter().zip(want).map(|(&g, &w)| square(g - w)).sum();
-    (diff / want.iter().map(|&w| square(w)).sum::<f64>()).sqrt()
-}
 
 #[test]
 fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
@@ -46,7 +37,7 @@ fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
         args.extend(["--width", "16", "--height", "16"]);
         args.extend(extra);
         succeeds(&args);
-        read(vertices)
+        read_vertices(vertices)
     };
     let plain = out("plain.hsr");
     precompute(&[], &plain);
@@ -64,9 +55,9 @@ fn a_bounce_cache_renders_the_gather_and_refuses_what_its_albedo_forbids() {
         args.extend(["--resolution", "8", "--bounces", b, "--vertices", p(&truth)]);
         args.push("--force");
         succeeds(&args);
-        let error = relative_rms(&got, &read(&truth));
+        let error = relative_rms(&got, &read_vertices(&truth));
         assert!(error < 1e-6, "{b} bounces: {error:e}");
-        assert!(relative_rms(&direct, &read(&truth)) > 1e-2);
+        assert!(relative_rms(&direct, &read_vertices(&truth)) > 1e-2);
         // The direct light of a bounce cache is the plain cache's, bit for bit.
         assert_eq!(render(&cache, &["--direct-only"], &out("d.npy")), direct);
     }

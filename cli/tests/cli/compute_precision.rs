@@ -55,7 +55,7 @@ fn library_rotation<T: Sample>(path: &Path) -> PlanarImage<T> {
 }
 
 /// `haarshift rotate INPUT -o OUTPUT --method keys --angle 30 --canvas expand EXTRA...`.
-fn rotate(input: &Path, output: &Path, extra: &[&str]) -> String {
+fn rotate_keys_30(input: &Path, output: &Path, extra: &[&str]) -> String {
     let mut args = vec![
         "rotate",
         p(input),
@@ -86,7 +86,7 @@ fn f32_files_rotate_in_f32_bit_for_bit_as_the_library() {
         &image::<f32>(Channels::Rgb, 37, 53, SampleDepth::F32),
     );
     let out = dir.path().join("out.npy");
-    let said = rotate(&input, &out, &[]);
+    let said = rotate_keys_30(&input, &out, &[]);
     assert!(said.contains("with keys in f32"), "{said}");
     let cli = read_image::<f32>(&out).unwrap();
     assert_eq!(cli.depth(), SampleDepth::F32);
@@ -100,7 +100,7 @@ fn f32_files_rotate_in_f32_bit_for_bit_as_the_library() {
 
     // On request the same file goes through f64.
     let out64 = dir.path().join("out64.npy");
-    let said = rotate(&input, &out64, &["--compute", "f64"]);
+    let said = rotate_keys_30(&input, &out64, &["--compute", "f64"]);
     assert!(said.contains("with keys in f64"), "{said}");
     assert_eq!(read_image::<f32>(&out64).unwrap(), via_f64);
 }
@@ -116,7 +116,7 @@ fn eight_and_sixteen_bit_pngs_rotate_in_f32_and_keep_their_depth() {
         let name = format!("{depth}-{channels}.png");
         let input = save(dir.path(), &name, &image::<f32>(channels, 29, 41, depth));
         let out = dir.path().join(format!("out-{name}"));
-        rotate(&input, &out, &[]);
+        rotate_keys_30(&input, &out, &[]);
         let cli = read_image::<f32>(&out).unwrap();
         assert_eq!(cli.depth(), depth, "{name}");
         assert_eq!(cli, library_rotation::<f32>(&input), "{name}");
@@ -137,7 +137,7 @@ fn float64_files_go_through_f64() {
         &image::<f64>(Channels::Gray, 33, 47, SampleDepth::F64),
     );
     let out = dir.path().join("out.npy");
-    let said = rotate(&input, &out, &[]);
+    let said = rotate_keys_30(&input, &out, &[]);
     assert!(said.contains("with keys in f64"), "{said}");
     let cli = read_image::<f64>(&out).unwrap();
     assert_eq!(cli.depth(), SampleDepth::F64);

@@ -5,6 +5,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
+use crate::common::strs;
 use crate::common::{
     fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, text, usage_error,
 };
@@ -136,9 +137,6 @@ fn a_killed_or_sharded_run_resumes_to_the_records_of_an_uninterrupted_one() {
         .map(String::from)
         .to_vec()
     };
-    fn strs(a: &[String]) -> Vec<&str> {
-        a.iter().map(String::as_str).collect()
-    }
     let whole = dir.path().join("whole");
     succeeds(&strs(&args(&whole)));
     let stopped = dir.path().join("stopped");

@@ -5,14 +5,14 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::common::{p, succeeds};
+use crate::common::run;
 
-use haarshift::io::{WriteOptions, read_image, write_image};
+use haarshift::io::{WriteOptions, write_image};
 use haarshift::{Channels, PlanarImage, SampleDepth};
 use ndarray::{Array2, Array3};
 
 /// Writes `planes` as `dir/name` at `depth` with `channels`.
-fn write(
+fn write_planes(
     dir: &Path,
     name: &str,
     planes: Array3<f64>,
@@ -23,14 +23,6 @@ fn write(
     let image = PlanarImage::new(planes, channels, depth).unwrap();
     write_image(&image, &path, WriteOptions::default()).unwrap();
     path
-}
-
-/// `haarshift COMMAND INPUT -o DIR/OUT FLAGS...`, required to succeed; the output read back.
-fn run(command: &str, input: &Path, out: &Path, flags: &[&str]) -> PlanarImage<f64> {
-    let mut args = vec![command, p(input), "-o", p(out)];
-    args.extend_from_slice(flags);
-    succeeds(&args);
-    read_image::<f64>(out).unwrap()
 }
 
 /// An irregular 10x12 gray plane of whole numbers 0..=250.
@@ -46,7 +38,7 @@ fn irregular() -> Array2<f64> {
 fn fill_sets_the_outside_value() {
     let dir = tempfile::tempdir().unwrap();
     let planes = Array3::from_elem((1, 16, 16), 100.0);
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "flat.png",
         planes,
@@ -98,7 +90,7 @@ fn shift_boundary_modes_continue_the_image_as_the_table_says() {
     let dir = tempfile::tempdir().unwrap();
     let x = irregular();
     let (h, w) = x.dim();
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "x.png",
         x.clone().into_shape_with_order((1, h, w)).unwrap(),
@@ -134,7 +126,7 @@ fn shift_boundary_modes_continue_the_image_as_the_table_says() {
 fn rotate_boundary_edge_continues_the_image() {
     let dir = tempfile::tempdir().unwrap();
     let planes = Array3::from_elem((1, 16, 16), 100.0);
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "flat.png",
         planes,
@@ -172,7 +164,7 @@ fn keys_a_sets_the_cubic_parameter() {
     let dir = tempfile::tempdir().unwrap();
     let (h, w) = (3, 16);
     let x = Array2::from_shape_fn((h, w), |(r, c)| ((c * c * 5 + r * 11) % 97) as f64 + 0.25);
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "x.npy",
         x.clone().into_shape_with_order((1, h, w)).unwrap(),
@@ -220,7 +212,7 @@ fn depth_u16_writes_sixteen_bit_codes() {
     let dir = tempfile::tempdir().unwrap();
     let (h, w) = (8, 8);
     let x = Array2::from_shape_fn((h, w), |(r, c)| 300.4 + 811.3 * (r * w + c) as f64);
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "x.npy",
         x.clone().into_shape_with_order((1, h, w)).unwrap(),
@@ -244,7 +236,7 @@ fn depth_u16_writes_sixteen_bit_codes() {
 fn depth_u16_from_eight_bits_keeps_the_finer_codes() {
     let dir = tempfile::tempdir().unwrap();
     let planes = irregular().insert_axis(ndarray::Axis(0));
-    let input = write(dir.path(), "i.png", planes, Channels::Gray, SampleDepth::U8);
+    let input = write_planes(dir.path(), "i.png", planes, Channels::Gray, SampleDepth::U8);
     let flags = ["--angle", "30", "--method", "linear"];
     let wide = run(
         "rotate",
@@ -300,7 +292,7 @@ fn depth_f16_writes_half_floats() {
     let x = Array2::from_shape_fn((h, w), |(r, c)| {
         0.1 + 0.0371 * ((r * 13 + c * 7) % 29) as f64
     });
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "x.npy",
         x.into_shape_with_order((1, h, w)).unwrap(),
@@ -330,7 +322,7 @@ fn rgba_shifts_move_every_plane() {
     let planes = Array3::from_shape_fn((4, h, w), |(k, r, c)| {
         ((k * 61 + r * 29 + c * 17 + r * c) % 256) as f64
     });
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "x.png",
         planes.clone(),
@@ -371,7 +363,7 @@ fn gray_alpha_rotation_does_not_bleed_from_transparent_pixels() {
         (_, true) => 255.0,
         (_, false) => 0.0,
     });
-    let input = write(
+    let input = write_planes(
         dir.path(),
         "ga.png",
         planes,

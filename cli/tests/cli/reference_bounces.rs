@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::common::read_vertices;
 use crate::common::{fails_cleanly, p, succeeds, succeeds_with_stdout, testdata};
 
 /// A scene file in `dir`: an open box, 2 x 2 cells a face (45 vertices).
@@ -14,10 +15,6 @@ fn open_box(dir: &Path) -> PathBuf {
     )
     .unwrap();
     path
-}
-
-fn read(path: &Path) -> ndarray::Array2<f32> {
-    ndarray_npy::read_npy(path).unwrap()
 }
 
 #[test]
@@ -43,7 +40,7 @@ fn bounces_light_the_box_and_paths_repeat_with_their_standard_error() {
     args.extend(["--bounces", "2", "--vertices", p(&bounced)]);
     let stdout = succeeds_with_stdout(&args);
     assert!(stdout.contains("2 bounces"), "{stdout}");
-    let (direct, bounced) = (read(&direct), read(&bounced));
+    let (direct, bounced) = (read_vertices(&direct), read_vertices(&bounced));
     assert_eq!(direct.dim(), (45, 3));
     // Every inside vertex sees another face's light: none darker, the floor's centre brighter.
     assert!(direct.iter().zip(&bounced).all(|(d, b)| b >= d));
@@ -61,8 +58,8 @@ fn bounces_light_the_box_and_paths_repeat_with_their_standard_error() {
         let stdout = succeeds_with_stdout(&args);
         assert!(stdout.contains("RMS standard error"), "{stdout}");
     }
-    assert_eq!(read(&a), read(&b));
-    assert!(read(&se).iter().any(|&x| x > 0.0));
+    assert_eq!(read_vertices(&a), read_vertices(&b));
+    assert!(read_vertices(&se).iter().any(|&x| x > 0.0));
     let fresh = out("fresh.npy");
     for (flags, needles) in [
         (&["--bounces", "9"][..], &["bounces", "0 to 8"][..]),

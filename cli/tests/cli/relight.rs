@@ -5,6 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::common::read_vertices;
+use crate::common::relative_rms;
 use crate::common::{
     fails_cleanly, p, succeeds, succeeds_with_stdout, testdata, text, usage_error,
 };
@@ -559,16 +561,6 @@ fn animate_writes_a_gif_or_numbered_frames_and_times_each() {
     let bad = dir.path().join("frame.png");
     args.extend(["-o", p(&bad)]);
     fails_cleanly(&args, &["frame.png", "%d"]);
-}
-
-/// The relative RMS difference of two `(V, 3)` arrays, over all vertices and channels.
-fn relative_rms(a: &ndarray::Array2<f32>, b: &ndarray::Array2<f32>) -> f64 {
-    haarshift::metrics::relative_rms_error(a.mapv(f64::from).view(), b.mapv(f64::from).view())
-        .unwrap()
-}
-
-fn read_vertices(path: &Path) -> ndarray::Array2<f32> {
-    ndarray_npy::read_npy(path).unwrap()
 }
 
 #[test]

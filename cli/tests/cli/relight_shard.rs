@@ -37,7 +37,7 @@ const OPTIONS: [&str; 6] = [
 ];
 
 /// `relight precompute SCENE OPTIONS EXTRA -o OUT`; returns standard output.
-fn precompute(scene: &Path, out: &Path, extra: &[&str]) -> String {
+fn precompute_with_options(scene: &Path, out: &Path, extra: &[&str]) -> String {
     let mut args = vec!["relight", "precompute", p(scene), "-o", p(out)];
     args.extend(OPTIONS);
     args.extend(extra);
@@ -49,7 +49,8 @@ fn shards(scene: &Path, dir: &Path, count: usize) -> Vec<PathBuf> {
     (0..count)
         .map(|i| {
             let out = dir.join(format!("part-{i}.hsr"));
-            let stdout = precompute(scene, &out, &["--shard", &format!("{i}/{count}")]);
+            let stdout =
+                precompute_with_options(scene, &out, &["--shard", &format!("{i}/{count}")]);
             assert!(
                 stdout.contains(&format!("(shard {i}/{count}: vertices ")),
                 "{stdout}"
@@ -85,7 +86,7 @@ fn one_three_and_seven_shards_merge_into_the_unsharded_cache_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let scene = ball_scene(dir.path(), "ball.json", 1.0);
     let whole = dir.path().join("whole.hsr");
-    precompute(&scene, &whole, &[]);
+    precompute_with_options(&scene, &whole, &[]);
     let expected = std::fs::read(&whole).unwrap();
     for count in [1, 3, 7] {
         let sub = dir.path().join(format!("n{count}"));
@@ -143,12 +144,12 @@ fn mesh_files_scene_files_and_generators_merge_byte_for_byte() {
         let sub = dir.path().join(k.to_string());
         std::fs::create_dir(&sub).unwrap();
         let whole = sub.join("whole.hsr");
-        precompute(input, &whole, extra);
+        precompute_with_options(input, &whole, extra);
         let parts: Vec<_> = ["1/2", "0/2"]
             .iter()
             .map(|shard| {
                 let out = sub.join(format!("part-{}.hsr", &shard[..1]));
-                precompute(input, &out, &[extra, &["--shard", shard]].concat());
+                precompute_with_options(input, &out, &[extra, &["--shard", shard]].concat());
                 out
             })
             .collect();
@@ -161,7 +162,8 @@ fn mesh_files_scene_files_and_generators_merge_byte_for_byte() {
             "{what}: the merged cache is not the unsharded one"
         );
         // A shard read back is its scene's, so a rerun skips it.
-        let again = precompute(input, &parts[1], &[extra, &["--shard", "0/2"]].concat());
+        let again =
+            precompute_with_options(input, &parts[1], &[extra, &["--shard", "0/2"]].concat());
         assert!(again.ends_with("is complete: skipped\n"), "{what}: {again}");
     }
 }
@@ -193,10 +195,10 @@ fn bad_sets_of_shards_are_refused_naming_the_file() {
     // Another scene (the ball higher up) and other options (another seed).
     let higher = ball_scene(dir.path(), "higher.json", 1.5);
     let stranger = dir.path().join("other-scene.hsr");
-    precompute(&higher, &stranger, &["--shard", "1/3"]);
+    precompute_with_options(&higher, &stranger, &["--shard", "1/3"]);
     merge_refused(&[a, &stranger, c], &out, &stranger, "has another mesh");
     let reseeded = dir.path().join("other-options.hsr");
-    precompute(&scene, &reseeded, &["--shard", "1/3", "--seed", "9"]);
+    precompute_with_options(&scene, &reseeded, &["--shard", "1/3", "--seed", "9"]);
     merge_refused(
         &[a, &reseeded, c],
         &out,
@@ -204,7 +206,7 @@ fn bad_sets_of_shards_are_refused_naming_the_file() {
         "other options (seed 9, not 0)",
     );
     let banded = dir.path().join("other-bands.hsr");
-    precompute(&scene, &banded, &["--shard", "1/3", "--sh-bands", "2"]);
+    precompute_with_options(&scene, &banded, &["--shard", "1/3", "--sh-bands", "2"]);
     merge_refused(
         &[a, &banded, c],
         &out,
@@ -218,7 +220,7 @@ fn bad_sets_of_shards_are_refused_naming_the_file() {
     std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
     merge_refused(&[a, &cut, c], &out, &cut, "scene cache is damaged");
     let whole = dir.path().join("whole.hsr");
-    precompute(&scene, &whole, &[]);
+    precompute_with_options(&scene, &whole, &[]);
     merge_refused(
         &[a, &whole],
         &out,
@@ -239,9 +241,9 @@ fn a_complete_shard_is_skipped_and_another_file_kept() {
     let dir = tempfile::tempdir().unwrap();
     let scene = ball_scene(dir.path(), "ball.json", 1.0);
     let part = dir.path().join("part-1.hsr");
-    precompute(&scene, &part, &["--shard", "1/3"]);
+    precompute_with_options(&scene, &part, &["--shard", "1/3"]);
     let first = std::fs::read(&part).unwrap();
-    let again = precompute(&scene, &part, &["--shard", "1/3"]);
+    let again = precompute_with_options(&scene, &part, &["--shard", "1/3"]);
     assert_eq!(
         again,
         format!(
@@ -309,7 +311,7 @@ fn shard_auto_reads_slurm_and_kubernetes_and_refuses_without_them() {
     );
     // The same bits as the shard named by hand.
     let named = dir.path().join("named.hsr");
-    precompute(&scene, &named, &["--shard", "6/7"]);
+    precompute_with_options(&scene, &named, &["--shard", "6/7"]);
     assert!(std::fs::read(&named).unwrap() == std::fs::read(dir.path().join("k8s.hsr")).unwrap());
 
     let out = dir.path().join("refused.hsr");

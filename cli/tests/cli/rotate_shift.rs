@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::common::run;
 use crate::common::{fails_cleanly, p, succeeds, testdata};
 
 use haarshift::Channels::{Gray, Rgb};
@@ -11,14 +12,6 @@ use haarshift::SampleDepth::{F64, U8, U16};
 use haarshift::io::{WriteOptions, read_image, write_image};
 use haarshift::{Channels, PlanarImage, SampleDepth};
 use ndarray::{Array2, Array3};
-
-/// `haarshift COMMAND INPUT -o OUT FLAGS...`, required to succeed; returns the output read back.
-fn run(command: &str, input: &Path, out: &Path, flags: &[&str]) -> PlanarImage<f64> {
-    let mut args = vec![command, p(input), "-o", p(out)];
-    args.extend_from_slice(flags);
-    succeeds(&args);
-    read_image::<f64>(out).unwrap()
-}
 
 /// Deterministic pseudo-random values in `0..max` (a 64-bit LCG), whole numbers.
 fn noise(len: usize, max: u64, seed: u64) -> Vec<f64> {

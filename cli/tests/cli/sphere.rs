@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use crate::common::strs;
 use crate::common::{
     fails_cleanly, fails_cleanly_in, p, succeeds, text, usage_error, usage_error_in,
 };
@@ -26,17 +27,12 @@ fn test_map() -> LatLongMap<f32> {
 }
 
 /// `sphere rotate INPUT -o OUTPUT FLAGS...`
-fn rotate(input: &str, output: &Path, flags: &[&str]) -> Vec<String> {
+fn sphere_rotate_args(input: &str, output: &Path, flags: &[&str]) -> Vec<String> {
     ["sphere", "rotate", input, "-o", p(output)]
         .iter()
         .chain(flags)
         .map(|s| s.to_string())
         .collect()
-}
-
-/// The arguments as the `&str`s the runners take.
-fn strs(args: &[String]) -> Vec<&str> {
-    args.iter().map(String::as_str).collect()
 }
 
 /// The map in a pixel file written by the CLI.
@@ -59,7 +55,7 @@ fn every_method_gives_exactly_what_the_library_gives() {
     let rotation = SphereRotation::from_degrees(yaw, pitch, roll).unwrap();
     for (method, level, ext) in cases {
         let out = dir.path().join(format!("{method}-{level:?}.{ext}"));
-        let mut args = rotate(
+        let mut args = sphere_rotate_args(
             MAP,
             &out,
             &[
@@ -97,11 +93,11 @@ fn identity_and_whole_column_yaw_return_the_input_exactly() {
     for &method in Method::ALL {
         let out = dir.path().join(format!("identity-{method}.npy"));
         let flags = ["--method", method.name(), "--samples", "2"];
-        succeeds(&strs(&rotate(MAP, &out, &flags)));
+        succeeds(&strs(&sphere_rotate_args(MAP, &out, &flags)));
         assert_eq!(read_map(&out), map, "{method}");
         // 45 degrees is 32 of 256 columns: g(theta, phi) = f(theta, phi + 45 degrees).
         let out = dir.path().join(format!("yaw-{method}.npy"));
-        succeeds(&strs(&rotate(
+        succeeds(&strs(&sphere_rotate_args(
             MAP,
             &out,
             &["--method", method.name(), "--yaw", "45"],
@@ -116,10 +112,10 @@ fn coefficients_are_a_readable_npy_with_sidecar_that_inverts_to_the_pixels() {
     let coeffs = dir.path().join("rotated.npy");
     let pixels = dir.path().join("rotated.exr");
     let flags = ["--pitch", "30", "--level", "5"];
-    let mut args = rotate(MAP, &coeffs, &flags);
+    let mut args = sphere_rotate_args(MAP, &coeffs, &flags);
     args.push("--coefficients".into());
     succeeds(&strs(&args));
-    succeeds(&strs(&rotate(MAP, &pixels, &flags)));
+    succeeds(&strs(&sphere_rotate_args(MAP, &pixels, &flags)));
 
     let file = CoefficientFile::read(&coeffs).unwrap();
     let meta = file.metadata();
@@ -174,26 +170,35 @@ fn bad_inputs_fail_with_one_line() {
     let square = concat!(env!("CARGO_MANIFEST_DIR"), "/../testdata/camera.png");
     let cases = [
         (
-            rotate(square, &out, &["--pitch", "10"]),
+            sphere_rotate_args(square, &out, &["--pitch", "10"]),
             vec!["camera.png", "twice as wide", "512 x 512"],
         ),
         (
-            rotate("no-such-map.hdr", &out, &[]),
+            sphere_rotate_args("no-such-map.hdr", &out, &[]),
             vec!["no-such-map.hdr"],
         ),
-        (rotate(MAP, &out, &["--yaw", "NaN"]), vec!["yaw", "NaN"]),
-        (rotate(MAP, &out, &["--pitch", "NaN"]), vec!["pitch", "NaN"]),
-        (rotate(MAP, &out, &["--roll=-inf"]), vec!["roll", "-inf"]),
         (
-            rotate(p(&odd), &out, &["--pitch", "10"]),
+            sphere_rotate_args(MAP, &out, &["--yaw", "NaN"]),
+            vec!["yaw", "NaN"],
+        ),
+        (
+            sphere_rotate_args(MAP, &out, &["--pitch", "NaN"]),
+            vec!["pitch", "NaN"],
+        ),
+        (
+            sphere_rotate_args(MAP, &out, &["--roll=-inf"]),
+            vec!["roll", "-inf"],
+        ),
+        (
+            sphere_rotate_args(p(&odd), &out, &["--pitch", "10"]),
             vec!["odd.npy", "power of two"],
         ),
         (
-            rotate(MAP, &out, &["--pitch", "1", "--level", "7"]),
+            sphere_rotate_args(MAP, &out, &["--pitch", "1", "--level", "7"]),
             vec!["level", "0..=6"],
         ),
         (
-            rotate(
+            sphere_rotate_args(
                 MAP,
                 &out,
                 &["--pitch", "1", "--method", "reference", "--samples", "0"],
@@ -201,20 +206,26 @@ fn bad_inputs_fail_with_one_line() {
             vec!["samples"],
         ),
         (
-            rotate(MAP, &exr, &["--coefficients"]),
+            sphere_rotate_args(MAP, &exr, &["--coefficients"]),
             vec!["c.exr", ".npy"],
         ),
-        (rotate(MAP, Path::new(MAP), &["--force"]), vec!["input"]),
+        (
+            sphere_rotate_args(MAP, Path::new(MAP), &["--force"]),
+            vec!["input"],
+        ),
     ];
     for (args, needles) in &cases {
         fails_cleanly(&strs(args), needles);
     }
-    succeeds(&strs(&rotate(MAP, &out, &[])));
-    fails_cleanly(&strs(&rotate(MAP, &out, &[])), &["out.npy", "--force"]);
-    succeeds(&strs(&rotate(MAP, &out, &["--force"])));
+    succeeds(&strs(&sphere_rotate_args(MAP, &out, &[])));
+    fails_cleanly(
+        &strs(&sphere_rotate_args(MAP, &out, &[])),
+        &["out.npy", "--force"],
+    );
+    succeeds(&strs(&sphere_rotate_args(MAP, &out, &["--force"])));
     // Usage errors are clap's: exit code 2.
     usage_error(
-        &strs(&rotate(MAP, &out, &["--method", "fft"])),
+        &strs(&sphere_rotate_args(MAP, &out, &["--method", "fft"])),
         &["--method", "fft"],
     );
 }

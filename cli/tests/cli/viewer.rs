@@ -592,8 +592,22 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
 
     // Another site's page may not drive the viewer, nor a socket that names no page; plain
     // HTTP gets its status lines.
-    assert!(Client::connect(&view.url, Some("http://example.com")).is_err());
-    assert!(Client::connect(&view.url, None).is_err());
+    let forbidden = |origin| match Client::connect(&view.url, origin) {
+        Err(tungstenite::Error::Http(response)) => {
+            assert_eq!(response.status(), 403, "{origin:?}");
+            // The reason, when it came with the status line's packet.
+            if let Some(body) = response.body() {
+                let body = String::from_utf8_lossy(body);
+                assert_eq!(body, "a page of another origin, or none\n", "{origin:?}");
+            }
+        }
+        other => panic!(
+            "{origin:?}: expected a 403, got {:?}",
+            other.map(|_| "a socket")
+        ),
+    };
+    forbidden(Some("http://example.com"));
+    forbidden(None);
     let host = authority(&view.url);
     let get = |path: &str| format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n");
     let ws = format!("GET /ws HTTP/1.1\r\nHost: {host}\r\nOrigin: http://{host}\r\n\r\n");

@@ -51,18 +51,6 @@ fn played(dir: &Path, scene: &Path, path: &Path) -> Array3<f32> {
     ndarray_npy::read_npy(&frames).unwrap()
 }
 
-/// The relative RMS difference of two radiance arrays.
-fn relative_rms(a: &[f32], b: &[f32]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let d: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| f64::from(x - y).powi(2))
-        .sum();
-    let r: f64 = b.iter().map(|&y| f64::from(y).powi(2)).sum();
-    (d / r).sqrt()
-}
-
 #[test]
 fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_them() {
     let dir = tempfile::tempdir().unwrap();
@@ -98,7 +86,7 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
     let expected = played(dir.path(), &scene, &to_two);
     let expected = expected.index_axis(ndarray::Axis(0), 2).to_owned();
     let expected = expected.as_slice().unwrap();
-    let moved_error = relative_rms(&moved, expected);
+    let moved_error = relative_rms_of_slices(&moved, expected);
     assert!(moved_error < 1e-6, "{moved_error}");
     assert_eq!(positions.len(), expected.len());
 
@@ -109,7 +97,7 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
     assert_eq!(kind, 6);
     let (_, _, at_rest) = page.packet();
     assert_ne!(back, positions);
-    let at_rest_error = relative_rms(&at_rest, expected);
+    let at_rest_error = relative_rms_of_slices(&at_rest, expected);
     assert!(
         at_rest_error > 100.0 * moved_error.max(1e-9),
         "{at_rest_error}"
@@ -126,7 +114,7 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
     );
     let all = played(dir.path(), &scene, &path);
     let frame8 = all.index_axis(ndarray::Axis(0), 8).to_owned();
-    let path_error = relative_rms(&frame, frame8.as_slice().unwrap());
+    let path_error = relative_rms_of_slices(&frame, frame8.as_slice().unwrap());
     assert!(path_error < 1e-6, "{path_error}");
 
     // What a dynamic scene does not offer, and states no page sends, are refused in one
@@ -164,7 +152,7 @@ fn a_dynamic_scene_s_objects_move_and_its_path_plays_as_relight_scene_computes_t
     let (kind, header, frame9) = page.packet();
     assert_eq!((kind, &header["seq"]), (3, &Value::from(9)), "{header}");
     let expected9 = all.index_axis(ndarray::Axis(0), 9).to_owned();
-    assert!(relative_rms(&frame9, expected9.as_slice().unwrap()) < 1e-6);
+    assert!(relative_rms_of_slices(&frame9, expected9.as_slice().unwrap()) < 1e-6);
 }
 
 #[test]
@@ -229,4 +217,11 @@ fn the_page_drags_a_dynamic_scene_s_object_and_plays_its_path_in_headless_chromi
         "document.getElementById('play').click(); true",
     );
     assert_eq!(browser.console_errors(), Vec::<String>::new());
+}
+
+/// The relative RMS difference of two radiance arrays of equal length (the library's
+/// [`haarshift::metrics::relative_rms_error`] of them as rows).
+fn relative_rms_of_slices(a: &[f32], b: &[f32]) -> f64 {
+    let row = |x: &[f32]| ndarray::Array2::from_shape_vec((1, x.len()), x.to_vec()).unwrap();
+    crate::common::relative_rms(&row(a), &row(b))
 }

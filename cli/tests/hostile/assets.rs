@@ -76,7 +76,7 @@ fn hostile_assets_are_refused_in_one_line_naming_the_part() {
     let out = tempfile::tempdir().unwrap();
     for (name, needles) in CASES {
         let input = folder.join(name);
-        let line = refused(out.path(), &precompute(p(&input), &[]), needles);
+        let line = refused(out.path(), &precompute_args(p(&input), &[]), needles);
         assert!(
             line.starts_with(&format!("haarshift: {}: ", input.display())),
             "{line}"

@@ -29,7 +29,7 @@ struct Cost {
 /// (and fails) after 60 s of wall time.
 // The child is reaped by `wait4` (which also gives its resource use), not by `Child::wait`.
 #[allow(clippy::zombie_processes)]
-fn run(dir: &Path, args: &[&str]) -> (Option<i32>, String, String, Cost) {
+fn run_measured(dir: &Path, args: &[&str]) -> (Option<i32>, String, String, Cost) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_haarshift"))
         .current_dir(dir)
         .args(args)
@@ -84,7 +84,7 @@ fn within_limits(args: &[&str], cost: &Cost) {
 /// Runs `haarshift ARGS` in `dir` and requires exit 1, one `haarshift:` line holding every
 /// needle, nothing on stdout, no panic, within the limits. Returns the line.
 fn refused(dir: &Path, args: &[&str], needles: &[&str]) -> String {
-    let (code, out, err, cost) = run(dir, args);
+    let (code, out, err, cost) = run_measured(dir, args);
     assert_eq!(code, Some(1), "{args:?}: {err}");
     assert!(out.is_empty(), "{args:?} wrote {out:?}");
     assert_eq!(err.lines().count(), 1, "{args:?}: not one line: {err:?}");
@@ -99,20 +99,20 @@ fn refused(dir: &Path, args: &[&str], needles: &[&str]) -> String {
 
 /// Runs `haarshift ARGS` in `dir` and requires success within the limits.
 fn accepted(dir: &Path, args: &[&str]) {
-    let (code, _, err, cost) = run(dir, args);
+    let (code, _, err, cost) = run_measured(dir, args);
     assert_eq!(code, Some(0), "{args:?}: {err}");
     within_limits(args, &cost);
 }
 
 /// `dir/name` holding `bytes`.
-fn file(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+fn input_file(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, bytes).unwrap();
     path
 }
 
 /// `relight precompute INPUT -o x.hsr --resolution 8 --force EXTRA...`.
-fn precompute<'a>(input: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+fn precompute_args<'a>(input: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "relight",
         "precompute",
@@ -150,20 +150,24 @@ fn coordinates_beyond_the_range_are_refused_by_vertex() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let obj = |y: &str| format!("v 0 0 0\nv 1 0 0\nv 0 {y} 0\nf 1 2 3\n");
-    file(d, "t.obj", obj("1e308"));
-    refused(d, &precompute("t.obj", &[]), &["t.obj", "vertex 2", "1e15"]);
-    file(d, "g.obj", obj("3.4e38"));
-    let args = precompute("g.obj", &["--ground-plane"]);
+    input_file(d, "t.obj", obj("1e308"));
+    refused(
+        d,
+        &precompute_args("t.obj", &[]),
+        &["t.obj", "vertex 2", "1e15"],
+    );
+    input_file(d, "g.obj", obj("3.4e38"));
+    let args = precompute_args("g.obj", &["--ground-plane"]);
     refused(d, &args, &["g.obj", "vertex 2", "1e15"]);
-    file(d, "x.obj", "v 1e25 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    let args = precompute("x.obj", &["--ground-plane"]);
+    input_file(d, "x.obj", "v 1e25 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let args = precompute_args("x.obj", &["--ground-plane"]);
     refused(d, &args, &["x.obj", "vertex 0", "1e15"]);
-    file(d, "t.ply", binary_ply(3.4e38));
-    let args = precompute("t.ply", &["--param", "cube"]);
+    input_file(d, "t.ply", binary_ply(3.4e38));
+    let args = precompute_args("t.ply", &["--param", "cube"]);
     refused(d, &args, &["t.ply", "vertex 2", "1e15"]);
     // The edge of the range is accepted.
-    file(d, "edge.obj", obj("1e15"));
-    accepted(d, &precompute("edge.obj", &[]));
+    input_file(d, "edge.obj", obj("1e15"));
+    accepted(d, &precompute_args("edge.obj", &[]));
 }
 
 #[test]
@@ -188,9 +192,9 @@ fn transforms_and_cameras_far_from_the_origin_are_refused() {
         args.extend(["--shells", "6", "--shell-grid", "4"]);
         args
     };
-    file(d, "far.json", scene("[-1e30, 0, 0]", "[0, 1e30, 0]", false));
+    input_file(d, "far.json", scene("[-1e30, 0, 0]", "[0, 1e30, 0]", false));
     refused(d, &render("far.json"), &["far.json", "1e15"]);
-    file(d, "eye.json", scene("[0, 0, 0]", "[0, 1e308, 0]", false));
+    input_file(d, "eye.json", scene("[0, 0, 0]", "[0, 1e308, 0]", false));
     refused(
         d,
         &render("eye.json"),
@@ -198,15 +202,19 @@ fn transforms_and_cameras_far_from_the_origin_are_refused() {
     );
     let chair = r#"{"objects": [{"generator": {"chair": {"cells": 2}},
         "transform": {"translate": [-1e30, 0, 0]}}], "ground_plane": true}"#;
-    file(d, "chair.json", chair);
-    refused(d, &precompute("chair.json", &[]), &["chair.json", "1e15"]);
+    input_file(d, "chair.json", chair);
+    refused(
+        d,
+        &precompute_args("chair.json", &[]),
+        &["chair.json", "1e15"],
+    );
     let inf = r#"{"objects": [{"generator": {"sphere": {"cells": 2}},
         "transform": {"translate": [1e308, 0, 0]}}], "ground_plane": true}"#;
-    file(d, "inf.json", inf);
-    refused(d, &precompute("inf.json", &[]), &["inf.json", "1e15"]);
+    input_file(d, "inf.json", inf);
+    refused(d, &precompute_args("inf.json", &[]), &["inf.json", "1e15"]);
     // A cache of a valid scene, rendered looking at a point out of range.
-    file(d, "ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    accepted(d, &precompute("ok.obj", &[]));
+    input_file(d, "ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    accepted(d, &precompute_args("ok.obj", &[]));
     let env = p(&env);
     let mut args = vec!["relight", "render", "x.hsr", "--env", env, "-o", "r.png"];
     args.extend(["--camera", "0,2,5", "--look-at", "0,1e308,0"]);
@@ -218,14 +226,14 @@ fn transforms_and_cameras_far_from_the_origin_are_refused() {
 fn a_ground_plane_under_a_mesh_without_width_or_depth_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    file(d, "point.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
-    file(d, "line.obj", "v 1 0 1\nv 1 1 1\nv 1 2 1\nf 1 2 3\n");
+    input_file(d, "point.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
+    input_file(d, "line.obj", "v 1 0 1\nv 1 1 1\nv 1 2 1\nf 1 2 3\n");
     for name in ["point.obj", "line.obj"] {
-        let args = precompute(name, &["--ground-plane"]);
+        let args = precompute_args(name, &["--ground-plane"]);
         refused(d, &args, &[name, "ground plane", "width or depth"]);
     }
     // Without the plane the same meshes have no area to hit and precompute.
-    accepted(d, &precompute("point.obj", &[]));
+    accepted(d, &precompute_args("point.obj", &[]));
 }
 
 #[test]
@@ -236,24 +244,28 @@ fn counts_that_would_wrap_are_refused_before_allocating() {
         for cells in ["18446744073709551615", "4294967296", "10000"] {
             let json =
                 format!(r#"{{"objects":[{{"generator":{{"{generator}":{{"cells":{cells}}}}}}}]}}"#);
-            file(d, "g.json", json);
-            refused(d, &precompute("g.json", &[]), &["g.json", "cells", cells]);
+            input_file(d, "g.json", json);
+            refused(
+                d,
+                &precompute_args("g.json", &[]),
+                &["g.json", "cells", cells],
+            );
         }
     }
     let cubes = r#"{"objects":[{"generator":{"cubes":{"count":4294967296,"cells":4294967296}}}]}"#;
-    file(d, "cubes.json", cubes);
+    input_file(d, "cubes.json", cubes);
     refused(
         d,
-        &precompute("cubes.json", &[]),
+        &precompute_args("cubes.json", &[]),
         &["cubes.json", "4294967296"],
     );
     let scene = r#"{"objects": [{"name": "ball", "generator": {"sphere": {"cells": 2}}}],
         "ground_plane": true}"#;
-    file(d, "s.json", scene);
+    input_file(d, "s.json", scene);
     let env = testdata("envmaps/rooitou_park_32x16.hdr");
     for frames in ["18446744073709551615", "2147483647", "4294967296"] {
         let path = format!(r#"{{"segments":[{{"frames":{frames},"light_yaw":90}}]}}"#);
-        file(d, "p.json", path);
+        input_file(d, "p.json", path);
         let mut args = vec!["relight", "scene", "s.json", "-o", "a.gif", "--force"];
         args.extend(["--animate", "p.json", "--env", p(&env)]);
         args.extend(["--resolution", "8", "--width", "8", "--height", "8"]);
@@ -280,11 +292,11 @@ fn generators_too_large_for_the_memory_limit_are_refused_before_they_are_built()
     ] {
         let json =
             format!(r#"{{"objects":[{{"generator":{{"{generator}":{{"cells":{cells}}}}}}}]}}"#);
-        file(d, "g.json", json);
+        input_file(d, "g.json", json);
         let cells = format!("\"cells\":{cells}");
         refused(
             d,
-            &precompute("g.json", &[]),
+            &precompute_args("g.json", &[]),
             &[
                 "g.json: object 0",
                 &cells,
@@ -294,26 +306,26 @@ fn generators_too_large_for_the_memory_limit_are_refused_before_they_are_built()
     }
     // The limit is the flag's: 10,086 vertices need 28.7 MB at lat-long 8 with every coefficient
     // (640 + 16 x 128 + 80 bytes each).
-    file(
+    input_file(
         d,
         "s.json",
         r#"{"objects":[{"generator":{"sphere":{"cells":40}}}]}"#,
     );
     refused(
         d,
-        &precompute("s.json", &["--memory-limit", "8MiB"]),
+        &precompute_args("s.json", &["--memory-limit", "8MiB"]),
         &[
             "s.json: object 0",
             "10086 vertices",
             "memory budget of 8388608 bytes",
         ],
     );
-    accepted(d, &precompute("s.json", &["--memory-limit", "64MiB"]));
+    accepted(d, &precompute_args("s.json", &["--memory-limit", "64MiB"]));
     // A mesh file is counted once read, before its BVH and transport.
     let bunny = testdata("meshes/bunny.ply");
     refused(
         d,
-        &precompute(p(&bunny), &["--memory-limit", "1MiB"]),
+        &precompute_args(p(&bunny), &["--memory-limit", "1MiB"]),
         &["bunny.ply: the scene (1839 vertices)", "memory budget"],
     );
 }
@@ -323,29 +335,29 @@ fn degenerate_meshes_build_their_bvh_in_linear_time() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let copies = "f 1 2 3\n".repeat(90_000);
-    file(
+    input_file(
         d,
         "copies.obj",
         format!("v 0 0 0\nv 1 0 0\nv 0 1 0\n{copies}"),
     );
-    accepted(d, &precompute("copies.obj", &[]));
+    accepted(d, &precompute_args("copies.obj", &[]));
     let fan = " 1 2 3".repeat(300_000);
-    file(d, "fan.obj", format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf{fan}\n"));
-    accepted(d, &precompute("fan.obj", &[]));
+    input_file(d, "fan.obj", format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf{fan}\n"));
+    accepted(d, &precompute_args("fan.obj", &[]));
     // 90,000 distinct triangles on 100 vertices inside a 1e-9 box: at (1, 1, 1) they are
     // distinct in f64 and one point in f32; at the origin f32 tells them apart, so exact
     // de-duplication alone would not pass.
     for (name, base) in [("tiny.obj", 1.0), ("origin.obj", 0.0)] {
-        file(d, name, tiny_triangles(base));
-        accepted(d, &precompute(name, &[]));
+        input_file(d, name, tiny_triangles(base));
+        accepted(d, &precompute_args(name, &[]));
     }
     // A whole scene of extent 1e-23 (found by the scene_structured fuzz target): its BVH's f32
     // surface areas underflow to zero, and it built for a minute until the scene was scaled.
     let tiny = r#"{"objects": [{"generator": {"cylinder_and_bump": {"cells": 63}},
         "transform": {"translate": [8.98e-320, 0, 0], "scale": 1.655976812239948e-24}}],
         "ground_plane": true}"#;
-    file(d, "tiny.json", tiny);
-    accepted(d, &precompute("tiny.json", &[]));
+    input_file(d, "tiny.json", tiny);
+    accepted(d, &precompute_args("tiny.json", &[]));
 }
 
 /// 100 vertices scattered inside `[base, base + 1e-9]^3` (a fixed Weyl sequence per axis) and
@@ -392,7 +404,7 @@ fn malformed_headers_and_sidecars_give_one_short_line() {
     npy.extend((header.len() as u16).to_le_bytes());
     npy.extend(header.as_bytes());
     npy.extend([0u8; 64]);
-    file(d, "long.npy", npy);
+    input_file(d, "long.npy", npy);
     let line = refused(
         d,
         &["info", "long.npy"],
@@ -400,7 +412,7 @@ fn malformed_headers_and_sidecars_give_one_short_line() {
     );
     assert!(line.len() < 400, "{} bytes: {line}", line.len());
     // A 21-byte file whose header says it is 2.4 GB long (found by the exr fuzz target).
-    file(
+    input_file(
         d,
         "liar.npy",
         b"\x93NUMPY\x03\x00\x00\x10\x00\x8f#\xcdh**#c\x00$",
@@ -412,7 +424,7 @@ fn malformed_headers_and_sidecars_give_one_short_line() {
     );
     // A coefficient file whose sidecar is a link to an endless device.
     let image = testdata("camera.png");
-    let (code, _, err, _) = run(d, &["transform", p(&image), "-o", "c.npy"]);
+    let (code, _, err, _) = run_measured(d, &["transform", p(&image), "-o", "c.npy"]);
     assert_eq!(code, Some(0), "{err}");
     std::fs::remove_file(d.join("c.npy.json")).unwrap();
     std::os::unix::fs::symlink("/dev/zero", d.join("c.npy.json")).unwrap();
@@ -423,12 +435,12 @@ fn malformed_headers_and_sidecars_give_one_short_line() {
     );
     // An OpenEXR file whose first chunk offset is u64::MAX.
     let env = testdata("envmaps/rooitou_park_32x16.hdr");
-    let (code, _, err, _) = run(d, &["rotate", p(&env), "--angle", "0", "-o", "a.exr"]);
+    let (code, _, err, _) = run_measured(d, &["rotate", p(&env), "--angle", "0", "-o", "a.exr"]);
     assert_eq!(code, Some(0), "{err}");
     let mut exr = std::fs::read(d.join("a.exr")).unwrap();
     let table = exr_offset_table(&exr);
     exr[table..table + 8].copy_from_slice(&u64::MAX.to_le_bytes());
-    file(d, "far.exr", exr);
+    input_file(d, "far.exr", exr);
     refused(
         d,
         &["info", "far.exr"],

@@ -51,7 +51,7 @@ fn direct(scene: &mut DynamicScene) {
 }
 
 /// A sky with a sun, as the shading's lighting and as the reference's lat-long map.
-fn sky() -> (Lighting, LatLongMap<f64>) {
+fn sunny_sky() -> (Lighting, LatLongMap<f64>) {
     let map = SphereMap::<f64>::from_fn(param(), 3, |d, o| {
         let sun = (8.0 * (d[0] * 0.6 + d[1] * 0.8 - 1.0)).exp();
         o.copy_from_slice(&[1.0 + 20.0 * sun, 0.5 + d[2].abs(), 0.2 + 10.0 * sun]);
@@ -65,7 +65,7 @@ fn sky() -> (Lighting, LatLongMap<f64>) {
 
 #[test]
 fn with_every_coefficient_and_direct_evaluation_the_shading_equals_the_reference() {
-    let (light, map) = sky();
+    let (light, map) = sunny_sky();
     for material in [PHONG, BLINN] {
         let mut scene = build(&box_alone(material));
         direct(&mut scene);
@@ -84,7 +84,7 @@ fn with_every_coefficient_and_direct_evaluation_the_shading_equals_the_reference
 
 #[test]
 fn the_reference_gives_each_object_its_own_material() {
-    let (_, map) = sky();
+    let (_, map) = sunny_sky();
     let mixed = build(&three([PHONG, BLINN, LAMBERT]));
     let got = mixed.reference(&map).unwrap();
     for (k, brdf) in ["phong:30", "blinn:20", "lambert"].iter().enumerate() {

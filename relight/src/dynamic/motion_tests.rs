@@ -7,8 +7,8 @@ use crate::dynamic::fields::FieldOptions;
 use haarshift::faces::param::{ParamKind, Parameterization};
 use haarshift::sphere::LatLongMap;
 
-fn scene() -> DynamicScene {
-    scene_of(
+fn two_spheres() -> DynamicScene {
+    dynamic_scene_of(
         r#"{"objects": [
             {"name": "a", "generator": {"sphere": {"cells": 2}}},
             {"name": "b", "generator": {"sphere": {"cells": 2}}, "transform": {"translate": [2.5, 0, 0]}}
@@ -18,7 +18,7 @@ fn scene() -> DynamicScene {
 
 /// A glossy sphere beside a Lambertian one, seen by a camera.
 fn glossy_scene() -> DynamicScene {
-    scene_of(
+    dynamic_scene_of(
         r#"{"objects": [
             {"name": "a", "generator": {"sphere": {"cells": 2}},
              "material": {"brdf": "phong", "exponent": 20, "albedo": [0.9, 0.8, 0.7]}},
@@ -27,7 +27,7 @@ fn glossy_scene() -> DynamicScene {
     )
 }
 
-fn scene_of(json: &str) -> DynamicScene {
+fn dynamic_scene_of(json: &str) -> DynamicScene {
     let file: SceneFile = serde_json::from_str(json).unwrap();
     let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
     let mut o = DynamicOptions::new(param);
@@ -72,7 +72,7 @@ fn path(json: &str) -> MotionPath {
 
 #[test]
 fn states_interpolate_each_segment_from_where_the_last_left_off() {
-    let s = scene();
+    let s = two_spheres();
     let p = path(
         r#"{"segments": [
             {"frames": 4, "object": "b", "to": {"translate": [0.5, 0, 2.5], "yaw": 90}},
@@ -122,7 +122,7 @@ fn an_eye_segment_orbits_the_camera_about_its_look_at_point() {
     // The eye stays where the segment left it.
     assert_eq!(states[3].eye, states[2].eye);
     // Without a camera there is nothing to orbit.
-    let message = p.states(&scene()).unwrap_err().to_string();
+    let message = p.states(&two_spheres()).unwrap_err().to_string();
     assert!(
         message.contains("segment 0") && message.contains("camera"),
         "{message}"
@@ -131,7 +131,7 @@ fn an_eye_segment_orbits_the_camera_about_its_look_at_point() {
 
 #[test]
 fn bad_segments_are_refused_with_their_number() {
-    let s = scene();
+    let s = two_spheres();
     for (json, reason) in [
         (r#"{"segments": []}"#, "at least one segment"),
         (
@@ -170,7 +170,7 @@ fn bad_segments_are_refused_with_their_number() {
 
 #[test]
 fn every_played_frame_is_the_full_product_integral_of_its_state() {
-    let mut s = scene();
+    let mut s = two_spheres();
     let sky = LatLongMap::<f64>::from_fn(16, 3, |d, out| {
         let sun = (0.8 * d[0] + 0.6 * d[1]).max(0.0).powi(6);
         out.fill(0.2 + 3.0 * sun + 0.1 * d[2]);

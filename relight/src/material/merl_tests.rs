@@ -5,7 +5,12 @@ use super::*;
 /// The unit directions of Rusinkiewicz angles, by the definition: the difference vector
 /// `d(theta_diff, phi_diff)` and the half vector `z` rotated together by `theta_half` about `y`
 /// and `phi_half` about `z`; `w_o` is `w_i` mirrored about the half vector.
-fn directions(theta_h: f64, phi_h: f64, theta_d: f64, phi_d: f64) -> ([f64; 3], [f64; 3]) {
+fn rusinkiewicz_directions(
+    theta_h: f64,
+    phi_h: f64,
+    theta_d: f64,
+    phi_d: f64,
+) -> ([f64; 3], [f64; 3]) {
     let rotate = |v: [f64; 3]| {
         let (s, c) = theta_h.sin_cos();
         let v = [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]];
@@ -38,7 +43,7 @@ fn half_diff_inverts_the_definition() {
         let td = uniform(&mut seed) * 1.5;
         let pd = (uniform(&mut seed) * 2.0 - 1.0) * PI * 0.999;
         let ph = uniform(&mut seed) * 2.0 * PI;
-        let (wi, wo) = directions(th, ph, td, pd);
+        let (wi, wo) = rusinkiewicz_directions(th, ph, td, pd);
         let (a, b, c) = half_diff(wi, wo).unwrap();
         assert!(
             (a - th).abs() < 1e-9 && (b - td).abs() < 1e-9 && (c - pd).abs() < 1e-9,
@@ -81,7 +86,7 @@ fn a_lookup_uses_the_bins_of_the_reference_formulas() {
         if uniform(&mut seed) < 0.5 {
             pd -= PI;
         }
-        let (wi, wo) = directions(th, uniform(&mut seed) * 2.0 * PI, td, pd);
+        let (wi, wo) = rusinkiewicz_directions(th, uniform(&mut seed) * 2.0 * PI, td, pd);
         if wi[2] <= 0.0 || wo[2] <= 0.0 {
             continue;
         }
@@ -159,7 +164,7 @@ fn a_file_round_trips_and_reads_unmeasured_entries_as_zero() {
 }
 
 /// The [`MerlError`] of reading `bytes` from a file, which the error must name.
-fn refusal(bytes: &[u8]) -> MerlError {
+fn merl_refusal(bytes: &[u8]) -> MerlError {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.binary");
     std::fs::write(&path, bytes).unwrap();
@@ -182,26 +187,26 @@ fn bad_files_are_refused_naming_the_problem() {
     let mut good = file_bytes([90, 90, 180], |k| (k % 7) as f64);
     let size = good.len() as u64;
     assert_eq!(size, FILE_BYTES);
-    assert_eq!(refusal(&good[..5]), MerlError::Truncated { bytes: 5 });
+    assert_eq!(merl_refusal(&good[..5]), MerlError::Truncated { bytes: 5 });
     assert_eq!(
-        refusal(&good[..good.len() - 1]),
+        merl_refusal(&good[..good.len() - 1]),
         MerlError::Truncated { bytes: size - 1 }
     );
     let mut wrong = good[..100].to_vec();
     wrong[8..12].copy_from_slice(&360i32.to_le_bytes());
     assert_eq!(
-        refusal(&wrong),
+        merl_refusal(&wrong),
         MerlError::Dimensions {
             found: [90, 90, 360]
         }
     );
     good.extend_from_slice(&[0; 8]);
-    assert_eq!(refusal(&good), MerlError::TooLarge { bytes: size + 8 });
+    assert_eq!(merl_refusal(&good), MerlError::TooLarge { bytes: size + 8 });
     good.truncate(size as usize);
     // The green block's entry at bins (2, 3, 4) is NaN.
     let at = 12 + 8 * (SAMPLES + MerlBrdf::index([2, 3, 4]));
     good[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
-    match refusal(&good) {
+    match merl_refusal(&good) {
         MerlError::NonFinite {
             channel: "green",
             bin: [2, 3, 4],
@@ -221,7 +226,7 @@ fn bad_files_are_refused_naming_the_problem() {
 pub(crate) fn phong_table(exponent: f64) -> MerlBrdf {
     let phong = crate::Brdf::Phong { exponent };
     MerlBrdf::from_fn(|th, td, pd| {
-        let (wi, wo) = directions(th, 0.0, td, pd);
+        let (wi, wo) = rusinkiewicz_directions(th, 0.0, td, pd);
         phong.evaluate([0.0, 0.0, 1.0], wi, wo)
     })
     .unwrap()
@@ -239,7 +244,7 @@ pub(crate) fn phong_table_at_centres(exponent: f64) -> MerlBrdf {
                 let th = ((i as f64 + 0.5) / nh as f64).powi(2) * FRAC_PI_2;
                 let td = (j as f64 + 0.5) / nd as f64 * FRAC_PI_2;
                 let pd = (k as f64 + 0.5) / np as f64 * PI;
-                let (wi, wo) = directions(th, 0.0, td, pd);
+                let (wi, wo) = rusinkiewicz_directions(th, 0.0, td, pd);
                 let v = phong.evaluate([0.0, 0.0, 1.0], wi, wo);
                 for c in 0..3 {
                     entries[c * SAMPLES + MerlBrdf::index([i, j, k])] = v[c] / CHANNEL_SCALES[c];
@@ -257,7 +262,7 @@ fn a_phong_table_returns_phong_at_its_grid_points() {
     // At a grid point nudged into its bin, the lookup is the grid point's exact value.
     for bins in [[0, 0, 0], [3, 10, 20], [20, 30, 170], [40, 5, 90]] {
         let (th, td, pd) = MerlBrdf::grid_point(bins);
-        let (wi, wo) = directions(th + 1e-9, 0.4, td + 1e-9, pd + 1e-9);
+        let (wi, wo) = rusinkiewicz_directions(th + 1e-9, 0.4, td + 1e-9, pd + 1e-9);
         let want = phong.evaluate([0.0, 0.0, 1.0], wi, wo)[0];
         let got = table.evaluate(wi, wo);
         assert!(

@@ -1,11 +1,8 @@
 use super::*;
+use crate::test_support::latlong;
 use haarshift::faces::param::SphereMap;
 use haarshift::sphere::latlong::direction;
 use haarshift::sphere::{LatLongMap, SphereCoefficients, yaw::yaw_coefficients};
-
-fn latlong(h: usize) -> Parameterization {
-    Parameterization::new(ParamKind::LatLong, h).unwrap()
-}
 
 /// The angle between two unit vectors.
 fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -8,13 +8,14 @@ use crate::ray_offset;
 use crate::scene::shapes::{cube_sphere, grid, merge};
 use crate::{Generator, vertex_major};
 use haarshift::faces::{ParamKind, Parameterization};
+use haarshift::metrics::relative_rms_error;
 
 fn cube(n: usize) -> Parameterization {
     Parameterization::new(ParamKind::Cube, n).unwrap()
 }
 
 /// Vertex `v`'s stored coefficients of `set` as a dense f64 vector.
-fn dense(set: &TransportSet, v: usize) -> Vec<f64> {
+fn dense_coefficients(set: &TransportSet, v: usize) -> Vec<f64> {
     let mut out = vec![0.0; set.param().texels()];
     let (indices, values) = set.coefficients(v);
     for (&i, &x) in indices.iter().zip(values) {
@@ -192,7 +193,10 @@ fn two_rgb_bounces_equal_a_dense_per_ray_oracle_haar_and_harmonics() {
     assert!(!got.is_grey() && report.rays > 0);
     let rays = |v| centre_rays(&mesh, options.param, v);
     for (what, f) in [
-        ("haar", &dense as &dyn Fn(&TransportSet, usize) -> Vec<f64>),
+        (
+            "haar",
+            &dense_coefficients as &dyn Fn(&TransportSet, usize) -> Vec<f64>,
+        ),
         ("sh", &sh),
     ] {
         let t0 = lifted(&direct, f);
@@ -236,10 +240,10 @@ fn jittered_sub_rays_weigh_one_over_s_squared() {
         });
         out
     };
-    let want = oracle_gather(&mesh, &albedo, &rays, &lifted(&direct, &dense));
+    let want = oracle_gather(&mesh, &albedo, &rays, &lifted(&direct, &dense_coefficients));
     for (v, want) in want.iter().enumerate() {
         for (c, want) in want.iter().enumerate() {
-            assert_close(&dense(got.channel(c), v), want, "S = 2");
+            assert_close(&dense_coefficients(got.channel(c), v), want, "S = 2");
         }
     }
 }
@@ -267,7 +271,7 @@ fn each_bounce_gathers_the_truncated_lower_sum() {
         }
         out
     };
-    let t0 = lifted(&direct, &dense);
+    let t0 = lifted(&direct, &dense_coefficients);
     let s1: Vec<Vec<Vec<f64>>> = oracle_gather(&mesh, &albedo, &rays, &t0)
         .iter()
         .map(|v| v.iter().map(|c| keep(c)).collect())
@@ -283,7 +287,7 @@ fn each_bounce_gathers_the_truncated_lower_sum() {
     let mut untruncated_differs = false;
     for (v, s2) in s2.iter().enumerate() {
         let want = keep(&s2[0]);
-        assert_close(&dense(got.channel(0), v), &want, "keep");
+        assert_close(&dense_coefficients(got.channel(0), v), &want, "keep");
         assert!(got.channel(0).coefficients(v).0.len() <= 6 + 6);
         untruncated_differs |= want.iter().zip(&s2[0]).any(|(a, b)| (a - b).abs() > 1e-4);
     }
@@ -474,13 +478,32 @@ fn refuses_what_it_cannot_gather() {
     let run = |albedo: ArrayView2<'_, f32>, b, range: Range<usize>| {
         bounce_range(&mesh, &bvh, &options, albedo, &direct, None, b, range).map(|_| ())
     };
-    assert!(run(albedo.view(), 9, 0..54).is_err());
-    assert!(run(albedo.view(), 0, 0..54).is_err());
-    assert!(run(albedo.view(), 1, 50..60).is_err());
-    assert!(run(albedo.slice(ndarray::s![..10, ..]), 1, 0..54).is_err());
+    let bounces = |albedo, b, range, needle| {
+        assert_err!(
+            run(albedo, b, range),
+            InvalidParameter {
+                name: "bounces",
+                ..
+            },
+            needle
+        );
+    };
+    bounces(albedo.view(), 9, 0..54, "9: must be 0 to 8");
+    bounces(albedo.view(), 0, 0..54, "0: must be 0 to 8");
+    bounces(albedo.view(), 1, 50..60, "vertices 50..60 of 54");
+    bounces(
+        albedo.slice(ndarray::s![..10, ..]),
+        1,
+        0..54,
+        "the albedo and the direct transport must have the mesh's 54 vertices",
+    );
     let mut bad = albedo.clone();
     bad[[3, 1]] = f32::NAN;
-    assert!(run(bad.view(), 1, 0..54).is_err());
+    assert_err!(
+        run(bad.view(), 1, 0..54),
+        InvalidParameter { name: "albedo", .. },
+        "NaN at vertex 3: must be finite and non-negative"
+    );
     let (one, _) = bounce_range(
         &mesh,
         &bvh,
@@ -502,14 +525,14 @@ fn refuses_what_it_cannot_gather() {
         1,
         0..54,
     );
-    assert!(again.is_err());
-}
-
-/// `(rms of got - want) / rms of want`.
-fn relative_rms(got: &Array2<f64>, want: &Array2<f64>) -> f64 {
-    let diff: f64 = got.iter().zip(want).map(|(g, w)| (g - w).powi(2)).sum();
-    let norm: f64 = want.iter().map(|w| w * w).sum();
-    (diff / norm).sqrt()
+    assert_err!(
+        again,
+        InvalidParameter {
+            name: "bounces",
+            ..
+        },
+        "1 bounces asked for from a sum of 1"
+    );
 }
 
 #[test]
@@ -572,13 +595,16 @@ fn rendered_bounces_equal_the_pixel_domain_gather_to_1e_6_of_the_rms() {
             };
             let mut input = ShadingInput::cache(&cache);
             let got = shade(&input);
-            let error = relative_rms(&got, &want);
+            let error = relative_rms_error(got.view(), want.view()).unwrap();
             assert!(error < 1e-6, "{bounces} bounces, {precision}: {error:e}");
             // Direct light alone is the reference's direct light, far from the bounced.
             input.bounced = None;
             let direct = shade(&input);
-            assert!(relative_rms(&direct, &truth.direct) < 1e-6);
-            assert!(relative_rms(&direct, &want) > 1e-2, "{bounces}");
+            assert!(relative_rms_error(direct.view(), truth.direct.view()).unwrap() < 1e-6);
+            assert!(
+                relative_rms_error(direct.view(), want.view()).unwrap() > 1e-2,
+                "{bounces}"
+            );
         }
     }
 }
@@ -624,10 +650,10 @@ fn bounced_harmonic_transfer_shades_as_its_haar_sum_with_every_band() {
     };
     let (haar, sh) = (shade(Method::Haar, true), shade(Method::Sh, true));
     let (haar0, sh0) = (shade(Method::Haar, false), shade(Method::Sh, false));
-    let with = relative_rms(&sh, &haar);
+    let with = relative_rms_error(sh.view(), haar.view()).unwrap();
     assert!(with < 1e-3, "{with:e}");
-    assert!(relative_rms(&sh0, &haar0) < 1e-3);
-    assert!(relative_rms(&sh0, &haar) > 10.0 * with);
+    assert!(relative_rms_error(sh0.view(), haar0.view()).unwrap() < 1e-3);
+    assert!(relative_rms_error(sh0.view(), haar.view()).unwrap() > 10.0 * with);
     // Other methods refuse a bounced input; with the sum dropped they shade.
     for method in [Method::Reference, Method::Ambient] {
         let spec = ShaderSpec {
@@ -643,5 +669,10 @@ fn bounced_harmonic_transfer_shades_as_its_haar_sum_with_every_band() {
     }
     let mut glossy = ShaderSpec::default();
     glossy.material.brdf = "phong:10".parse().unwrap();
-    assert!(glossy.build(&ShadingInput::cache(&cache)).is_err());
+    assert_err!(
+        glossy.build(&ShadingInput::cache(&cache)),
+        InvalidParameter { name: "scene", .. },
+        "1 bounces of light baked",
+        "--brdf phong:10 cannot show"
+    );
 }

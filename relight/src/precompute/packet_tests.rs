@@ -5,7 +5,12 @@ use proptest::prelude::*;
 use super::*;
 
 /// The oracle: every triangle tested with `RtTriangle::intersect`, a hit at `0 <= t < t_max`.
-fn brute_force(bvh: &PacketBvh, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
+fn packet_hit_by_brute_force(
+    bvh: &PacketBvh,
+    origin: [f32; 3],
+    direction: [f32; 3],
+    t_max: f32,
+) -> bool {
     let ray = Ray::new(
         Vec3A::from_array(origin),
         Vec3A::from_array(direction),
@@ -31,7 +36,7 @@ fn point(grid: bool) -> impl Strategy<Value = [f32; 3]> {
 
 /// A scene of up to 300 triangles, half of them in a plane of constant coordinate (flat
 /// boxes), of non-zero area.
-fn scene(grid: bool) -> impl Strategy<Value = Vec<Triangle>> {
+fn triangle_soup(grid: bool) -> impl Strategy<Value = Vec<Triangle>> {
     let triangle = (point(grid), point(grid), point(grid), 0..6usize);
     prop::collection::vec(triangle, 1..300).prop_map(|corners| {
         corners
@@ -50,7 +55,7 @@ fn scene(grid: bool) -> impl Strategy<Value = Vec<Triangle>> {
 
 /// Up to 32 directions around a random one (a packet's cone) or anywhere, some with zero
 /// components.
-fn directions(grid: bool) -> impl Strategy<Value = Vec<[f32; 3]>> {
+fn packet_directions(grid: bool) -> impl Strategy<Value = Vec<[f32; 3]>> {
     (
         point(false),
         0.0f32..1.5,
@@ -74,7 +79,7 @@ fn check<const N: usize>(bvh: &PacketBvh, origin: [f32; 3], rays: &[[f32; 3]], t
         for (d, &b) in packet.iter().zip(&blocked) {
             assert_eq!(
                 b,
-                brute_force(bvh, origin, *d, t_max),
+                packet_hit_by_brute_force(bvh, origin, *d, t_max),
                 "{origin:?} {d:?} {t_max}"
             );
             let mut one = [false];
@@ -90,7 +95,7 @@ proptest! {
     #[test]
     fn packets_answer_as_testing_every_triangle(
         (triangles, origin, rays, short) in any::<bool>().prop_flat_map(|grid| {
-            (scene(grid), point(grid), directions(grid), any::<bool>())
+            (triangle_soup(grid), point(grid), packet_directions(grid), any::<bool>())
         }),
     ) {
         prop_assume!(!triangles.is_empty());
@@ -141,7 +146,7 @@ fn a_ray_from_a_corner_along_an_edge_and_rays_along_a_flat_box() {
         check::<LANES>(&bvh, o, &rays, f32::INFINITY);
         hits += rays
             .iter()
-            .filter(|&&d| brute_force(&bvh, o, d, f32::INFINITY))
+            .filter(|&&d| packet_hit_by_brute_force(&bvh, o, d, f32::INFINITY))
             .count();
     }
     assert!(hits >= 3, "{hits}");

@@ -4,14 +4,8 @@ use rand::{Rng, SeedableRng};
 use obvhs::ray::Ray;
 
 use super::*;
-use crate::{Scene, add_ground_plane};
-
-fn bunny_on_ground() -> Mesh {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../testdata/meshes/bunny.ply");
-    let mut mesh = Mesh::load(path.as_ref()).unwrap();
-    add_ground_plane(&mut mesh).unwrap();
-    mesh
-}
+use crate::Scene;
+use crate::test_support::bunny_on_ground;
 
 /// The triangles our packets trace (none for another tracer).
 fn traced(bvh: &SceneBvh) -> &[obvhs::rt_triangle::RtTriangle] {
@@ -101,7 +95,12 @@ fn exact(mesh: &Mesh, o: [f32; 3], d: [f32; 3], t_max: f32) -> Option<bool> {
 }
 
 /// The oracle: every triangle tested, the same intersection routine.
-fn brute_force(bvh: &SceneBvh, origin: [f32; 3], direction: [f32; 3], t_max: f32) -> bool {
+fn bvh_hit_by_brute_force(
+    bvh: &SceneBvh,
+    origin: [f32; 3],
+    direction: [f32; 3],
+    t_max: f32,
+) -> bool {
     let ray = Ray::new(
         Vec3A::from_array(origin),
         Vec3A::from_array(direction),
@@ -160,7 +159,7 @@ fn bvh_answers_as_testing_every_triangle() {
     assert_eq!(traced(&bvh).len(), mesh.triangles().len()); // none degenerate here
     let mut hits = 0;
     for (k, (origin, d, t_max)) in bunny_rays(&mesh).enumerate() {
-        let want = brute_force(&bvh, origin, d, t_max);
+        let want = bvh_hit_by_brute_force(&bvh, origin, d, t_max);
         assert_eq!(bvh.occluded(origin, d, t_max), want, "ray {k}");
         hits += usize::from(want);
     }
@@ -284,7 +283,7 @@ fn packets_from_vertices_answer_as_testing_every_triangle() {
     for origin in &origins {
         bvh.occluded_from(*origin, &directions, f32::INFINITY, &mut blocked);
         for (d, &b) in directions.iter().zip(&blocked) {
-            let want = brute_force(&bvh, *origin, *d, f32::INFINITY);
+            let want = bvh_hit_by_brute_force(&bvh, *origin, *d, f32::INFINITY);
             assert_eq!(b, want, "{origin:?} {d:?}");
             hits += usize::from(b);
         }

@@ -18,7 +18,7 @@ fn ball_on_ground() -> Scene {
     scene
 }
 
-fn options(order: Order) -> PrecomputeOptions {
+fn packet_options(order: Order) -> PrecomputeOptions {
     let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
     let mut o = PrecomputeOptions::new(VisibilityOptions::new(param));
     o.ray_tracer = RayTracer::Packets;
@@ -36,7 +36,7 @@ fn refinement(tolerance: f64, max_vertices: usize) -> Refinement {
 
 /// A dim sky of 0.05 with a sun of 50 within 0.15 rad of `(0.8, 0.6, 0)`, 37 degrees up in
 /// the +x sky: the ball's shadow falls on the ground from about `x = 0` to `x = -3`.
-fn sunny() -> Environment {
+fn sun_environment() -> Environment {
     let sun = [0.8, 0.6, 0.0];
     let len = dot(sun, sun).sqrt();
     let map = LatLongMap::<f64>::from_fn(64, 3, |d, out| {
@@ -125,7 +125,7 @@ fn the_difference_is_the_dense_vectors_and_the_scale_an_unoccluded_vertex() {
 #[test]
 fn refined_cache_is_a_precompute_of_the_refined_mesh() {
     let scene = ball_on_ground();
-    let o = options(Order::Vertex);
+    let o = packet_options(Order::Vertex);
     // Lat-long 8's texels are large: one texel turning dark is a step of about a quarter of
     // an unoccluded vertex's transport, so 0.6 is a tolerance the refinement can meet.
     let tolerance = 0.6;
@@ -160,11 +160,12 @@ fn refined_cache_is_a_precompute_of_the_refined_mesh() {
 
 #[test]
 fn refine_first_then_bounce_bounces_over_the_refined_mesh() {
-    let mut o = options(Order::Vertex);
+    let mut o = packet_options(Order::Vertex);
     o.bounces = 1;
     let r = refinement(0.6, 2000);
     let (bounced, _, _) = precompute_refined(ball_on_ground(), &o, &r).unwrap();
-    let (direct, _, _) = precompute_refined(ball_on_ground(), &options(Order::Vertex), &r).unwrap();
+    let (direct, _, _) =
+        precompute_refined(ball_on_ground(), &packet_options(Order::Vertex), &r).unwrap();
     // The refinement judges direct transport alone: the same mesh with or without bounces.
     assert_eq!(
         (&bounced.mesh, &bounced.transport),
@@ -184,8 +185,8 @@ fn refine_first_then_bounce_bounces_over_the_refined_mesh() {
 
 #[test]
 fn the_probe_s_radiance_is_the_shaded_one_and_an_open_vertex_s_its_unoccluded_sum() {
-    let o = options(Order::Vertex);
-    let probe = Probe::new("sun", &sunny(), o.visibility.param).unwrap();
+    let o = packet_options(Order::Vertex);
+    let probe = Probe::new("sun", &sun_environment(), o.visibility.param).unwrap();
     let (cache, _) = precompute(ball_on_ground(), &o).unwrap();
     // Against the Lambertian shading of the same transport (albedo pi: radiance <T, L>).
     let albedo = Array2::<f32>::from_elem((cache.mesh.vertex_count(), 3), std::f32::consts::PI);
@@ -220,7 +221,7 @@ fn the_probe_s_radiance_is_the_shaded_one_and_an_open_vertex_s_its_unoccluded_su
     r.probe = Some(
         Probe::new(
             "sun",
-            &sunny(),
+            &sun_environment(),
             Parameterization::new(ParamKind::Cube, 4).unwrap(),
         )
         .unwrap(),
@@ -231,10 +232,10 @@ fn the_probe_s_radiance_is_the_shaded_one_and_an_open_vertex_s_its_unoccluded_su
 
 #[test]
 fn under_a_sunny_probe_the_refinement_follows_the_shadow_to_its_far_end() {
-    let o = options(Order::Vertex);
+    let o = packet_options(Order::Vertex);
     let mut r = refinement(0.3, 400);
     let (by_transport, _, _) = precompute_refined(ball_on_ground(), &o, &r).unwrap();
-    r.probe = Some(Probe::new("sun", &sunny(), o.visibility.param).unwrap());
+    r.probe = Some(Probe::new("sun", &sun_environment(), o.visibility.param).unwrap());
     let (by_probe, _, report) = precompute_refined(ball_on_ground(), &o, &r).unwrap();
     // The ground's 2 x 2 cells span [-4, 4]. The transport splits the ground's edges around
     // the contact alike on every side; the probe follows the shadow, which the sun at +x
@@ -266,7 +267,7 @@ fn under_a_sunny_probe_the_refinement_follows_the_shadow_to_its_far_end() {
 
 #[test]
 fn the_budget_is_never_exceeded_and_what_it_left_is_reported() {
-    let o = options(Order::Vertex);
+    let o = packet_options(Order::Vertex);
     for max in [63, 64, 70, 90] {
         let (cache, _, report) =
             precompute_refined(ball_on_ground(), &o, &refinement(0.05, max)).unwrap();
@@ -283,7 +284,7 @@ fn the_budget_is_never_exceeded_and_what_it_left_is_reported() {
 
 #[test]
 fn a_refined_cache_reads_back_with_its_ground_vertices() {
-    let o = options(Order::Vertex);
+    let o = packet_options(Order::Vertex);
     let (cache, _, report) =
         precompute_refined(ball_on_ground(), &o, &refinement(0.5, 90)).unwrap();
     let dir = tempfile::tempdir().unwrap();
@@ -305,9 +306,9 @@ fn what_refinement_cannot_be_combined_with_is_refused_before_any_work() {
             .to_string();
         assert!(err.contains(why), "{err}");
     };
-    let o = options(Order::Vertex);
+    let o = packet_options(Order::Vertex);
     refuse(
-        &options(Order::Direction),
+        &packet_options(Order::Direction),
         refinement(0.1, 100),
         "--order direction",
     );

@@ -2,13 +2,11 @@ use std::f64::consts::PI;
 
 use super::*;
 use crate::precompute::cast::f32x3;
+use crate::test_support::bunny_on_ground;
 use crate::test_support::corner_form_factor;
+use crate::test_support::latlong;
 use crate::{Generator, SceneBvh, add_ground_plane};
 use haarshift::faces::ParamKind;
-
-fn latlong(n: usize) -> Parameterization {
-    Parameterization::new(ParamKind::LatLong, n).unwrap()
-}
 
 /// Vertex `v`'s transport as pixels `(faces, S, S)`.
 fn pixels(set: &TransportSet, v: usize) -> Vec<f32> {
@@ -32,13 +30,6 @@ fn rms_difference(a: &TransportSet, b: &TransportSet) -> (f64, f64) {
         mean(&|k| (total(a, k) - total(b, k)).powi(2)),
         mean(&|k| total(a, k).powi(2)),
     )
-}
-
-fn bunny_on_ground() -> Mesh {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../testdata/meshes/bunny.ply");
-    let mut mesh = Mesh::load(path.as_ref()).unwrap();
-    add_ground_plane(&mut mesh).unwrap();
-    mesh
 }
 
 #[test]

@@ -414,7 +414,7 @@ fn triangles_through_the_near_plane_are_clipped_not_dropped() {
 /// order, coverage from the edge functions evaluated at the centre itself (top-left rule), the
 /// nearest fragment kept (the earlier of two at the same depth), its radiance interpolated
 /// there; `background(i, j)` elsewhere. No bands, no bounding boxes, no stepping, no threads.
-fn brute_force(
+fn raster_by_brute_force(
     camera: &Camera,
     w: usize,
     h: usize,
@@ -513,7 +513,7 @@ fn the_banded_parallel_image_equals_brute_force_bit_for_bit() {
         };
         let colour = [0.25, 0.5, 0.75];
         let got = render(&camera, w, h, &mesh, Background::Colour(colour)).unwrap();
-        let want = brute_force(&camera, w, h, &mesh, |_, _| colour);
+        let want = raster_by_brute_force(&camera, w, h, &mesh, |_, _| colour);
         assert_eq!(got.planes(), want, "scene {scene}");
         // Some pixels drawn, some left to the background.
         let background = (0..h * w)
@@ -524,7 +524,7 @@ fn the_banded_parallel_image_equals_brute_force_bit_for_bit() {
             "scene {scene}: {background}"
         );
         let got = render(&camera, w, h, &mesh, Background::Environment(&env)).unwrap();
-        let want = brute_force(&camera, w, h, &mesh, |i, j| {
+        let want = raster_by_brute_force(&camera, w, h, &mesh, |i, j| {
             let (theta, phi) = angles(camera.ray(j as f64 + 0.5, i as f64 + 0.5, w, h));
             let mut v = [0.0; 3];
             env.bilinear(theta, phi, &mut v);

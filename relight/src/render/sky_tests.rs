@@ -133,5 +133,9 @@ fn a_lookup_serves_only_its_camera_size_and_map_height() {
             "{err}"
         );
     }
-    assert!(SkyLookup::new(&camera, 0, 10, &map).is_err());
+    assert_err!(
+        SkyLookup::new(&camera, 0, 10, &map),
+        InvalidShape { .. },
+        "invalid shape [10, 0]: an image is 1 to 32768 pixels wide and high"
+    );
 }

@@ -14,7 +14,7 @@ fn box_scene() -> Scene {
 
 /// Cube 8, 2 x 2 jittered rays a texel (the jitter is what depends on the vertex index), the
 /// 3-band spherical-harmonic transfer beside the Haar transport.
-fn options() -> PrecomputeOptions {
+fn jittered_cube_options() -> PrecomputeOptions {
     let mut visibility = VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 8).unwrap());
     visibility.samples = 2;
     visibility.seed = 7;
@@ -24,11 +24,13 @@ fn options() -> PrecomputeOptions {
 
 fn shard(index: usize, count: usize) -> CacheShard {
     let shard = Shard::new(index, count).unwrap();
-    precompute_shard(box_scene(), &options(), shard).unwrap().0
+    precompute_shard(box_scene(), &jittered_cube_options(), shard)
+        .unwrap()
+        .0
 }
 
 /// Shards `0..count` written as `part-I.hsr` in `dir`.
-fn written(dir: &Path, count: usize) -> Vec<PathBuf> {
+fn written_shards(dir: &Path, count: usize) -> Vec<PathBuf> {
     (0..count)
         .map(|i| {
             let path = dir.join(format!("part-{i}.hsr"));
@@ -39,7 +41,7 @@ fn written(dir: &Path, count: usize) -> Vec<PathBuf> {
 }
 
 /// The one-line refusal of merging `paths`, which must name `culprit`.
-fn refusal(paths: &[PathBuf], culprit: &Path) -> String {
+fn merge_refusal(paths: &[PathBuf], culprit: &Path) -> String {
     let e = merge_shards(paths).unwrap_err();
     let message = e.to_string();
     assert!(
@@ -52,7 +54,7 @@ fn refusal(paths: &[PathBuf], culprit: &Path) -> String {
 
 #[test]
 fn a_shard_has_the_bits_of_the_whole_whatever_the_count() {
-    let (whole, _) = precompute(box_scene(), &options()).unwrap();
+    let (whole, _) = precompute(box_scene(), &jittered_cube_options()).unwrap();
     let sh = |t: &TransportSet, v: usize| t.sh().unwrap().coefficients().row(v).to_vec();
     for count in [1, 2, 3, 7, 17] {
         let mut next = 0;
@@ -91,12 +93,12 @@ fn a_shard_has_the_bits_of_the_whole_whatever_the_count() {
 fn merged_shards_are_the_whole_cache_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let whole = dir.path().join("whole.hsr");
-    let (cache, _) = precompute(box_scene(), &options()).unwrap();
+    let (cache, _) = precompute(box_scene(), &jittered_cube_options()).unwrap();
     cache.write(&whole, false).unwrap();
     for count in [1, 3, 7] {
         let sub = dir.path().join(count.to_string());
         std::fs::create_dir(&sub).unwrap();
-        let mut parts = written(&sub, count);
+        let mut parts = written_shards(&sub, count);
         parts.reverse(); // any order
         let merged = merge_shards(&parts).unwrap();
         assert_eq!(merged, cache);
@@ -109,19 +111,19 @@ fn merged_shards_are_the_whole_cache_byte_for_byte() {
 #[test]
 fn merge_refuses_gaps_overlaps_strangers_and_damage_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let parts = written(dir.path(), 3); // 0..53, 53..106, 106..159
-    let missing = refusal(&[parts[0].clone(), parts[2].clone()], &parts[2]);
+    let parts = written_shards(dir.path(), 3); // 0..53, 53..106, 106..159
+    let missing = merge_refusal(&[parts[0].clone(), parts[2].clone()], &parts[2]);
     assert!(
         missing.ends_with("vertices 53..106 are in no shard (before shard 2/3)"),
         "{missing}"
     );
-    let last = refusal(&parts[1..], &parts[1]);
+    let last = merge_refusal(&parts[1..], &parts[1]);
     assert!(
         last.ends_with("vertices 0..53 are in no shard (before shard 1/3)"),
         "{last}"
     );
     let twice = [parts.clone(), vec![parts[1].clone()]].concat();
-    let message = refusal(&twice, &parts[1]);
+    let message = merge_refusal(&twice, &parts[1]);
     assert!(
         message.ends_with(&format!(
             "vertices 53..106 of shard 1/3 are also in {}",
@@ -132,7 +134,7 @@ fn merge_refuses_gaps_overlaps_strangers_and_damage_naming_the_file() {
     // Overlapping shards of different counts: 2/7 is 45..68.
     let odd = dir.path().join("odd.hsr");
     shard(2, 7).write(&odd, false).unwrap();
-    let message = refusal(&[parts.clone(), vec![odd.clone()]].concat(), &odd);
+    let message = merge_refusal(&[parts.clone(), vec![odd.clone()]].concat(), &odd);
     assert!(
         message.contains("vertices 45..53 of shard 2/7 are also in"),
         "{message}"
@@ -142,11 +144,11 @@ fn merge_refuses_gaps_overlaps_strangers_and_damage_naming_the_file() {
     let other = dir.path().join("other-scene.hsr");
     let mesh = Generator::PlaneUnderBox { height: 0.75 }.mesh().unwrap();
     let scene = Scene::from_mesh(mesh, false).unwrap();
-    let part = precompute_shard(scene, &options(), Shard::new(1, 3).unwrap())
+    let part = precompute_shard(scene, &jittered_cube_options(), Shard::new(1, 3).unwrap())
         .unwrap()
         .0;
     part.write(&other, false).unwrap();
-    let message = refusal(&[parts[0].clone(), other.clone(), parts[2].clone()], &other);
+    let message = merge_refusal(&[parts[0].clone(), other.clone(), parts[2].clone()], &other);
     assert!(
         message.contains("shard 1/3 has another mesh (159 vertices, hash"),
         "{message}"
@@ -154,13 +156,13 @@ fn merge_refuses_gaps_overlaps_strangers_and_damage_naming_the_file() {
 
     // Other options: another seed of the jitter.
     let reseeded = dir.path().join("other-options.hsr");
-    let mut seed = options();
+    let mut seed = jittered_cube_options();
     seed.visibility.seed = 8;
     let part = precompute_shard(box_scene(), &seed, Shard::new(1, 3).unwrap())
         .unwrap()
         .0;
     part.write(&reseeded, false).unwrap();
-    let message = refusal(
+    let message = merge_refusal(
         &[parts[0].clone(), reseeded.clone(), parts[2].clone()],
         &reseeded,
     );
@@ -176,17 +178,17 @@ fn merge_refuses_gaps_overlaps_strangers_and_damage_naming_the_file() {
     let cut = dir.path().join("cut.hsr");
     let bytes = std::fs::read(&parts[1]).unwrap();
     std::fs::write(&cut, &bytes[..bytes.len() - 100]).unwrap();
-    let message = refusal(&[parts[0].clone(), cut.clone(), parts[2].clone()], &cut);
+    let message = merge_refusal(&[parts[0].clone(), cut.clone(), parts[2].clone()], &cut);
     assert!(message.ends_with("scene cache is damaged (checksum mismatch); compute it again"));
 
     // A whole cache is not a shard, and a shard is not a whole cache.
     let whole = dir.path().join("whole.hsr");
-    precompute(box_scene(), &options())
+    precompute(box_scene(), &jittered_cube_options())
         .unwrap()
         .0
         .write(&whole, false)
         .unwrap();
-    let message = refusal(&[parts[0].clone(), whole.clone()], &whole);
+    let message = merge_refusal(&[parts[0].clone(), whole.clone()], &whole);
     assert!(
         message.ends_with("is a whole scene cache, not a shard"),
         "{message}"
@@ -200,7 +202,11 @@ fn merge_refuses_gaps_overlaps_strangers_and_damage_naming_the_file() {
             parts[1].display()
         )
     );
-    assert!(merge_shards(&[]).is_err());
+    assert_err!(
+        merge_shards(&[]),
+        InvalidParameter { name: "shards", .. },
+        "give at least one shard to merge"
+    );
 }
 
 #[test]
@@ -213,7 +219,7 @@ fn sharded_bounces_merged_bounce_by_bounce_are_the_unsharded_cache_byte_for_byte
         s.albedo.column_mut(1).fill(0.4);
         s
     };
-    let mut options = options();
+    let mut options = jittered_cube_options();
     let merged_of = |parts: &[PathBuf], name: &str| {
         let path = dir.path().join(name);
         merge_shards(parts).unwrap().write(&path, false).unwrap();

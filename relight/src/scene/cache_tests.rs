@@ -45,21 +45,21 @@ fn made_with(cells: usize, sh_bands: Option<usize>) -> SceneCache {
     cache
 }
 
-fn written(cache: &SceneCache) -> (tempfile::TempDir, PathBuf) {
+fn written_cache(cache: &SceneCache) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.hsr");
     cache.write(&path, false).unwrap();
     (dir, path)
 }
 
-fn refusal(path: &Path) -> SceneError {
+fn cache_refusal(path: &Path) -> SceneError {
     crate::refusal_in(SceneCache::read(path), path)
 }
 
 #[test]
 fn a_cache_reads_back_exactly() {
     let cache = made(3);
-    let (_dir, path) = written(&cache);
+    let (_dir, path) = written_cache(&cache);
     let back = SceneCache::read(&path).unwrap();
     assert_eq!(back, cache);
     assert!(back.transport.stored_bytes() > 0);
@@ -81,7 +81,7 @@ fn a_cache_reads_back_exactly() {
 
 #[test]
 fn a_flipped_byte_anywhere_is_refused() {
-    let (_dir, path) = written(&made(2));
+    let (_dir, path) = written_cache(&made(2));
     let good = std::fs::read(&path).unwrap();
     // Every byte of the checksum and header, then every 31st (in memory: the same parser).
     let bytes = (12..400).chain((400..good.len()).step_by(31));
@@ -97,20 +97,20 @@ fn a_flipped_byte_anywhere_is_refused() {
     bad[100] ^= 0x01;
     std::fs::write(&path, &bad).unwrap();
     assert_eq!(
-        refusal(&path),
+        cache_refusal(&path),
         SceneError::CacheCorrupt("checksum mismatch".into())
     );
     let mut bad = good.clone();
     bad[3] ^= 1;
     std::fs::write(&path, &bad).unwrap();
-    assert!(matches!(refusal(&path), SceneError::CacheCorrupt(r) if r.contains("not a")));
+    assert!(matches!(cache_refusal(&path), SceneError::CacheCorrupt(r) if r.contains("not a")));
 }
 
 #[test]
 fn every_array_starts_at_a_multiple_of_8_with_zeros_before_it() {
     // Version 4's promise: the header is followed by zeros up to an aligned offset; a non-zero
     // gap (with a right checksum) is refused rather than read past.
-    let (_dir, path) = written(&made(2));
+    let (_dir, path) = written_cache(&made(2));
     let good = std::fs::read(&path).unwrap();
     let header_len = u64::from_le_bytes(good[16..24].try_into().unwrap()) as usize;
     let first_array = (24 + header_len).next_multiple_of(8);
@@ -125,19 +125,19 @@ fn every_array_starts_at_a_multiple_of_8_with_zeros_before_it() {
     bad[12..16].copy_from_slice(&checksum.to_le_bytes());
     std::fs::write(&path, &bad).unwrap();
     assert_eq!(
-        refusal(&path),
+        cache_refusal(&path),
         SceneError::CacheCorrupt("padding that is not zero".into())
     );
 }
 
 #[test]
 fn a_truncated_file_is_refused() {
-    let (_dir, path) = written(&made(2));
+    let (_dir, path) = written_cache(&made(2));
     let good = std::fs::read(&path).unwrap();
     for cut in [0, 5, 16, 23, 40, good.len() / 2, good.len() - 1] {
         std::fs::write(&path, &good[..cut]).unwrap();
         assert!(
-            matches!(refusal(&path), SceneError::CacheCorrupt(_)),
+            matches!(cache_refusal(&path), SceneError::CacheCorrupt(_)),
             "cut at {cut}"
         );
     }
@@ -145,11 +145,11 @@ fn a_truncated_file_is_refused() {
 
 #[test]
 fn another_version_is_refused_with_both_versions_named() {
-    let (_dir, path) = written(&made(2));
+    let (_dir, path) = written_cache(&made(2));
     let mut bytes = std::fs::read(&path).unwrap();
     bytes[8..12].copy_from_slice(&(CACHE_VERSION + 1).to_le_bytes());
     std::fs::write(&path, &bytes).unwrap();
-    let e = refusal(&path);
+    let e = cache_refusal(&path);
     assert_eq!(
         e,
         SceneError::CacheVersion {
@@ -163,7 +163,7 @@ fn another_version_is_refused_with_both_versions_named() {
 #[test]
 fn a_cache_of_another_scene_is_refused() {
     let cache = made(2);
-    let (_dir, path) = written(&cache);
+    let (_dir, path) = written_cache(&cache);
     assert!(SceneCache::read_for(&path, &cache.mesh).is_ok());
     let other = made(3).mesh;
     assert!(matches!(
@@ -213,7 +213,7 @@ fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
         transfer.coefficients().dim(),
         (cache.mesh.vertex_count(), 9)
     );
-    let (_dir, path) = written(&cache);
+    let (_dir, path) = written_cache(&cache);
     assert_eq!(SceneCache::read(&path).unwrap(), cache);
     // The transfer is the file's last V x 9 f32: a flipped byte there fails the checksum.
     let good = std::fs::read(&path).unwrap();
@@ -223,7 +223,7 @@ fn the_spherical_harmonic_transfer_reads_back_and_is_checksummed() {
         bad[k] ^= 0x04;
         std::fs::write(&path, &bad).unwrap();
         assert_eq!(
-            refusal(&path),
+            cache_refusal(&path),
             SceneError::CacheCorrupt("checksum mismatch".into()),
             "byte {k}"
         );
@@ -258,13 +258,13 @@ fn version_1_to_5_files_are_refused() {
     // Version 1 had no spherical-harmonic transfer, version 2 no shard record, version 3 no
     // aligned arrays, version 4 no ray tracer, version 5 no ground plane counts: their files
     // must be remade, not misread.
-    let (_dir, path) = written(&made(2));
+    let (_dir, path) = written_cache(&made(2));
     let good = std::fs::read(&path).unwrap();
     for old in [1u32, 2, 3, 4, 5] {
         let mut bytes = good.clone();
         bytes[8..12].copy_from_slice(&old.to_le_bytes());
         std::fs::write(&path, &bytes).unwrap();
-        let e = refusal(&path);
+        let e = cache_refusal(&path);
         assert_eq!(
             e,
             SceneError::CacheVersion {
@@ -312,7 +312,7 @@ fn a_cache_of_any_scene_reads_back_its_mesh_bit_for_bit() {
     let options = PrecomputeOptions::new(VisibilityOptions::new(param));
     for (name, scene) in scenes {
         let (cache, _) = precompute(scene, &options).unwrap();
-        let (_dir, path) = written(&cache);
+        let (_dir, path) = written_cache(&cache);
         let (header, parts) = read_parts(&path).unwrap();
         let differing = differing_bits(&parts.mesh, &cache.mesh);
         assert_eq!(
@@ -388,7 +388,7 @@ fn bounced_caches_read_back_exactly_grey_and_rgb() {
         let b = cache.bounced.as_ref().unwrap();
         assert_eq!((cache.params.bounces, b.channels().len()), (2, sets));
         assert!(b.channel(0).sh().is_some() && b.coefficient_count() > 0);
-        let (_dir, path) = written(&cache);
+        let (_dir, path) = written_cache(&cache);
         let back = SceneCache::read(&path).unwrap();
         assert_eq!(back, cache);
         let channel = back.bounced.as_ref().unwrap().channel(sets - 1);
@@ -400,7 +400,7 @@ fn bounced_caches_read_back_exactly_grey_and_rgb() {
     }
     // A cache without bounces writes neither field: its bytes are those of a cache made
     // before bounces existed.
-    let (_dir, path) = written(&made(2));
+    let (_dir, path) = written_cache(&made(2));
     let (header, _) = header_of(&std::fs::read(&path).unwrap());
     assert!(!header.to_string().contains("bounce"), "{header}");
 }
@@ -432,25 +432,57 @@ fn a_bounced_sum_that_does_not_match_is_refused() {
         cache.albedo.clone(),
         cache.transport.clone(),
     );
-    assert!(SceneCache::new(params, m, a, t).is_err());
+    assert_err!(
+        SceneCache::new(params, m, a, t),
+        InvalidParameter {
+            name: "cache parameters",
+            ..
+        },
+        "they say 3 bounces but the bounced sum has 0"
+    );
 }
 
 #[test]
 fn hostile_bounce_headers_are_refused_without_a_panic() {
-    let (_dir, path) = written(&bounced_with(Some(2), true));
+    let (_dir, path) = written_cache(&bounced_with(Some(2), true));
     let good = std::fs::read(&path).unwrap();
     let (header, _) = header_of(&good);
-    let edits: [(&str, serde_json::Value); 8] = [
-        ("bounces", 0.into()),
-        ("bounces", 9.into()),
-        ("bounces", usize::MAX.into()),
-        ("bounced_coefficients", serde_json::json!([])),
-        ("bounced_coefficients", serde_json::json!([1, 2])),
-        ("bounced_coefficients", serde_json::json!([0, 0, 0])),
-        ("bounced_coefficients", serde_json::json!([u64::MAX, 0, 0])),
-        ("bounced_coefficients", serde_json::json!([1, 2, 3, 4])),
+    // Each edit and the refusal it meets: a count of bounces out of range is refused as a
+    // parameter, a bounced sum that does not fit the header as a damaged cache.
+    let sets = |b: usize, n: usize| {
+        format!("{b} bounces with {n} bounced sets (0 and none, or 1 to 8 and 1 or 3)")
+    };
+    let edits: [(&str, serde_json::Value, String); 8] = [
+        ("bounces", 0.into(), sets(0, 3)),
+        ("bounces", 9.into(), "9: must be 0 to 8".into()),
+        (
+            "bounces",
+            usize::MAX.into(),
+            format!("{}: must be 0 to 8", usize::MAX),
+        ),
+        ("bounced_coefficients", serde_json::json!([]), sets(2, 0)),
+        (
+            "bounced_coefficients",
+            serde_json::json!([1, 2]),
+            sets(2, 2),
+        ),
+        (
+            "bounced_coefficients",
+            serde_json::json!([0, 0, 0]),
+            "bytes after the bounced sum".into(),
+        ),
+        (
+            "bounced_coefficients",
+            serde_json::json!([u64::MAX, 0, 0]),
+            "size overflows".into(),
+        ),
+        (
+            "bounced_coefficients",
+            serde_json::json!([1, 2, 3, 4]),
+            sets(2, 4),
+        ),
     ];
-    for (field, value) in edits {
+    for (field, value, needle) in edits {
         let mut h = header.clone();
         match field {
             "bounces" => h["params"][field] = value.clone(),
@@ -458,7 +490,25 @@ fn hostile_bounce_headers_are_refused_without_a_panic() {
         }
         let bad = with_header(&good, &h);
         let got = parse_bytes(&bad).and_then(SceneCache::from_file_parts);
-        assert!(got.is_err(), "{field} {value}");
+        if needle.contains("must be 0 to 8") {
+            assert_err!(
+                got,
+                InvalidParameter {
+                    name: "bounces",
+                    ..
+                },
+                &needle
+            );
+        } else {
+            assert_err!(
+                got,
+                Scene {
+                    source: SceneError::CacheCorrupt(_),
+                    ..
+                },
+                &format!("scene cache is damaged ({needle}); compute it again")
+            );
+        }
     }
     // The untouched header passes through the same rewriting.
     let same = with_header(&good, &header);

@@ -61,7 +61,7 @@ fn load(doc: &Value, budget: &MemoryBudget) -> (Result<MeshAsset>, tempfile::Tem
 }
 
 /// The one-line refusal of `doc`, which must name the file.
-fn refusal(doc: &Value) -> String {
+fn gltf_refusal(doc: &Value) -> String {
     let (result, dir) = load(doc, &MemoryBudget::default());
     let e = result.unwrap_err().to_string();
     assert!(
@@ -347,7 +347,7 @@ fn hostile_documents_are_refused_in_one_line_naming_the_part() {
         ),
     ];
     for (doc, needles) in cases {
-        let e = refusal(&doc);
+        let e = gltf_refusal(&doc);
         for needle in needles {
             assert!(e.contains(needle), "{e} lacks {needle:?}");
         }
@@ -373,7 +373,7 @@ fn indices_beyond_the_vertices_and_nan_positions_are_refused() {
             "data:application/octet-stream;base64,{}",
             data_encoding::BASE64.encode(&data)
         ));
-        let e = refusal(&doc);
+        let e = gltf_refusal(&doc);
         assert!(
             e.contains("node 0, mesh 0, primitive 0: ") && e.contains(needle),
             "{e}"
@@ -432,9 +432,9 @@ fn counts_and_textures_beyond_the_budget_are_refused_before_they_are_read() {
     let huge = textured(
         json!({"uri": format!("data:image/png;base64,{}", data_encoding::BASE64.encode(&png))}),
     );
-    let e = refusal(&huge);
+    let e = gltf_refusal(&huge);
     assert!(e.contains("image 0: ") && e.contains("memory limit"), "{e}");
-    let outside = refusal(&textured(json!({"uri": "../checker.png"})));
+    let outside = gltf_refusal(&textured(json!({"uri": "../checker.png"})));
     assert!(
         outside.contains("image 0: \"../checker.png\" climbs out"),
         "{outside}"
@@ -445,7 +445,7 @@ fn counts_and_textures_beyond_the_budget_are_refused_before_they_are_read() {
         d["textures"] = json!([{"source": 0}]);
         d["images"] = json!([{"uri": "x.png"}]);
     });
-    assert!(refusal(&missing_uv).contains("reads TEXCOORD_0, which it lacks"));
+    assert!(gltf_refusal(&missing_uv).contains("reads TEXCOORD_0, which it lacks"));
 }
 
 #[test]

@@ -29,7 +29,7 @@ fn load_in(name: &str, bytes: &[u8]) -> (Result<Mesh>, PathBuf) {
 }
 
 /// The refusal of a mesh file, which must name the file.
-fn scene_error((result, path): (Result<Mesh>, PathBuf)) -> SceneError {
+fn mesh_refusal((result, path): (Result<Mesh>, PathBuf)) -> SceneError {
     crate::refusal_in(result, &path)
 }
 
@@ -190,16 +190,16 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
         .unwrap()
         .to_string();
     assert_eq!(
-        scene_error(load_in("a.ply", no_faces.as_bytes())),
+        mesh_refusal(load_in("a.ply", no_faces.as_bytes())),
         SceneError::NoFaces
     );
     assert_eq!(
-        scene_error(load_in("a.obj", b"v 0 0 0\nv 1 0 0\n")),
+        mesh_refusal(load_in("a.obj", b"v 0 0 0\nv 1 0 0\n")),
         SceneError::NoFaces
     );
     let out_of_range = PYRAMID_ASCII.replace("3 3 0 4", "3 3 0 7");
     assert_eq!(
-        scene_error(load_in("a.ply", out_of_range.as_bytes())),
+        mesh_refusal(load_in("a.ply", out_of_range.as_bytes())),
         SceneError::IndexOutOfRange {
             triangle: 5,
             index: 7,
@@ -207,19 +207,19 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
         }
     );
     assert!(matches!(
-        scene_error(load_in("a.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
+        mesh_refusal(load_in("a.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
         SceneError::IndexOutOfRange { index: 3, .. }
     ));
     for bad in ["nan", "inf", "-inf"] {
         let obj = format!("v 0 0 0\nv 1 {bad} 0\nv 0 1 0\nf 1 2 3\n");
         assert!(matches!(
-            scene_error(load_in("a.obj", obj.as_bytes())),
+            mesh_refusal(load_in("a.obj", obj.as_bytes())),
             SceneError::NonFinite { vertex: 1, .. }
         ));
     }
     let nan_ply = PYRAMID_ASCII.replace("0.5 1 -0.5", "0.5 nan -0.5");
     assert!(matches!(
-        scene_error(load_in("a.ply", nan_ply.as_bytes())),
+        mesh_refusal(load_in("a.ply", nan_ply.as_bytes())),
         SceneError::NonFinite { vertex: 4, .. } | SceneError::Corrupt(_)
     ));
     // Truncated binary and ASCII files, a damaged header, garbage.
@@ -227,7 +227,7 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
     for cut in [bunny.len() - 1, bunny.len() / 2, 200, 20] {
         assert!(
             matches!(
-                scene_error(load_in("a.ply", &bunny[..cut])),
+                mesh_refusal(load_in("a.ply", &bunny[..cut])),
                 SceneError::Corrupt(_)
             ),
             "cut at {cut}"
@@ -235,11 +235,11 @@ fn bad_meshes_give_typed_errors_naming_the_file() {
     }
     let ascii_cut = &PYRAMID_ASCII[..PYRAMID_ASCII.len() - 10];
     assert!(matches!(
-        scene_error(load_in("a.ply", ascii_cut.as_bytes())),
+        mesh_refusal(load_in("a.ply", ascii_cut.as_bytes())),
         SceneError::Corrupt(_)
     ));
     assert!(matches!(
-        scene_error(load_in("a.obj", b"v 0 zero 0\n")),
+        mesh_refusal(load_in("a.obj", b"v 0 zero 0\n")),
         SceneError::Corrupt(_)
     ));
     assert!(matches!(
@@ -269,7 +269,7 @@ fn a_byte_order_mark_keeps_the_first_vertex_and_index_0_is_named() {
     let mesh = mesh.unwrap();
     assert_eq!(mesh.vertex_count(), 3);
     assert_eq!(mesh.positions().row(0).to_vec(), vec![9.0, 9.0, 9.0]);
-    let zero = scene_error(load_in("z.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"));
+    let zero = mesh_refusal(load_in("z.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"));
     assert_eq!(
         zero,
         SceneError::Corrupt("line 4: face index 0 (OBJ counts vertices from 1)".into())
@@ -278,7 +278,7 @@ fn a_byte_order_mark_keeps_the_first_vertex_and_index_0_is_named() {
 
 #[test]
 fn positions_beyond_the_range_are_refused_by_vertex() {
-    let far = scene_error(load_in(
+    let far = mesh_refusal(load_in(
         "far.obj",
         b"v 0 0 0\nv 1 0 0\nv 0 1e308 0\nf 1 2 3\n",
     ));

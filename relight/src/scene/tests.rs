@@ -175,7 +175,7 @@ fn transforms_scale_rotate_then_translate() {
     );
 }
 
-fn scene_error(json: &str) -> SceneError {
+fn scene_file_refusal(json: &str) -> SceneError {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.json");
     std::fs::write(&path, json).unwrap();
@@ -202,7 +202,7 @@ fn scene_files_refuse_unknown_keys_and_bad_objects() {
     ];
     for json in &cases {
         assert!(
-            matches!(scene_error(json), SceneError::SceneFile(_)),
+            matches!(scene_file_refusal(json), SceneError::SceneFile(_)),
             "{json}"
         );
     }
@@ -283,5 +283,12 @@ fn the_open_box_has_five_inward_faces_and_the_stated_extent() {
         assert!(dot(n, cross(sub(b, a), sub(c, a))) > 0.0);
     }
     assert_eq!(Generator::OpenBox { cells }.vertex_count(), Some(5 * face));
-    assert!(Generator::OpenBox { cells: 0 }.mesh().is_err());
+    assert_err!(
+        Generator::OpenBox { cells: 0 }.mesh(),
+        InvalidParameter {
+            name: "generator",
+            ..
+        },
+        "0 cells: must be at least 1"
+    );
 }

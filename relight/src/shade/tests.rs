@@ -15,7 +15,7 @@ use haarshift::sphere::harmonics::SphericalHarmonics;
 use haarshift::sphere::{LatLongMap, SphereRotation};
 
 /// A sphere on the ground plane precomputed at lat-long 8 with 3 bands of harmonics.
-fn scene() -> (Scene, TransportSet) {
+fn sphere_with_harmonics() -> (Scene, TransportSet) {
     let scene = Scene::from_mesh(Generator::Sphere { cells: 3 }.mesh().unwrap(), true).unwrap();
     let mut options = VisibilityOptions::new(Parameterization::new(ParamKind::LatLong, 8).unwrap());
     options.sh_bands = Some(3);
@@ -23,7 +23,7 @@ fn scene() -> (Scene, TransportSet) {
     (scene, set)
 }
 
-fn sky() -> Environment {
+fn coloured_sky() -> Environment {
     Environment::new(
         LatLongMap::<f64>::from_fn(16, 3, |d, o| {
             o[0] = 1.0 + d[1].max(0.0) * 4.0;
@@ -46,7 +46,7 @@ fn shade_with(spec: &ShaderSpec, scene: &Scene, set: &TransportSet) -> Shading {
     spec.build(&input)
         .unwrap()
         .shade(&FrameSpec {
-            environment: &sky(),
+            environment: &coloured_sky(),
             rotation: SphereRotation::from_degrees(30.0, 10.0, 0.0).unwrap(),
             eye: Some(EYE),
         })
@@ -59,8 +59,8 @@ fn turn() -> SphereRotation {
 
 #[test]
 fn every_shader_returns_what_its_numeric_code_returns_bit_for_bit() {
-    let (scene, set) = scene();
-    let env = sky();
+    let (scene, set) = sphere_with_harmonics();
+    let env = coloured_sky();
     let param = set.param();
     let objects = scene.object_vertices();
     let albedo = scene.albedo.view();
@@ -172,7 +172,7 @@ fn every_shader_returns_what_its_numeric_code_returns_bit_for_bit() {
 
 #[test]
 fn a_glossy_shader_keeps_its_rotation_cache_from_frame_to_frame() {
-    let (scene, set) = scene();
+    let (scene, set) = sphere_with_harmonics();
     let spec = ShaderSpec {
         material: GlossyOptions {
             brdf: Brdf::Phong { exponent: 20.0 },
@@ -188,7 +188,7 @@ fn a_glossy_shader_keeps_its_rotation_cache_from_frame_to_frame() {
         scene.object_vertices(),
     );
     let mut shader = spec.build(&input).unwrap();
-    let env = sky();
+    let env = coloured_sky();
     let frame = FrameSpec {
         environment: &env,
         rotation: turn(),
@@ -215,7 +215,7 @@ fn a_glossy_shader_keeps_its_rotation_cache_from_frame_to_frame() {
 
 #[test]
 fn specs_that_would_change_nothing_or_cannot_be_built_are_refused() {
-    let (scene, set) = scene();
+    let (scene, set) = sphere_with_harmonics();
     let input = ShadingInput::new(
         &scene.mesh,
         scene.albedo.view(),
@@ -283,7 +283,10 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
         if path.is_dir() {
             sources(&path, out);
         } else if path.extension().is_some_and(|e| e == "rs")
-            && path.file_name().is_some_and(|n| n != "tests.rs")
+            && path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n != "tests.rs" && !n.ends_with("_tests.rs"))
         {
             out.push(path);
         }
@@ -337,8 +340,8 @@ fn dispatch(line: &str) -> Option<String> {
 fn no_caller_dispatches_on_the_shading_method() {
     // The command line, the Python bindings and the experiments build a ShaderSpec (or a
     // DynamicShader of a DynamicMethod) and loop; only this module chooses between methods.
-    // Test files (tests.rs), which check the shaders against their numeric code, are not
-    // searched.
+    // Test files (`tests.rs`, `*_tests.rs`), which check the shaders against their numeric
+    // code, are not searched.
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut files = Vec::new();
     for dir in ["cli/src", "python/src", "experiments/src"] {

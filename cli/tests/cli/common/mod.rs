@@ -180,3 +180,27 @@ pub fn text(bytes: &[u8]) -> String {
 pub fn p(path: &Path) -> &str {
     path.to_str().unwrap()
 }
+
+/// The `(V, 3)` f32 array of a `.npy` file (radiance per vertex, or a frame).
+pub fn read_vertices(path: &Path) -> ndarray::Array2<f32> {
+    ndarray_npy::read_npy(path).unwrap()
+}
+
+/// The relative RMS difference of two `(V, 3)` arrays over all vertices and channels: the
+/// library's [`haarshift::metrics::relative_rms_error`].
+pub fn relative_rms(a: &ndarray::Array2<f32>, b: &ndarray::Array2<f32>) -> f64 {
+    haarshift::metrics::relative_rms_error(a.view(), b.view()).unwrap()
+}
+
+/// The arguments as the `&str`s the runners take.
+pub fn strs(args: &[String]) -> Vec<&str> {
+    args.iter().map(String::as_str).collect()
+}
+
+/// `haarshift COMMAND INPUT -o OUT FLAGS...`, required to succeed; returns the output read back.
+pub fn run(command: &str, input: &Path, out: &Path, flags: &[&str]) -> haarshift::PlanarImage<f64> {
+    let mut args = vec![command, p(input), "-o", p(out)];
+    args.extend_from_slice(flags);
+    succeeds(&args);
+    haarshift::io::read_image::<f64>(out).unwrap()
+}

@@ -3,15 +3,13 @@ use std::path::Path;
 use super::*;
 use crate::dynamic::fields::Truncation;
 use crate::dynamic::{DynamicOptions, DynamicScene};
+use crate::test_support::latlong;
+use crate::test_support::squashed_sphere;
 use crate::{Lighting, SceneFile, refusal_in};
 use haarshift::faces::param::SphereMap;
 use haarshift::product::Selection;
 
-fn latlong(n: usize) -> Parameterization {
-    Parameterization::new(ParamKind::LatLong, n).unwrap()
-}
-
-fn options() -> FieldOptions {
+fn field_options() -> FieldOptions {
     FieldOptions {
         keep: Selection::Largest(20),
         circles: 5,
@@ -22,18 +20,9 @@ fn options() -> FieldOptions {
     }
 }
 
-/// An off-centre, squashed sphere, so that its frame has no round numbers.
-fn object() -> Mesh {
-    Generator::Sphere { cells: 3 }
-        .mesh()
-        .unwrap()
-        .mapped(|p| [1.5 * p[0] + 0.3, p[1], 0.6 * p[2]], |n| n)
-        .unwrap()
-}
-
-fn written(dir: &Path) -> (OcclusionField, PathBuf) {
-    let mesh = object();
-    let (field, _) = OcclusionField::build(&mesh, &options()).unwrap();
+fn written_field(dir: &Path) -> (OcclusionField, PathBuf) {
+    let mesh = squashed_sphere();
+    let (field, _) = OcclusionField::build(&mesh, &field_options()).unwrap();
     let path = dir.join("object.hsf");
     field.write(&path, &mesh, "test object", false).unwrap();
     (field, path)
@@ -51,7 +40,7 @@ const POINTS: [[f64; 3]; 5] = [
 #[test]
 fn write_then_read_gives_bit_identical_maps_and_identical_lookups() {
     let dir = tempfile::tempdir().unwrap();
-    let (field, path) = written(dir.path());
+    let (field, path) = written_field(dir.path());
     let bytes = std::fs::metadata(&path).unwrap().len();
     // 16 framing bytes, the header, then (samples + 1) offsets and 8 bytes a coefficient.
     let samples = 5 * 12 + 4 * 6 * 9;
@@ -64,7 +53,7 @@ fn write_then_read_gives_bit_identical_maps_and_identical_lookups() {
     assert_eq!(header.coefficients, field.coefficient_count());
     assert_eq!(header.shape.source, "test object");
     assert_eq!(header.frame, *field.frame());
-    assert_eq!(header.options, FieldRecord::of(&options()));
+    assert_eq!(header.options, FieldRecord::of(&field_options()));
     let bits = |f: &OcclusionField| {
         (0..f.sample_count())
             .flat_map(|i| {
@@ -78,7 +67,7 @@ fn write_then_read_gives_bit_identical_maps_and_identical_lookups() {
     };
     assert_eq!(bits(&read), bits(&field));
     assert_eq!(read, field);
-    let loaded = OcclusionField::read_for(&path, &object(), &options()).unwrap();
+    let loaded = OcclusionField::read_for(&path, &squashed_sphere(), &field_options()).unwrap();
     assert_eq!(loaded, field);
     let texels = latlong(8).texels();
     let mut scratch = vec![0.0; texels];
@@ -110,7 +99,7 @@ fn corrupt_reason(e: SceneError) -> String {
 #[test]
 fn a_truncated_file_a_flipped_byte_and_a_wrong_magic_or_version_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let (_, path) = written(dir.path());
+    let (_, path) = written_field(dir.path());
     let good = std::fs::read(&path).unwrap();
     let bad = dir.path().join("bad.hsf");
     let refusal = |bytes: &[u8]| {
@@ -174,7 +163,7 @@ fn rechecksummed(good: &[u8], f: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
 #[test]
 fn a_file_that_passes_its_checksum_but_holds_no_field_is_refused_without_a_panic() {
     let dir = tempfile::tempdir().unwrap();
-    let (field, path) = written(dir.path());
+    let (field, path) = written_field(dir.path());
     let good = std::fs::read(&path).unwrap();
     let bad = dir.path().join("bad.hsf");
     let refusal = |bytes: Vec<u8>| {
@@ -214,9 +203,9 @@ fn mismatch(result: Result<OcclusionField>, path: &Path) -> String {
 #[test]
 fn a_file_built_with_other_options_or_for_another_mesh_is_refused_naming_the_difference() {
     let dir = tempfile::tempdir().unwrap();
-    let (_, path) = written(dir.path());
-    let mesh = object();
-    let base = options();
+    let (_, path) = written_field(dir.path());
+    let mesh = squashed_sphere();
+    let base = field_options();
     let cases: [(FieldOptions, &str); 9] = [
         (FieldOptions { circles: 6, ..base }, "circles 5 (asked: 6)"),
         (
@@ -294,22 +283,22 @@ fn a_file_built_with_other_options_or_for_another_mesh_is_refused_naming_the_dif
     assert!(OcclusionField::read_for(&path, &mesh, &quiet).is_ok());
     // A field is written only with the mesh it was built from.
     let (field, _) = OcclusionField::read(&path).unwrap();
-    assert!(
-        field
-            .write(&dir.path().join("x.hsf"), &other, "x", false)
-            .is_err()
+    assert_err!(
+        field.write(&dir.path().join("x.hsf"), &other, "x", false),
+        InvalidParameter { name: "mesh", .. },
+        "the field was not built from this mesh"
     );
 }
 
 #[test]
 fn a_store_reads_what_matches_builds_what_is_absent_and_refuses_what_is_stale() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = object();
+    let mesh = squashed_sphere();
     let generator = Generator::Sphere { cells: 3 };
     let mut store = FieldStore::new(dir.path(), false);
     let path = dir.path().join("sphere-cells-3.hsf");
     let (built, origin) = store
-        .field(&mesh, None, Some(&generator), &options())
+        .field(&mesh, None, Some(&generator), &field_options())
         .unwrap();
     let FieldOrigin::Built { report, bytes } = origin else {
         panic!("{origin:?}")
@@ -317,14 +306,14 @@ fn a_store_reads_what_matches_builds_what_is_absent_and_refuses_what_is_stale() 
     assert_eq!(report.rays, built.sample_count() as u64 * 128);
     assert_eq!(bytes, std::fs::metadata(&path).unwrap().len());
     let (loaded, origin) = store
-        .field(&mesh, None, Some(&generator), &options())
+        .field(&mesh, None, Some(&generator), &field_options())
         .unwrap();
     assert!(matches!(origin, FieldOrigin::Loaded { bytes: b, .. } if b == bytes));
     assert_eq!(loaded, built);
     // Other options: refused, the file untouched; a store that may replace builds again.
     let other = FieldOptions {
         shells: 5,
-        ..options()
+        ..field_options()
     };
     let reason = mismatch(
         store
@@ -346,9 +335,9 @@ fn a_store_reads_what_matches_builds_what_is_absent_and_refuses_what_is_stale() 
     );
     // Two sources that would share one file name.
     let (a, b) = (Path::new("a/ball.ply"), Path::new("b/ball.ply"));
-    store.field(&mesh, Some(a), None, &options()).unwrap();
+    store.field(&mesh, Some(a), None, &field_options()).unwrap();
     let e = store
-        .field(&mesh, Some(b), None, &options())
+        .field(&mesh, Some(b), None, &field_options())
         .unwrap_err()
         .to_string();
     assert!(e.contains("would share the field file"), "{e}");
@@ -367,7 +356,7 @@ fn a_scene_shaded_from_loaded_fields_equals_one_from_fields_built_afresh() {
     let mut dynamic = DynamicOptions::new(latlong(8));
     dynamic.field = FieldOptions {
         keep: Selection::Largest(30),
-        ..options()
+        ..field_options()
     };
     let sky = SphereMap::<f64>::from_fn(latlong(8), 3, |d, out| {
         let sun = (d[0] + 0.5 * d[1]).max(0.0).powi(8);

@@ -2,7 +2,8 @@ use ndarray::{Array3, Axis};
 use proptest::prelude::*;
 
 use super::*;
-use crate::Generator;
+use crate::test_support::latlong;
+use crate::test_support::squashed_sphere;
 use haarshift::faces::integrate::layout;
 use haarshift::product::{FaceLayout, HaarTree};
 
@@ -14,19 +15,6 @@ fn small(param: Parameterization) -> FieldOptions {
         shell_grid: 3,
         ..FieldOptions::new(param)
     }
-}
-
-fn latlong(n: usize) -> Parameterization {
-    Parameterization::new(ParamKind::LatLong, n).unwrap()
-}
-
-/// A box off-centre, so that nothing about it is symmetric.
-fn object() -> Mesh {
-    let mut m = Generator::Sphere { cells: 3 }.mesh().unwrap();
-    m = m
-        .mapped(|p| [1.5 * p[0] + 0.3, p[1], 0.6 * p[2]], |n| n)
-        .unwrap();
-    m
 }
 
 /// The visibility of `mesh` from `x` at every texel centre, 1 or 0, `(faces, S, S)`.
@@ -54,7 +42,7 @@ fn coefficients(pixels: &Array3<f32>, param: Parameterization) -> Array3<f32> {
     t.to_coefficients().index_axis_move(Axis(3), 0)
 }
 
-fn dense(indices: &[u32], values: &[f32], param: Parameterization) -> Array3<f32> {
+fn dense_faces(indices: &[u32], values: &[f32], param: Parameterization) -> Array3<f32> {
     let s = param.face_size();
     let mut out = Array3::zeros((param.faces(), s, s));
     let flat = out.as_slice_mut().unwrap();
@@ -77,7 +65,7 @@ fn a_field_looked_up_at_a_sample_point_is_the_ray_cast_visibility_from_it() {
         latlong(8),
         Parameterization::new(ParamKind::Cube, 4).unwrap(),
     ] {
-        let mesh = object();
+        let mesh = squashed_sphere();
         let (field, report) = OcclusionField::build(&mesh, &small(param)).unwrap();
         assert_eq!(report.rays, (60 + 4 * 54) as u64 * param.texels() as u64);
         let points = field.sample_points();
@@ -111,7 +99,7 @@ fn a_field_looked_up_at_a_sample_point_is_the_ray_cast_visibility_from_it() {
                 .unwrap();
             let got: Vec<f32> = out.1.iter().map(|&v| v as f32).collect();
             assert!(
-                max_diff(&dense(&out.0, &got, param), &want) < 1e-5,
+                max_diff(&dense_faces(&out.0, &got, param), &want) < 1e-5,
                 "sample {i}"
             );
             assert!(scratch.iter().all(|&v| v == 0.0));
@@ -124,7 +112,7 @@ fn a_field_looked_up_at_a_sample_point_is_the_ray_cast_visibility_from_it() {
 #[test]
 fn radii_are_geometric_between_the_options_bounds_and_beyond_the_last_shell_nothing_occludes() {
     let param = latlong(4);
-    let mesh = object();
+    let mesh = squashed_sphere();
     let (field, _) = OcclusionField::build(&mesh, &small(param)).unwrap();
     let f = *field.frame();
     let points = field.sample_points();
@@ -168,7 +156,7 @@ fn radii_are_geometric_between_the_options_bounds_and_beyond_the_last_shell_noth
 #[test]
 fn a_point_between_samples_blends_their_maps_linearly() {
     let param = latlong(8);
-    let mesh = object();
+    let mesh = squashed_sphere();
     let (field, _) = OcclusionField::build(&mesh, &small(param)).unwrap();
     let f = *field.frame();
     let x = [f.centre[0] + 0.8, f.centre[1] + 0.9, f.centre[2] - 0.4];
@@ -176,7 +164,7 @@ fn a_point_between_samples_blends_their_maps_linearly() {
     let mut want = Array3::<f32>::zeros((2, 8, 8));
     for &(i, w) in blend.samples() {
         let (idx, val) = field.map(i as usize);
-        want.scaled_add(w, &dense(idx, val, param));
+        want.scaled_add(w, &dense_faces(idx, val, param));
     }
     let mut scratch = vec![0.0; param.texels()];
     let mut out = (Vec::new(), Vec::new());
@@ -184,7 +172,7 @@ fn a_point_between_samples_blends_their_maps_linearly() {
         .blended(x, Truncation::Before, &mut scratch, &mut out)
         .unwrap();
     let got: Vec<f32> = out.1.iter().map(|&v| v as f32).collect();
-    assert!(max_diff(&dense(&out.0, &got, param), &want) < 1e-5);
+    assert!(max_diff(&dense_faces(&out.0, &got, param), &want) < 1e-5);
     // Truncating after the blend keeps the largest details of the blend (and the scaling).
     field
         .blended(
@@ -218,7 +206,7 @@ fn a_point_between_samples_blends_their_maps_linearly() {
 #[test]
 fn a_turned_field_is_the_field_of_the_turned_object() {
     let param = latlong(8);
-    let mesh = object();
+    let mesh = squashed_sphere();
     let (field, _) = OcclusionField::build(&mesh, &small(param)).unwrap();
     let k = 5; // 5 of 16 columns: 112.5 degrees
     let turned = field.turned(k).unwrap();
@@ -232,7 +220,7 @@ fn a_turned_field_is_the_field_of_the_turned_object() {
         occluded += pixels.iter().filter(|&&v| v == 0.0).count();
         let (idx, val) = turned.map(i);
         let got = HaarTree::<f32, 1>::from_coefficients(
-            dense(idx, val, param).insert_axis(Axis(3)).view(),
+            dense_faces(idx, val, param).insert_axis(Axis(3)).view(),
             FaceLayout::Stacked,
             Selection::All,
         )
@@ -258,7 +246,7 @@ fn a_turned_field_is_the_field_of_the_turned_object() {
 #[test]
 fn bad_options_are_refused() {
     let param = latlong(4);
-    let mesh = object();
+    let mesh = squashed_sphere();
     let mut o = small(param);
     o.shell_radii = (2.0, 1.0);
     assert_err!(
@@ -359,6 +347,6 @@ proptest! {
             }
         }
         let want = coefficients(&rolled, param);
-        prop_assert!(max_diff(&dense(&ti, &tv, param), &want) < 1e-5);
+        prop_assert!(max_diff(&dense_faces(&ti, &tv, param), &want) < 1e-5);
     }
 }

@@ -11,7 +11,7 @@ use haarshift::sphere::{LatLongMap, SphereRotation};
 
 /// A sphere on the ground plane, precomputed at lat-long `n`: the sphere shadows the plane
 /// and the plane the sphere's lower half.
-fn scene(n: usize) -> (Scene, crate::TransportSet) {
+fn sphere_on_ground(n: usize) -> (Scene, crate::TransportSet) {
     let scene = Scene::from_mesh(Generator::Sphere { cells: 4 }.mesh().unwrap(), true).unwrap();
     let param = Parameterization::new(ParamKind::LatLong, n).unwrap();
     let (set, _) = vertex_major(
@@ -47,7 +47,7 @@ fn ambient_occlusion_is_the_quadrature_of_the_transport_under_a_white_sky() {
     // transport, by the reference's direct quadrature under radiance 1 at the same texels (no
     // Haar transform; the same rays).
     let n = 16;
-    let (scene, set) = scene(n);
+    let (scene, set) = sphere_on_ground(n);
     let got = ambient(&scene, &set)
         .shade(&FrameSpec {
             environment: &Environment::new(map(n, |_| 1.0)),
@@ -79,7 +79,7 @@ fn ambient_occlusion_is_the_quadrature_of_the_transport_under_a_white_sky() {
 #[test]
 fn ambient_occlusion_ignores_the_lighting() {
     let n = 8;
-    let (scene, set) = scene(n);
+    let (scene, set) = sphere_on_ground(n);
     let mut shader = ambient(&scene, &set);
     let bright = Environment::new(map(n, |d| 2.0 + d[1]));
     let dark = Environment::new(map(2 * n, |d| 0.1 * d[0].abs()));
@@ -144,7 +144,7 @@ fn an_open_upward_vertex_reflects_its_albedo() {
 
 #[test]
 fn a_glossy_material_or_a_scene_without_transport_is_refused() {
-    let (scene, set) = scene(8);
+    let (scene, set) = sphere_on_ground(8);
     let mut spec = ShaderSpec {
         method: Method::Ambient,
         ..ShaderSpec::default()

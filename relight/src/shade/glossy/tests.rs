@@ -53,7 +53,7 @@ fn transport(param: Parameterization, mesh: &Mesh) -> TransportSet {
     set
 }
 
-fn lighting(param: Parameterization, keep: Selection) -> Lighting {
+fn sunlit_lighting(param: Parameterization, keep: Selection) -> Lighting {
     let map = SphereMap::<f64>::from_fn(param, 3, |d, o| {
         let sun = (d[0] * 0.3 + d[1] * 0.8 + d[2] * 0.52).max(0.0).powi(40) * 30.0;
         o[0] = 1.0 + d[1] + sun;
@@ -152,7 +152,7 @@ fn the_shading_is_the_pixel_domain_triple_product_of_the_truncated_factors() {
         (Selection::All, None, None, None, Some(2)),
         (Selection::Largest(30), None, Some(20), Some(3), Some(1)),
     ] {
-        let light = lighting(param, keep_light);
+        let light = sunlit_lighting(param, keep_light);
         let shade = ShadeOptions {
             keep_visibility: keep_visibility.map(Selection::Largest),
             depth,
@@ -190,8 +190,8 @@ fn a_cached_vertex_is_the_weighted_triple_product_of_its_bins() {
     // Each vertex against the pixel-domain oracle of every bin it blends, weighted: the blend
     // of the bins' texels is the blend of their triple products.
     let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
-    let (mesh, set, albedo) = scene(param, 6);
-    let light = lighting(param, Selection::Largest(50));
+    let (mesh, set, albedo) = strip_scene(param, 6);
+    let light = sunlit_lighting(param, Selection::Largest(50));
     let eye = [0.5, 2.0, 3.0];
     for (brdf, bins) in [
         (Brdf::Phong { exponent: 12.0 }, 8),
@@ -232,8 +232,8 @@ fn the_f32_shading_stays_within_its_rounding_of_the_f64_one() {
     // f32 everywhere: the rotation, the texels, the sums in runs. Measured 5.4e-7 of the RMS
     // without a cache, 4.5e-7 with one.
     let param = Parameterization::new(ParamKind::LatLong, 32).unwrap();
-    let (mesh, set, albedo) = scene(param, 8);
-    let light = lighting(param, Selection::All);
+    let (mesh, set, albedo) = strip_scene(param, 8);
+    let light = sunlit_lighting(param, Selection::All);
     let shade = ShadeOptions::default();
     for bins in [None, Some(16)] {
         let options = GlossyOptions {
@@ -256,7 +256,7 @@ fn the_f32_shading_stays_within_its_rounding_of_the_f64_one() {
 }
 
 /// A strip, its transport and albedo, for the tests below.
-fn scene(param: Parameterization, n: usize) -> (Mesh, TransportSet, Array2<f32>) {
+fn strip_scene(param: Parameterization, n: usize) -> (Mesh, TransportSet, Array2<f32>) {
     let mesh = strip(n);
     let set = transport(param, &mesh);
     let albedo = Array2::from_shape_fn((n, 3), |(v, c)| 0.2 + 0.15 * ((v + 2 * c) % 5) as f32);
@@ -269,7 +269,7 @@ fn shader(
     options: &GlossyOptions,
     object_vertices: usize,
 ) -> (GlossyShader<f64>, PreparedTransport<f64>) {
-    let (mesh, set, albedo) = scene(param, n);
+    let (mesh, set, albedo) = strip_scene(param, n);
     let shade = ShadeOptions::default();
     let glossy =
         GlossyShader::new(&set, &mesh, albedo.view(), &shade, options, object_vertices).unwrap();
@@ -283,7 +283,7 @@ fn shader(
 fn phong_zero_is_lambert_with_the_same_albedo() {
     // 0^0 = 1: Phong 0 is 1/pi everywhere, whatever the rotation or the cache.
     let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
-    let light = lighting(param, Selection::All);
+    let light = sunlit_lighting(param, Selection::All);
     for (rotation, bins) in [
         (BrdfRotation::Direct, None),
         (BrdfRotation::Haar, None),
@@ -306,7 +306,7 @@ fn phong_zero_is_lambert_with_the_same_albedo() {
 #[test]
 fn the_ground_plane_stays_lambertian() {
     let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
-    let light = lighting(param, Selection::All);
+    let light = sunlit_lighting(param, Selection::All);
     let options = GlossyOptions {
         brdf: Brdf::Phong { exponent: 30.0 },
         ..GlossyOptions::default()
@@ -324,7 +324,7 @@ fn the_ground_plane_stays_lambertian() {
 #[test]
 fn the_rotation_cache_reuses_bins_and_stays_close_to_exact_frames() {
     let param = Parameterization::new(ParamKind::LatLong, 32).unwrap();
-    let light = lighting(param, Selection::All);
+    let light = sunlit_lighting(param, Selection::All);
     let exact = GlossyOptions {
         brdf: Brdf::Phong { exponent: 10.0 },
         ..GlossyOptions::default()
@@ -354,7 +354,7 @@ fn the_rotation_cache_reuses_bins_and_stays_close_to_exact_frames() {
 #[test]
 fn a_cache_filled_ahead_serves_every_view_with_the_same_maps() {
     let param = Parameterization::new(ParamKind::LatLong, 16).unwrap();
-    let light = lighting(param, Selection::All);
+    let light = sunlit_lighting(param, Selection::All);
     let options = GlossyOptions {
         brdf: Brdf::Phong { exponent: 10.0 },
         cache_bins: Some(8),
@@ -400,7 +400,7 @@ fn a_cache_filled_ahead_serves_every_view_with_the_same_maps() {
 #[test]
 fn bad_inputs_are_refused() {
     let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
-    let (mesh, set, albedo) = scene(param, 4);
+    let (mesh, set, albedo) = strip_scene(param, 4);
     let shade = ShadeOptions::default();
     let make = |options: &GlossyOptions, glossy: usize| {
         GlossyShader::<f32>::new(&set, &mesh, albedo.view(), &shade, options, glossy)
@@ -443,7 +443,7 @@ fn bad_inputs_are_refused() {
         "5 glossy"
     );
     let shader = make(&phong, 4).unwrap();
-    let light = lighting(param, Selection::All);
+    let light = sunlit_lighting(param, Selection::All);
     assert_err!(
         shader.shade(&light, [f64::NAN, 0.0, 0.0]),
         InvalidParameter { name: "camera", .. },
@@ -455,7 +455,7 @@ fn bad_inputs_are_refused() {
         InvalidParameter { name: "camera", .. },
         "vertex 2"
     );
-    let other = lighting(
+    let other = sunlit_lighting(
         Parameterization::new(ParamKind::LatLong, 16).unwrap(),
         Selection::All,
     );

@@ -26,7 +26,7 @@ fn random_set(param: Parameterization, vertices: usize, seen: f64, seed: u64) ->
     set
 }
 
-fn sky(param: Parameterization) -> Lighting {
+fn sky_lighting(param: Parameterization) -> Lighting {
     let map = SphereMap::<f64>::from_fn(param, 3, |d, out| {
         out[0] = 1.0 + d[0];
         out[1] = 2.0 + d[1] * d[2];
@@ -88,7 +88,7 @@ fn every_coefficient_is_within_half_a_step_and_the_radiance_within_the_rounding_
         assert_within_half_a_step(&exact, &packed);
         // The radiance: f64 sums of the exact coefficients, against the bound of the module
         // docs, albedo / pi x s_v / 2 x sum_k |L(i_k)|, and f32's rounding beside it.
-        let light = sky(param);
+        let light = sky_lighting(param);
         let rows = light.coefficients_f64();
         let got = packed.shade(&light).unwrap();
         let mut worst = 0.0f64;
@@ -136,7 +136,7 @@ fn gaps_over_65535_are_bridged_by_zero_entries() {
     assert_eq!(packed.entry_count(), 3, "one zero entry bridges the gap");
     assert_eq!(packed.coefficients(0).0, [0, 65_535, 81_920]);
     assert_within_half_a_step(&exact, &packed);
-    let light = sky(param);
+    let light = sky_lighting(param);
     let (a, b) = (exact.shade(&light).unwrap(), packed.shade(&light).unwrap());
     for c in 0..3 {
         assert!(
@@ -150,7 +150,7 @@ fn gaps_over_65535_are_bridged_by_zero_entries() {
 fn a_lighting_of_another_map_or_a_wrong_output_is_refused() {
     let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
     let packed = QuantisedTransport::new(&prepared(&random_set(param, 3, 0.5, 1)));
-    let other = sky(Parameterization::new(ParamKind::Cube, 8).unwrap());
+    let other = sky_lighting(Parameterization::new(ParamKind::Cube, 8).unwrap());
     assert!(
         packed
             .shade(&other)
@@ -159,5 +159,9 @@ fn a_lighting_of_another_map_or_a_wrong_output_is_refused() {
             .contains("precomputed at")
     );
     let mut out = Array2::<f64>::zeros((2, 3));
-    assert!(packed.shade_into(&sky(param), &mut out).is_err());
+    assert_err!(
+        packed.shade_into(&sky_lighting(param), &mut out),
+        InvalidShape { .. },
+        "invalid shape [2, 3]: the output must be (3, 3)"
+    );
 }

@@ -6,16 +6,13 @@ use super::*;
 use crate::light::downsample::downsample_solid_angle;
 use crate::light::environment::Environment;
 use crate::test_support::corner_form_factor;
+use crate::test_support::latlong;
 use crate::{Generator, Mesh, Occlusion, SceneBvh, VisibilityOptions, ray_offset, vertex_major};
 use haarshift::faces::integrate::layout;
 use haarshift::faces::param::{ParamKind, SphereMap};
 use haarshift::metrics::relative_rms_error;
 use haarshift::product::{HaarTree, IntegralOptions, product_integral, triple::triple_integral};
 use haarshift::sphere::{LatLongMap, SphereRotation};
-
-fn latlong(n: usize) -> Parameterization {
-    Parameterization::new(ParamKind::LatLong, n).unwrap()
-}
 
 /// The mesh's transport at `param`, one ray per texel centre, every coefficient kept.
 fn precompute(mesh: &Mesh, param: Parameterization) -> TransportSet {

@@ -6,10 +6,11 @@ use super::*;
 use crate::Generator;
 use crate::scene::shapes::{grid, merge};
 use crate::shade::reference::reference;
+use haarshift::metrics::rms;
 use haarshift::sphere::latlong::{direction, pixel_centre, pixel_solid_angle};
 
 /// A gray-free sky: radiance rising toward +Y, different in each channel.
-fn sky(n: usize) -> LatLongMap<f64> {
+fn rising_sky(n: usize) -> LatLongMap<f64> {
     LatLongMap::from_fn(n, 3, |d, o| {
         o[0] = 1.0 + d[1];
         o[1] = 0.5 + 0.5 * d[0] * d[0];
@@ -50,7 +51,7 @@ fn corner(cells: usize, away: bool) -> Mesh {
     merge([floor, wall.unwrap()])
 }
 
-fn albedo(v: usize) -> Array2<f32> {
+fn mottled_albedo(v: usize) -> Array2<f32> {
     Array2::from_shape_fn((v, 3), |(i, c)| {
         0.3 + 0.1 * c as f32 + 0.02 * (i % 7) as f32
     })
@@ -88,7 +89,7 @@ fn brute_hit(mesh: &Mesh, o: [f64; 3], d: [f64; 3]) -> Option<(usize, [f64; 3], 
 
 /// The gather of the contract written out densely: `U_0` by quadrature with every ray, then
 /// `U_(b+1) = W U_b` with `W` a dense `V x V` matrix per channel.
-fn brute_force(
+fn gather_by_brute_force(
     mesh: &Mesh,
     albedo: &Array2<f32>,
     lighting: &LatLongMap<f64>,
@@ -150,33 +151,33 @@ fn brute_force(
     out
 }
 
-fn rms(a: &Array2<f64>) -> f64 {
-    (a.iter().map(|x| x * x).sum::<f64>() / a.len() as f64).sqrt()
-}
-
 #[test]
 fn the_gather_equals_a_brute_force_oracle_on_a_corner() {
     let mesh = corner(3, false);
-    let a = albedo(mesh.vertex_count());
-    let light = sky(8);
+    let a = mottled_albedo(mesh.vertex_count());
+    let light = rising_sky(8);
     let got = interreflected(&mesh, &SceneBvh::new(&mesh), a.view(), &light, 3, false).unwrap();
-    let want = brute_force(&mesh, &a, &light, 3);
+    let want = gather_by_brute_force(&mesh, &a, &light, 3);
     let computed = std::iter::once(&got.direct).chain(&got.bounces);
     for (b, (g, w)) in computed.zip(&want).enumerate() {
         let worst = (g - w).iter().fold(0.0f64, |m, x| m.max(x.abs()));
         // The BVH's f32 rays and barycentrics against the oracle's f64: each about 6e-8 of its
         // value, compounding bounce by bounce (measured: 1.7e-6 of the RMS at bounce 2).
         assert!(
-            worst < 1e-5 * rms(w),
+            worst < 1e-5 * rms(w.view()),
             "bounce {b}: {worst:e} of {:e}",
-            rms(w)
+            rms(w.view())
         );
-        assert!(rms(&(g - w)) < 1e-6 * rms(w), "bounce {b}");
-        assert!(rms(w) > 1e-4, "bounce {b} carries light: {:e}", rms(w));
+        assert!(rms((g - w).view()) < 1e-6 * rms(w.view()), "bounce {b}");
+        assert!(
+            rms(w.view()) > 1e-4,
+            "bounce {b} carries light: {:e}",
+            rms(w.view())
+        );
     }
     // Each bounce is dimmer than the last (albedo below 0.5, the wall a quarter of the view).
     for b in 1..4 {
-        assert!(rms(&want[b]) < 0.5 * rms(&want[b - 1]));
+        assert!(rms(want[b].view()) < 0.5 * rms(want[b - 1].view()));
     }
 }
 
@@ -184,8 +185,8 @@ fn the_gather_equals_a_brute_force_oracle_on_a_corner() {
 fn back_faces_and_the_space_below_the_horizon_give_nothing() {
     // The wall turned away: every floor ray toward it meets its back side.
     let away = corner(3, true);
-    let a = albedo(away.vertex_count());
-    let light = sky(8);
+    let a = mottled_albedo(away.vertex_count());
+    let light = rising_sky(8);
     let bvh = SceneBvh::new(&away);
     // The wall, facing -Z, has the whole floor behind it.
     let got = interreflected(&away, &bvh, a.view(), &light, 2, false).unwrap();
@@ -200,7 +201,7 @@ fn back_faces_and_the_space_below_the_horizon_give_nothing() {
         grid([-1.0, 0.0, 1.0], [2.0, 0.0, 0.0], [0.0, 0.0, -2.0], 3, 3).unwrap(),
         grid([-1.0, 0.5, 1.0], [2.0, 0.0, 0.0], [0.0, 0.0, -2.0], 3, 3).unwrap(),
     ]);
-    let a = albedo(stacked.vertex_count());
+    let a = mottled_albedo(stacked.vertex_count());
     let got = interreflected(
         &stacked,
         &SceneBvh::new(&stacked),
@@ -217,8 +218,8 @@ fn back_faces_and_the_space_below_the_horizon_give_nothing() {
 #[test]
 fn no_bounce_is_the_direct_reference_and_a_lone_grid_gains_nothing() {
     let mesh = corner(2, false);
-    let a = albedo(mesh.vertex_count());
-    let light = sky(8);
+    let a = mottled_albedo(mesh.vertex_count());
+    let light = rising_sky(8);
     let bvh = SceneBvh::new(&mesh);
     let direct = reference(&mesh, &bvh, a.view(), &light, &ReferenceOptions::default()).unwrap();
     let none = interreflected(&mesh, &bvh, a.view(), &light, 0, false).unwrap();
@@ -226,7 +227,7 @@ fn no_bounce_is_the_direct_reference_and_a_lone_grid_gains_nothing() {
     assert_eq!(none.report.rays, direct.1.rays);
     // A flat grid alone: bit for bit the direct light.
     let flat = grid([-1.0, 0.0, 1.0], [2.0, 0.0, 0.0], [0.0, 0.0, -2.0], 4, 4).unwrap();
-    let a = albedo(flat.vertex_count());
+    let a = mottled_albedo(flat.vertex_count());
     let bvh = SceneBvh::new(&flat);
     let got = interreflected(&flat, &bvh, a.view(), &light, 3, false).unwrap();
     let direct = reference(&flat, &bvh, a.view(), &light, &ReferenceOptions::default()).unwrap();
@@ -239,8 +240,16 @@ fn a_lone_sphere_gains_less_than_a_percent() {
     // vertex's horizon: any gain is rounding at grazing rays.
     let mesh = Generator::Sphere { cells: 4 }.mesh().unwrap();
     let a = Array2::from_elem((mesh.vertex_count(), 3), 0.8f32);
-    let got = interreflected(&mesh, &SceneBvh::new(&mesh), a.view(), &sky(16), 2, false).unwrap();
-    let gain = rms(&(got.radiance(2) - &got.direct)) / rms(&got.direct);
+    let got = interreflected(
+        &mesh,
+        &SceneBvh::new(&mesh),
+        a.view(),
+        &rising_sky(16),
+        2,
+        false,
+    )
+    .unwrap();
+    let gain = rms((got.radiance(2) - &got.direct).view()) / rms(got.direct.view());
     assert!(gain < 0.01, "{gain:e}");
 }
 
@@ -248,9 +257,13 @@ fn a_lone_sphere_gains_less_than_a_percent() {
 fn too_many_bounces_and_a_wrong_albedo_are_refused() {
     let mesh = corner(1, false);
     let bvh = SceneBvh::new(&mesh);
-    let a = albedo(mesh.vertex_count());
-    let e = interreflected(&mesh, &bvh, a.view(), &sky(4), 9, false).unwrap_err();
+    let a = mottled_albedo(mesh.vertex_count());
+    let e = interreflected(&mesh, &bvh, a.view(), &rising_sky(4), 9, false).unwrap_err();
     assert!(e.to_string().contains("0 to 8"), "{e}");
-    let short = albedo(3);
-    assert!(interreflected(&mesh, &bvh, short.view(), &sky(4), 1, false).is_err());
+    let short = mottled_albedo(3);
+    assert_err!(
+        interreflected(&mesh, &bvh, short.view(), &rising_sky(4), 1, false),
+        InvalidShape { .. },
+        "invalid shape [3, 3]: the albedo must be (8, 3), one RGB row per vertex"
+    );
 }

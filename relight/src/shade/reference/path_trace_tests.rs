@@ -7,9 +7,10 @@ use crate::ReferenceOptions;
 use crate::scene::shapes::{grid, merge};
 use crate::shade::reference::interreflection::interreflected;
 use crate::shade::reference::reference;
+use haarshift::metrics::rms;
 
 /// Radiance varying over the sphere, different in each channel.
-fn sky(n: usize) -> LatLongMap<f64> {
+fn varied_sky(n: usize) -> LatLongMap<f64> {
     LatLongMap::from_fn(n, 3, |d, o| {
         o[0] = 1.0 + d[1];
         o[1] = 0.5 + d[0] * d[0];
@@ -20,7 +21,7 @@ fn sky(n: usize) -> LatLongMap<f64> {
 
 /// A 2 x 2 floor facing +Y, `cells` a side, with (when `wall`) a 2 x 1 wall just behind its
 /// back edge facing it.
-fn scene(cells: usize, wall: bool) -> Mesh {
+fn floor_and_wall(cells: usize, wall: bool) -> Mesh {
     let floor = grid(
         [-1.0, 0.0, 1.0],
         [2.0, 0.0, 0.0],
@@ -43,7 +44,7 @@ fn scene(cells: usize, wall: bool) -> Mesh {
     merge([floor, wall])
 }
 
-fn albedo(v: usize) -> Array2<f32> {
+fn albedo_by_channel(v: usize) -> Array2<f32> {
     Array2::from_shape_fn((v, 3), |(_, c)| [0.7f32, 0.5, 0.3][c])
 }
 
@@ -54,7 +55,7 @@ fn trace(
     bounces: usize,
     seed: u64,
 ) -> PathTrace {
-    let a = albedo(mesh.vertex_count());
+    let a = albedo_by_channel(mesh.vertex_count());
     let options = PathTraceOptions {
         paths,
         bounces,
@@ -64,14 +65,10 @@ fn trace(
     path_trace(mesh, &SceneBvh::new(mesh), a.view(), light, &options).unwrap()
 }
 
-fn rms(a: &Array2<f64>) -> f64 {
-    (a.iter().map(|x| x * x).sum::<f64>() / a.len() as f64).sqrt()
-}
-
 #[test]
 fn runs_repeat_bit_for_bit_and_the_seed_changes_them() {
-    let mesh = scene(3, true);
-    let light = sky(8);
+    let mesh = floor_and_wall(3, true);
+    let light = varied_sky(8);
     let first = trace(&mesh, &light, 32, 2, 7);
     let again = trace(&mesh, &light, 32, 2, 7);
     assert_eq!(first.radiance, again.radiance);
@@ -101,12 +98,12 @@ fn upward_exact(light: &LatLongMap<f64>, a: [f64; 3]) -> [f64; 3] {
 
 #[test]
 fn four_times_the_paths_halve_the_error_against_the_closed_form() {
-    let flat = scene(12, false);
-    let light = sky(8);
+    let flat = floor_and_wall(12, false);
+    let light = varied_sky(8);
     let exact = upward_exact(&light, [0.7, 0.5, 0.3]);
     let error = |t: &PathTrace| {
         let e = Array2::from_shape_fn(t.radiance.dim(), |(v, c)| t.radiance[[v, c]] - exact[c]);
-        rms(&e)
+        rms(e.view())
     };
     let (few, many) = (
         trace(&flat, &light, 64, 0, 1),
@@ -125,15 +122,15 @@ fn four_times_the_paths_halve_the_error_against_the_closed_form() {
 
 #[test]
 fn direct_light_agrees_with_the_reference_within_its_standard_errors() {
-    let mesh = scene(4, true);
-    let light = sky(32);
-    let a = albedo(mesh.vertex_count());
+    let mesh = floor_and_wall(4, true);
+    let light = varied_sky(32);
+    let a = albedo_by_channel(mesh.vertex_count());
     let bvh = SceneBvh::new(&mesh);
     let (truth, _) =
         reference(&mesh, &bvh, a.view(), &light, &ReferenceOptions::default()).unwrap();
     let t = trace(&mesh, &light, 512, 0, 3);
     let z = (&t.radiance - &truth) / &t.standard_error;
-    let (rms_z, worst) = (rms(&z), z.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    let (rms_z, worst) = (rms(z.view()), z.iter().fold(0.0f64, |m, x| m.max(x.abs())));
     // Measured: see the message; a z-score's RMS is 1 where the reference's quadrature error
     // is far below the standard error.
     assert!(rms_z < 1.3 && worst < 4.5, "rms z {rms_z}, worst {worst}");
@@ -141,18 +138,18 @@ fn direct_light_agrees_with_the_reference_within_its_standard_errors() {
 
 #[test]
 fn one_bounce_agrees_with_the_gather_on_a_corner() {
-    let mesh = scene(8, true);
-    let light = sky(16);
-    let a = albedo(mesh.vertex_count());
+    let mesh = floor_and_wall(8, true);
+    let light = varied_sky(16);
+    let a = albedo_by_channel(mesh.vertex_count());
     let bvh = SceneBvh::new(&mesh);
     let gather = interreflected(&mesh, &bvh, a.view(), &light, 1, false).unwrap();
     let t = trace(&mesh, &light, 1024, 1, 5);
-    let bounce = rms(&gather.bounces[0]);
-    let difference = rms(&(&t.radiance - &gather.radiance(1)));
+    let bounce = rms(gather.bounces[0].view());
+    let difference = rms((&t.radiance - &gather.radiance(1)).view());
     // The gather interpolates over 8 x 8 cells and takes 16 x 32 directions; the difference
     // stays a small part of the bounced light (measured: see the message), and without the
     // bounce the path tracer would be a whole bounce away.
-    let direct = rms(&(&t.radiance - &gather.direct));
+    let direct = rms((&t.radiance - &gather.direct).view());
     assert!(
         difference < 0.25 * bounce && direct > 0.8 * bounce,
         "difference {difference:e}, bounce {bounce:e}, standard error {:e}, direct only {direct:e}",
@@ -162,15 +159,22 @@ fn one_bounce_agrees_with_the_gather_on_a_corner() {
 
 #[test]
 fn few_paths_and_too_many_bounces_are_refused() {
-    let mesh = scene(1, false);
+    let mesh = floor_and_wall(1, false);
     let bvh = SceneBvh::new(&mesh);
-    let a = albedo(mesh.vertex_count());
-    let light = sky(4);
+    let a = albedo_by_channel(mesh.vertex_count());
+    let light = varied_sky(4);
     let e = path_trace(&mesh, &bvh, a.view(), &light, &PathTraceOptions::new(1)).unwrap_err();
     assert!(e.to_string().contains("2 to"), "{e}");
     let deep = PathTraceOptions {
         bounces: 9,
         ..PathTraceOptions::new(4)
     };
-    assert!(path_trace(&mesh, &bvh, a.view(), &light, &deep).is_err());
+    assert_err!(
+        path_trace(&mesh, &bvh, a.view(), &light, &deep),
+        InvalidParameter {
+            name: "bounces",
+            ..
+        },
+        "9: must be 0 to 8"
+    );
 }

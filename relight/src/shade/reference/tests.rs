@@ -232,7 +232,7 @@ fn run_with(
 }
 
 /// A sky with a sun near `(0.6, 0.8, 0)`, RGB, positive everywhere.
-fn sunny(n: usize) -> LatLongMap<f64> {
+fn sunny_map(n: usize) -> LatLongMap<f64> {
     LatLongMap::<f64>::from_fn(n, 3, |d, o| {
         let sun = (8.0 * (d[0] * 0.6 + d[1] * 0.8 - 1.0)).exp();
         o.copy_from_slice(&[1.0 + 20.0 * sun, 0.5 + d[2].abs(), 0.2 + 10.0 * sun]);
@@ -244,7 +244,7 @@ fn sunny(n: usize) -> LatLongMap<f64> {
 fn phong_zero_is_lambert_with_albedo_one_and_the_ground_stays_lambertian() {
     let mesh = Generator::PlaneUnderBox { height: 1.0 }.mesh().unwrap();
     let ones = Array2::from_elem((mesh.vertex_count(), 3), 1.0f32);
-    let lighting = sunny(16);
+    let lighting = sunny_map(16);
     let eye = [4.0, 3.0, 5.0];
     let lambert = run(&mesh, ones.view(), &lighting);
     let phong0 = run_with(&mesh, ones.view(), &lighting, &glossy("phong:0", eye));
@@ -388,7 +388,7 @@ fn a_merl_table_of_phong_agrees_with_phong_to_its_quantisation() {
     use std::sync::Arc;
     let mesh = Generator::PlaneUnderBox { height: 1.0 }.mesh().unwrap();
     let albedo = Array2::from_elem((mesh.vertex_count(), 3), 0.7f32);
-    let lighting = sunny(32);
+    let lighting = sunny_map(32);
     let eye = [2.5, 4.0, 3.0];
     let shade = |options: &ReferenceOptions| run_with(&mesh, albedo.view(), &lighting, options);
     // Only vertices that face the eye: seen from below its horizon a measured BRDF is 0 (the
@@ -461,8 +461,8 @@ fn cached_visibility_gives_the_reference_bit_for_bit() {
     assert!(bits.report().rays > 0);
     let shadows = LatLongMap::<f64>::from_fn(12, 3, |d, o| o.fill(0.1 + d[1].max(0.0)));
     for (lighting, options) in [
-        (sunny(12), ReferenceOptions::default()),
-        (sunny(12), glossy("phong:30", [2.0, 3.0, 1.0])),
+        (sunny_map(12), ReferenceOptions::default()),
+        (sunny_map(12), glossy("phong:30", [2.0, 3.0, 1.0])),
         (shadows.unwrap(), glossy("blinn:8", [-1.0, 2.0, 0.5])),
     ] {
         let options = ReferenceOptions {
@@ -487,7 +487,7 @@ fn cached_visibility_gives_the_reference_bit_for_bit() {
         bits.reference(
             &mesh,
             albedo.view(),
-            &sunny(8),
+            &sunny_map(8),
             &ReferenceOptions::default()
         ),
         InvalidParameter {

@@ -87,7 +87,7 @@ fn error_of(sh: &Array2<f32>, reference: &Array2<f64>) -> (f64, f64) {
 }
 
 /// A lumpy albedo, `(V, 3)`.
-fn albedo(vertices: usize) -> Array2<f32> {
+fn lumpy_albedo(vertices: usize) -> Array2<f32> {
     Array2::from_shape_fn((vertices, 3), |(v, c)| {
         0.4 + 0.15 * ((v + 2 * c) % 4) as f32
     })
@@ -113,7 +113,7 @@ fn sh_render(
     );
     let map = haarshift::faces::param::SphereMap::from_lat_long(lighting).unwrap();
     let l = SphericalHarmonics::new(bands).unwrap().project(&map);
-    shade_sh(transfer, albedo(mesh.vertex_count()).view(), l.view()).unwrap()
+    shade_sh(transfer, lumpy_albedo(mesh.vertex_count()).view(), l.view()).unwrap()
 }
 
 /// The reference render of the same.
@@ -122,7 +122,7 @@ fn reference_render(
     occlusion: &impl crate::Occlusion,
     lighting: &haarshift::sphere::LatLongMap<f64>,
 ) -> Array2<f64> {
-    let a = albedo(mesh.vertex_count());
+    let a = lumpy_albedo(mesh.vertex_count());
     let options = crate::ReferenceOptions::default();
     crate::reference(mesh, occlusion, a.view(), lighting, &options)
         .unwrap()
