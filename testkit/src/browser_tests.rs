@@ -1,4 +1,4 @@
-use super::find_chromium;
+use super::{BrowserError, find_chromium};
 use std::os::unix::fs::PermissionsExt;
 
 #[test]
@@ -28,12 +28,12 @@ fn only_an_executable_file_counts_as_chromium() {
     let missing = dir.path().join("nonexistent");
     // Neither a missing file nor a directory is the browser asked for.
     let refused = |named: &std::path::Path| {
-        haarshift_testkit::assert_err_matches!(
+        crate::assert_err_matches!(
             found(Some(named)),
-            haarshift_relight::Error::Core(haarshift::Error::InvalidParameter {
-                name: "browser",
+            BrowserError {
+                what: "browser",
                 ..
-            }),
+            },
             &format!(
                 "$CHROMIUM names {}, which is no executable file",
                 named.display()
@@ -49,12 +49,12 @@ fn only_an_executable_file_counts_as_chromium() {
     assert_eq!(found(Some("".as_ref())).unwrap(), browser, "empty: not set");
     // A $CHROMIUM that is missing is absent, even with one on the PATH.
     refused(&missing);
-    haarshift_testkit::assert_err_matches!(
+    crate::assert_err_matches!(
         find_chromium(None, None),
-        haarshift_relight::Error::Core(haarshift::Error::InvalidParameter {
-            name: "browser",
+        BrowserError {
+            what: "browser",
             ..
-        }),
+        },
         "no chromium on the PATH"
     );
 }
