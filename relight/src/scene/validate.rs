@@ -164,6 +164,31 @@ impl Default for MemoryBudget {
     }
 }
 
+/// A memory limit as people write it (`--memory-limit`): a number of bytes with an optional
+/// unit (`4GiB`, `512 MiB`, `2G`), more than 0.
+///
+/// ```
+/// use haarshift_relight::scene::validate::parse_memory_limit;
+/// assert_eq!(parse_memory_limit("4GiB").unwrap(), 4 << 30);
+/// assert_eq!(parse_memory_limit("512 MiB").unwrap(), 512 << 20);
+/// let err = parse_memory_limit("0").unwrap_err().to_string();
+/// assert_eq!(err, r#"invalid memory limit: "0": must be more than 0 bytes"#);
+/// assert!(parse_memory_limit("lots").is_err());
+/// ```
+pub fn parse_memory_limit(s: &str) -> crate::Result<u64> {
+    match s.parse::<bytesize::ByteSize>() {
+        Ok(size) if size.as_u64() > 0 => Ok(size.as_u64()),
+        Ok(_) => Err(crate::Error::parameter(
+            "memory limit",
+            format!("{s:?}: must be more than 0 bytes"),
+        )),
+        Err(e) => Err(crate::Error::parameter(
+            "memory limit",
+            format!("{s:?}: {e}"),
+        )),
+    }
+}
+
 impl MemoryBudget {
     /// The bytes `vertices` vertices need under this budget (in `u128`: no count wraps).
     pub fn needed(&self, vertices: u128) -> u128 {
