@@ -384,8 +384,7 @@ fn precompute(
         },
         ..PrecomputeRequest::new(SceneInput::File(scene))
     };
-    // Refused before the scene is read, and outside the released GIL's work.
-    request.check().or_raise()?;
+    // Checked in full before the scene is read.
     let run = py.detach(|| request.run()).or_raise()?;
     let warning = py.get_type::<PyUserWarning>();
     for text in &run.warnings {

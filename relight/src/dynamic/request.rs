@@ -532,3 +532,76 @@ pub struct PlayedFrame {
     /// Where the eye was.
     pub eye: [f64; 3],
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamic::DynamicBudgets;
+    use haarshift::faces::ParamKind;
+
+    fn request(output: Option<&Path>) -> PlayRequest {
+        let param = Parameterization::new(ParamKind::LatLong, 8).unwrap();
+        PlayRequest {
+            output: output.map(Path::to_path_buf),
+            ..PlayRequest::new(
+                "scene.json".into(),
+                DynamicOptions::from_budgets(&DynamicBudgets::new(param)),
+            )
+        }
+    }
+
+    /// The refusal's whole message.
+    fn refusal(request: &PlayRequest) -> String {
+        request.check().unwrap_err().to_string()
+    }
+
+    #[test]
+    fn every_refusal_comes_before_the_scene_is_read() {
+        // scene.json does not exist: each refusal is made before anything reads it.
+        let bounced = PlayRequest {
+            bounces: 1,
+            ..request(Some(Path::new("f.png")))
+        };
+        assert!(refusal(&bounced).starts_with("invalid bounces: a dynamic scene's objects move"));
+        let shard = Some(ShardSpec::Given(Shard::new(0, 2).unwrap()));
+        let no_dir = PlayRequest {
+            shard,
+            ..request(None)
+        };
+        assert_eq!(
+            refusal(&no_dir),
+            "invalid shard: --shard builds fields into a directory: add --fields-dir DIR"
+        );
+        let rendering = PlayRequest {
+            shard,
+            ..request(Some(Path::new("f.png")))
+        };
+        assert_eq!(
+            refusal(&rendering),
+            "invalid shard: --shard only builds fields and renders nothing: no -o, --animate \
+             or --vertices"
+        );
+        assert_eq!(
+            refusal(&request(None)),
+            "invalid output: -o IMAGE is needed to render (only --shard renders nothing)"
+        );
+        assert_eq!(
+            refusal(&request(Some(Path::new("f.gif")))),
+            "invalid output: a .gif needs --animate PATH.json; one frame is .png or .exr"
+        );
+        assert!(refusal(&request(Some(Path::new("f.bmp")))).contains("f.bmp"));
+        let dir = tempfile::tempdir().unwrap();
+        let taken = dir.path().join("taken.png");
+        std::fs::write(&taken, b"mine").unwrap();
+        match request(Some(&taken)).check() {
+            Err(Error::Core(haarshift::Error::OutputExists { path })) => assert_eq!(path, taken),
+            other => panic!("expected the output refused, got {other:?}"),
+        }
+        let forced = PlayRequest {
+            force: true,
+            ..request(Some(&taken))
+        };
+        forced.check().unwrap();
+        assert_eq!(std::fs::read(&taken).unwrap(), b"mine");
+    }
+}
