@@ -216,11 +216,7 @@ impl PrecomputeRequest {
         if let Some(cells) = self.ground_cells {
             crate::scene::check_ground_cells(cells)?;
         }
-        needs(
-            self.memory_limit == 0,
-            "memory limit",
-            "must be more than 0 bytes",
-        )?;
+        crate::scene::validate::check_memory_limit(self.memory_limit)?;
         needs(
             self.max_vertices.is_some() && self.refine.is_none(),
             "max vertices",
