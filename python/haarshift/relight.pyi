@@ -53,41 +53,56 @@ class Cache:
 def precompute(
     scene: Union[str, "os.PathLike[str]"],
     *,
+    output: Union[str, "os.PathLike[str]", None] = None,
     param: Literal["latlong", "cube"] = "latlong",
     resolution: int = 32,
+    keep_visibility: Optional[int] = None,
+    visibility_samples: int = 1,
+    seed: int = 0,
+    ray_tracer: Optional[Literal["embree", "packets"]] = None,
+    map_size: int = 2048,
+    sh_bands: Optional[int] = None,
+    force: bool = False,
     ground_plane: bool = False,
     ground_cells: Optional[int] = None,
-    keep_visibility: Optional[int] = None,
-    samples: int = 1,
-    seed: int = 0,
+    memory_limit: Union[int, str, None] = None,
     order: Literal["vertex", "direction"] = "vertex",
-    sh_bands: Optional[int] = None,
-    shard: None = None,
-    output: Union[str, "os.PathLike[str]", None] = None,
-    force: bool = False,
     bounces: int = 0,
+    refine: Optional[float] = None,
+    max_vertices: Optional[int] = None,
+    refine_light: Union[str, "os.PathLike[str]", None] = None,
+    shard: None = None,
+    shards: None = None,
+    bounce_from: None = None,
 ) -> Cache:
-    """Precomputes a mesh or scene file as `haarshift relight precompute` does."""
+    """Precomputes a mesh or scene file as `haarshift relight precompute` does: every keyword
+    is the command line's flag of the same name."""
 
 @overload
 def precompute(
     scene: Union[str, "os.PathLike[str]"],
     *,
+    output: Union[str, "os.PathLike[str]"],
     param: Literal["latlong", "cube"] = "latlong",
     resolution: int = 32,
+    keep_visibility: Optional[int] = None,
+    visibility_samples: int = 1,
+    seed: int = 0,
+    ray_tracer: Optional[Literal["embree", "packets"]] = None,
+    map_size: int = 2048,
+    sh_bands: Optional[int] = None,
+    force: bool = False,
     ground_plane: bool = False,
     ground_cells: Optional[int] = None,
-    keep_visibility: Optional[int] = None,
-    samples: int = 1,
-    seed: int = 0,
+    memory_limit: Union[int, str, None] = None,
     order: Literal["vertex"] = "vertex",
-    sh_bands: Optional[int] = None,
-    shard: Tuple[int, int],
-    output: Union[str, "os.PathLike[str]"],
-    force: bool = False,
+    bounces: int = 0,
+    bounce_from: Union[str, "os.PathLike[str]", None] = None,
+    shard: Union[str, Tuple[int, int]],
+    shards: Optional[int] = None,
 ) -> str:
-    """Precomputes shard `i` of `n` into `output` (skipped when it is there, complete); returns
-    the path."""
+    """Precomputes shard `"i/n"` (or `"auto"`, or `(i, n)`) into `output` (skipped when it is
+    there, complete); returns the path."""
 
 def merge(
     shards: Sequence[Union[str, "os.PathLike[str]"]],

@@ -10,18 +10,21 @@ use haarshift::product::Selection;
 use haarshift::sphere::{LatLongMap, SphereRotation};
 use haarshift_relight::dynamic::{DynamicBudgets, DynamicOptions, DynamicScene};
 use haarshift_relight::light::environment::Environment;
-use haarshift_relight::precompute::shard::Shard;
-use haarshift_relight::precompute::{Order, PrecomputeOptions, precompute_shard, shard_is_done};
+use haarshift_relight::precompute::request::{
+    DEFAULT_RESOLUTION, Outcome, PrecomputeRequest, SceneInput,
+};
+use haarshift_relight::precompute::shard::{Shard, ShardSpec};
+use haarshift_relight::precompute::{DEFAULT_MAP_SIZE, Order};
 use haarshift_relight::render::view::ViewSpec;
+use haarshift_relight::scene::validate::{DEFAULT_MEMORY_LIMIT, parse_memory_limit};
 use haarshift_relight::shade::dynamic_scene::{DynamicMethod, DynamicShader};
 use haarshift_relight::shade::glossy::GlossyOptions;
 use haarshift_relight::shade::{
     FrameSpec, LightSpec, Method, ShadeOptions, Shader as LibraryShader, ShaderSpec, ShadingInput,
 };
-use haarshift_relight::{
-    Brdf, EnvironmentSpec, RayTracer, Scene, SceneCache, VisibilityOptions, merge_shards,
-};
+use haarshift_relight::{Brdf, EnvironmentSpec, RayTracer, SceneCache, merge_shards};
 use numpy::{IntoPyArray, PyArray2};
+use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 
 use crate::arrays::ArrayArg;
@@ -272,17 +275,28 @@ impl Cache {
     }
 }
 
-/// Precomputes `scene` (a mesh .obj/.ply or a scene file .json) as `haarshift relight
-/// precompute` does: every vertex's visibility x cosine over a `param` map of side
-/// `resolution`, Haar-transformed and truncated to `keep_visibility` detail coefficients
-/// (None: all), with `sh_bands` bands of spherical harmonics beside it when asked. With
-/// `output` the cache is also written there (an existing file only with `force=True`).
+/// Precomputes `scene` (a mesh .obj/.ply/.gltf/.glb or a scene file .json) as `haarshift
+/// relight precompute` does, through the same library request: every keyword is the command
+/// line's flag of the same name (`--visibility-samples` is `visibility_samples`, `-o` is
+/// `output`), with its default, its checks and its messages, all made before any work. Every
+/// vertex's visibility x cosine over a `param` map of side `resolution`, Haar-transformed and
+/// truncated to `keep_visibility` detail coefficients (None: all), with `sh_bands` bands of
+/// spherical harmonics beside it when asked. With `output` the cache is also written there
+/// (an existing file only with `force=True`). What the mesh files approximated (a glossy glTF
+/// material taken as its base colour) is a `UserWarning`, one a line, as the command line
+/// prints it.
 ///
-/// With `shard=(i, n)` only shard `i` of `n` is computed (the vertices `[i V / n, (i + 1) V /
-/// n)`, traced against the whole scene, the bits an unsharded run gives them), written to
-/// `output` (required), and `output` is returned as a string, so that a task on a Dask or Ray
-/// worker returns a path; an `output` that already holds this shard complete is not computed
-/// again (`force=True` recomputes it). `merge` joins the shards.
+/// `memory_limit` is bytes (an int) or a size as the command line writes it (`"8GiB"`,
+/// `"512 MiB"`; None: 4 GiB): a scene or transport that would need more is refused
+/// (`MemoryError`) before it is built.
+///
+/// With `shard="i/n"` (or `(i, n)`) only shard `i` of `n` is computed (the vertices `[i V / n,
+/// (i + 1) V / n)`, traced against the whole scene, the bits an unsharded run gives them),
+/// written to `output` (required), and `output` is returned as a string, so that a task on a
+/// Dask or Ray worker returns a path; an `output` that already holds this shard complete is
+/// not computed again (`force=True` recomputes it). `shard="auto"` reads it from a Slurm
+/// array job or a Kubernetes Indexed Job (with `shards=N`, the Job's completions). `merge`
+/// joins the shards. `bounces` with a shard adds one bounce to the merged cache `bounce_from`.
 ///
 /// `ground_cells` (with `ground_plane=True`, default 32) is the ground plane's cells per side.
 ///
@@ -290,107 +304,140 @@ impl Cache {
 /// libembree3.so.3 loads at run time; refused with what to install where it does not) or
 /// `"packets"` (haarshift's own, always available); the two answer alike except on rays
 /// through a triangle's edge. The cache records the one that cast (`Cache.ray_tracer`).
+/// `order="direction"` casts with shadow buffers of side `map_size` instead.
 ///
 /// `bounces` (0 to 8) also gathers that many bounces of interreflected light over the same
-/// rays and stores their sum beside the transport (`Cache.bounces`); not with `shard=` (a
-/// shard's next bounce needs the merged cache of the last: `haarshift relight precompute
-/// --bounce-from`).
+/// rays and stores their sum beside the transport (`Cache.bounces`).
+///
+/// `refine=TOL` splits the edges whose ends' transports differ by more than TOL (in (0, 2]),
+/// up to `max_vertices`, judged under the lighting `refine_light` (a file) when given.
 ///
 /// >>> import json, os, tempfile, haarshift
 /// >>> d = tempfile.mkdtemp(); path = os.path.join(d, "ball.json")
 /// >>> with open(path, "w") as f:
 /// ...     json.dump({"objects": [{"generator": {"sphere": {"cells": 2}}}]}, f)
-/// >>> parts = [haarshift.relight.precompute(path, resolution=8, shard=(i, 2),
+/// >>> parts = [haarshift.relight.precompute(path, resolution=8, shard=f"{i}/2",
 /// ...          output=os.path.join(d, f"part-{i}.hsr")) for i in range(2)]
 /// >>> merged = haarshift.relight.merge(parts, output=os.path.join(d, "ball.hsr"))
 /// >>> whole = haarshift.relight.precompute(path, resolution=8, output=os.path.join(d, "whole.hsr"))
 /// >>> open(os.path.join(d, "ball.hsr"), "rb").read() == open(os.path.join(d, "whole.hsr"), "rb").read()
 /// True
+/// >>> haarshift.relight.precompute(path, resolution=8, refine=0.3, max_vertices=80).vertex_count
+/// 80
+/// >>> try:
+/// ...     haarshift.relight.precompute(path, resolution=8, refine=3.0)
+/// ... except ValueError as e:
+/// ...     print(e)
+/// invalid refine: 3: the tolerance is a fraction of an unoccluded vertex's transport, in (0, 2]
 #[pyfunction]
-#[pyo3(signature = (scene, *, param = "latlong", resolution = 32, ground_plane = false, ground_cells = None, keep_visibility = None, samples = 1, seed = 0, order = "vertex", sh_bands = None, shard = None, output = None, force = false, ray_tracer = None, bounces = 0))]
+#[pyo3(signature = (scene, *, output = None, param = "latlong", resolution = DEFAULT_RESOLUTION, keep_visibility = None, visibility_samples = 1, seed = 0, order = "vertex", ray_tracer = None, map_size = DEFAULT_MAP_SIZE, sh_bands = None, bounces = 0, bounce_from = None, refine = None, max_vertices = None, refine_light = None, shard = None, shards = None, force = false, ground_plane = false, ground_cells = None, memory_limit = None))]
 #[allow(clippy::too_many_arguments)] // the keyword arguments of one Python function
 fn precompute(
     py: Python<'_>,
     scene: PathBuf,
+    output: Option<PathBuf>,
     param: &str,
     resolution: usize,
-    ground_plane: bool,
-    ground_cells: Option<usize>,
     keep_visibility: Option<usize>,
-    samples: usize,
+    visibility_samples: usize,
     seed: u64,
     order: &str,
-    sh_bands: Option<usize>,
-    shard: Option<(usize, usize)>,
-    output: Option<PathBuf>,
-    force: bool,
     ray_tracer: Option<&str>,
+    map_size: usize,
+    sh_bands: Option<usize>,
     bounces: usize,
+    bounce_from: Option<PathBuf>,
+    refine: Option<f64>,
+    max_vertices: Option<usize>,
+    refine_light: Option<PathBuf>,
+    shard: Option<&Bound<'_, PyAny>>,
+    shards: Option<usize>,
+    force: bool,
+    ground_plane: bool,
+    ground_cells: Option<usize>,
+    memory_limit: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<PyAny>> {
-    let param = Parameterization::new(parse::<ParamKind>(param)?, resolution).or_raise()?;
-    let mut visibility = VisibilityOptions::new(param);
-    visibility.samples = samples;
-    visibility.seed = seed;
-    visibility.sh_bands = sh_bands;
-    visibility.keep = keep_visibility.map_or(Selection::All, Selection::Largest);
-    let mut options = PrecomputeOptions::new(visibility);
-    options.order = parse::<Order>(order)?;
-    options.bounces = bounces;
-    if let Some(tracer) = ray_tracer {
-        options.ray_tracer = parse::<RayTracer>(tracer)?;
+    let request = PrecomputeRequest {
+        output,
+        param: parse::<ParamKind>(param)?,
+        resolution,
+        keep_visibility,
+        visibility_samples,
+        seed,
+        order: parse::<Order>(order)?,
+        ray_tracer: ray_tracer.map(parse::<RayTracer>).transpose()?,
+        map_size,
+        sh_bands,
+        bounces,
+        bounce_from,
+        refine,
+        max_vertices,
+        refine_light,
+        shard: shard.map(shard_spec).transpose()?,
+        shards,
+        force,
+        ground_plane,
+        ground_cells,
+        memory_limit: match memory_limit {
+            Some(limit) => memory_size(limit)?,
+            None => DEFAULT_MEMORY_LIMIT,
+        },
+        ..PrecomputeRequest::new(SceneInput::File(scene))
+    };
+    // Checked in full before the scene is read.
+    let run = py.detach(|| request.run()).or_raise()?;
+    let warning = py.get_type::<PyUserWarning>();
+    for text in &run.warnings {
+        let text = std::ffi::CString::new(text.replace('\0', " "))?;
+        PyErr::warn(py, &warning, &text, 1)?;
     }
-    // Refused before the scene is read.
-    options.check().or_raise()?;
-    if ground_cells.is_some() && !ground_plane {
-        return Err(bad_argument(
-            "ground_cells",
-            "the ground plane's cells need ground_plane=True",
-        ));
-    }
-    let load = || -> haarshift_relight::Result<Scene> {
-        let mut loaded = Scene::load(&scene)?;
-        match (ground_plane, ground_cells) {
-            (false, _) => {}
-            (true, None) => loaded.add_ground_plane()?,
-            (true, Some(cells)) => loaded.add_ground_plane_of(cells)?,
+    match run.outcome {
+        Outcome::Whole { cache, .. } => {
+            let cache = Cache {
+                cache: *cache,
+                path: request.output,
+            };
+            Ok(Py::new(py, cache)?.into_any())
         }
-        Ok(loaded)
-    };
-    if let Some((index, count)) = shard {
-        let shard = Shard::new(index, count).or_raise()?;
-        let Some(path) = output else {
-            return Err(bad_argument(
-                "output",
-                "a shard is written to a file: give output=",
-            ));
-        };
-        py.detach(|| -> haarshift_relight::Result<()> {
-            let loaded = load()?;
-            if !force && shard_is_done(&path, &loaded, &options, shard)? {
-                return Ok(());
-            }
-            precompute_shard(loaded, &options, shard)?
-                .0
-                .write(&path, force)
-                .map(drop)
-        })
-        .or_raise()?;
-        return Ok(path.into_pyobject(py)?.str()?.into_any().unbind());
+        Outcome::Shard { .. } | Outcome::Skipped { .. } => {
+            let path = request.output.unwrap_or_default();
+            Ok(path.into_pyobject(py)?.str()?.into_any().unbind())
+        }
     }
-    let cache = py
-        .detach(|| -> haarshift_relight::Result<_> {
-            let (cache, _) = haarshift_relight::precompute::precompute(load()?, &options)?;
-            if let Some(path) = &output {
-                cache.write(path, force)?;
-            }
-            Ok(cache)
-        })
-        .or_raise()?;
-    let cache = Cache {
-        cache,
-        path: output,
-    };
-    Ok(Py::new(py, cache)?.into_any())
+}
+
+/// `shard`: `"I/N"` or `"auto"` as the command line's `--shard` takes it, or a pair `(i, n)`.
+fn shard_spec(value: &Bound<'_, PyAny>) -> PyResult<ShardSpec> {
+    if let Ok(text) = value.extract::<String>() {
+        return parse(&text);
+    }
+    match value.extract::<(usize, usize)>() {
+        Ok((index, count)) => Ok(ShardSpec::Given(Shard::new(index, count).or_raise()?)),
+        Err(_) => Err(bad_argument(
+            "shard",
+            format!(
+                "{} is neither \"I/N\", \"auto\" nor a pair (i, n)",
+                value.repr()?
+            ),
+        )),
+    }
+}
+
+/// `memory_limit`: bytes, or a size such as `"8GiB"` read as `--memory-limit` reads it.
+fn memory_size(value: &Bound<'_, PyAny>) -> PyResult<u64> {
+    if let Ok(text) = value.extract::<String>() {
+        return parse_memory_limit(&text).or_raise();
+    }
+    match value.extract::<u64>() {
+        Ok(bytes) => Ok(bytes),
+        Err(_) => Err(bad_argument(
+            "memory_limit",
+            format!(
+                "{} is neither bytes nor a size such as \"8GiB\"",
+                value.repr()?
+            ),
+        )),
+    }
 }
 
 /// Merges the shard files `shards` (any order) into the cache an unsharded `precompute`

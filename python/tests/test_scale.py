@@ -10,7 +10,7 @@ from dask.distributed import Client, LocalCluster
 import haarshift
 from conftest import needs
 
-OPTIONS = dict(param="cube", resolution=4, samples=2, seed=3, sh_bands=2)
+OPTIONS = dict(param="cube", resolution=4, visibility_samples=2, seed=3, sh_bands=2)
 
 
 @pytest.fixture
@@ -60,7 +60,7 @@ def test_a_shard_is_skipped_when_complete_and_bad_shards_are_refused(tmp_path, b
     assert part.stat().st_mtime_ns == before  # complete: not written again
     with pytest.raises(OSError, match="holds shard 1/2, not 0/2"):
         haarshift.relight.precompute(balls, shard=(0, 2), output=part, **OPTIONS)
-    with pytest.raises(ValueError, match="give output="):
+    with pytest.raises(ValueError, match="a shard is written to a file: give --output"):
         haarshift.relight.precompute(balls, shard=(0, 2), **OPTIONS)
     with pytest.raises(ValueError, match="below the count"):
         haarshift.relight.precompute(balls, shard=(2, 2), output=part, **OPTIONS)

@@ -371,6 +371,7 @@ pub mod motion;
 mod options;
 mod placement;
 mod products;
+pub mod request;
 mod shading;
 pub use jrt::{Change, JustInTimeTransfer, TransferReport};
 pub use options::{DynamicBudgets, DynamicOptions};

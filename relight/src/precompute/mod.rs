@@ -20,6 +20,7 @@ pub mod embree;
 mod packet;
 pub mod raycast;
 pub mod refine;
+pub mod request;
 pub mod shadowmap;
 pub mod shard;
 pub mod sparse;
@@ -149,6 +150,43 @@ impl PrecomputeOptions {
                 param.texels()
             ),
         ))
+    }
+
+    /// Refuses what a shard cannot do, before any scene is read: the direction order (every
+    /// shadow buffer serves all vertices at once) and bounces without `bounce_from` (bounce
+    /// `b + 1` of a shard's vertices needs bounce `b` of every vertex: the merged cache of the
+    /// last bounce, [`precompute_bounce_shard`]).
+    ///
+    /// ```
+    /// use haarshift_relight::precompute::{Order, PrecomputeOptions};
+    /// use haarshift_relight::VisibilityOptions;
+    /// use haarshift::faces::{ParamKind, Parameterization};
+    /// let mut o = PrecomputeOptions::new(VisibilityOptions::new(Parameterization::new(ParamKind::Cube, 4).unwrap()));
+    /// assert!(o.check_shard(false).is_ok());
+    /// o.bounces = 1;
+    /// let err = o.check_shard(false).unwrap_err().to_string();
+    /// assert!(err.contains("--bounce-from MERGED.hsr"), "{err}");
+    /// assert!(o.check_shard(true).is_ok());
+    /// o.order = Order::Direction;
+    /// assert!(o.check_shard(true).unwrap_err().to_string().contains("cannot be sharded"));
+    /// ```
+    pub fn check_shard(&self, bounce_from: bool) -> Result<()> {
+        if self.order == Order::Direction {
+            return Err(Error::parameter(
+                "order",
+                "direction: every shadow buffer serves all vertices at once, so it cannot be \
+                 sharded; shard with --order vertex",
+            ));
+        }
+        if self.bounces > 0 && !bounce_from {
+            return Err(Error::parameter(
+                "bounces",
+                "bounce b + 1 of a shard's vertices needs bounce b of every vertex: shard \
+                 without --bounces, merge, then add one bounce at a time with --bounce-from \
+                 MERGED.hsr",
+            ));
+        }
+        Ok(())
     }
 
     /// The [`MemoryBudget`] of this precomputation: per vertex, beyond the mesh, the most
@@ -321,13 +359,7 @@ pub fn precompute_shard(
     options: &PrecomputeOptions,
     shard: Shard,
 ) -> Result<(CacheShard, PrecomputeReport)> {
-    if options.bounces > 0 {
-        return Err(Error::parameter(
-            "bounces",
-            "bounce b + 1 of a shard's vertices needs bounce b of every vertex: shard without \
-             --bounces, merge, then add one bounce at a time with --bounce-from MERGED.hsr",
-        ));
-    }
+    options.check_shard(false)?;
     let (transport, _, report) = transport(&scene, options, Some(shard))?;
     let mut part = CacheShard::new(
         shard,
@@ -476,6 +508,10 @@ fn transport(
     shard: Option<Shard>,
 ) -> Result<(TransportSet, Option<BouncedTransport>, PrecomputeReport)> {
     options.check()?;
+    if shard.is_some() {
+        // Refuses the direction order, so that below a shard is in the vertex order.
+        options.check_shard(true)?;
+    }
     let mesh = &scene.mesh;
     (options.budget(shard)).check("the scene", mesh.vertex_count() as u128)?;
     let without_bounces = |(set, report)| (set, None, report);
@@ -498,13 +534,8 @@ fn transport(
             shard.unwrap_or(Shard::whole()).range(mesh.vertex_count()),
         )
         .map(without_bounces),
-        (Order::Direction, None) => {
+        (Order::Direction, _) => {
             direction_major(mesh, &options.visibility, options.map_size).map(without_bounces)
         }
-        (Order::Direction, Some(_)) => Err(Error::parameter(
-            "order",
-            "direction: every shadow buffer serves all vertices at once, so it cannot be \
-             sharded; shard with --order vertex",
-        )),
     }
 }

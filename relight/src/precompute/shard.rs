@@ -238,6 +238,29 @@ impl ShardSpec {
     }
 }
 
+impl ShardSpec {
+    /// The shard of `spec` (none without one), `auto` read from this process's environment
+    /// ([`resolve`](Self::resolve)); `shards` without a `spec` is refused, as it names the
+    /// count of `auto` only.
+    ///
+    /// ```
+    /// use haarshift_relight::precompute::shard::{Shard, ShardSpec};
+    /// let given = "1/4".parse::<ShardSpec>().ok();
+    /// assert_eq!(ShardSpec::from_env(given, None).unwrap(), Some(Shard::new(1, 4).unwrap()));
+    /// assert_eq!(ShardSpec::from_env(None, None).unwrap(), None);
+    /// let err = ShardSpec::from_env(None, Some(4)).unwrap_err().to_string();
+    /// assert_eq!(err, "invalid shards: goes with --shard auto");
+    /// ```
+    pub fn from_env(spec: Option<ShardSpec>, shards: Option<usize>) -> Result<Option<Shard>> {
+        match (spec, shards) {
+            (None, Some(_)) => Err(Error::parameter("shards", "goes with --shard auto")),
+            (spec, shards) => spec
+                .map(|s| s.resolve(|name| std::env::var(name).ok(), shards))
+                .transpose(),
+        }
+    }
+}
+
 /// `auto` or `I/N`.
 impl FromStr for ShardSpec {
     type Err = Error;

@@ -164,6 +164,44 @@ impl Default for MemoryBudget {
     }
 }
 
+/// A memory limit as people write it (`--memory-limit`): a number of bytes with an optional
+/// unit (`4GiB`, `512 MiB`, `2G`), more than 0.
+///
+/// ```
+/// use haarshift_relight::scene::validate::parse_memory_limit;
+/// assert_eq!(parse_memory_limit("4GiB").unwrap(), 4 << 30);
+/// assert_eq!(parse_memory_limit("512 MiB").unwrap(), 512 << 20);
+/// let err = parse_memory_limit("0").unwrap_err().to_string();
+/// assert_eq!(err, "invalid memory limit: must be more than 0 bytes");
+/// assert!(parse_memory_limit("lots").is_err());
+/// ```
+pub fn parse_memory_limit(s: &str) -> crate::Result<u64> {
+    match s.parse::<bytesize::ByteSize>() {
+        Ok(size) => check_memory_limit(size.as_u64()),
+        Err(e) => Err(crate::Error::parameter(
+            "memory limit",
+            format!("{s:?}: {e}"),
+        )),
+    }
+}
+
+/// `limit` bytes, refused when 0 (nothing fits).
+///
+/// ```
+/// use haarshift_relight::scene::validate::check_memory_limit;
+/// assert_eq!(check_memory_limit(1 << 30).unwrap(), 1 << 30);
+/// assert!(check_memory_limit(0).is_err());
+/// ```
+pub fn check_memory_limit(limit: u64) -> crate::Result<u64> {
+    match limit {
+        0 => Err(crate::Error::parameter(
+            "memory limit",
+            "must be more than 0 bytes",
+        )),
+        _ => Ok(limit),
+    }
+}
+
 impl MemoryBudget {
     /// The bytes `vertices` vertices need under this budget (in `u128`: no count wraps).
     pub fn needed(&self, vertices: u128) -> u128 {

@@ -45,13 +45,9 @@ pub struct SceneFlags {
     pub memory_limit: u64,
 }
 
-/// A size in bytes: a number with an optional unit (`4GiB`, `512 MiB`, `2G`).
+/// `--memory-limit`, read by the library (as Python's `memory_limit` is).
 fn memory_size(s: &str) -> std::result::Result<u64, String> {
-    match s.parse::<bytesize::ByteSize>() {
-        Ok(size) if size.as_u64() > 0 => Ok(size.as_u64()),
-        Ok(_) => Err(format!("{s:?}: must be more than 0 bytes")),
-        Err(e) => Err(format!("{s:?}: {e}")),
-    }
+    haarshift_relight::scene::validate::parse_memory_limit(s).map_err(|e| e.to_string())
 }
 
 impl SceneFlags {
@@ -132,9 +128,7 @@ pub struct ShardFlags {
 impl ShardFlags {
     /// The shard named or read from the scheduler's environment, if any.
     pub fn resolve(&self) -> Result<Option<Shard>> {
-        self.shard
-            .map(|spec| spec.resolve(|name| std::env::var(name).ok(), self.shards))
-            .transpose()
+        ShardSpec::from_env(self.shard, self.shards)
     }
 }
 

@@ -2,22 +2,18 @@
 
 use std::path::PathBuf;
 
-use haarshift::faces::{ParamKind, Parameterization};
+use haarshift::faces::ParamKind;
 use haarshift::memory::peak_resident_bytes;
-use haarshift::product::Selection;
+use haarshift_relight::RayTracer;
 use haarshift_relight::Result;
-use haarshift_relight::light::environment::Environment;
-use haarshift_relight::precompute::refine::{
-    MIN_EDGE_OFFSETS, Probe, Refinement, precompute_refined,
+use haarshift_relight::precompute::refine::{MIN_EDGE_OFFSETS, RefineReport};
+use haarshift_relight::precompute::request::{
+    DEFAULT_RESOLUTION, Outcome, PrecomputeRequest, SceneInput,
 };
-use haarshift_relight::precompute::{
-    DEFAULT_MAP_SIZE, Order, PrecomputeOptions, precompute, precompute_bounce_shard,
-    precompute_shard, shard_is_done,
-};
-use haarshift_relight::{RayTracer, Scene, SceneCache, VisibilityOptions};
+use haarshift_relight::precompute::{DEFAULT_MAP_SIZE, Order};
 
 use super::flags::{SceneFlags, ShardFlags, bytes};
-use crate::commands::{choice, names, print, refuse_outputs};
+use crate::commands::{choice, names, print};
 
 const HELP: &str = "\
 For every vertex, the visibility over the sphere at the texel centres of the chosen
@@ -105,7 +101,7 @@ pub struct Args {
     pub param: ParamKind,
 
     /// Face side N, a power of two
-    #[arg(long, value_name = "N", default_value_t = 32)]
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_RESOLUTION)]
     pub resolution: usize,
 
     /// Detail coefficients kept per vertex (the largest, orthonormal) [default: all]
@@ -179,60 +175,59 @@ pub fn tracer_help() -> String {
     format!("Ray tracer on this machine: {}", RayTracer::choice())
 }
 
-pub fn run(args: Args) -> Result<()> {
-    let shard = args.shard.resolve()?;
-    // An existing shard is looked at below (a complete one is skipped), once the scene is read.
-    let existing_allowed = args.force || shard.is_some();
-    let mut inputs = vec![args.scene.input.as_path()];
-    inputs.extend(args.bounce_from.as_deref());
-    inputs.extend(args.refine_light.as_deref());
-    refuse_outputs(&inputs, &[&args.output], existing_allowed)?;
-    let param = Parameterization::new(args.param, args.resolution)?;
-    let mut visibility = VisibilityOptions::new(param);
-    visibility.samples = args.visibility_samples;
-    visibility.seed = args.seed;
-    visibility.sh_bands = args.sh_bands;
-    visibility.progress = true;
-    visibility.keep = args
-        .keep_visibility
-        .map_or(Selection::All, Selection::Largest);
-    let options = PrecomputeOptions {
-        visibility,
-        order: args.order,
-        map_size: args.map_size,
+/// The request these flags make: the library checks and runs it.
+fn request(args: Args) -> PrecomputeRequest {
+    PrecomputeRequest {
+        ground_plane: args.scene.ground_plane,
+        ground_cells: args.scene.ground_cells,
         memory_limit: args.scene.memory_limit,
-        ray_tracer: args.ray_tracer.unwrap_or_else(RayTracer::best),
+        output: Some(args.output),
+        param: args.param,
+        resolution: args.resolution,
+        keep_visibility: args.keep_visibility,
+        visibility_samples: args.visibility_samples,
+        seed: args.seed,
+        order: args.order,
+        ray_tracer: args.ray_tracer,
+        map_size: args.map_size,
+        sh_bands: args.sh_bands,
         bounces: args.bounces,
-    };
-    options.check()?;
-    let probe = match &args.refine_light {
-        Some(path) => {
-            let env = Environment::load(path)?;
-            let name = path
-                .file_name()
-                .map_or(String::new(), |n| n.to_string_lossy().into());
-            Some(Probe::new(name, &env, param).map_err(|e| e.in_file(path))?)
-        }
-        None => None,
-    };
-    let refinement = args.refine.map(|tolerance| Refinement {
-        tolerance,
+        bounce_from: args.bounce_from,
+        refine: args.refine,
         max_vertices: args.max_vertices,
-        probe,
-    });
-    if let Some(r) = &refinement {
-        r.check_with(&options, shard)?;
+        refine_light: args.refine_light,
+        shard: args.shard.shard,
+        shards: args.shard.shards,
+        force: args.force,
+        progress: true,
+        ..PrecomputeRequest::new(SceneInput::File(args.scene.input))
     }
-    let scene = args.scene.load_within(options.budget(shard))?;
-    let (mut vertices, mut triangles) = (scene.mesh.vertex_count(), scene.mesh.triangles().len());
-    let (what, transport, file_bytes, report) = match shard {
-        None => {
-            let (cache, report) = match &refinement {
-                Some(r) => refined(scene, &options, r)?,
-                None => precompute(scene, &options)?,
-            };
-            (vertices, triangles) = (cache.mesh.vertex_count(), cache.mesh.triangles().len());
-            let file_bytes = cache.write(&args.output, args.force)?;
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let (output, tolerance) = (args.output.clone(), args.refine);
+    let run = request(args).run()?;
+    for warning in &run.warnings {
+        eprintln!("haarshift: warning: {warning}");
+    }
+    let (vertices, triangles, what, transport, file_bytes, report) = match &run.outcome {
+        Outcome::Skipped { shard, vertices } => {
+            return print(&format!(
+                "{}: shard {shard} (vertices {}..{}) is complete: skipped\n",
+                output.display(),
+                vertices.start,
+                vertices.end
+            ));
+        }
+        Outcome::Whole {
+            cache,
+            report,
+            refined,
+            file_bytes,
+        } => {
+            if let (Some(r), Some(tolerance)) = (refined, tolerance) {
+                print(&refine_line(r, tolerance))?;
+            }
             let what = cache.bounced.as_ref().map_or(String::new(), |b| {
                 format!(
                     " (and {} bounces: {} sets, {} coefficients, {:.3} s)",
@@ -242,31 +237,39 @@ pub fn run(args: Args) -> Result<()> {
                     report.bounce_seconds
                 )
             });
-            (what, cache.transport, file_bytes, report)
+            let mesh = &cache.mesh;
+            (
+                mesh.vertex_count(),
+                mesh.triangles().len(),
+                what,
+                &cache.transport,
+                file_bytes.unwrap_or(0),
+                report,
+            )
         }
-        Some(shard) => {
-            let range = shard.range(vertices);
-            let what = format!(" (shard {shard}: vertices {}..{})", range.start, range.end);
-            if !args.force && shard_is_done(&args.output, &scene, &options, shard)? {
-                return print(&format!(
-                    "{}: shard {shard} (vertices {}..{}) is complete: skipped\n",
-                    args.output.display(),
-                    range.start,
-                    range.end
-                ));
-            }
-            let (part, report) = match &args.bounce_from {
-                Some(merged) => {
-                    let merged_cache = SceneCache::read(merged)?;
-                    precompute_bounce_shard(scene, &options, shard, &merged_cache)
-                        .map_err(|e| e.in_file(merged))?
-                }
-                None => precompute_shard(scene, &options, shard)?,
-            };
-            let file_bytes = part.write(&args.output, args.force)?;
-            (what, part.transport, file_bytes, report)
+        Outcome::Shard {
+            shard,
+            vertices,
+            part,
+            report,
+            file_bytes,
+        } => {
+            let what = format!(
+                " (shard {shard}: vertices {}..{})",
+                vertices.start, vertices.end
+            );
+            let mesh = &part.mesh;
+            (
+                mesh.vertex_count(),
+                mesh.triangles().len(),
+                what,
+                &part.transport,
+                *file_bytes,
+                report,
+            )
         }
     };
+    let param = run.param;
     let rate = if report.seconds > 0.0 {
         report.rays as f64 / report.seconds
     } else {
@@ -276,11 +279,11 @@ pub fn run(args: Args) -> Result<()> {
         "{}: {vertices} vertices{what}, {triangles} triangles, {} {} ({} texels), {} order\n\
          rays {}{}, {:.3} s, {:.3} M rays/s, working memory {}\n\
          transport {} ({} coefficients), file {}, peak memory {}\n",
-        args.output.display(),
+        output.display(),
         param.kind(),
         param.face_size(),
         param.texels(),
-        args.order,
+        run.order,
         report.rays,
         report.tracer.map_or(String::new(), |t| format!(" ({t})")),
         report.seconds,
@@ -293,14 +296,8 @@ pub fn run(args: Args) -> Result<()> {
     ))
 }
 
-/// [`precompute_refined`], with its one line on what the refinement did.
-fn refined(
-    scene: Scene,
-    options: &PrecomputeOptions,
-    refinement: &Refinement,
-) -> Result<(SceneCache, haarshift_relight::PrecomputeReport)> {
-    let (cache, report, r) = precompute_refined(scene, options, refinement)?;
-    let tolerance = refinement.tolerance;
+/// The one line on what a refinement to `tolerance` did.
+fn refine_line(r: &RefineReport, tolerance: f64) -> String {
     let mut end = if r.stopped_by_budget() {
         format!(
             "stopped by --max-vertices {} with {} edges above {tolerance}",
@@ -315,9 +312,8 @@ fn refined(
             r.short
         );
     }
-    print(&format!(
+    format!(
         "refined {} -> {} vertices ({} of them the ground's) in {} rounds: {end}\n",
         r.original, r.vertices, r.ground_vertices, r.rounds
-    ))?;
-    Ok((cache, report))
+    )
 }

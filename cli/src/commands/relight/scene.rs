@@ -2,28 +2,14 @@
 //! an animation.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
-use haarshift::SampleDepth;
-use haarshift::product::Selection;
 use haarshift_relight::Result;
-use haarshift_relight::dynamic::fields::file::FieldStore;
-use haarshift_relight::dynamic::motion::{MotionPath, play};
-use haarshift_relight::dynamic::{Change, DynamicScene};
-use haarshift_relight::light::environment::LightRotation;
-use haarshift_relight::precompute::shard::Shard;
-use haarshift_relight::render::animation::{numbered_path, write_gif};
-use haarshift_relight::render::view::Frames;
-use haarshift_relight::render::{Camera, render_format, to_srgb8, write_render};
-use haarshift_relight::shade::dynamic_scene::{DynamicMethod, DynamicShader, glossy_material};
-use haarshift_relight::shade::{FrameSpec, Shader, ShaderSpec};
-use haarshift_relight::{Brdf, CameraSpec};
-use ndarray::{Array2, Array3};
+use haarshift_relight::dynamic::Change;
+use haarshift_relight::dynamic::request::{FrameLine, PlayOutcome, PlayReport, PlayRequest};
+use haarshift_relight::shade::dynamic_scene::DynamicMethod;
 
-use super::flags::{
-    CameraFlags, DynamicFlags, GlossyFlags, LightFlags, ShardFlags, brdf, bytes, ms, rotation,
-};
-use crate::commands::{choice, names, print, refuse_outputs};
+use super::flags::{CameraFlags, DynamicFlags, GlossyFlags, LightFlags, ShardFlags, brdf, bytes};
+use crate::commands::{choice, names, print};
 
 const HELP: &str = "\
 Every object of the scene file gets occlusion fields (Sun 2006): from sample points on 100
@@ -150,143 +136,67 @@ pub struct Args {
     pub bounces: usize,
 }
 
-/// `--shard`: this machine's share of the shapes' fields, built (or found) in --fields-dir.
-fn build_fields(args: &Args, shard: Shard) -> Result<()> {
-    let dir = args.dynamic.fields_dir.as_ref().ok_or_else(|| {
-        haarshift_relight::Error::from(haarshift::Error::InvalidParameter {
-            name: "shard",
-            reason: "--shard builds fields into a directory: add --fields-dir DIR".into(),
-        })
-    })?;
-    let options = args.dynamic.options()?;
-    let mut store = FieldStore::new(dir, args.force);
-    store.prepare()?;
-    let start = Instant::now();
-    let r = DynamicScene::build_fields(&args.scene, &options, &mut store, shard)?;
-    print(&format!(
-        "{}: shard {shard}: fields of {} shapes in {}: {} built ({} rays, {:.1} s), {} loaded \
-         ({:.2} s), {} on disk; {:.1} s in all\n",
-        args.scene.display(),
-        r.fields_written + r.fields_loaded,
-        dir.display(),
-        r.fields_written,
-        r.field_rays,
-        r.field_seconds,
-        r.fields_loaded,
-        r.field_load_seconds,
-        bytes(r.field_file_bytes),
-        ms(start) / 1e3,
-    ))
+/// The request these flags make: the library checks and runs it.
+fn request(args: &Args) -> Result<PlayRequest> {
+    Ok(PlayRequest {
+        output: args.output.clone(),
+        animate: args.animate.clone(),
+        vertices: args.vertices.clone(),
+        method: args.method,
+        keep_light: args.keep_light,
+        fields_dir: args.dynamic.fields_dir.clone(),
+        shard: args.shard.shard,
+        shards: args.shard.shards,
+        delay: args.delay,
+        brdf: args.brdf.clone(),
+        // The BRDF is the scene's first glossy material, set by the run.
+        glossy: args.glossy.options(&Default::default()),
+        fill_cache: args.glossy.fill_cache,
+        light: args.light.spec(),
+        light_rotation: args.light.light_rotation,
+        view: args.camera.view()?,
+        exposure: args.camera.exposure,
+        force: args.force,
+        bounces: args.bounces,
+        ..PlayRequest::new(args.scene.clone(), args.dynamic.options()?)
+    })
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if args.bounces > 0 {
-        return Err(haarshift_relight::Error::from(
-            haarshift::Error::InvalidParameter {
-                name: "bounces",
-                reason: "a dynamic scene's objects move, so their interreflections are not \
-                     precomputed: --bounces is for static scenes (relight precompute --bounces)"
-                    .into(),
-            },
-        ));
-    }
-    if let Some(shard) = args.shard.resolve()? {
-        return build_fields(&args, shard);
-    }
-    let output = args.output.as_deref().ok_or_else(|| {
-        haarshift_relight::Error::from(haarshift::Error::InvalidParameter {
-            name: "output",
-            reason: "-o IMAGE is needed to render (only --shard renders nothing)".into(),
-        })
-    })?;
-    let gif = output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
-    let path = args.animate.as_deref().map(MotionPath::load).transpose()?;
-    let frame_count = path.as_ref().map_or(1, MotionPath::frame_count);
-    if path.is_none() && gif {
-        return Err(haarshift_relight::Error::from(
-            haarshift::Error::InvalidParameter {
-                name: "output",
-                reason: "a .gif needs --animate PATH.json; one frame is .png or .exr".into(),
-            },
-        ));
-    }
-    let frame_paths: Vec<PathBuf> = match (&path, gif) {
-        (Some(_), false) => (0..frame_count)
-            .map(|k| numbered_path(output, k))
-            .collect::<Result<_>>()?,
-        _ => Vec::new(),
-    };
-    match frame_paths.first() {
-        Some(first) => render_format(first).map(|_| ())?,
-        None if !gif => render_format(output).map(|_| ())?,
-        None => {}
-    }
-    let mut outputs: Vec<&Path> = if frame_paths.is_empty() {
-        vec![output]
-    } else {
-        frame_paths.iter().map(PathBuf::as_path).collect()
-    };
-    outputs.extend(args.vertices.as_deref());
-    let mut inputs = vec![args.scene.as_path()];
-    inputs.extend(args.animate.as_deref());
-    inputs.extend(args.light.env.as_deref());
-    inputs.extend(
-        args.brdf
-            .as_deref()
-            .and_then(|b| b.strip_prefix("merl:"))
-            .map(Path::new),
-    );
-    refuse_outputs(&inputs, &outputs, args.force)?;
-    if args.light.light_rotation != LightRotation::Source && args.animate.is_some() {
-        return Err(haarshift_relight::Error::from(
-            haarshift::Error::InvalidParameter {
-                name: "light-rotation",
-                reason:
-                    "--light-rotation prefiltered applies to one frame; an animation's lighting \
-                     is rotated at the source's resolution"
-                        .into(),
-            },
-        ));
-    }
-    let view = args.camera.view()?;
-    let options = args.dynamic.options()?;
-    let mut store = args.dynamic.field_store(args.force)?;
-
-    let start = Instant::now();
-    let mut scene = DynamicScene::load_with(&args.scene, &options, store.as_mut())?;
-    let build_ms = ms(start);
-    let (env, angles) = args.light.load(scene.environment.as_ref())?;
-    let camera = view.camera(scene.camera.as_ref(), &scene.mesh())?;
-    if let Some(spec) = &args.brdf {
-        let brdf: Brdf = spec.parse()?;
-        for k in 0..scene.object_count() {
-            scene.set_brdf(k, brdf.clone())?;
+    match request(&args)?.run()? {
+        PlayOutcome::Fields {
+            shard,
+            dir,
+            report: r,
+            seconds,
+        } => print(&format!(
+            "{}: shard {shard}: fields of {} shapes in {}: {} built ({} rays, {:.1} s), {} loaded \
+             ({:.2} s), {} on disk; {:.1} s in all\n",
+            args.scene.display(),
+            r.fields_written + r.fields_loaded,
+            dir.display(),
+            r.fields_written,
+            r.field_rays,
+            r.field_seconds,
+            r.fields_loaded,
+            r.field_load_seconds,
+            bytes(r.field_file_bytes),
+            seconds,
+        )),
+        PlayOutcome::Frames(report) => {
+            let output = args.output.as_deref().unwrap_or(Path::new(""));
+            print(&frames_text(&args, output, &report))
         }
     }
-    // The glossy flags apply to the first glossy material (any other is rotated alike).
-    let glossy = args.glossy.options(&glossy_material(&scene)?);
-    ShaderSpec {
-        material: glossy.clone(),
-        fill_cache: args.glossy.fill_cache,
-        ..ShaderSpec::default()
-    }
-    .check()?;
-    scene.set_glossy(&glossy)?;
-    scene.set_eye(camera.position())?;
-    // The camera as resolved from the flags and the file: eye segments orbit its look-at point.
-    scene.camera = Some(CameraSpec {
-        position: camera.position(),
-        look_at: camera.look_at(),
-        fov: camera.fov(),
-    });
-    let param = scene.param();
-    let r = *scene.report();
-    let files = store.as_ref().map_or(String::new(), |s| {
+}
+
+/// What `relight scene` prints of a rendering: the build, a line a frame, and the images.
+fn frames_text(args: &Args, output: &Path, report: &PlayReport) -> String {
+    let r = &report.build;
+    let files = report.fields_dir.as_ref().map_or(String::new(), |dir| {
         format!(
             "; field files in {}: {} loaded in {:.2} s, {} written, {} on disk",
-            s.dir().display(),
+            dir.display(),
             r.fields_loaded,
             r.field_load_seconds,
             r.fields_written,
@@ -297,148 +207,61 @@ pub fn run(args: Args) -> Result<()> {
         "{}: {} objects ({} shapes), {} vertices, {} {}; fields: {} samples a shape, {} rays, \
          {:.1} s, {} stored{files}; own transport: {} rays, {:.1} s; built in {:.1} s\n",
         args.scene.display(),
-        scene.object_count(),
-        scene.shape_count(),
-        scene.vertex_count(),
-        param.kind(),
-        param.face_size(),
-        options.field.samples(),
+        report.objects,
+        report.shapes,
+        report.vertices,
+        report.param.kind(),
+        report.param.face_size(),
+        report.field_samples,
         r.field_rays,
         r.field_seconds,
         bytes(r.field_bytes as u64),
         r.transport_rays,
         r.transport_seconds,
-        build_ms / 1e3,
+        report.build_seconds,
     );
-    let keep_light = args.keep_light.map_or(Selection::All, Selection::Largest);
-    let mut all_radiance: Vec<Array2<f32>> = Vec::new();
-    let mut gif_frames = Vec::new();
-    // Each pixel's place in the environment, prepared with the first frame and kept while
-    // the camera stays.
-    let mut frames = Frames::new(view);
-    let mut draw = |scene: &DynamicScene,
-                    camera: &Camera,
-                    radiance: &Array2<f32>,
-                    turn: &haarshift::sphere::SphereRotation,
-                    index: usize,
-                    text: &mut String,
-                    what: String|
-     -> Result<()> {
-        let start = Instant::now();
-        let image = frames.draw(camera, &scene.mesh(), radiance.view(), &env, turn)?;
-        let raster_ms = ms(start);
-        match (frame_paths.get(index), gif) {
-            (Some(p), _) => write_render(&image, p, args.camera.exposure, args.force)?,
-            (None, true) => gif_frames.push(to_srgb8(&image, args.camera.exposure)?),
-            (None, false) => write_render(&image, output, args.camera.exposure, args.force)?,
-        }
-        *text += &format!("{what}, rasterisation {raster_ms:.1} ms\n");
-        if args.vertices.is_some() {
-            all_radiance.push(radiance.clone());
-        }
-        Ok(())
-    };
-    match &path {
-        None => {
-            let turn = rotation(angles)?;
-            let shading = DynamicShader::new(&scene, args.method, keep_light)
-                .with_light_rotation(args.light.light_rotation)
-                .shade(&FrameSpec {
-                    environment: &env,
-                    rotation: turn,
-                    eye: None,
-                })?;
-            let radiance = shading.radiance.to_f32();
-            let what = format!(
-                "{}: {} {:.1} ms",
-                output.display(),
-                shading.description,
-                shading.timing.total_seconds() * 1e3
-            );
-            draw(&scene, &camera, &radiance, &turn, 0, &mut text, what)?;
-        }
-        Some(path) => {
-            play(
-                &mut scene,
-                &env,
-                angles,
-                keep_light,
-                path,
-                |scene, radiance, turn, report| {
-                    let shading =
-                        args.method
-                            .played(scene, radiance, report.shade_seconds, &env, turn)?;
-                    let shade = format!(
-                        "{} {:.1} ms",
-                        shading.description,
-                        shading.timing.total_seconds() * 1e3
-                    );
-                    let radiance = shading.radiance.to_f32();
-                    let vertices = scene.vertex_count().max(1) as f64;
-                    let reformed = report.reformed.map_or(String::new(), |r| {
-                        format!(
-                            "re-formed in {:.1} ms ({:.0} coefficients a vertex, {}), ",
-                            r.seconds * 1e3,
-                            r.coefficients as f64 / vertices,
-                            bytes(r.bytes as u64)
-                        )
-                    });
-                    let state = match report.state.placement {
-                        Some(p) => format!(
-                            "{:?} at {:.3?} scale {:.3} yaw {:.2}",
-                            report.state.change,
-                            p.translate,
-                            p.scale,
-                            p.yaw_degrees(param)
-                        ),
-                        None if report.state.change == Change::View => {
-                            format!("eye at {:.3?}", scene.eye().unwrap_or(camera.position()))
-                        }
-                        None => format!("lighting yaw {:+.2}", report.state.light_yaw),
-                    };
-                    let what = format!("frame {}: {state}: {reformed}{shade}", report.index);
-                    let seen_from = match scene.eye() {
-                        Some(eye) if eye != camera.position() => {
-                            Camera::new(eye, camera.look_at(), camera.fov())?
-                        }
-                        _ => camera,
-                    };
-                    draw(
-                        scene,
-                        &seen_from,
-                        &radiance,
-                        turn,
-                        report.index,
-                        &mut text,
-                        what,
-                    )
-                },
-            )?;
-        }
+    for frame in &report.frames {
+        text += &format!(
+            "{}, rasterisation {:.1} ms\n",
+            frame_line(output, report, frame),
+            frame.raster_seconds * 1e3
+        );
     }
-    if gif {
-        write_gif(&gif_frames, output, args.delay, args.force)?;
-    }
-    if let Some(out) = &args.vertices {
-        match &path {
-            None => {
-                haarshift::io::write_npy(all_radiance[0].view(), SampleDepth::F32, out, args.force)?
-            }
-            Some(_) => {
-                let (v, _) = all_radiance[0].dim();
-                let mut stack = Array3::<f32>::zeros((all_radiance.len(), v, 3));
-                for (k, r) in all_radiance.iter().enumerate() {
-                    stack.index_axis_mut(ndarray::Axis(0), k).assign(r);
-                }
-                haarshift::io::write_npy(stack.view(), SampleDepth::F32, out, args.force)?;
-            }
-        }
-    }
-    text += &format!(
-        "{}: {frame_count} frame(s) of {} x {}\n",
+    text + &format!(
+        "{}: {} frame(s) of {} x {}\n",
         output.display(),
+        report.frames.len(),
         args.camera.width,
         args.camera.height
-    );
-    print(&text)
+    )
+}
+
+/// One frame's line, before its rasterisation time.
+fn frame_line(output: &Path, report: &PlayReport, frame: &FrameLine) -> String {
+    let shade = format!("{} {:.1} ms", frame.description, frame.shade_seconds * 1e3);
+    let Some(played) = &frame.played else {
+        return format!("{}: {shade}", output.display());
+    };
+    let r = &played.report;
+    let vertices = report.vertices.max(1) as f64;
+    let reformed = r.reformed.map_or(String::new(), |t| {
+        format!(
+            "re-formed in {:.1} ms ({:.0} coefficients a vertex, {}), ",
+            t.seconds * 1e3,
+            t.coefficients as f64 / vertices,
+            bytes(t.bytes as u64)
+        )
+    });
+    let state = match r.state.placement {
+        Some(p) => format!(
+            "{:?} at {:.3?} scale {:.3} yaw {:.2}",
+            r.state.change,
+            p.translate,
+            p.scale,
+            p.yaw_degrees(report.param)
+        ),
+        None if r.state.change == Change::View => format!("eye at {:.3?}", played.eye),
+        None => format!("lighting yaw {:+.2}", r.state.light_yaw),
+    };
+    format!("frame {}: {state}: {reformed}{shade}", r.index)
 }
