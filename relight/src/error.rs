@@ -141,7 +141,7 @@ pub enum SceneError {
         length: f64,
     },
     /// A coordinate is not finite or farther from the origin than
-    /// [`MAX_COORDINATE`](super::validate::MAX_COORDINATE) (what the BVH's f32 boxes can hold).
+    /// [`MAX_COORDINATE`](crate::scene::validate::MAX_COORDINATE) (what the BVH's f32 boxes can hold).
     #[error(
         "{what} has a coordinate {value:e}: coordinates must be finite and within 1e15 of the origin"
     )]

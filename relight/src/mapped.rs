@@ -1,20 +1,20 @@
 //! Flat arrays of numbers read in place from a memory-mapped file, or owned.
 //!
 //! A scene cache's transport can be larger than the memory a render should hold twice
-//! (issue 33's production asset: 3.4 GB). [`MappedFile`] maps the file read-only and
-//! [`Buffer`] is a slice of it seen as `[T]` without a copy: the pages are the file's, which
+//! (issue 33's production asset: 3.4 GB). `MappedFile` maps the file read-only and
+//! `Buffer` is a slice of it seen as `[T]` without a copy: the pages are the file's, which
 //! the kernel reads on first touch and may drop again under pressure, so they count in a
 //! process's file-backed resident memory and never in its anonymous memory. A buffer made
 //! from a `Vec` is the same type, so that code reading an array never asks where it lives.
 //!
 //! In place means the file's little-endian bytes are the machine's numbers: on a big-endian
 //! machine, or where an array is not aligned to its type, a reader copies instead
-//! ([`Buffer::mapped`] says `None`).
+//! (`Buffer::mapped` says `None`).
 //!
 //! **The one caveat of every memory map**: a file truncated by another program while it is
 //! mapped makes the next read of a lost page fault (`SIGBUS`). haarshift never truncates a
 //! file it may be reading: its outputs replace a file by renaming a complete new one over it
-//! ([`write_file_atomically`](super::write_file_atomically)), which leaves the mapped old file
+//! ([`write_file_atomically`](haarshift::io::write_file_atomically)), which leaves the mapped old file
 //! intact.
 
 use std::any::{Any, TypeId};

@@ -12,7 +12,7 @@
 //! when [`VisibilityOptions::sh_bands`](crate::VisibilityOptions::sh_bands) asks, and the
 //! [`TransportSet`](crate::TransportSet) carries it beside the Haar coefficients.
 //!
-//! Shading with it (Lambertian [`shade_sh`] and the glossy baseline [`PhongSh`]) is a stage of
+//! Shading with it (Lambertian `shade_sh` and the glossy baseline `PhongSh`) is a stage of
 //! its own: [`shade::sh`](super::shade::sh).
 
 use ndarray::{Array2, ArrayView2};

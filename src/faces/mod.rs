@@ -3,7 +3,7 @@
 //! six; texel directions, exact texel solid angles, [`SphereMap`]), [`cube`] (the cube map's
 //! faces, orientation and exact spherical-quadrilateral solid angles), [`convert`] (between
 //! parameterisations by solid-angle integration over each target texel), [`integrate`] (the
-//! integral over the sphere of a product of maps, on their Haar trees) and [`product`] (the
+//! integral over the sphere of a product of maps, on their Haar trees) and `product` (the
 //! product of maps as a map, through their Haar trees).
 //!
 //! Directions and conventions are [`crate::sphere::latlong`]'s.

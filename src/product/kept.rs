@@ -1,7 +1,7 @@
-//! The coefficients a [`HaarTree`] keeps, as a flat list, without building the tree: what a
+//! The coefficients a `HaarTree` keeps, as a flat list, without building the tree: what a
 //! precomputation stores of every vertex's transport.
 //!
-//! [`HaarTree::from_pixels`] followed by [`HaarTree::to_coefficients`] and a scan for the
+//! `HaarTree::from_pixels` followed by `HaarTree::to_coefficients` and a scan for the
 //! non-zero ones gives the same list (tested to the bit), but builds a quadtree node by node
 //! and walks every candidate coefficient to mark it kept; a vertex-major precomputation does
 //! that once per vertex, where it cost as much as casting a third of the vertex's rays. Here

@@ -40,7 +40,7 @@ use super::harmonics::SphericalHarmonics;
 use crate::{Error, Result};
 
 /// The most bands accepted (degrees 0 to 15): the transfer's limit
-/// ([`relight::sh_transfer::MAX_SH_BANDS`](crate::relight::sh_transfer::MAX_SH_BANDS)).
+/// (`haarshift_relight::sh_transfer::MAX_SH_BANDS`).
 pub const MAX_GAUNT_BANDS: usize = 16;
 
 /// One non-zero coefficient `G_ijk`.

@@ -36,7 +36,7 @@
 //!
 //! Conventions: [`latlong`] (map geometry, seam and poles), [`rotation`] (yaw, pitch, roll),
 //! [`coefficients`] (how a 2:1 map maps onto two square Haar pyramids side by side).
-//! Measurements: [`experiment`].
+//! Measurements: `experiment`.
 //!
 //! **Spherical harmonics.** [`harmonics`] (real spherical harmonics: evaluation, projection,
 //! reconstruction, the Lambertian convolution) and [`gaunt`] (their triple products). Maps

@@ -3,7 +3,7 @@
 //! Every connection gets a thread. Its request head is read (at most [`MAX_HEAD`] bytes within
 //! [`HEAD_WAIT`]) and parsed by `httparse`; `GET /` and `GET /viewer.js` are answered with the
 //! files embedded in the binary, `GET /ws` with the WebSocket handshake (RFC 6455, the accept
-//! key by `tungstenite`), after which the thread runs the page's [`Session`]. Every page gets
+//! key by `tungstenite`), after which the thread runs the page's `Session`. Every page gets
 //! a session of its own (its own shader, frames and reference) up to
 //! [`ViewerOptions::max_sessions`] at once; one more is told so in one line and closed.
 //!

@@ -6,7 +6,7 @@
 //! **Ground truth.** [`reference`](haarshift_relight::reference()) at `truth_resolution`
 //! (`N x 2N` texels, the lighting brought there by solid-angle means): one ray per texel,
 //! the BRDF evaluated analytically per texel in the vertex's own frame; no transform, no
-//! rotation, no truncation. The rays are cast once per scene ([`ReferenceVisibility`]) and
+//! rotation, no truncation. The rays are cast once per scene (`ReferenceVisibility`) and
 //! integrated under every lighting, material and view.
 //!
 //! **Axes**, each its own rows (`axis` in a record):
@@ -17,7 +17,7 @@
 //!   truth, `spatial_difference` is the thesis's own metric, the RMS of (this render - the
 //!   spatially rotated render) over the truth's RMS;
 //! * `coefficients` (Fig. 4.7): each rotated BRDF map cut to `C` coefficients per face,
-//!   either coarse to fine (`cutoff`: the detail levels whose faces hold `C`, [`GlossyOptions::brdf_levels`])
+//!   either coarse to fine (`cutoff`: the detail levels whose faces hold `C`, `GlossyOptions::brdf_levels`)
 //!   or the `faces x C` largest (`largest`, the scaling coefficients among them);
 //! * `resolution` (Vollick and Lessig's tables): lat-long and cube maps of several sizes times the
 //!   kept ratio `r` of the lighting's and each transport's detail coefficients (and each
@@ -28,7 +28,7 @@
 //!   larger budgets (to compare at equal time).
 //!
 //! Errors are per-vertex radiance differences, RMS and maximum over all vertices and channels
-//! ([`RelativeError`]), relative to the truth's RMS radiance; `image_rms` is the same over the
+//! (`RelativeError`), relative to the truth's RMS radiance; `image_rms` is the same over the
 //! pixels of the two renders (black background), relative to the truth image's RMS.
 //! Times are wall-clock seconds on all cores: `precompute_seconds` is the transport's ray
 //! casting and encoding plus the shader's preparation (truncating the transport, tables of

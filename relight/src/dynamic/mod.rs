@@ -28,8 +28,8 @@
 //!
 //! **Own transport and the ground.** An object's `T_v` is precomputed at its placement in the
 //! scene file, against itself and the ground plane (when the scene has one), exactly as
-//! [`vertex_major`] does for a static scene. Moving the object keeps it; turning it by `k`
-//! columns turns it ([`yaw_sparse`]). The ground's own transport sees the whole upper
+//! `vertex_major` does for a static scene. Moving the object keeps it; turning it by `k`
+//! columns turns it (`yaw_sparse`). The ground's own transport sees the whole upper
 //! hemisphere; objects shadow it through their planar fields. So one object alone at its
 //! file placement, without a ground plane, is shaded exactly as the static path shades it
 //! (tested); with a ground plane, moving an object keeps the ground's occlusion of it as it

@@ -129,7 +129,7 @@ impl DynamicScene {
 
     /// Every vertex's outgoing radiance `(V, 3)` by the n-function product integral of its
     /// own transport, the lighting and every other object's occlusion (issue 7's traversal),
-    /// with no reuse between frames: the oracle of [`JustInTimeTransfer`] and the cost it saves.
+    /// with no reuse between frames: the oracle of `JustInTimeTransfer` and the cost it saves.
     pub fn shade<T: Sample>(&self, lighting: &Lighting) -> Result<Array2<T>> {
         let depth = self.check_lighting(lighting)?;
         let param = self.param();

@@ -19,7 +19,7 @@
 //! the coefficient at Mallat index `i = (face, row, col)` row-major: face after face, each face
 //! a full-depth [`pyramid`](haarshift::transform::pyramid), exactly the index of a vertex's sparse
 //! transport ([`TransportSet`](crate::TransportSet)). So `<T_v, L>` is a sparse dot product
-//! of the vertex's stored `(index, value)` pairs with these rows ([`fn@crate::shade`]). The values
+//! of the vertex's stored `(index, value)` pairs with these rows (`fn@crate::shade`). The values
 //! are computed in f64; an f32 copy is kept for the fast path.
 //!
 //! **Channels.** A one-channel (grey) environment is broadcast to RGB; a map of any other

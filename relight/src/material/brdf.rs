@@ -17,7 +17,7 @@
 //!
 //! **Lambert** leaves the integral as a per-vertex constant (`1 / pi`, [`Brdf::evaluate`]) and
 //! what is left is the double product integral `<T_v, L>` of the transport and the lighting
-//! ([`fn@crate::shade`]): the triple product with `rho` constant, whose tree has only scaling
+//! (`fn@crate::shade`): the triple product with `rho` constant, whose tree has only scaling
 //! coefficients.
 //!
 //! **Glossy BRDFs** depend on `w_i` and on `w_o` (fixed per vertex by the camera). In the

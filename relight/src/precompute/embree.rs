@@ -7,7 +7,7 @@
 //! directions), Embree's 16-wide packet query `rtcOccluded16` traverses its wide BVHs with
 //! SIMD box tests per node and tests several triangles at once: the whole precomputation,
 //! rays and encoding, runs 1.9-3.3x faster on one thread than through haarshift's own
-//! binary-tree packets ([`packet`](super::packet)) on the scenes `benches/rays_results.md`
+//! binary-tree packets (`packet`) on the scenes `benches/rays_results.md`
 //! measures, the more the larger the scene. Our packets stay the portable path and the one
 //! whose every bit is specified; Embree is chosen where it loads and its device starts
 //! ([`RayTracer::best`](super::raycast::RayTracer::best)).
@@ -18,12 +18,12 @@
 //! 3's, laid out as its default build has them (`RTC_MAX_INSTANCE_LEVEL_COUNT` 1,
 //! `RTC_MIN_WIDTH` 0: Debian's and Intel's releases). Why it did not load is kept, for the
 //! one-line refusal of `--ray-tracer embree` and for `relight precompute --help`
-//! ([`unavailable`]).
+//! (`unavailable`).
 //!
-//! **What is bound** (one table, [`Api`]): device, geometry and scene creation, the any-hit
+//! **What is bound** (one table, `Api`): device, geometry and scene creation, the any-hit
 //! queries `rtcOccluded1`/`rtcOccluded16` and the closest-hit query `rtcIntersect16`.
 //! `rtcInitIntersectContext` is an inline function of Embree's header, not an exported
-//! symbol: [`IntersectContext::coherent`] writes what it writes, with the coherent flag.
+//! symbol: `IntersectContext::coherent` writes what it writes, with the coherent flag.
 //!
 //! **What differs from our packets.** Embree's triangle test is its own, so a ray through a
 //! shared edge may be answered otherwise than by our packets' Moller-Trumbore: every such ray

@@ -337,7 +337,7 @@ pub(crate) fn add_bounces(
 }
 
 /// Precomputes shard `shard` of `scene` ([`shard`] module: the vertices
-/// [`Shard::vertices`] names, traced against the whole scene) into a [`CacheShard`] that
+/// `Shard::vertices` names, traced against the whole scene) into a [`CacheShard`] that
 /// [`merge_shards`](crate::merge_shards) joins with the others. The vertex order only:
 /// the direction order renders every vertex into each shadow buffer at once, so it is refused.
 ///

@@ -15,7 +15,7 @@
 //! * [`RayTracer::Packets`]: our own, in every build. `obvhs` builds a binary BVH with PLOC,
 //!   reinsertion and leaf collapsing (small dependencies: `glam`, `bytemuck`, a radix sort; dual
 //!   MIT/Apache); it is laid out with both children's boxes in each node and traced by packets
-//!   of up to 16 rays that share their origin ([`packet`](super::packet)), which is every query
+//!   of up to 16 rays that share their origin (`packet`), which is every query
 //!   visibility makes. Its answers are those of testing every triangle with Moller-Trumbore in
 //!   f32, bit for bit. Of the pure-Rust crates `tools/bvh-compare` measured (its own workspace,
 //!   so the candidates never enter this crate's build: `cd tools/bvh-compare && cargo run
@@ -46,7 +46,7 @@
 //! triangles (the same three corners in any order) are kept once, since they answer every
 //! query alike and many copies of one box make PLOC's merging quadratic. The mesh itself is not
 //! touched: cleaning feeds only the BVH. Positions reach it within
-//! [`MAX_COORDINATE`](super::validate::MAX_COORDINATE) (a [`Mesh`] holds no other), so every
+//! `MAX_COORDINATE`](super::validate::MAX_COORDINATE) (a [`Mesh` holds no other), so every
 //! box it builds is finite. A scene smaller than [`SMALL_EXTENT`] is scaled up by a power of
 //! two, to an extent between 1 and 2, before the build (and rays with it): PLOC ranks merges by
 //! box surface areas in f32, which underflow to zero below about `1e-19`, and a scene whose

@@ -150,7 +150,7 @@ impl PrecomputeRequest {
     /// with [`ground_plane`](Self::ground_plane), [`max_vertices`](Self::max_vertices) and
     /// [`refine_light`](Self::refine_light) with [`refine`](Self::refine),
     /// [`bounce_from`](Self::bounce_from) and [`shards`](Self::shards) with
-    /// [`shard`](Self::shard)), a shard without an output, an output that is an input or
+    /// `shard`), a shard without an output, an output that is an input or
     /// exists (unless [`force`](Self::force), or a shard, whose complete output is skipped),
     /// a bad resolution, a transport too large, a tracer not available, bounces, a shard or a
     /// refinement the other options rule out. `--shard auto` is resolved from the process's

@@ -21,10 +21,10 @@
 //! file's pages, which the kernel reads when touched and may drop again. Resident anonymous
 //! memory is then near the mesh's, whatever the transport's size (`results/scale/`).
 //!
-//! A **shard** ([`CacheShard`], what `relight precompute --shard I/N` writes) is the same file
+//! A **shard** (`CacheShard`, what `relight precompute --shard I/N` writes) is the same file
 //! with [`CacheHeader::shard`] set: the whole mesh and albedo, and the transport (and transfer)
 //! of its vertex range only, `V` above read as the range's length in the transport's rows.
-//! [`SceneCache::read`] refuses a shard, and [`CacheShard::read`] a whole cache.
+//! [`SceneCache::read`] refuses a shard, and `CacheShard::read` a whole cache.
 //!
 //! Version 2 added the spherical-harmonic transfer and `sh_bands`, and the scene file's
 //! environment and camera in the header; version 3 the shard record; version 4 the aligned

@@ -132,7 +132,7 @@ pub const MESH_BYTES_PER_VERTEX: u64 = 640;
 /// before anything is built: [`MESH_BYTES_PER_VERTEX`] times the vertices, plus `per_vertex`
 /// (what the caller stores for each vertex, e.g. a precomputation's transport) times the
 /// vertices of the largest of `shards` equal shares, against `limit`; more is an
-/// [`Error::MemoryBudget`](crate::Error::MemoryBudget).
+/// [`Error::MemoryBudget`](haarshift::Error::MemoryBudget).
 ///
 /// ```
 /// use haarshift_relight::scene::validate::{DEFAULT_MEMORY_LIMIT, MemoryBudget};

@@ -77,7 +77,7 @@ pub struct OutputFlags {
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
     /// Directory for the reports: CSV, JSON, a Markdown table and PNG plots [default: the
-    /// scratch directory <temp>/haarshift/<experiment>, which every run overwrites]. In a
+    /// scratch directory `<temp>/haarshift/<experiment>`, which every run overwrites]. In a
     /// directory given here, reports of an earlier run stop the command before it computes
     /// anything, unless --force
     #[arg(long, value_name = "DIR")]

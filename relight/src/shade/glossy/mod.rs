@@ -9,7 +9,7 @@
 //! `--keep-visibility`, the lighting to `--keep-light`, the BRDF to `--keep-brdf` (the `K`
 //! largest orthonormal details by RGB magnitude plus each face's scaling coefficient, the rule
 //! of [`haarshift::product::selection`]), and all three to the detail levels `0..depth`. Vertices
-//! from `object_vertices` on (the ground plane) stay Lambertian ([`fn@crate::shade`]).
+//! from `object_vertices` on (the ground plane) stay Lambertian (`fn@crate::shade`).
 //!
 //! **How.** The triple product of the three truncated functions is the integral of the
 //! product of their reconstructions, `B_v = a_v sum_p t_v(p) L~(p) rho~_v(p)` over the texels
@@ -662,7 +662,7 @@ fn light_pixels<T: Sample>(lighting: &Lighting, depth: usize) -> Result<Vec<T>> 
     Ok(pixels.into_iter().map(T::from_f64).collect())
 }
 
-/// Glossy Haar shading behind [`Shader`](super::Shader): a [`GlossyShader`] made once (and
+/// Glossy Haar shading behind [`Shader`]: a [`GlossyShader`] made once (and
 /// with [`ShaderSpec::fill_cache`] its rotation cache filled), each frame's lighting encoded
 /// and shaded from the frame's eye; the rotation cache lasts from frame to frame.
 #[derive(Debug)]

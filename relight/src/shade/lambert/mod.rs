@@ -496,7 +496,7 @@ fn retruncate<T: Sample>(
     out.into_iter().unzip()
 }
 
-/// Lambertian Haar shading behind [`Shader`](super::Shader): the transport prepared once
+/// Lambertian Haar shading behind [`Shader`]: the transport prepared once
 /// ([`PreparedTransport`], or with [`Precision::Q16`](super::Precision::Q16) a
 /// [`QuantisedTransport`]), each frame's lighting encoded and dotted with it. With a bounced
 /// sum ([`ShadingInput::bounced`]) each of its sets is prepared alike and dotted too, channel

@@ -23,7 +23,7 @@ use haarshift::faces::Parameterization;
 /// The largest magnitude of a quantised coefficient.
 const STEPS: f32 = 32767.0;
 
-/// A [`PreparedTransport`]'s coefficients in 16 bits each; see the [module docs](self).
+/// A [`PreparedTransport`]'s coefficients in 16 bits each; see the module docs.
 ///
 /// ```
 /// use haarshift::product::Selection;

@@ -391,7 +391,7 @@ fn outgoing(mesh: &Mesh, v: usize, n: [f64; 3], e: [f64; 3]) -> [f64; 3] {
     if len > 0.0 { d.map(|x| x / len) } else { n }
 }
 
-/// The reference behind [`Shader`](super::Shader): each frame's environment downsampled to
+/// The reference behind [`Shader`]: each frame's environment downsampled to
 /// `N x 2N` ([`ShaderSpec::reference_resolution`], default the transport's face size) and
 /// integrated by [`reference()`] toward the frame's eye, against the scene's own bounding
 /// volume hierarchy (built once).

@@ -199,7 +199,7 @@ pub struct PhongSh {
 }
 
 impl PhongSh {
-    /// The baseline for `bands` bands (1 to [`MAX_SH_BANDS`]) and the energy-normalised Phong
+    /// The baseline for `bands` bands (1 to `MAX_SH_BANDS`) and the energy-normalised Phong
     /// lobe `(e + 2) / (2 pi) max(0, r . w)^e`, `e = exponent` from 0 to
     /// [`MAX_PHONG_EXPONENT`](haarshift::sphere::harmonics::MAX_PHONG_EXPONENT).
     pub fn new(bands: usize, exponent: f64) -> Result<Self> {
@@ -326,7 +326,7 @@ pub fn shade_sh_glossy(
     PhongSh::new(transfer.bands(), exponent)?.shade(transfer, albedo, lighting, mirror, glossy)
 }
 
-/// The spherical-harmonics baseline behind [`Shader`](super::Shader): the stored transfer
+/// The spherical-harmonics baseline behind [`Shader`]: the stored transfer
 /// (its first [`ShaderSpec::sh_bands`] bands), each frame's lighting projected onto the same
 /// bands and shaded by [`shade_sh`], or for Phong by [`PhongSh`] (made once) toward the
 /// frame's eye. Blinn-Phong and measured BRDFs are refused ([`non_zonal_material`]).
