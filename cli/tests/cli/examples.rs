@@ -3,29 +3,10 @@
 //! that run two of them are run as written by `readme`.)
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use haarshift::io::read_image;
 
-use crate::common::testdata;
-
-/// Runs the example program `name` with `args` from the repository's root; returns stdout.
-fn example(name: &str, args: &[&Path]) -> String {
-    let program = Path::new(env!("CARGO_BIN_EXE_haarshift"))
-        .parent()
-        .unwrap()
-        .join("examples")
-        .join(name);
-    assert!(program.exists(), "{}: not built", program.display());
-    let out = Command::new(&program)
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .unwrap();
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    assert!(out.status.success(), "{name}: {}", text(&out.stderr));
-    text(&out.stdout)
-}
+use crate::common::{run_example as example, testdata};
 
 #[test]
 fn rotate_image_turns_the_coins_a_quarter_with_both_kernels() {

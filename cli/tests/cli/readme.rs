@@ -12,11 +12,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const CARGO_RUN: &str = "cargo run --release -p haarshift-cli -- ";
+use crate::common::repository;
 
-fn repository() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+const CARGO_RUN: &str = "cargo run --release -p haarshift-cli -- ";
 
 /// The `haarshift` arguments of every `cargo run` line in the README's first code block.
 fn opening_commands(readme: &str) -> Vec<Vec<String>> {
@@ -316,11 +314,6 @@ fn every_readme_example_program_runs_as_written() {
         "the README runs {} example programs",
         runs.len()
     );
-    // `cargo test` builds every example's program beside the binaries.
-    let examples = Path::new(env!("CARGO_BIN_EXE_haarshift"))
-        .parent()
-        .unwrap()
-        .join("examples");
     let work = tempfile::tempdir().unwrap();
     for (name, args) in runs {
         let args: Vec<String> = args
@@ -330,18 +323,6 @@ fn every_readme_example_program_runs_as_written() {
                 None => a.clone(),
             })
             .collect();
-        let program = examples.join(&name);
-        assert!(program.exists(), "{}: not built", program.display());
-        let out = Command::new(&program)
-            .args(&args)
-            .current_dir(repository())
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "example {name} {}: {}",
-            args.join(" "),
-            String::from_utf8_lossy(&out.stderr)
-        );
+        crate::common::run_example(&name, &args);
     }
 }

@@ -14,6 +14,33 @@ pub fn testdata(name: &str) -> PathBuf {
         .join(name)
 }
 
+/// The repository's root.
+pub fn repository() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Runs the example program `name` (built by `cargo test` beside the binaries) with `args`
+/// from the repository's root and requires success; returns its standard output.
+pub fn run_example<S: AsRef<std::ffi::OsStr>>(name: &str, args: &[S]) -> String {
+    let program = Path::new(env!("CARGO_BIN_EXE_haarshift"))
+        .parent()
+        .unwrap()
+        .join("examples")
+        .join(name);
+    assert!(program.exists(), "{}: not built", program.display());
+    let out = Command::new(&program)
+        .args(args)
+        .current_dir(repository())
+        .output()
+        .expect("the example runs");
+    assert!(
+        out.status.success(),
+        "example {name}: {}",
+        text(&out.stderr)
+    );
+    text(&out.stdout)
+}
+
 /// Runs the `haarshift` binary with `args`, in `dir` when given.
 pub fn run_in(dir: Option<&Path>, args: &[&str]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_haarshift"));
