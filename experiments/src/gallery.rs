@@ -94,12 +94,8 @@ pub struct GalleryRow {
 
 /// The environment maps of `dir`: `*.hdr`, `*.exr` and `*.npy` files in name order.
 pub fn environment_maps(dir: &Path) -> Result<Vec<PathBuf>> {
-    let entries = std::fs::read_dir(dir).map_err(|source| {
-        crate::Error::from(haarshift::Error::Io {
-            path: dir.to_path_buf(),
-            source,
-        })
-    })?;
+    let entries =
+        std::fs::read_dir(dir).map_err(|source| crate::Error::io(dir.to_path_buf(), source))?;
     let mut maps: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
@@ -183,12 +179,8 @@ pub fn gallery(
     }
     .build(&input)?;
     let identity = SphereRotation::identity();
-    std::fs::create_dir_all(out_dir).map_err(|source| {
-        crate::Error::from(haarshift::Error::Io {
-            path: out_dir.to_path_buf(),
-            source,
-        })
-    })?;
+    std::fs::create_dir_all(out_dir)
+        .map_err(|source| crate::Error::io(out_dir.to_path_buf(), source))?;
     let mut rows = Vec::with_capacity(maps.len());
     for (path, env) in maps.iter().zip(&environments) {
         let frame = FrameSpec {

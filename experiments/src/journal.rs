@@ -173,12 +173,7 @@ impl Journal {
                 path: path.to_owned(),
             }));
         }
-        let io = |source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: path.to_owned(),
-                source,
-            })
-        };
+        let io = |source| crate::Error::io(path.to_owned(), source);
         let mut file = File::create(path).map_err(io)?;
         let header = Header {
             journal: FORMAT.into(),
@@ -227,12 +222,8 @@ impl Journal {
             return Ok(Vec::new());
         };
         let prefix = format!("{name}.shard-");
-        let listing = std::fs::read_dir(dir).map_err(|source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: dir.to_owned(),
-                source,
-            })
-        })?;
+        let listing =
+            std::fs::read_dir(dir).map_err(|source| crate::Error::io(dir.to_owned(), source))?;
         let mut found: Vec<PathBuf> = listing
             .filter_map(|e| e.ok())
             .filter(|e| {
@@ -251,12 +242,7 @@ impl Journal {
 
     /// Reopens one journal file: [`Journal::resume`] without the shards.
     fn reopen(path: &Path, options: &str) -> Result<Self> {
-        let io = |source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: path.to_owned(),
-                source,
-            })
-        };
+        let io = |source| crate::Error::io(path.to_owned(), source);
         let text = std::fs::read(path).map_err(io)?;
         // Only whole lines count: a kill can leave the last one unfinished.
         let complete = text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
@@ -313,12 +299,7 @@ impl Journal {
             };
             let mut line = serde_json::to_string(&entry).map_err(|e| Self::bad(path, e))?;
             line.push('\n');
-            let io = |source| {
-                crate::Error::from(haarshift::Error::Io {
-                    path: path.clone(),
-                    source,
-                })
-            };
+            let io = |source| crate::Error::io(path.clone(), source);
             file.write_all(line.as_bytes()).map_err(io)?;
             file.sync_data().map_err(io)?;
         }
@@ -353,12 +334,8 @@ impl Journal {
     pub fn fingerprint(inputs: &[PathBuf]) -> Result<String> {
         let mut out = Vec::new();
         for path in inputs {
-            let bytes = std::fs::read(path).map_err(|source| {
-                crate::Error::from(haarshift::Error::Io {
-                    path: path.clone(),
-                    source,
-                })
-            })?;
+            let bytes =
+                std::fs::read(path).map_err(|source| crate::Error::io(path.clone(), source))?;
             out.push(format!(
                 "{} ({} bytes, CRC-32 {:08x})",
                 path.display(),
@@ -410,10 +387,7 @@ impl Journal {
         for file in self.sidecars.iter().chain(&self.absorbed).chain([&path]) {
             match std::fs::remove_file(file) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(crate::Error::from(haarshift::Error::Io {
-                        path: file.clone(),
-                        source: e,
-                    }));
+                    return Err(crate::Error::io(file.clone(), e));
                 }
                 _ => {}
             }

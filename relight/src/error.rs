@@ -84,6 +84,16 @@ impl Error {
         haarshift::Error::parameter(name, reason).into()
     }
 
+    /// Shorthand for the core's [`haarshift::Error::Io`]: `source` met reading or writing
+    /// `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        haarshift::Error::Io {
+            path: path.into(),
+            source,
+        }
+        .into()
+    }
+
     /// Shorthand for the core's [`haarshift::Error::InvalidShape`].
     pub fn shape(shape: &[usize], reason: impl Into<String>) -> Self {
         haarshift::Error::shape(shape, reason).into()

@@ -35,12 +35,7 @@ pub(crate) struct MappedFile(Arc<Mmap>);
 impl MappedFile {
     /// Maps `path`; an unreadable file is an [`Error::Io`] naming it.
     pub fn open(path: &Path) -> Result<Self> {
-        let io = |source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-        };
+        let io = |source| crate::Error::io(path.to_path_buf(), source);
         let file = std::fs::File::open(path).map_err(io)?;
         // SAFETY: the map is read-only and haarshift never truncates or rewrites a file in
         // place (module docs); another program doing so is the caveat every memory map has.

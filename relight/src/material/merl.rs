@@ -269,12 +269,7 @@ impl MerlBrdf {
 
     /// Reads a MERL file ([module docs](self)); every error names `path`.
     pub fn read(path: &Path) -> Result<MerlBrdf> {
-        let io = |source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-        };
+        let io = |source| crate::Error::io(path.to_path_buf(), source);
         let bad = |source| Error::Merl {
             path: path.to_path_buf(),
             source,

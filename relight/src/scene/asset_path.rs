@@ -92,12 +92,7 @@ pub(crate) fn resolve(part: &str, uri: &str, dir: &Path) -> Result<AssetSource> 
 /// when they exceed `limit` bytes.
 pub(crate) fn read_limited(path: &Path, length: Option<u64>, limit: u64) -> Result<Vec<u8>> {
     use std::io::Read;
-    let io = |source| {
-        crate::Error::from(haarshift::Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-    };
+    let io = |source| crate::Error::io(path.to_path_buf(), source);
     let file = std::fs::File::open(path).map_err(io)?;
     let size = length.unwrap_or(file.metadata().map_err(io)?.len());
     if size > limit {

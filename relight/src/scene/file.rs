@@ -302,12 +302,8 @@ pub struct SceneFile {
 /// Reads a JSON file of the scene family (scene files, motion paths) into `T`; a bad file is
 /// a [`SceneError::SceneFile`] naming it.
 pub(crate) fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = std::fs::read_to_string(path).map_err(|source| {
-        crate::Error::from(haarshift::Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-    })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| crate::Error::io(path.to_path_buf(), source))?;
     serde_json::from_str(&text)
         .map_err(|e| Error::from(SceneError::SceneFile(e.to_string())).in_file(path))
 }

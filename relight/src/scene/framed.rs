@@ -154,12 +154,7 @@ impl Format {
             w.write_all(&checksum.to_le_bytes())?;
             Ok(len)
         };
-        let len = write().map_err(|source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-        })?;
+        let len = write().map_err(|source| crate::Error::io(path.to_path_buf(), source))?;
         file.commit()?;
         Ok((PREFIX + len) as u64)
     }

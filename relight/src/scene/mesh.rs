@@ -392,12 +392,8 @@ pub(crate) fn corrupt(reason: impl std::fmt::Display) -> Error {
 pub(crate) fn read_ply(path: &Path) -> Result<MeshAsset> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let file = std::fs::File::open(path).map_err(|source| {
-        crate::Error::from(haarshift::Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-    })?;
+    let file =
+        std::fs::File::open(path).map_err(|source| crate::Error::io(path.to_path_buf(), source))?;
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut std::io::BufReader::new(file))
         .map_err(corrupt)?;

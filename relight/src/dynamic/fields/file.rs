@@ -243,12 +243,8 @@ impl OcclusionField {
     /// assert!(OcclusionField::read(&path).unwrap_err().to_string().contains("damaged"));
     /// ```
     pub fn read(path: &Path) -> Result<(Self, FieldHeader)> {
-        let bytes = std::fs::read(path).map_err(|source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-        })?;
+        let bytes =
+            std::fs::read(path).map_err(|source| crate::Error::io(path.to_path_buf(), source))?;
         Self::parse(&bytes).map_err(|e| e.in_file(path))
     }
 
@@ -439,12 +435,7 @@ impl FieldStore {
     /// assert!(FieldStore::new(&file, false).prepare().is_err());
     /// ```
     pub fn prepare(&self) -> Result<()> {
-        let io = |source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: self.dir.clone(),
-                source,
-            })
-        };
+        let io = |source| crate::Error::io(self.dir.clone(), source);
         std::fs::create_dir_all(&self.dir).map_err(io)?;
         tempfile::tempfile_in(&self.dir).map_err(io)?;
         Ok(())

@@ -52,12 +52,8 @@ pub struct BakedGltf {
 impl BakedGltf {
     /// Reads `path` (`.glb` or `.gltf`, by its first bytes).
     pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).map_err(|source| {
-            crate::Error::from(haarshift::Error::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-        })?;
+        let bytes =
+            std::fs::read(path).map_err(|source| crate::Error::io(path.to_path_buf(), source))?;
         Self::from_bytes(&bytes).map_err(|reason| {
             crate::Error::from(haarshift::Error::Format {
                 path: path.to_path_buf(),
