@@ -343,7 +343,8 @@ impl SceneBvh {
     /// SceneBvh::new(&roofs).closest_hits_from([0.0; 3], &[[0.0, 1.0, 0.0], [0.0, -1.0, 0.0]],
     ///                                         f32::INFINITY, &mut hits);
     /// let hit = hits[0].unwrap();
-    /// assert_eq!((hit.triangle, hit.t), (1, 1.0));
+    /// // Embree's t is within an ulp or so of 1, depending on the CPU's instruction set.
+    /// assert!(hit.triangle == 1 && (hit.t - 1.0).abs() < 1e-6);
     /// assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.5).abs() < 1e-6);
     /// assert_eq!(hits[1], None);
     /// ```
