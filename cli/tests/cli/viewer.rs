@@ -595,8 +595,9 @@ fn bad_requests_are_refused_in_one_line_and_the_viewer_keeps_serving() {
     let forbidden = |origin| match Client::connect(&view.url, origin) {
         Err(tungstenite::Error::Http(response)) => {
             assert_eq!(response.status(), 403, "{origin:?}");
-            // The reason, when it came with the status line's packet.
-            if let Some(body) = response.body() {
+            // The reason, when it came with the status line's packet (an empty body when it
+            // did not: the client stops reading at the end of the headers).
+            if let Some(body) = response.body().as_ref().filter(|b| !b.is_empty()) {
                 let body = String::from_utf8_lossy(body);
                 assert_eq!(body, "a page of another origin, or none\n", "{origin:?}");
             }
