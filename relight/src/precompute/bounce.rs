@@ -13,9 +13,13 @@
 //! Sloan, Kautz and Snyder (2002, section 5) gather their interreflected transfer. The cosine
 //! and the solid angle are those of the texel's centre, as in visibility. `interp_hit`
 //! interpolates the hit triangle's three vertices' transport barycentrically (the [`Hit`]'s
-//! `(1 - u - v, u, v)`), and `rho_hit` their RGB albedo the same way. A ray whose hit
-//! triangle's winding normal `(p1 - p0) x (p2 - p0)` points along it (`>= 0`: a back face)
-//! contributes zero, and so does a jittered sub-ray below the horizon (it is not cast).
+//! `(1 - u - v, u, v)`), and `rho_hit` their RGB albedo the same way. A ray contributes zero
+//! when the hit's **shading normal** (its triangle's three vertex normals interpolated by the
+//! same weights) does not face back along it (`n_s . u >= 0`), whatever the triangle's
+//! winding: a one-sided diffuse surface reflects only on its shading normal's side, as Mitsuba
+//! 3's `diffuse` and pbrt-v4's `DiffuseBxDF` do (both evaluate the BSDF in the shading frame;
+//! the winding decides nothing). A jittered sub-ray below the horizon contributes zero too (it
+//! is not cast). Rays start where [`origin`](super::origin) says, off creases and contact.
 //! [`SceneBvh`] holds one triangle of each set of duplicates (the same three corners in any
 //! order) and none of zero area, and a hit names the mesh triangle it stands for: of a pair of
 //! opposite-facing duplicates (a two-sided sheet) the first in the mesh's order answers, so
@@ -78,7 +82,7 @@ use crate::precompute::raycast::{Hit, SceneBvh};
 use crate::precompute::transport_set::Encoder;
 use crate::precompute::transport_set::{Encoded, TransportSet};
 use crate::precompute::visibility::{PrecomputeReport, VisibilityOptions, texel_directions};
-use crate::scene::mesh::{cross, dot, sub};
+use crate::scene::mesh::dot;
 use crate::sh_transfer::ShTransfer;
 use crate::{Error, Result};
 use haarshift::faces::integrate::layout;
@@ -493,19 +497,13 @@ impl Caster for HitFolding<'_> {
     ) {
         let hits = &mut folder.hits[..directions.len()];
         (self.bvh).closest_hits_from(origin, directions, f32::INFINITY, hits);
-        let (p, triangles) = (self.mesh.positions(), self.mesh.triangles());
+        let triangles = self.mesh.triangles();
         for (k, hit) in hits.iter().enumerate() {
             blocked[k] = hit.is_some();
             let Some(hit) = hit else { continue };
             let corners = triangles[hit.triangle];
-            let at = |c: u32| {
-                let r = p.row(c as usize);
-                [r[0], r[1], r[2]]
-            };
-            let [a, b, c] = corners.map(at);
-            let winding = cross(sub(b, a), sub(c, a));
-            if dot(winding, directions[k].map(f64::from)) >= 0.0 {
-                continue; // the back of the triangle
+            if facing_normal(self.mesh, hit, directions[k].map(f64::from)).is_none() {
+                continue; // the far side of the hit's shading normal
             }
             let (u, v) = (f64::from(hit.u), f64::from(hit.v));
             let beta = [1.0 - u - v, u, v];
@@ -527,6 +525,23 @@ impl Caster for HitFolding<'_> {
     fn finish(&self, folder: &mut Folder, _: [f64; 3], _: &[u32]) -> Result<Self::Row> {
         Ok(folder.weights.take())
     }
+}
+
+/// The shading normal at `hit` (its triangle's vertex normals interpolated by the hit's
+/// barycentric weights, not normalised) when it faces back along the ray's direction `d`
+/// (`n_s . d < 0`), and `None` otherwise: the one-sided rule by which a hit sends light back
+/// (see the [module docs](self)).
+pub(crate) fn facing_normal(mesh: &Mesh, hit: &Hit, d: [f64; 3]) -> Option<[f64; 3]> {
+    let corners = mesh.triangles()[hit.triangle];
+    let normals = mesh.normals();
+    let (u, v) = (f64::from(hit.u), f64::from(hit.v));
+    let beta = [1.0 - u - v, u, v];
+    let n: [f64; 3] = std::array::from_fn(|k| {
+        (0..3)
+            .map(|i| beta[i] * normals[[corners[i] as usize, k]])
+            .sum()
+    });
+    (dot(n, d) < 0.0).then_some(n)
 }
 
 /// One thread's closest hits of a batch and the weights of the vertex being cast.

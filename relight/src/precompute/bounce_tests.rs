@@ -3,8 +3,8 @@ use std::f64::consts::PI;
 use ndarray::{Array2, array};
 
 use super::*;
-use crate::precompute::cast::{RaySet, f32x3, origin_and_normal};
-use crate::ray_offset;
+use crate::precompute::cast::{RaySet, f32x3};
+use crate::precompute::origin::RayOrigins;
 use crate::scene::shapes::{cube_sphere, grid, merge};
 use crate::{Generator, vertex_major};
 use haarshift::faces::{ParamKind, Parameterization};
@@ -40,34 +40,30 @@ fn oracle_gather(
     x: &[Vec<Vec<f64>>],
 ) -> Vec<Vec<Vec<f64>>> {
     let bvh = SceneBvh::new(mesh);
-    let eps = ray_offset(mesh);
-    let p = mesh.positions();
+    let origins = RayOrigins::new(mesh);
+    let normals = mesh.normals();
     let len = x[0][0].len();
     (0..mesh.vertex_count())
         .map(|v| {
-            let (o, _) = origin_and_normal(mesh, v, eps);
+            let (o, _) = origins.origin_and_normal(v);
             let mut out = vec![vec![0.0; len]; 3];
             for (d, w) in rays(v) {
                 let mut hit = [None];
                 bvh.closest_hits_from(f32x3(o), &[d], f32::INFINITY, &mut hit);
                 let Some(h) = hit[0] else { continue };
                 let tri = mesh.triangles()[h.triangle].map(|i| i as usize);
-                let q = |i: usize| [p[[i, 0]], p[[i, 1]], p[[i, 2]]];
-                let (a, b, c) = (q(tri[0]), q(tri[1]), q(tri[2]));
-                let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-                let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-                let ng = [
-                    e1[1] * e2[2] - e1[2] * e2[1],
-                    e1[2] * e2[0] - e1[0] * e2[2],
-                    e1[0] * e2[1] - e1[1] * e2[0],
-                ];
-                let along =
-                    ng[0] * f64::from(d[0]) + ng[1] * f64::from(d[1]) + ng[2] * f64::from(d[2]);
+                let (u, vv) = (f64::from(h.u), f64::from(h.v));
+                let beta = [1.0 - u - vv, u, vv];
+                // The one-sided rule: the interpolated shading normal faces back along the ray.
+                let along: f64 = (0..3)
+                    .map(|axis| {
+                        let n: f64 = (0..3).map(|k| beta[k] * normals[[tri[k], axis]]).sum();
+                        n * f64::from(d[axis])
+                    })
+                    .sum();
                 if along >= 0.0 {
                     continue;
                 }
-                let (u, vv) = (f64::from(h.u), f64::from(h.v));
-                let beta = [1.0 - u - vv, u, vv];
                 for ch in 0..3 {
                     let rho: f64 = (0..3)
                         .map(|k| beta[k] * f64::from(albedo[[tri[k], ch]]))
@@ -294,10 +290,16 @@ fn each_bounce_gathers_the_truncated_lower_sum() {
     assert!(untruncated_differs, "the truncation must matter here");
 }
 
-/// One floor triangle at `y = 0`, normals up, and a second at `y = at`: wound to face down
-/// (towards the floor) when `facing_floor`, else up.
-fn floor_and_sheet(at: f64, facing_floor: bool) -> Mesh {
-    let sheet = if facing_floor { [3, 5, 4] } else { [3, 4, 5] };
+/// One floor triangle at `y = 0`, normals up, and a second at `y = at` whose shading normals
+/// face down (towards the floor) when `facing_floor`, else up; `wound` the same way when
+/// `wound_alike`, the other way otherwise.
+fn floor_and_sheet(at: f64, facing_floor: bool, wound_alike: bool) -> Mesh {
+    let sheet = if facing_floor == wound_alike {
+        [3, 5, 4]
+    } else {
+        [3, 4, 5]
+    };
+    let sheet_normal = if facing_floor { -1.0 } else { 1.0 };
     Mesh::new(
         array![
             [-0.1, 0.0, 0.1],
@@ -308,8 +310,10 @@ fn floor_and_sheet(at: f64, facing_floor: bool) -> Mesh {
             [0.0, at, -5.0]
         ],
         vec![[0, 1, 2], sheet],
-        Some(Array2::from_shape_fn((6, 3), |(_, k)| {
-            if k == 1 { 1.0 } else { 0.0 }
+        Some(Array2::from_shape_fn((6, 3), |(v, k)| match (v, k) {
+            (0..3, 1) => 1.0,
+            (_, 1) => sheet_normal,
+            _ => 0.0,
         })),
     )
     .unwrap()
@@ -327,12 +331,15 @@ fn floor_gain(mesh: &Mesh, samples: usize) -> usize {
 }
 
 #[test]
-fn back_face_hits_and_rays_below_the_horizon_gather_nothing() {
-    // A sheet above the floor lit from above: its underside is its front only when wound so.
-    assert!(floor_gain(&floor_and_sheet(1.0, true), 1) > 0);
-    assert_eq!(floor_gain(&floor_and_sheet(1.0, false), 1), 0);
+fn hits_behind_their_shading_normal_and_rays_below_the_horizon_gather_nothing() {
+    // A sheet above the floor lit from above: its underside sends light down only when its
+    // shading normals face down, whatever its winding (Mitsuba's and pbrt's one-sided rule).
+    for wound_alike in [true, false] {
+        assert!(floor_gain(&floor_and_sheet(1.0, true, wound_alike), 1) > 0);
+        assert_eq!(floor_gain(&floor_and_sheet(1.0, false, wound_alike), 1), 0);
+    }
     // A sheet below the floor facing up: only rays below the floor's horizon could reach it.
-    assert_eq!(floor_gain(&floor_and_sheet(-0.5, false), 3), 0);
+    assert_eq!(floor_gain(&floor_and_sheet(-0.5, false, true), 3), 0);
 }
 
 #[test]
@@ -392,11 +399,14 @@ fn a_lone_sphere_gains_less_than_one_percent() {
     );
 }
 
-/// The inside of a closed surface: a cube sphere's triangles wound and its normals turned
-/// inwards. (An inward box loses light at its edges: a vertex on an edge lies in the
-/// neighbouring face's plane, so its rays towards that face start on it and pass.)
+/// The inside of a closed surface: a box's triangles wound and its flat normals turned
+/// inwards. Its edge vertices are contact vertices ([`RayOrigins`]): each lifted point lies in
+/// the neighbouring face's plane, and only their move into their own faces keeps their rays
+/// towards that face from passing through it. (A coarse sphere would not do: its facets meet
+/// near a vertex's tangent plane, where the smooth shading normal of the facet hit faces away
+/// from the ray, and the one-sided rule drops that light.)
 fn inward_box() -> Mesh {
-    let outward = cube_sphere([0.0; 3], 1.0, 3).unwrap();
+    let outward = crate::scene::shapes::cuboid([-1.0; 3], [1.0; 3], 3).unwrap();
     let triangles = outward
         .triangles()
         .iter()
@@ -414,13 +424,15 @@ fn inward_box() -> Mesh {
 /// vertex given the transport of seeing the whole sphere as `T0` (nothing reaches inside).
 fn box_sums(rho: f32) -> Vec<f64> {
     let mesh = inward_box();
-    let options = VisibilityOptions::new(cube(4));
+    // (Fine enough that the texel centres' quadrature of the cosine about a face's normal,
+    // the same at every vertex of a box, is within a few percent of pi.)
+    let options = VisibilityOptions::new(cube(8));
     let bvh = SceneBvh::new(&mesh);
     let v = mesh.vertex_count();
     let mut direct = TransportSet::new(options.param, Selection::All);
     for _ in 0..v {
         direct
-            .push(ndarray::Array3::ones((6, 4, 4)).view())
+            .push(ndarray::Array3::ones((6, 8, 8)).view())
             .unwrap();
     }
     let albedo = Array2::from_elem((v, 3), rho);

@@ -22,9 +22,10 @@ use rayon::prelude::*;
 
 use crate::Mesh;
 use crate::Result;
+use crate::precompute::origin::RayOrigins;
 use crate::precompute::raycast::Occlusion;
 use crate::precompute::transport_set::{Encoded, Encoder};
-use crate::precompute::visibility::{VisibilityOptions, ray_offset, texel_directions};
+use crate::precompute::visibility::{VisibilityOptions, texel_directions};
 use crate::scene::mesh::dot;
 use haarshift::faces::Parameterization;
 use haarshift::progress::Task;
@@ -42,13 +43,6 @@ pub(crate) fn jitter(seed: u64, vertex: usize, texel: usize, sample: usize) -> (
     let h = mix(seed ^ mix((vertex as u64) << 32 ^ texel as u64) ^ mix(sample as u64 + 1));
     let unit = |x: u64| (x >> 11) as f64 / (1u64 << 53) as f64;
     (unit(h), unit(mix(h)))
-}
-
-/// The ray origin of vertex `v` and its normal.
-pub(crate) fn origin_and_normal(mesh: &Mesh, v: usize, eps: f64) -> ([f64; 3], [f64; 3]) {
-    let (p, n) = (mesh.positions(), mesh.normals());
-    let n = [n[[v, 0]], n[[v, 1]], n[[v, 2]]];
-    (std::array::from_fn(|k| p[[v, k]] + eps * n[k]), n)
 }
 
 #[inline]
@@ -277,7 +271,7 @@ pub(crate) fn cast_vertices<C: Caster>(
     label: &str,
 ) -> Result<(Vec<C::Row>, u64)> {
     let rays = RaySet::new(options);
-    let eps = ray_offset(mesh);
+    let origins = RayOrigins::new(mesh);
     let texels = options.param.texels();
     let bar = Task::begin(options.progress, label, vertices.len());
     let rows: Vec<Result<(C::Row, u64)>> = vertices
@@ -285,7 +279,7 @@ pub(crate) fn cast_vertices<C: Caster>(
         .map_init(
             || (Batch::new(texels), caster.thread()),
             |(batch, thread), v| {
-                let (origin, n) = origin_and_normal(mesh, v, eps);
+                let (origin, n) = origins.origin_and_normal(v);
                 batch.start(f32x3(origin), n);
                 rays.for_each(v, n, |d, t| batch.push(caster, thread, d, t));
                 batch.flush(caster, thread);

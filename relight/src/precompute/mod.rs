@@ -6,6 +6,12 @@
 //! [`PrecomputeOptions::bounces`] `B > 0` the direct transport is followed by the bounced sum
 //! of `B` bounces of interreflected light ([`bounce`]), gathered over the same rays.
 //!
+//! **The contract of a ray**, which every caster here, `relight reference` and the path
+//! tracer share: a vertex's rays start at the origin [`origin`] defines (one ray offset off
+//! its surface, and off any other surface it touches: creases and contact); a ray is blocked
+//! by the closest triangle it meets at `0 <= t`, whichever tracer casts it
+//! ([`raycast`]); and a hit sends light back only on its shading normal's side ([`bounce`]).
+//!
 //! **Limits.** A precomputation holds one `(faces, S, S)` array of f32 per thread and, in the
 //! direction order, one bit per (vertex, direction); a transport of more than [`MAX_TEXELS`]
 //! texels (lat-long `2048 x 4096`, cube `6 x 1024^2` are inside) is refused before any work,
@@ -17,6 +23,7 @@ pub mod bounce;
 pub(crate) mod cast;
 pub(crate) mod combine;
 pub mod embree;
+pub mod origin;
 mod packet;
 pub mod raycast;
 pub mod refine;

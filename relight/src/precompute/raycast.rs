@@ -25,13 +25,12 @@
 //!
 //! The two answer alike except on rays through a triangle's edge, whose f32 answer is decided
 //! by rounding (`benches/compare_rays.py` works each such ray out in f64), and on rays that
-//! start in a triangle's plane, which meet it at `t = 0` to within rounding. The second is
-//! not rare where walls meet: a vertex on the inner corner of a box (`bunny_in_box.json`)
-//! starts its rays, offset along its own wall's normal, in the plane of the wall beside it.
-//! There Embree counts the hits (the vertex is black) and the packets do not (it sees out
-//! through the wall): 289 of that scene's 3,284 vertices, 15% of its radiance's RMS
-//! (`results/relight/bounces.md`). Neither is the light there; an origin moved off every
-//! surface near it, not only its own, would be.
+//! start in a triangle's plane, which meet it at `t = 0` to within rounding: Embree counts
+//! such a hit, and our packets count it or not as the rounding of `t` falls. No vertex's rays
+//! start there: a vertex on a crease or touching another surface (a floor vertex against a
+//! wall, whose lifted point lies in the wall's plane) has its origin moved into its own faces
+//! first ([`origin`](super::origin), which defines these *contact vertices*: 260 of
+//! `bunny_in_box.json`'s 3,284), so both tracers meet the wall at `t >= eps / 2` or so.
 //!
 //! **Closest hits.** [`SceneBvh::closest_hits_from`] finds, for each ray, the nearest
 //! triangle it meets ([`Hit`]: the mesh's triangle, the distance, the barycentric weights of
@@ -246,6 +245,54 @@ fn scale_for(lo: [f32; 3], hi: [f32; 3]) -> f32 {
     2f32.powi(up.min(room).clamp(0, 126))
 }
 
+/// What a BVH of a mesh is built from (see the [module docs](self)): its distinct triangles of
+/// non-zero area, in f32, scaled by `scale` (a power of two, 1 unless the scene is smaller
+/// than [`SMALL_EXTENT`]).
+pub(crate) struct CleanTriangles {
+    pub(crate) triangles: Vec<[[f32; 3]; 3]>,
+    /// `source[i]`: the mesh triangle `triangles[i]` stands for.
+    pub(crate) source: Vec<u32>,
+    pub(crate) scale: f32,
+}
+
+impl CleanTriangles {
+    pub(crate) fn of(mesh: &Mesh) -> Self {
+        let p = mesh.positions();
+        let f32_row = |i: usize| {
+            let r = p.row(i);
+            [r[0] as f32, r[1] as f32, r[2] as f32]
+        };
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for i in 0..mesh.vertex_count() {
+            let v = f32_row(i);
+            for k in 0..3 {
+                (lo[k], hi[k]) = (lo[k].min(v[k]), hi[k].max(v[k]));
+            }
+        }
+        let scale = scale_for(lo, hi);
+        let point = |i: u32| f32_row(i as usize).map(|x| x * scale);
+        let mut seen = HashSet::with_capacity(mesh.triangles().len());
+        let (triangles, source) = mesh
+            .triangles()
+            .iter()
+            .zip(0u32..)
+            .filter_map(|(t, index)| {
+                let corners = t.map(point);
+                let [a, b, c] = corners.map(|v| v.map(f64::from));
+                let mut key = corners.map(|v| v.map(f32::to_bits));
+                key.sort_unstable();
+                (cross(sub(b, a), sub(c, a)) != [0.0; 3] && seen.insert(key))
+                    .then_some((corners, index))
+            })
+            .unzip();
+        CleanTriangles {
+            triangles,
+            source,
+            scale,
+        }
+    }
+}
+
 impl SceneBvh {
     /// Builds the BVH of `mesh`'s distinct triangles of non-zero area in f32 (see the
     /// [module docs](self)), a scene smaller than [`SMALL_EXTENT`] scaled up first, with
@@ -271,35 +318,11 @@ impl SceneBvh {
     /// }
     /// ```
     pub fn with_tracer(mesh: &Mesh, tracer: RayTracer) -> Self {
-        let p = mesh.positions();
-        let f32_row = |i: usize| {
-            let r = p.row(i);
-            [r[0] as f32, r[1] as f32, r[2] as f32]
-        };
-        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for i in 0..mesh.vertex_count() {
-            let v = f32_row(i);
-            for k in 0..3 {
-                (lo[k], hi[k]) = (lo[k].min(v[k]), hi[k].max(v[k]));
-            }
-        }
-        let scale = scale_for(lo, hi);
-        let point = |i: u32| f32_row(i as usize).map(|x| x * scale);
-        let mut seen = HashSet::with_capacity(mesh.triangles().len());
-        let (triangles, source): (Vec<[[f32; 3]; 3]>, Vec<u32>) = mesh
-            .triangles()
-            .iter()
-            .zip(0u32..)
-            .filter_map(|(t, index)| {
-                let corners = t.map(point);
-                let [a, b, c] = corners.map(|v| v.map(f64::from));
-                let mut key = corners.map(|v| v.map(f32::to_bits));
-                key.sort_unstable();
-                (cross(sub(b, a), sub(c, a)) != [0.0; 3] && seen.insert(key))
-                    .then_some((corners, index))
-            })
-            .unzip();
-        drop(seen);
+        let CleanTriangles {
+            triangles,
+            source,
+            scale,
+        } = CleanTriangles::of(mesh);
         let built = (!triangles.is_empty()).then(|| build(&triangles, tracer));
         let kind = match &built {
             None if tracer.available() => tracer,

@@ -39,9 +39,8 @@ use ndarray::Array3;
 use rayon::prelude::*;
 
 use crate::Mesh;
-use crate::precompute::cast::{
-    Occluding, Visible, cast_vertices, origin_and_normal, working_bytes,
-};
+use crate::precompute::cast::{Occluding, Visible, cast_vertices, working_bytes};
+use crate::precompute::origin::RayOrigins;
 use crate::precompute::raycast::{Occlusion, RayTracer};
 use crate::precompute::shadowmap::ShadowMap;
 use crate::precompute::transport_set::{Encoded, Encoder, TransportSet};
@@ -274,11 +273,11 @@ pub fn direction_major(
     let start = Instant::now();
     let param = options.param;
     let directions = texel_directions(param);
-    let eps = ray_offset(mesh);
     let vertices = mesh.vertex_count();
     let words = vertices.div_ceil(64);
+    let origins = RayOrigins::new(mesh);
     let origins: Vec<([f64; 3], [f64; 3])> = (0..vertices)
-        .map(|v| origin_and_normal(mesh, v, eps))
+        .map(|v| origins.origin_and_normal(v))
         .collect();
     // One column of V bits per direction: bit v set when vertex v sees the direction.
     let columns: Vec<Vec<u64>> = directions

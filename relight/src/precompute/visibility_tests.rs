@@ -245,7 +245,7 @@ fn both_orders_agree_on_the_bunny_with_its_ground_plane() {
     let mesh = bunny_on_ground();
     let bvh = SceneBvh::new(&mesh);
     let param = latlong(8);
-    let eps = ray_offset(&mesh);
+    let origins = RayOrigins::new(&mesh);
     let size = 2048;
     let (mut pairs, mut differ, mut contact, mut unexplained) = (0usize, 0usize, 0usize, 0usize);
     let weights = param.solid_angles();
@@ -254,7 +254,7 @@ fn both_orders_agree_on_the_bunny_with_its_ground_plane() {
     for (t, w) in texel_directions(param).into_iter().enumerate() {
         let map = ShadowMap::render(&mesh, w, size);
         for v in 0..mesh.vertex_count() {
-            let (o, n) = origin_and_normal(&mesh, v, eps);
+            let (o, n) = origins.origin_and_normal(v);
             let cos = dot(n, w);
             if cos <= 0.0 {
                 continue;

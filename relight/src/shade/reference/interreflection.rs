@@ -14,9 +14,10 @@
 //!
 //! `interp_hit` and `rho_hit` the barycentric interpolation of the hit triangle's three
 //! corners' `U_b` and albedo (Sloan, Kautz and Snyder 2002's interreflected transfer, section
-//! 5, gathered at vertices as their PRT does). A hit on a triangle's back side (its winding
-//! normal `(p1 - p0) x (p2 - p0)` has `n . w_t >= 0` with the ray's direction) contributes
-//! zero, as does every ray that escapes (its light is bounce 0's). The BVH keeps one of
+//! 5, gathered at vertices as their PRT does). A hit on the far side of its shading normal (the
+//! hit triangle's vertex normals interpolated, `n_s . w_t >= 0`: the gather's one-sided rule,
+//! [`bounce`](crate::precompute::bounce)) contributes zero, as does every ray that escapes (its
+//! light is bounce 0's). Rays start at [`RayOrigins`]'s origins, as the precomputation's do. The BVH keeps one of
 //! repeated triangles and never returns one of zero area ([`raycast`](crate::precompute::raycast)),
 //! so a pair of opposite-facing duplicates answers as the first in the mesh's order: lit from
 //! that one's front, dark from its back.
@@ -37,9 +38,10 @@ use ndarray::{Array2, ArrayView2, Axis};
 use rayon::prelude::*;
 
 use super::{ReferenceOptions, ReferenceReport, ReferenceVisibility, lit_texels};
-use crate::precompute::cast::{f32x3, origin_and_normal};
-use crate::precompute::visibility::ray_offset;
-use crate::scene::mesh::{cross, dot, sub};
+use crate::precompute::bounce::facing_normal;
+use crate::precompute::cast::f32x3;
+use crate::precompute::origin::RayOrigins;
+use crate::scene::mesh::dot;
 use crate::{Brdf, Mesh, SceneBvh};
 use crate::{Error, Result};
 use haarshift::progress::Task;
@@ -104,16 +106,15 @@ impl Gather {
     ) -> Result<(Self, u64)> {
         let sky = LatLongMap::<f64>::from_fn(height, 1, |_, o| o[0] = 1.0)?;
         let texels = lit_texels(&sky)?;
-        let eps = ray_offset(mesh);
-        let (p, triangles) = (mesh.positions(), mesh.triangles());
-        let corner = |i: u32| [0, 1, 2].map(|k| p[[i as usize, k]]);
+        let origins = RayOrigins::new(mesh);
+        let triangles = mesh.triangles();
         let bar = Task::begin(progress, "reference bounces (rays)", mesh.vertex_count());
         let rows: Vec<(GatherRow, u64)> = (0..mesh.vertex_count())
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Vec::new(), Vec::new()),
                 |(rays, weights, hits), v| {
-                    let (origin, n) = origin_and_normal(mesh, v, eps);
+                    let (origin, n) = origins.origin_and_normal(v);
                     rays.clear();
                     weights.clear();
                     for t in &texels {
@@ -130,9 +131,8 @@ impl Gather {
                     for (hit, &(w, weight)) in hits.iter().zip(weights.iter()) {
                         let Some(hit) = hit else { continue };
                         let tri = triangles[hit.triangle];
-                        let [a, b, c] = tri.map(corner);
-                        if dot(cross(sub(b, a), sub(c, a)), w) >= 0.0 {
-                            continue; // the back side, or edge on
+                        if facing_normal(mesh, hit, w).is_none() {
+                            continue; // the far side of the shading normal, or edge on
                         }
                         let (u, s) = (f64::from(hit.u), f64::from(hit.v));
                         let bary = [1.0 - u - s, u, s];

@@ -4,6 +4,7 @@ use ndarray::Array2;
 
 use super::*;
 use crate::Generator;
+use crate::scene::mesh::{cross, sub};
 use crate::scene::shapes::{grid, merge};
 use crate::shade::reference::reference;
 use haarshift::metrics::rms;
@@ -58,7 +59,8 @@ fn mottled_albedo(v: usize) -> Array2<f32> {
 }
 
 /// The closest hit of the ray `o + t d` by testing every triangle in f64 (Moller and Trumbore
-/// 1997), as `(triangle, [w0, w1, w2], whether it is the front side)`.
+/// 1997), as `(triangle, [w0, w1, w2], whether it faces the ray)`: the hit's shading normal,
+/// its corners' normals interpolated, points against `d`.
 fn brute_hit(mesh: &Mesh, o: [f64; 3], d: [f64; 3]) -> Option<(usize, [f64; 3], bool)> {
     let p = mesh.positions();
     let at = |i: u32| [p[[i as usize, 0]], p[[i as usize, 1]], p[[i as usize, 2]]];
@@ -80,8 +82,13 @@ fn brute_hit(mesh: &Mesh, o: [f64; 3], d: [f64; 3]) -> Option<(usize, [f64; 3], 
             continue;
         }
         if best.is_none_or(|(bt, ..)| t < bt) {
-            let front = dot(cross(e1, e2), d) < 0.0;
-            best = Some((t, k, [1.0 - u - v, u, v], front));
+            let w = [1.0 - u - v, u, v];
+            let normal: [f64; 3] = std::array::from_fn(|axis| {
+                (0..3)
+                    .map(|m| w[m] * mesh.normals()[[tri[m] as usize, axis]])
+                    .sum()
+            });
+            best = Some((t, k, w, dot(normal, d) < 0.0));
         }
     }
     best.map(|(_, k, w, front)| (k, w, front))

@@ -36,9 +36,9 @@ use super::{
     FrameSpec, Preparation, Radiance, Shader, ShaderSpec, Shading, ShadingInput, Timing, seconds,
 };
 use crate::SceneBvh;
-use crate::precompute::cast::{f32x3, origin_and_normal};
+use crate::precompute::cast::f32x3;
+use crate::precompute::origin::RayOrigins;
 use crate::precompute::raycast::Occlusion;
-use crate::precompute::visibility::ray_offset;
 use crate::scene::mesh::dot;
 use crate::{Brdf, Mesh};
 use crate::{Error, Result};
@@ -207,7 +207,7 @@ fn quadrature(
     let objects = options.object_vertices.unwrap_or(vertices);
     let start = Instant::now();
     let texels = lit_texels(lighting)?;
-    let eps = ray_offset(mesh);
+    let origins = RayOrigins::new(mesh);
     let bar = Task::begin(options.progress, "reference (rays)", vertices);
     let mut out = Array2::<f64>::zeros((vertices, 3));
     let rays: u64 = out
@@ -215,7 +215,7 @@ fn quadrature(
         .into_par_iter()
         .enumerate()
         .map(|(v, mut radiance)| {
-            let (origin, n) = origin_and_normal(mesh, v, eps);
+            let (origin, n) = origins.origin_and_normal(v);
             // The glossy vertex's view, or None for a Lambertian one.
             let view = match eye {
                 Some(e) if v < objects => Some(outgoing(mesh, v, n, e)),
@@ -303,7 +303,7 @@ impl ReferenceVisibility {
         let texels = lit_texels(&sky)?;
         let words = (2 * height * height).div_ceil(64);
         let vertices = mesh.vertex_count();
-        let eps = ray_offset(mesh);
+        let origins = RayOrigins::new(mesh);
         let start = Instant::now();
         let bar = Task::begin(progress, "reference visibility (rays)", vertices);
         let mut bits = vec![0u64; vertices * words];
@@ -311,7 +311,7 @@ impl ReferenceVisibility {
             .par_chunks_mut(words.max(1))
             .enumerate()
             .map(|(v, row)| {
-                let (origin, n) = origin_and_normal(mesh, v, eps);
+                let (origin, n) = origins.origin_and_normal(v);
                 let o = f32x3(origin);
                 let mut rays = 0;
                 for t in &texels {

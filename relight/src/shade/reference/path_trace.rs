@@ -11,14 +11,15 @@
 //!
 //! when its ray from the `k`-th surface point escapes in direction `w_k` (`k <= B`, the depth,
 //! `--bounces`), and 0 when its `(B + 1)`-th ray hits something too, or any ray meets a
-//! triangle's back side (winding normal along the ray, as in the gather,
-//! [`interreflection`](super::interreflection)). `L` is the lighting map's texel containing
+//! surface on the far side of its shading normal (the gather's one-sided rule,
+//! [`bounce`](crate::precompute::bounce)). `L` is the lighting map's texel containing
 //! `w_k` (the same `N x 2N` downsampled environment as the reference's; no interpolation). At a
 //! hit the path goes on from the hit point itself: its position, normal (the hit triangle's
 //! vertex normals interpolated barycentrically, normalised) and albedo (likewise), nothing
 //! interpolated over the mesh's stored radiance and no direction discretised, so its
-//! difference from the gather measures those two errors. Every ray starts off its surface
-//! along the (interpolated) normal by [`ray_offset`], as the reference's do.
+//! difference from the gather measures those two errors. A path's first ray starts at the vertex's
+//! origin ([`RayOrigins`], off creases and contact, as the reference's do); every later one
+//! off its hit point along the interpolated normal by [`ray_offset`].
 //!
 //! **Repeatable.** The two uniform numbers of path `k`'s bounce `d` at vertex `v` are a
 //! counter-based hash of `(seed, v, k, d)` (SplitMix64, as the visibility jitter's), so the
@@ -37,10 +38,11 @@ use rayon::prelude::*;
 use super::ReferenceReport;
 use super::interreflection::check_bounces;
 use crate::material::brdf::tangents;
+use crate::precompute::bounce::facing_normal;
 use crate::precompute::cast::{f32x3, jitter};
+use crate::precompute::origin::RayOrigins;
 use crate::precompute::raycast::Hit;
-use crate::precompute::visibility::ray_offset;
-use crate::scene::mesh::{cross, dot, sub};
+use crate::scene::mesh::dot;
 use crate::{Error, Result};
 use crate::{Mesh, SceneBvh};
 use haarshift::progress::Task;
@@ -136,7 +138,8 @@ fn cosine_direction(n: [f64; 3], (a, b): (f64, f64)) -> [f64; 3] {
     std::array::from_fn(|k| x * t[k] + y * s[k] + z * n[k])
 }
 
-/// The surface a front-side hit stands for, with its albedo; `None` for a back side.
+/// The surface a hit stands for, with its albedo; `None` on the far side of its shading
+/// normal ([`facing_normal`]).
 fn surface_at(
     mesh: &Mesh,
     albedo: ArrayView2<'_, f32>,
@@ -145,20 +148,14 @@ fn surface_at(
     eps: f64,
 ) -> Option<(Surface, [f64; 3])> {
     let tri = mesh.triangles()[hit.triangle];
-    let (p, n) = (mesh.positions(), mesh.normals());
-    let corner =
-        |a: &ndarray::ArrayView2<'_, f64>, k: usize| [0, 1, 2].map(|c| a[[tri[k] as usize, c]]);
-    let [a, b, c] = [0, 1, 2].map(|k| corner(&p, k));
-    if dot(cross(sub(b, a), sub(c, a)), d) >= 0.0 {
-        return None;
-    }
+    let normal = facing_normal(mesh, hit, d)?;
+    let p = mesh.positions();
     let (u, v) = (f64::from(hit.u), f64::from(hit.v));
     let w = [1.0 - u - v, u, v];
     let mix = |f: &dyn Fn(usize, usize) -> f64| -> [f64; 3] {
         std::array::from_fn(|c| (0..3).map(|k| w[k] * f(k, c)).sum())
     };
     let position = mix(&|k, c| p[[tri[k] as usize, c]]);
-    let normal = mix(&|k, c| n[[tri[k] as usize, c]]);
     let len = dot(normal, normal).sqrt();
     if len.is_nan() || len <= 0.0 {
         return None; // opposite normals cancelling: no hemisphere to sample
@@ -221,16 +218,16 @@ pub fn path_trace(
         ));
     }
     let start = Instant::now();
-    let eps = ray_offset(mesh);
+    let origins = RayOrigins::new(mesh);
+    let eps = origins.eps();
     let bar = Task::begin(options.progress, "path tracing (vertices)", vertices);
     let per_vertex: Vec<([f64; 3], [f64; 3], u64)> = (0..vertices)
         .into_par_iter()
         .map(|v| {
+            let (origin, normal) = origins.origin_and_normal(v);
             let start = Surface {
-                origin: f32x3(std::array::from_fn(|k| {
-                    mesh.positions()[[v, k]] + eps * mesh.normals()[[v, k]]
-                })),
-                normal: [0, 1, 2].map(|k| mesh.normals()[[v, k]]),
+                origin: f32x3(origin),
+                normal,
             };
             let a = [0, 1, 2].map(|c| f64::from(albedo[[v, c]]));
             let (mut sum, mut squares, mut rays) = ([0.0f64; 3], [0.0f64; 3], 0u64);
