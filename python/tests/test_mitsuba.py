@@ -15,9 +15,14 @@ TOOL = ROOT / "tools" / "mitsuba" / "vertex_radiance.py"
 MAP = ROOT / "testdata" / "envmaps" / "venice_sunset_1k.hdr"
 
 # Relative RMS over the chosen vertices, Mitsuba's noise taken out: the largest difference
-# allowed. Measured at this size (lat-long 32, one bounce): see the test's assertions' messages
-# and results/relight/mitsuba.md for the full table.
+# allowed. Measured at this size (lat-long 32, one bounce, 48 vertices of 576 directions):
+# 1.9% on the bunny on its ground (noise 2.6%), below the noise on the box (noise 6.7%); with
+# the map mirrored 28% and 24%; with Mitsuba's origins left in the walls' planes at the box's
+# creases (so that it sees through them), 71%.
 THRESHOLD = 0.03
+# The most noise (Mitsuba's standard error, relative to the RMS) at which the comparison
+# still tells a crease's error apart (today's were 50% to 400% of the light there).
+NOISE = 0.08
 
 
 def tool():
@@ -81,8 +86,9 @@ def test_one_bounce_agrees_with_mitsuba_and_a_mirrored_map_does_not(name, source
     error = relative_rms(ours[chosen], truth, se)
     noise = float(np.sqrt(np.mean(se ** 2)) / np.sqrt(np.mean(truth ** 2)))
     assert error < THRESHOLD, f"{name}: {error:.4f} of the RMS off Mitsuba (noise {noise:.4f})"
+    assert noise < NOISE, f"{name}: Mitsuba's noise {noise:.4f} of the RMS"
     mirrored, se_m, _ = mitsuba_radiance(module, path, chosen, mirror=True)
-    assert relative_rms(ours[chosen], mirrored, se_m) > 3 * THRESHOLD
+    assert relative_rms(ours[chosen], mirrored, se_m) > 5 * THRESHOLD
 
 
 def test_the_map_reaches_mitsuba_with_haarshift_s_axes():

@@ -9,7 +9,7 @@
 //!
 //! the sum over every texel `t` with centre direction `w_t` and exact solid angle `dOmega_t`
 //! ([`sphere::latlong`](haarshift::sphere::latlong)), `V(v, t)` one ray through the texel centre
-//! from the offset origin `p_v + eps n_v` ([`ray_offset`]), through the
+//! from the origin of [`RayOrigins`] (`p_v + eps n_v`, moved off creases and contact), through the
 //! [`Occlusion`] trait, and `rho` evaluated analytically at `(w_t, w_o,v)` in the vertex's own
 //! frame ([`Brdf::evaluate`]): no local copy, no rotation. For a Lambertian vertex `rho = 1/pi`
 //! leaves the sum as `a_v / pi x sum_t L(t) V(v, t) max(0, n_v . w_t) dOmega_t`, which is

@@ -19,7 +19,8 @@
 //! interpolated over the mesh's stored radiance and no direction discretised, so its
 //! difference from the gather measures those two errors. A path's first ray starts at the vertex's
 //! origin ([`RayOrigins`], off creases and contact, as the reference's do); every later one
-//! off its hit point along the interpolated normal by [`ray_offset`].
+//! off its hit point along the interpolated normal by
+//! [`ray_offset`](crate::precompute::visibility::ray_offset).
 //!
 //! **Repeatable.** The two uniform numbers of path `k`'s bounce `d` at vertex `v` are a
 //! counter-based hash of `(seed, v, k, d)` (SplitMix64, as the visibility jitter's), so the
