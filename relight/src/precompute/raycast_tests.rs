@@ -457,3 +457,64 @@ fn a_closest_hit_names_the_first_of_repeated_triangles_and_never_a_flat_one() {
         assert_eq!(hits[0], None);
     }
 }
+
+/// The box scene of `testdata/scenes`, whose floor and walls meet in creases.
+fn bunny_in_box() -> Mesh {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../testdata/scenes/bunny_in_box.json"
+    );
+    Scene::load(path.as_ref()).unwrap().mesh
+}
+
+/// Every ray visibility casts in the box scene (every vertex from its [`RayOrigins`] origin,
+/// every cube 8 x 8 texel centre above its horizon): where Embree and our packets answer a ray
+/// differently, it is a ray that rounding decides (the f64 oracle finds it within [`TOL`] of
+/// an edge or of the origin), never a clear-cut one. Before the crease contract, the rays of the
+/// box's 260 crease vertices started in a wall's plane and the tracers differed on 15% of the
+/// radiance's RMS.
+#[test]
+fn embree_and_our_packets_differ_on_the_box_scene_only_where_rounding_decides() {
+    let mesh = bunny_in_box();
+    let tracers = every_tracer(&mesh);
+    let [embree, ours] = tracers.as_slice() else {
+        return; // Embree is missing: every_tracer said so in one line
+    };
+    let param =
+        haarshift::faces::Parameterization::new(haarshift::faces::ParamKind::Cube, 8).unwrap();
+    let directions: Vec<[f32; 3]> = (0..param.texels())
+        .map(|t| {
+            param
+                .texel_direction(t / 64, (t / 8) % 8, t % 8)
+                .map(|x| x as f32)
+        })
+        .collect();
+    let origins = crate::precompute::origin::RayOrigins::new(&mesh);
+    let (mut a, mut b) = (vec![false; directions.len()], vec![false; directions.len()]);
+    let (mut rays, mut differ) = (0usize, 0usize);
+    for v in 0..mesh.vertex_count() {
+        let (o, n) = origins.origin_and_normal(v);
+        let o = o.map(|x| x as f32);
+        embree.occluded_from(o, &directions, f32::INFINITY, &mut a);
+        ours.occluded_from(o, &directions, f32::INFINITY, &mut b);
+        for (k, d) in directions.iter().enumerate() {
+            let above = (0..3).map(|i| n[i] * f64::from(d[i])).sum::<f64>() > 0.0;
+            if !above {
+                continue;
+            }
+            rays += 1;
+            if a[k] != b[k] {
+                differ += 1;
+                assert_eq!(
+                    exact(&mesh, o, *d, f32::INFINITY),
+                    None,
+                    "vertex {v} ray {d:?}"
+                );
+            }
+        }
+    }
+    // Measured: 1,081 of 630,528 rays (0.17%), all through an edge to within rounding.
+    // (Without the contract: 4,463.)
+    assert!(differ * 400 < rays, "{differ} of {rays}");
+    eprintln!("{differ} of {rays} rays answered differently, none clear-cut");
+}
