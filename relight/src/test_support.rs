@@ -80,6 +80,16 @@ pub(crate) fn bunny_on_ground() -> crate::Mesh {
     mesh
 }
 
+/// The box scene of `testdata/scenes`: the bunny in an open box of 16 cells a side, whose floor
+/// and walls meet in creases.
+pub(crate) fn bunny_in_box() -> crate::Mesh {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../testdata/scenes/bunny_in_box.json"
+    );
+    crate::Scene::load(path.as_ref()).unwrap().mesh
+}
+
 /// An off-centre, squashed sphere, so that nothing about it is symmetric and its frame has no
 /// round numbers.
 pub(crate) fn squashed_sphere() -> crate::Mesh {

@@ -214,18 +214,24 @@ def build_scene(mi, mesh, image, bounces):
     return scene, integrator
 
 
+def emitter_values(mi, scene, directions):
+    """The RGB radiance (M, 3) Mitsuba's environment sends towards unit directions (M, 3)."""
+    emitter = scene.environment()
+    out = np.empty((len(directions), 3))
+    for k, d in enumerate(directions):
+        si = mi.SurfaceInteraction3f()
+        si.wi = mi.Vector3f(*(-d))
+        out[k] = np.array(emitter.eval(si))
+    return out
+
+
 def check_orientation(mi, scene, image, count=2000, seed=1):
     """The largest relative difference between Mitsuba's emitter and haarshift's function."""
     rng = np.random.default_rng(seed)
     d = rng.normal(size=(count, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     ours = map_value(image, d).mean(axis=1)
-    emitter = scene.environment()
-    theirs = np.empty(count)
-    for k in range(count):
-        si = mi.SurfaceInteraction3f()
-        si.wi = mi.Vector3f(*(-d[k]))
-        theirs[k] = np.mean(np.array(emitter.eval(si)))
+    theirs = emitter_values(mi, scene, d).mean(axis=1)
     return float(np.max(np.abs(theirs - ours)) / np.max(np.abs(ours)))
 
 

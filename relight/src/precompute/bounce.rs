@@ -505,8 +505,7 @@ impl Caster for HitFolding<'_> {
             if facing_normal(self.mesh, hit, directions[k].map(f64::from)).is_none() {
                 continue; // the far side of the hit's shading normal
             }
-            let (u, v) = (f64::from(hit.u), f64::from(hit.v));
-            let beta = [1.0 - u - v, u, v];
+            let beta = hit.weights();
             let mut rho = [0.0; 3];
             for (&corner, &bk) in corners.iter().zip(&beta) {
                 let albedo = self.albedo.row(corner as usize);
@@ -534,8 +533,7 @@ impl Caster for HitFolding<'_> {
 pub(crate) fn facing_normal(mesh: &Mesh, hit: &Hit, d: [f64; 3]) -> Option<[f64; 3]> {
     let corners = mesh.triangles()[hit.triangle];
     let normals = mesh.normals();
-    let (u, v) = (f64::from(hit.u), f64::from(hit.v));
-    let beta = [1.0 - u - v, u, v];
+    let beta = hit.weights();
     let n: [f64; 3] = std::array::from_fn(|k| {
         (0..3)
             .map(|i| beta[i] * normals[[corners[i] as usize, k]])

@@ -2,18 +2,10 @@ use ndarray::array;
 use proptest::prelude::*;
 
 use super::*;
+use crate::Occlusion;
 use crate::precompute::raycast::tests::every_tracer;
 use crate::scene::mesh::cross;
-use crate::{Occlusion, Scene};
-
-/// The box scene of `testdata/scenes`: the bunny in an open box of 16 cells a side.
-fn bunny_in_box() -> Mesh {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../testdata/scenes/bunny_in_box.json"
-    );
-    Scene::load(path.as_ref()).unwrap().mesh
-}
+use crate::test_support::bunny_in_box;
 
 /// Rule 2 by brute force: every vertex against every triangle of non-zero area.
 fn contact_by_brute_force(mesh: &Mesh) -> Vec<usize> {

@@ -226,6 +226,20 @@ pub struct Hit {
     pub v: f32,
 }
 
+impl Hit {
+    /// The barycentric weights of the triangle's three corners, `(1 - u - v, u, v)`, in f64.
+    ///
+    /// ```
+    /// use haarshift_relight::precompute::raycast::Hit;
+    /// let hit = Hit { triangle: 0, t: 1.0, u: 0.25, v: 0.5 };
+    /// assert_eq!(hit.weights(), [0.25, 0.25, 0.5]);
+    /// ```
+    pub fn weights(&self) -> [f64; 3] {
+        let (u, v) = (f64::from(self.u), f64::from(self.v));
+        [1.0 - u - v, u, v]
+    }
+}
+
 /// The extent (largest side of the bounding box, in f32) below which [`SceneBvh`] scales a
 /// scene up: `2^-20`, far above where PLOC's surface areas underflow.
 pub const SMALL_EXTENT: f32 = 1.0 / (1 << 20) as f32;

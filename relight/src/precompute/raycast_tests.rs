@@ -5,7 +5,7 @@ use obvhs::ray::Ray;
 
 use super::*;
 use crate::Scene;
-use crate::test_support::bunny_on_ground;
+use crate::test_support::{bunny_in_box, bunny_on_ground};
 
 /// The triangles our packets trace (none for another tracer).
 fn traced(bvh: &SceneBvh) -> &[obvhs::rt_triangle::RtTriangle] {
@@ -249,18 +249,23 @@ fn tiny_answers_as_near(near: &SceneBvh, tiny: &SceneBvh, unit: f64) {
     assert!((1_000..19_000).contains(&hits), "{hits}");
 }
 
-/// The visibility case: from just above every 97th vertex of `mesh`, one ray to every cube
-/// 8 x 8 texel centre, in the order precomputation casts them.
-fn vertex_rays(mesh: &Mesh) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+/// The cube 8 x 8 texel centres in texel order, as visibility casts them.
+fn cube8_directions() -> Vec<[f32; 3]> {
     let param =
         haarshift::faces::Parameterization::new(haarshift::faces::ParamKind::Cube, 8).unwrap();
-    let directions = (0..param.texels())
+    (0..param.texels())
         .map(|t| {
             param
                 .texel_direction(t / 64, (t / 8) % 8, t % 8)
                 .map(|x| x as f32)
         })
-        .collect();
+        .collect()
+}
+
+/// The visibility case: from just above every 97th vertex of `mesh`, one ray to every cube
+/// 8 x 8 texel centre, in the order precomputation casts them.
+fn vertex_rays(mesh: &Mesh) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let directions = cube8_directions();
     let eps = crate::ray_offset(mesh);
     let origins = (0..mesh.vertex_count())
         .step_by(97)
@@ -458,15 +463,6 @@ fn a_closest_hit_names_the_first_of_repeated_triangles_and_never_a_flat_one() {
     }
 }
 
-/// The box scene of `testdata/scenes`, whose floor and walls meet in creases.
-fn bunny_in_box() -> Mesh {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../testdata/scenes/bunny_in_box.json"
-    );
-    Scene::load(path.as_ref()).unwrap().mesh
-}
-
 /// Every ray visibility casts in the box scene (every vertex from its [`RayOrigins`] origin,
 /// every cube 8 x 8 texel centre above its horizon): where Embree and our packets answer a ray
 /// differently, it is a ray that rounding decides (the f64 oracle finds it within [`TOL`] of
@@ -480,15 +476,7 @@ fn embree_and_our_packets_differ_on_the_box_scene_only_where_rounding_decides() 
     let [embree, ours] = tracers.as_slice() else {
         return; // Embree is missing: every_tracer said so in one line
     };
-    let param =
-        haarshift::faces::Parameterization::new(haarshift::faces::ParamKind::Cube, 8).unwrap();
-    let directions: Vec<[f32; 3]> = (0..param.texels())
-        .map(|t| {
-            param
-                .texel_direction(t / 64, (t / 8) % 8, t % 8)
-                .map(|x| x as f32)
-        })
-        .collect();
+    let directions = cube8_directions();
     let origins = crate::precompute::origin::RayOrigins::new(&mesh);
     let (mut a, mut b) = (vec![false; directions.len()], vec![false; directions.len()]);
     let (mut rays, mut differ) = (0usize, 0usize);

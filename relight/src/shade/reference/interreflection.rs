@@ -134,8 +134,7 @@ impl Gather {
                         if facing_normal(mesh, hit, w).is_none() {
                             continue; // the far side of the shading normal, or edge on
                         }
-                        let (u, s) = (f64::from(hit.u), f64::from(hit.v));
-                        let bary = [1.0 - u - s, u, s];
+                        let bary = hit.weights();
                         let rho: [f64; 3] = std::array::from_fn(|ch| {
                             (0..3)
                                 .map(|k| bary[k] * f64::from(albedo[[tri[k] as usize, ch]]))

@@ -151,8 +151,7 @@ fn surface_at(
     let tri = mesh.triangles()[hit.triangle];
     let normal = facing_normal(mesh, hit, d)?;
     let p = mesh.positions();
-    let (u, v) = (f64::from(hit.u), f64::from(hit.v));
-    let w = [1.0 - u - v, u, v];
+    let w = hit.weights();
     let mix = |f: &dyn Fn(usize, usize) -> f64| -> [f64; 3] {
         std::array::from_fn(|c| (0..3).map(|k| w[k] * f(k, c)).sum())
     };
